@@ -1,0 +1,27 @@
+#pragma once
+// Pairwise marker distance statistics over a training take. Markers on the same patch of skin
+// keep their distance while the body moves; a hand passing a hip does not. The "skin distance"
+// mean + k * stddev is what the marker surface and the hold anchors are built on, so that a
+// triangulation never joins a hand to a hip even when they touch in the reference pose.
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "core/capture.h"
+
+namespace skinstream {
+
+struct MarkerDistanceStats {
+  Eigen::MatrixXd mean;    // N x N, mm
+  Eigen::MatrixXd stddev;  // N x N, mm
+  Eigen::MatrixXi samples; // frames both markers were present
+
+  // mean + k * stddev; pairs never seen together get +infinity.
+  Eigen::MatrixXd skin_distance(double k = 2.0) const;
+};
+
+// `markers` are channel indices of `capture`; at most `max_frames` evenly spaced frames are used.
+MarkerDistanceStats compute_marker_distance_stats(const Capture& capture, const std::vector<int>& markers,
+                                                  int max_frames = 2000);
+
+}  // namespace skinstream

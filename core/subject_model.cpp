@@ -1,0 +1,55 @@
+#include "core/subject_model.h"
+
+#include <cmath>
+#include <sstream>
+
+namespace skinstream {
+
+double SubjectModel::neighbour_distance(int i) const {
+  const int count = ring_size(i);
+  if (count == 0) return 0.0;
+  double sum = 0.0;
+  for (int k = ring_offsets[i]; k < ring_offsets[i + 1]; ++k) sum += ring_local_reference[k].norm();
+  return sum / count;
+}
+
+int SubjectModel::marker_index(const std::string& name) const {
+  for (int i = 0; i < marker_count(); ++i)
+    if (marker_names[i] == name) return i;
+  return -1;
+}
+
+std::string SubjectModel::validate() const {
+  std::ostringstream why;
+  const size_t n = marker_names.size();
+  if (n == 0) return "no markers";
+  if (reference_positions.size() != n) why << "reference pose has " << reference_positions.size() << " markers, expected " << n << "; ";
+  if (ring_offsets.size() != n + 1 || ring_offsets.front() != 0 || ring_offsets.back() != static_cast<int>(ring.size()))
+    return why.str() + "one-ring offsets inconsistent";
+  if (ring_local_reference.size() != ring.size()) why << "local reference positions do not match the one-rings; ";
+  if (local_reference_frames.size() != n) why << "local frames count " << local_reference_frames.size() << "; ";
+  if (anchor_offsets.size() != n + 1 || anchor_offsets.front() != 0 || anchor_offsets.back() != static_cast<int>(anchors.size()))
+    why << "anchor offsets inconsistent; ";
+  if (pca.size() != n) why << "PCA models count " << pca.size() << "; ";
+  if (!why.str().empty()) return why.str();
+  for (size_t i = 0; i < n; ++i) {
+    if (!is_present(reference_positions[i])) why << "marker " << marker_names[i] << " has no reference position; ";
+    const int rs = ring_offsets[i + 1] - ring_offsets[i];
+    if (rs < 0 || rs > kMaxRing) why << "marker " << marker_names[i] << " ring size " << rs << "; ";
+    const MarkerPcaModel& m = pca[i];
+    if (m.mean.size() != 3 * rs || m.basis.rows() != 3 * rs || m.basis.cols() != m.variance.size())
+      why << "marker " << marker_names[i] << " PCA shape does not match its ring; ";
+    else if (!m.mean.allFinite() || !m.basis.allFinite() || !m.variance.allFinite() || !std::isfinite(m.residual_variance))
+      why << "marker " << marker_names[i] << " PCA has non-finite values; ";
+  }
+  for (int j : ring)
+    if (j < 0 || j >= static_cast<int>(n)) return why.str() + "one-ring index out of range";
+  for (int j : anchors)
+    if (j < 0 || j >= static_cast<int>(n)) return why.str() + "anchor index out of range";
+  for (const auto& t : triangles)
+    for (int v : t)
+      if (v < 0 || v >= static_cast<int>(n)) return why.str() + "triangle index out of range";
+  return why.str();
+}
+
+}  // namespace skinstream
