@@ -1,0 +1,374 @@
+#include "core/gap_filler.h"
+
+#include <Eigen/Cholesky>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace skinstream {
+namespace {
+
+constexpr int kMaxDims = 3 * SubjectModel::kMaxRing;
+using SmallMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxDims, kMaxDims>;
+using SmallVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxDims, 1>;
+constexpr int kNoFragment = std::numeric_limits<int>::min();
+
+}  // namespace
+
+GapFiller::GapFiller(const SubjectModel& model, const GapFillerOptions& options)
+    : model_(model), options_(options), n_(model.marker_count()) {
+  // Reverse one-rings: which markers' PCA models can predict marker i, and at which slot.
+  std::vector<std::vector<std::pair<int, int>>> predictors(n_);
+  for (int j = 0; j < n_; ++j)
+    for (int k = model.ring_offsets[j]; k < model.ring_offsets[j + 1]; ++k)
+      predictors[model.ring[k]].push_back({j, k - model.ring_offsets[j]});
+  predictor_offsets_.push_back(0);
+  for (int i = 0; i < n_; ++i) {
+    for (const auto& [j, slot] : predictors[i]) {
+      predictor_marker_.push_back(j);
+      predictor_slot_.push_back(slot);
+    }
+    predictor_offsets_.push_back(static_cast<int>(predictor_marker_.size()));
+    eps1_.push_back(model.parameters.alpha1 * model.neighbour_distance(i));
+    eps2_.push_back(model.parameters.alpha2 * model.neighbour_distance(i));
+  }
+
+  previous_.assign(n_, Vec3::Zero());
+  previous_status_.assign(n_, MarkerStatus::Held);
+  assigned_id_.assign(n_, kNoFragment);
+  gap_offset_.assign(n_, Vec3::Zero());
+  gap_age_.assign(n_, 0);
+  current_.assign(n_, Vec3::Zero());
+  status_.assign(n_, MarkerStatus::Held);
+  observed_.assign(n_, 0);
+  estimated_.assign(n_, 0);
+  has_rotation_.assign(n_, 0);
+  estimate_.assign(n_, Vec3::Zero());
+  rotation_.assign(n_, Eigen::Matrix3d::Identity());
+  available_neighbours_.assign(n_, 0);
+  missing_.reserve(n_);
+  free_points_.assign(kMaxFreePoints, Vec3::Zero());
+  free_ids_.assign(kMaxFreePoints, 0);
+  free_used_.assign(kMaxFreePoints, 0);
+  candidates_.reserve(n_);
+  pca_stamp_.assign(n_, -1);
+  pca_ok_.assign(n_, 0);
+  pca_rotation_.assign(n_, Eigen::Matrix3d::Identity());
+  pca_coefficients_.assign(static_cast<size_t>(n_) * kMaxDims, 0.0);
+  const size_t scratch = std::max<size_t>(n_, SubjectModel::kMaxRing);
+  scratch_source_.assign(scratch, Vec3::Zero());
+  scratch_target_.assign(scratch, Vec3::Zero());
+  scratch_index_.assign(scratch, 0);
+}
+
+void GapFiller::reset() {
+  has_previous_ = false;
+  std::fill(assigned_id_.begin(), assigned_id_.end(), kNoFragment);
+  std::fill(gap_age_.begin(), gap_age_.end(), 0);
+  std::fill(gap_offset_.begin(), gap_offset_.end(), Vec3::Zero());
+}
+
+bool GapFiller::neighbourhood_rotation(int i, Eigen::Matrix3d& out) const {
+  if (i < 0 || i >= n_ || !has_rotation_[i]) return false;
+  out = rotation_[i];
+  return true;
+}
+
+void GapFiller::add_free_point(const Vec3& p, int id) {
+  if (!is_present(p) || free_count_ >= kMaxFreePoints) {
+    ++stats_.ignored_points;
+    return;
+  }
+  free_points_[free_count_] = p;
+  free_ids_[free_count_] = id;
+  free_used_[free_count_] = 0;
+  ++free_count_;
+}
+
+FillStats GapFiller::run(const FrameInput& in, const FrameOutput& out) {
+  stats_ = FillStats{};
+  if (static_cast<int>(in.labelled.size()) != n_ || static_cast<int>(out.positions.size()) != n_ ||
+      static_cast<int>(out.status.size()) != n_ ||
+      (!in.unlabelled_ids.empty() && in.unlabelled_ids.size() != in.unlabelled.size())) {
+    stats_.ok = false;
+    return stats_;
+  }
+  ++frame_;
+  free_count_ = 0;
+  for (int i = 0; i < n_; ++i) {
+    current_[i] = in.labelled[i];
+    observed_[i] = is_present(current_[i]);
+    status_[i] = MarkerStatus::Measured;
+    has_rotation_[i] = 0;
+    if (!observed_[i] && (std::isfinite(current_[i].x()) || std::isfinite(current_[i].y()) || std::isfinite(current_[i].z())))
+      ++stats_.ignored_points;  // partly NaN: a broken sample, treated as missing
+  }
+  // Free-point ids: the source's trajectory ids (>= 0); rejected labelled points get -(i + 1).
+  for (size_t p = 0; p < in.unlabelled.size(); ++p)
+    add_free_point(in.unlabelled[p], in.unlabelled_ids.empty() ? static_cast<int>(p) : in.unlabelled_ids[p]);
+
+  if (options_.check_labels && has_previous_) check_labels();
+  for (int i = 0; i < n_; ++i)
+    if (observed_[i]) assigned_id_[i] = kNoFragment;  // the capture system has it again
+
+  estimate_rigid();
+  relabel();
+  fill_missing();
+
+  for (int i = 0; i < n_; ++i) {
+    out.positions[i] = current_[i];
+    out.status[i] = status_[i];
+    previous_[i] = current_[i];
+    previous_status_[i] = status_[i];
+    switch (status_[i]) {
+      case MarkerStatus::Measured: ++stats_.measured; break;
+      case MarkerStatus::Relabelled: ++stats_.relabelled; break;
+      case MarkerStatus::FilledPca:
+      case MarkerStatus::FilledRigid: ++stats_.filled; break;
+      case MarkerStatus::Held: ++stats_.held; break;
+    }
+  }
+  has_previous_ = true;
+  return stats_;
+}
+
+// A correctly labelled point moves with its neighbours: within 8 ms its offset from them changes
+// by millimetres, while a swapped or mislabelled point is off by about the marker spacing. The
+// previous position (measured, or estimated during a gap) is carried by the mean displacement
+// of the observed one-ring; a labelled point farther than eps2 from there is taken as unlabelled.
+// Rotation within one frame moves a neighbour a few mm at most, far below eps2.
+void GapFiller::check_labels() {
+  for (int i = 0; i < n_; ++i) {
+    if (!observed_[i] || previous_status_[i] == MarkerStatus::Held) continue;
+    Vec3 displacement = Vec3::Zero();
+    int count = 0;
+    for (int k = model_.ring_offsets[i]; k < model_.ring_offsets[i + 1]; ++k) {
+      const int j = model_.ring[k];
+      if (!observed_[j]) continue;
+      displacement += current_[j] - previous_[j];
+      ++count;
+    }
+    if (count < 2) continue;
+    const Vec3 expected = previous_[i] + displacement / count;
+    if ((current_[i] - expected).norm() > eps2_[i]) {
+      add_free_point(current_[i], -(i + 1));
+      observed_[i] = 0;
+      ++stats_.rejected_labels;
+    }
+  }
+}
+
+// Eq. 2, greedy: repeatedly estimate the missing marker with the most available neighbours
+// (at least three), then count it as available for the others.
+void GapFiller::estimate_rigid() {
+  missing_.clear();
+  for (int i = 0; i < n_; ++i) {
+    estimated_[i] = observed_[i];
+    if (observed_[i]) estimate_[i] = current_[i];
+    else missing_.push_back(i);
+  }
+  for (int i : missing_) {
+    int count = 0;
+    for (int k = model_.ring_offsets[i]; k < model_.ring_offsets[i + 1]; ++k) count += estimated_[model_.ring[k]];
+    available_neighbours_[i] = count;
+  }
+  for (;;) {
+    int best = -1, best_count = 2;
+    for (int i : missing_)
+      if (!estimated_[i] && available_neighbours_[i] > best_count) {
+        best = i;
+        best_count = available_neighbours_[i];
+      }
+    if (best < 0) break;
+    int count = 0;
+    for (int k = model_.ring_offsets[best]; k < model_.ring_offsets[best + 1]; ++k) {
+      const int j = model_.ring[k];
+      if (!estimated_[j]) continue;
+      scratch_source_[count] = model_.ring_local_reference[k];
+      scratch_target_[count] = estimate_[j];
+      ++count;
+    }
+    RigidTransform t;
+    fit_rigid({scratch_source_.data(), static_cast<size_t>(count)}, {scratch_target_.data(), static_cast<size_t>(count)}, t);
+    estimate_[best] = t.translation;  // the local frame's origin is the marker
+    rotation_[best] = t.rotation;
+    has_rotation_[best] = 1;
+    estimated_[best] = 1;
+    for (int p = predictor_offsets_[best]; p < predictor_offsets_[best + 1]; ++p)
+      ++available_neighbours_[predictor_marker_[p]];
+  }
+}
+
+void GapFiller::relabel() {
+  bool changed = false;
+  // Fragments already standing for a marker stay while within eps2 of its estimate.
+  for (int i : missing_) {
+    const int id = assigned_id_[i];
+    if (id == kNoFragment) continue;
+    int found = -1;
+    for (int p = 0; p < free_count_; ++p)
+      if (!free_used_[p] && free_ids_[p] == id) {
+        found = p;
+        break;
+      }
+    const Vec3& expected = estimated_[i] ? estimate_[i] : previous_[i];
+    if (found >= 0 && (free_points_[found] - expected).norm() <= eps2_[i]) {
+      free_used_[found] = 1;
+      current_[i] = free_points_[found];
+      observed_[i] = 1;
+      status_[i] = MarkerStatus::Relabelled;
+      changed = true;
+    } else {
+      assigned_id_[i] = kNoFragment;
+    }
+  }
+  // New matches: each still-missing marker's nearest free point within eps1, closest pairs first.
+  candidates_.clear();
+  for (int i : missing_) {
+    if (observed_[i] || !estimated_[i]) continue;
+    int best = -1;
+    double best_distance = eps1_[i];
+    for (int p = 0; p < free_count_; ++p) {
+      if (free_used_[p]) continue;
+      const double d = (free_points_[p] - estimate_[i]).norm();
+      if (d <= best_distance) {
+        best = p;
+        best_distance = d;
+      }
+    }
+    if (best >= 0) candidates_.push_back({best_distance, i, best});
+  }
+  std::sort(candidates_.begin(), candidates_.end(),
+            [](const Candidate& a, const Candidate& b) { return a.distance < b.distance; });
+  for (const Candidate& c : candidates_) {
+    if (free_used_[c.point] || observed_[c.marker]) continue;
+    free_used_[c.point] = 1;
+    current_[c.marker] = free_points_[c.point];
+    observed_[c.marker] = 1;
+    status_[c.marker] = MarkerStatus::Relabelled;
+    assigned_id_[c.marker] = free_ids_[c.point];
+    changed = true;
+  }
+  if (changed) estimate_rigid();  // the new points make better estimates for the rest
+}
+
+// Section 4.3 for the model of marker j: rotate j's observed one-ring into its local frame
+// (eq. 5) and find the PCA coefficients c that best explain it, with the PCA variances as a
+// prior (c_k ~ N(0, variance_k), residual ~ N(0, residual_variance)) so that a ring seen only
+// in part cannot push the coefficients far outside what training saw.
+bool GapFiller::solve_pca(int j) {
+  pca_stamp_[j] = frame_;
+  pca_ok_[j] = 0;
+  const MarkerPcaModel& m = model_.pca[j];
+  const int first = model_.ring_offsets[j];
+  const int ring = model_.ring_size(j);
+  int count = 0;
+  for (int k = 0; k < ring; ++k) {
+    const int member = model_.ring[first + k];
+    if (!observed_[member]) continue;
+    scratch_source_[count] = current_[member] - current_[j];
+    scratch_target_[count] = model_.ring_local_reference[first + k];
+    scratch_index_[count] = k;
+    ++count;
+  }
+  if (count < 2) return false;
+  Eigen::Matrix3d& r = pca_rotation_[j];
+  fit_rotation({scratch_source_.data(), static_cast<size_t>(count)}, {scratch_target_.data(), static_cast<size_t>(count)}, r);
+  const int components = static_cast<int>(m.variance.size());
+  double* coefficients = &pca_coefficients_[static_cast<size_t>(j) * kMaxDims];
+  if (components == 0) {
+    pca_ok_[j] = 1;
+    return true;
+  }
+  SmallMatrix b(3 * count, components);
+  SmallVector z(3 * count);
+  for (int o = 0; o < count; ++o) {
+    const int k = scratch_index_[o];
+    b.middleRows<3>(3 * o) = m.basis.middleRows<3>(3 * k);
+    z.segment<3>(3 * o) = r * scratch_source_[o] - m.mean.segment<3>(3 * k);
+  }
+  SmallMatrix normal(components, components);
+  normal.noalias() = b.transpose() * b;
+  for (int c = 0; c < components; ++c) normal(c, c) += m.residual_variance / m.variance(c);
+  SmallVector rhs(components);
+  rhs.noalias() = b.transpose() * z;
+  Eigen::LLT<SmallMatrix> llt(normal);
+  if (llt.info() != Eigen::Success) return false;
+  const SmallVector c = llt.solve(rhs);
+  for (int k = 0; k < components; ++k) coefficients[k] = c(k);
+  pca_ok_[j] = 1;
+  return true;
+}
+
+// Moves `previous` (where a marker was last frame) with the rigid motion of `members` from the
+// last frame to this one. Needs three members known in both frames.
+bool GapFiller::transfer_motion(int first, int last, const std::vector<int>& members, const Vec3& previous, Vec3& out) {
+  int count = 0;
+  for (int k = first; k < last; ++k) {
+    const int j = members[k];
+    if (!estimated_[j]) continue;
+    scratch_source_[count] = previous_[j];
+    scratch_target_[count] = estimate_[j];
+    ++count;
+  }
+  if (count < 3) return false;
+  RigidTransform t;
+  fit_rigid({scratch_source_.data(), static_cast<size_t>(count)}, {scratch_target_.data(), static_cast<size_t>(count)}, t);
+  out = t.apply(previous);
+  return true;
+}
+
+void GapFiller::fill_missing() {
+  const double decay_frames = options_.continuity_seconds * options_.rate_hz;
+  for (int i : missing_) {
+    if (observed_[i]) continue;  // relabelled
+    Vec3 sum = Vec3::Zero();
+    int count = 0;
+    if (options_.use_pca) {
+      for (int p = predictor_offsets_[i]; p < predictor_offsets_[i + 1]; ++p) {
+        const int j = predictor_marker_[p];
+        if (!observed_[j]) continue;
+        if (pca_stamp_[j] != frame_) solve_pca(j);
+        if (!pca_ok_[j]) continue;
+        const MarkerPcaModel& m = model_.pca[j];
+        const int slot = predictor_slot_[p];
+        Vec3 local = m.mean.segment<3>(3 * slot);
+        const double* c = &pca_coefficients_[static_cast<size_t>(j) * kMaxDims];
+        for (int k = 0; k < m.basis.cols(); ++k) local += m.basis.block<3, 1>(3 * slot, k) * c[k];
+        sum += current_[j] + pca_rotation_[j].transpose() * local;
+        ++count;
+      }
+    }
+    if (count > 0) {
+      current_[i] = sum / count;
+      status_[i] = MarkerStatus::FilledPca;
+    } else if (estimated_[i]) {
+      current_[i] = estimate_[i];
+      status_[i] = MarkerStatus::FilledRigid;
+    } else {
+      // Held: carried with the rigid motion of the anchors, else kept where it was.
+      Vec3 moved;
+      if (has_previous_ && transfer_motion(model_.anchor_offsets[i], model_.anchor_offsets[i + 1], model_.anchors, previous_[i], moved))
+        current_[i] = moved;
+      else
+        current_[i] = has_previous_ ? previous_[i] : model_.reference_positions[i];
+      status_[i] = MarkerStatus::Held;
+      continue;
+    }
+
+    // Continuity: the gap starts where the last measurement, moved with the neighbours, would be.
+    if (decay_frames <= 0.0 || !has_rotation_[i] || !has_previous_) continue;
+    if (is_observed(previous_status_[i])) {
+      Vec3 expected;
+      gap_age_[i] = 0;
+      gap_offset_[i].setZero();
+      if (transfer_motion(model_.ring_offsets[i], model_.ring_offsets[i + 1], model_.ring, previous_[i], expected))
+        gap_offset_[i] = rotation_[i].transpose() * (expected - current_[i]);
+    } else {
+      ++gap_age_[i];
+    }
+    current_[i] += rotation_[i] * gap_offset_[i] * std::exp(-gap_age_[i] / decay_frames);
+  }
+}
+
+}  // namespace skinstream

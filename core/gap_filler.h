@@ -1,0 +1,128 @@
+#pragma once
+// The online, causal per-frame job of section 4.2-4.3: takes one frame of labelled points
+// (NaN = missing) and unlabelled points, and returns every marker of the subject.
+//
+//   1. Label check: a labelled point that did not move with its one-ring since the last frame
+//      (off by more than eps2) is treated as unlabelled: that is how swapped and mislabelled
+//      fragments look.
+//   2. Rigid estimates (eq. 2, Horn), greedy: the missing marker with the most available
+//      neighbours first, reusing earlier estimates.
+//   3. Relabelling: a tracked fragment stays with its marker while within eps2 (alpha2); a new
+//      one is taken when within eps1 (alpha1) of a missing marker's estimate (eq. 3), closest
+//      pairs first. Rigid estimates are then redone with the new points.
+//   4. PCA fill: every observed neighbour's PCA model reconstructs the missing marker from that
+//      neighbour's observed one-ring (regularised least squares on the coefficients); the
+//      estimates are averaged. Without one, the rigid estimate; without that, held relative to
+//      the marker's anchors.
+//   5. Continuity: at the start of a gap, the difference between where the marker's last
+//      measurement moved with its neighbours and the estimate is kept in the local frame and
+//      decays over `continuity_seconds`, so a gap does not start with a jump.
+//
+// All buffers are sized in the constructor; run() allocates nothing.
+
+#include <Eigen/Core>
+#include <span>
+#include <vector>
+
+#include "core/absolute_orientation.h"
+#include "core/marker_status.h"
+#include "core/subject_model.h"
+
+namespace skinstream {
+
+struct GapFillerOptions {
+  double rate_hz = 120.0;
+  double continuity_seconds = 1.0;  // 0 turns the gap-start continuity off
+  bool use_pca = true;              // false: eq. 2 estimates only
+  bool check_labels = true;
+};
+
+struct FrameInput {
+  std::span<const Vec3> labelled;        // one per subject marker, NaN = missing
+  std::span<const Vec3> unlabelled;      // free points this frame
+  std::span<const int> unlabelled_ids;   // trajectory id per free point (same fragment, same id); may be empty
+};
+
+struct FrameOutput {
+  std::span<Vec3> positions;          // one per subject marker
+  std::span<MarkerStatus> status;     // one per subject marker
+};
+
+struct FillStats {
+  bool ok = true;           // false: input sizes did not match the subject (output untouched)
+  int measured = 0;
+  int relabelled = 0;
+  int filled = 0;           // PCA or rigid
+  int held = 0;
+  int rejected_labels = 0;  // labelled points taken as mislabelled this frame
+  int ignored_points = 0;   // non-finite or beyond capacity
+};
+
+class GapFiller {
+ public:
+  static constexpr int kMaxFreePoints = 1024;
+
+  explicit GapFiller(const SubjectModel& model, const GapFillerOptions& options = {});
+
+  FillStats run(const FrameInput& in, const FrameOutput& out);
+  void reset();  // forget the past (new take, source reconnected)
+
+  // Rotation of marker i's neighbourhood this frame (local reference -> world), valid for
+  // markers that were filled by an estimate; used to carry corrections with the body.
+  bool neighbourhood_rotation(int i, Eigen::Matrix3d& out) const;
+
+ private:
+  void check_labels();
+  void estimate_rigid();
+  void relabel();
+  bool solve_pca(int j);
+  void fill_missing();
+  bool transfer_motion(int first, int last, const std::vector<int>& members, const Vec3& previous, Vec3& out);
+  void add_free_point(const Vec3& p, int id);
+
+  const SubjectModel& model_;
+  GapFillerOptions options_;
+  int n_ = 0;
+
+  // Static, derived from the model.
+  std::vector<int> predictor_offsets_;  // markers whose one-ring contains i (CSR)
+  std::vector<int> predictor_marker_;
+  std::vector<int> predictor_slot_;     // i's position in that marker's ring
+  std::vector<double> eps1_, eps2_;
+
+  // Carried from frame to frame.
+  bool has_previous_ = false;
+  long frame_ = 0;
+  std::vector<Vec3> previous_;
+  std::vector<MarkerStatus> previous_status_;
+  std::vector<int> assigned_id_;      // free-point trajectory currently standing for marker i
+  std::vector<Vec3> gap_offset_;      // continuity offset in the local frame
+  std::vector<int> gap_age_;
+
+  // Per-frame scratch.
+  std::vector<Vec3> current_;
+  std::vector<MarkerStatus> status_;
+  std::vector<char> observed_, estimated_, has_rotation_;
+  std::vector<Vec3> estimate_;
+  std::vector<Eigen::Matrix3d> rotation_;
+  std::vector<int> available_neighbours_, missing_;
+  std::vector<Vec3> free_points_;
+  std::vector<int> free_ids_;
+  std::vector<char> free_used_;
+  int free_count_ = 0;
+  struct Candidate {
+    double distance;
+    int marker;
+    int point;
+  };
+  std::vector<Candidate> candidates_;
+  std::vector<long> pca_stamp_;
+  std::vector<char> pca_ok_;
+  std::vector<Eigen::Matrix3d> pca_rotation_;
+  std::vector<double> pca_coefficients_;  // n x (3 * kMaxRing)
+  std::vector<Vec3> scratch_source_, scratch_target_;
+  std::vector<int> scratch_index_;
+  FillStats stats_;
+};
+
+}  // namespace skinstream

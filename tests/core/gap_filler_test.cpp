@@ -1,0 +1,236 @@
+#include "core/gap_filler.h"
+
+#include <gtest/gtest.h>
+
+#include "support/allocation_counter.h"
+#include "core/offline/subject_builder.h"
+#include "support/synthetic_limb.h"
+
+namespace skinstream {
+namespace {
+
+struct Fixture {
+  explicit Fixture(test::LimbOptions o = {}) : options(o), truth(test::make_limb_capture(o)), model(build_subject(truth, {})) {}
+  test::LimbOptions options;
+  Capture truth;
+  SubjectModel model;
+};
+
+struct Frame {
+  explicit Frame(int n) : labelled(n), positions(n), status(n) {}
+  std::vector<Vec3> labelled, unlabelled;
+  std::vector<int> ids;
+  std::vector<Vec3> positions;
+  std::vector<MarkerStatus> status;
+  FillStats run(GapFiller& filler) { return filler.run({labelled, unlabelled, ids}, {positions, status}); }
+};
+
+void load(const Capture& c, int f, Frame& frame) {
+  for (int p = 0; p < c.point_count(); ++p) frame.labelled[p] = c.at(f, p);
+  frame.unlabelled.clear();
+  frame.ids.clear();
+}
+
+// A marker in the middle of the limb and the opposite one.
+constexpr int kMiddle = 3 * 8 + 2;
+constexpr int kOther = 3 * 8 + 6;
+
+TEST(GapFiller, RejectsInputOfTheWrongSize) {
+  Fixture fx;
+  GapFiller filler(fx.model);
+  Frame frame(fx.model.marker_count() - 1);
+  std::vector<Vec3> positions(fx.model.marker_count());
+  std::vector<MarkerStatus> status(fx.model.marker_count());
+  EXPECT_FALSE(filler.run({frame.labelled, {}, {}}, {positions, status}).ok);
+}
+
+TEST(GapFiller, RejectsIdsThatDoNotMatchThePoints) {
+  Fixture fx;
+  GapFiller filler(fx.model);
+  Frame frame(fx.model.marker_count());
+  load(fx.truth, 0, frame);
+  frame.unlabelled = {Vec3(1, 2, 3)};
+  frame.ids = {1, 2};
+  EXPECT_FALSE(frame.run(filler).ok);
+}
+
+TEST(GapFiller, FillsARigidNeighbourhoodExactly) {
+  test::LimbOptions o;
+  o.bulge = o.twist = 0.0;
+  Fixture fx(o);
+  GapFiller filler(fx.model);
+  Frame frame(fx.model.marker_count());
+  for (int f = 0; f < 200; ++f) {
+    load(fx.truth, f, frame);
+    if (f >= 50) frame.labelled[kMiddle] = frame.labelled[kOther] = missing_point();
+    ASSERT_TRUE(frame.run(filler).ok);
+    if (f >= 50) {
+      EXPECT_EQ(frame.status[kMiddle], MarkerStatus::FilledPca);
+      EXPECT_LT((frame.positions[kMiddle] - fx.truth.at(f, kMiddle)).norm(), 1e-6) << "frame " << f;
+      EXPECT_LT((frame.positions[kOther] - fx.truth.at(f, kOther)).norm(), 1e-6);
+    }
+  }
+}
+
+double mean_fill_error(const Fixture& fx, const GapFillerOptions& options, int hide_ring_members) {
+  GapFiller filler(fx.model, options);
+  Frame frame(fx.model.marker_count());
+  double sum = 0;
+  int count = 0;
+  const int ring_first = fx.model.ring_offsets[kMiddle];
+  for (int f = 0; f < fx.truth.frame_count; ++f) {
+    load(fx.truth, f, frame);
+    if (f >= 100) {
+      frame.labelled[kMiddle] = missing_point();
+      for (int k = 0; k < hide_ring_members; ++k) frame.labelled[fx.model.ring[ring_first + k]] = missing_point();
+    }
+    frame.run(filler);
+    if (f >= 100) {
+      sum += (frame.positions[kMiddle] - fx.truth.at(f, kMiddle)).norm();
+      ++count;
+    }
+  }
+  return sum / count;
+}
+
+TEST(GapFiller, PcaBeatsTheRigidEstimateOnADeformingLimb) {
+  Fixture fx;
+  GapFillerOptions rigid;
+  rigid.use_pca = false;
+  GapFillerOptions pca;
+  pca.continuity_seconds = rigid.continuity_seconds = 0.0;  // compare the estimators alone
+  const double rigid_error = mean_fill_error(fx, rigid, 0);
+  const double pca_error = mean_fill_error(fx, pca, 0);
+  const double spacing = fx.model.neighbour_distance(kMiddle);
+  EXPECT_LT(pca_error, 0.5 * rigid_error);
+  EXPECT_LT(pca_error / spacing, 0.02);  // the paper reports about 0.02 on real data
+}
+
+TEST(GapFiller, PcaFitsWithMissingEntriesInTheRing) {
+  Fixture fx;
+  GapFillerOptions o;
+  o.continuity_seconds = 0.0;
+  const double spacing = fx.model.neighbour_distance(kMiddle);
+  // Hide the marker and two of its neighbours: the remaining ring members drive the fit.
+  EXPECT_LT(mean_fill_error(fx, o, 2) / spacing, 0.05);
+}
+
+TEST(GapFiller, RelabelsAnUnlabelledPointNearTheEstimateAndIgnoresAFarOne) {
+  Fixture fx;
+  GapFiller filler(fx.model);
+  Frame frame(fx.model.marker_count());
+  const double eps1 = fx.model.parameters.alpha1 * fx.model.neighbour_distance(kMiddle);
+  for (int f = 0; f < 20; ++f) {
+    load(fx.truth, f, frame);
+    frame.run(filler);
+  }
+  load(fx.truth, 20, frame);
+  const Vec3 truth = frame.labelled[kMiddle];
+  frame.labelled[kMiddle] = missing_point();
+  frame.unlabelled = {truth + Vec3(0, 0, 3.0 * eps1), truth + Vec3(0.5, 0, 0)};  // a ghost, the marker
+  frame.ids = {100, 101};
+  const FillStats s = frame.run(filler);
+  EXPECT_EQ(s.relabelled, 1);
+  EXPECT_EQ(frame.status[kMiddle], MarkerStatus::Relabelled);
+  EXPECT_LT((frame.positions[kMiddle] - (truth + Vec3(0.5, 0, 0))).norm(), 1e-12);
+
+  // Only the ghost: nothing within eps1, so the marker is filled, not relabelled.
+  load(fx.truth, 21, frame);
+  const Vec3 truth21 = frame.labelled[kMiddle];
+  frame.labelled[kMiddle] = missing_point();
+  frame.unlabelled = {truth21 + Vec3(0, 0, 3.0 * eps1)};
+  frame.ids = {100};
+  frame.run(filler);
+  EXPECT_EQ(frame.status[kMiddle], MarkerStatus::FilledPca);
+}
+
+TEST(GapFiller, KeepsAFragmentWhileWithinEps2AndDropsItBeyond) {
+  Fixture fx;
+  GapFiller filler(fx.model);
+  Frame frame(fx.model.marker_count());
+  const double spacing = fx.model.neighbour_distance(kMiddle);
+  const double eps1 = fx.model.parameters.alpha1 * spacing, eps2 = fx.model.parameters.alpha2 * spacing;
+  for (int f = 0; f < 60; ++f) {
+    load(fx.truth, f, frame);
+    const Vec3 truth = frame.labelled[kMiddle];
+    if (f >= 10) {
+      frame.labelled[kMiddle] = missing_point();
+      // The broken trajectory comes back as fragment 7: first close, then drifting to between
+      // eps1 and eps2 (kept), then beyond eps2 (dropped).
+      const double drift = f < 30 ? 0.2 * eps1 : f < 45 ? 0.5 * (eps1 + eps2) : 1.5 * eps2;
+      frame.unlabelled = {truth + Vec3(drift, 0, 0)};
+      frame.ids = {7};
+    }
+    frame.run(filler);
+    if (f >= 10 && f < 45) {
+      EXPECT_EQ(frame.status[kMiddle], MarkerStatus::Relabelled) << "frame " << f;
+    }
+    if (f >= 45) {
+      EXPECT_NE(frame.status[kMiddle], MarkerStatus::Relabelled) << "frame " << f;
+    }
+  }
+}
+
+TEST(GapFiller, RejoinsSwappedLabels) {
+  Fixture fx;
+  GapFiller filler(fx.model);
+  Frame frame(fx.model.marker_count());
+  const int a = kMiddle, b = fx.model.ring[fx.model.ring_offsets[kMiddle]];  // neighbours
+  for (int f = 0; f < 40; ++f) {
+    load(fx.truth, f, frame);
+    if (f >= 20) std::swap(frame.labelled[a], frame.labelled[b]);  // the capture system swapped them
+    const FillStats s = frame.run(filler);
+    if (f >= 20) {
+      EXPECT_EQ(s.rejected_labels, 2) << "frame " << f;
+      EXPECT_EQ(frame.status[a], MarkerStatus::Relabelled);
+      EXPECT_EQ(frame.status[b], MarkerStatus::Relabelled);
+      EXPECT_LT((frame.positions[a] - fx.truth.at(f, a)).norm(), 1e-9);
+      EXPECT_LT((frame.positions[b] - fx.truth.at(f, b)).norm(), 1e-9);
+    }
+  }
+}
+
+TEST(GapFiller, NeverOutputsNaN) {
+  Fixture fx;
+  GapFiller filler(fx.model);
+  Frame frame(fx.model.marker_count());
+  for (int f = 0; f < 30; ++f) {
+    load(fx.truth, f, frame);
+    if (f < 3 || f > 20)  // nothing at all, at the start and after some frames
+      for (Vec3& p : frame.labelled) p = missing_point();
+    if (f == 10) frame.labelled[0] = Vec3(std::nan(""), 1, 2);  // partly NaN
+    frame.run(filler);
+    for (const Vec3& p : frame.positions) ASSERT_TRUE(p.allFinite()) << "frame " << f;
+  }
+}
+
+TEST(GapFiller, AllocatesNothingPerFrame) {
+  Fixture fx;
+  GapFiller filler(fx.model);
+  Frame frame(fx.model.marker_count());
+  frame.unlabelled.reserve(8);
+  frame.ids.reserve(8);
+  auto make = [&](int f) {
+    load(fx.truth, f, frame);
+    const Vec3 truth = frame.labelled[kMiddle];
+    frame.labelled[kMiddle] = missing_point();
+    if (f % 3 == 0) frame.labelled[kOther] = missing_point();
+    if (f % 2 == 0) {
+      frame.unlabelled.push_back(truth);
+      frame.ids.push_back(f % 4);
+    }
+  };
+  for (int f = 0; f < 10; ++f) {
+    make(f);
+    frame.run(filler);
+  }
+  test::CountAllocations counter;
+  for (int f = 10; f < 200; ++f) {
+    make(f);
+    frame.run(filler);
+  }
+  EXPECT_EQ(counter.count(), 0u);
+}
+
+}  // namespace
+}  // namespace skinstream
