@@ -1,6 +1,5 @@
 #include "core/gap_filler.h"
 
-#include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -8,9 +7,6 @@
 namespace skinstream {
 namespace {
 
-constexpr int kMaxDims = 3 * SubjectModel::kMaxRing;
-using SmallMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxDims, kMaxDims>;
-using SmallVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxDims, 1>;
 constexpr int kNoFragment = std::numeric_limits<int>::min();
 
 }  // namespace
@@ -54,7 +50,9 @@ GapFiller::GapFiller(const SubjectModel& model, const GapFillerOptions& options)
   pca_stamp_.assign(n_, -1);
   pca_ok_.assign(n_, 0);
   pca_rotation_.assign(n_, Eigen::Matrix3d::Identity());
-  pca_coefficients_.assign(static_cast<size_t>(n_) * kMaxDims, 0.0);
+  pca_slot_local_.assign(model.ring.size(), Vec3::Zero());
+  pca_slot_variance_.assign(model.ring.size(), 1.0);
+  rigid_support_.assign(n_, 0);
   const size_t scratch = std::max<size_t>(n_, SubjectModel::kMaxRing);
   scratch_source_.assign(scratch, Vec3::Zero());
   scratch_target_.assign(scratch, Vec3::Zero());
@@ -188,6 +186,9 @@ void GapFiller::estimate_rigid() {
       scratch_target_[count] = estimate_[j];
       ++count;
     }
+    int observed_support = 0;
+    for (int k = model_.ring_offsets[best]; k < model_.ring_offsets[best + 1]; ++k) observed_support += observed_[model_.ring[k]];
+    rigid_support_[best] = observed_support;
     RigidTransform t;
     fit_rigid({scratch_source_.data(), static_cast<size_t>(count)}, {scratch_target_.data(), static_cast<size_t>(count)}, t);
     estimate_[best] = t.translation;  // the local frame's origin is the marker
@@ -253,9 +254,8 @@ void GapFiller::relabel() {
 }
 
 // Section 4.3 for the model of marker j: rotate j's observed one-ring into its local frame
-// (eq. 5) and find the PCA coefficients c that best explain it, with the PCA variances as a
-// prior (c_k ~ N(0, variance_k), residual ~ N(0, residual_variance)) so that a ring seen only
-// in part cannot push the coefficients far outside what training saw.
+// (eq. 5), fit the PCA coefficients to it (pca_fit.h) and keep, for every ring member that is
+// not observed, its reconstruction and calibrated predictive variance.
 bool GapFiller::solve_pca(int j) {
   pca_stamp_[j] = frame_;
   pca_ok_[j] = 0;
@@ -274,28 +274,14 @@ bool GapFiller::solve_pca(int j) {
   if (count < 2) return false;
   Eigen::Matrix3d& r = pca_rotation_[j];
   fit_rotation({scratch_source_.data(), static_cast<size_t>(count)}, {scratch_target_.data(), static_cast<size_t>(count)}, r);
-  const int components = static_cast<int>(m.variance.size());
-  double* coefficients = &pca_coefficients_[static_cast<size_t>(j) * kMaxDims];
-  if (components == 0) {
-    pca_ok_[j] = 1;
-    return true;
+  for (int o = 0; o < count; ++o) scratch_source_[o] = r * scratch_source_[o];
+  if (!pca_fit_.fit(m, {scratch_index_.data(), static_cast<size_t>(count)}, {scratch_source_.data(), static_cast<size_t>(count)}))
+    return false;
+  for (int k = 0; k < ring; ++k) {
+    if (observed_[model_.ring[first + k]]) continue;
+    pca_slot_local_[first + k] = pca_fit_.reconstruct(m, k);
+    pca_slot_variance_[first + k] = pca_fit_.predictive_variance(m, k) * m.slot_calibration(k);
   }
-  SmallMatrix b(3 * count, components);
-  SmallVector z(3 * count);
-  for (int o = 0; o < count; ++o) {
-    const int k = scratch_index_[o];
-    b.middleRows<3>(3 * o) = m.basis.middleRows<3>(3 * k);
-    z.segment<3>(3 * o) = r * scratch_source_[o] - m.mean.segment<3>(3 * k);
-  }
-  SmallMatrix normal(components, components);
-  normal.noalias() = b.transpose() * b;
-  for (int c = 0; c < components; ++c) normal(c, c) += m.residual_variance / m.variance(c);
-  SmallVector rhs(components);
-  rhs.noalias() = b.transpose() * z;
-  Eigen::LLT<SmallMatrix> llt(normal);
-  if (llt.info() != Eigen::Success) return false;
-  const SmallVector c = llt.solve(rhs);
-  for (int k = 0; k < components; ++k) coefficients[k] = c(k);
   pca_ok_[j] = 1;
   return true;
 }
@@ -323,6 +309,7 @@ void GapFiller::fill_missing() {
   for (int i : missing_) {
     if (observed_[i]) continue;  // relabelled
     Vec3 sum = Vec3::Zero();
+    double weights = 0.0;
     int count = 0;
     if (options_.use_pca) {
       for (int p = predictor_offsets_[i]; p < predictor_offsets_[i + 1]; ++p) {
@@ -330,17 +317,22 @@ void GapFiller::fill_missing() {
         if (!observed_[j]) continue;
         if (pca_stamp_[j] != frame_) solve_pca(j);
         if (!pca_ok_[j]) continue;
-        const MarkerPcaModel& m = model_.pca[j];
-        const int slot = predictor_slot_[p];
-        Vec3 local = m.mean.segment<3>(3 * slot);
-        const double* c = &pca_coefficients_[static_cast<size_t>(j) * kMaxDims];
-        for (int k = 0; k < m.basis.cols(); ++k) local += m.basis.block<3, 1>(3 * slot, k) * c[k];
-        sum += current_[j] + pca_rotation_[j].transpose() * local;
+        const int at = model_.ring_offsets[j] + predictor_slot_[p];
+        const double weight = options_.weight_by_variance ? 1.0 / pca_slot_variance_[at] : 1.0;
+        sum += weight * (current_[j] + pca_rotation_[j].transpose() * pca_slot_local_[at]);
+        weights += weight;
         ++count;
       }
     }
+    // The rigid estimate joins as one more opinion, weighed by its error on the training take,
+    // inflated when part of the ring it stood on was itself only estimated.
+    if (count > 0 && options_.weight_by_variance && options_.fuse_rigid && estimated_[i] && rigid_support_[i] > 0) {
+      const double variance = model_.pca[i].rigid_variance * model_.ring_size(i) / rigid_support_[i];
+      sum += estimate_[i] / variance;
+      weights += 1.0 / variance;
+    }
     if (count > 0) {
-      current_[i] = sum / count;
+      current_[i] = sum / weights;
       status_[i] = MarkerStatus::FilledPca;
     } else if (estimated_[i]) {
       current_[i] = estimate_[i];

@@ -12,7 +12,8 @@
 //      pairs first. Rigid estimates are then redone with the new points.
 //   4. PCA fill: every observed neighbour's PCA model reconstructs the missing marker from that
 //      neighbour's observed one-ring (regularised least squares on the coefficients); the
-//      estimates are averaged. Without one, the rigid estimate; without that, held relative to
+//      estimates are averaged, each weighted by the inverse of its predictive variance
+//      (calibrated on the training take), together with the rigid estimate weighed likewise. Without one, the rigid estimate; without that, held relative to
 //      the marker's anchors.
 //   5. Continuity: at the start of a gap, the difference between where the marker's last
 //      measurement moved with its neighbours and the estimate is kept in the local frame and
@@ -26,6 +27,7 @@
 
 #include "core/absolute_orientation.h"
 #include "core/marker_status.h"
+#include "core/pca_fit.h"
 #include "core/subject_model.h"
 
 namespace skinstream {
@@ -34,6 +36,10 @@ struct GapFillerOptions {
   double rate_hz = 120.0;
   double continuity_seconds = 1.0;  // 0 turns the gap-start continuity off
   bool use_pca = true;              // false: eq. 2 estimates only
+  // Average the neighbours' PCA estimates weighted by each one's predictive variance (true),
+  // or plainly as the paper does (false).
+  bool weight_by_variance = true;
+  bool fuse_rigid = true;  // with weighting: the rigid estimate (eq. 2) is one more weighed opinion
   bool check_labels = true;
 };
 
@@ -119,7 +125,10 @@ class GapFiller {
   std::vector<long> pca_stamp_;
   std::vector<char> pca_ok_;
   std::vector<Eigen::Matrix3d> pca_rotation_;
-  std::vector<double> pca_coefficients_;  // n x (3 * kMaxRing)
+  PcaFit pca_fit_;
+  std::vector<Vec3> pca_slot_local_;       // parallel to model.ring: reconstruction in the local frame
+  std::vector<double> pca_slot_variance_;  // parallel to model.ring: calibrated predictive variance (mm^2)
+  std::vector<int> rigid_support_;         // observed ring members behind each rigid estimate
   std::vector<Vec3> scratch_source_, scratch_target_;
   std::vector<int> scratch_index_;
   FillStats stats_;

@@ -39,7 +39,10 @@ std::string SubjectModel::validate() const {
     const MarkerPcaModel& m = pca[i];
     if (m.mean.size() != 3 * rs || m.basis.rows() != 3 * rs || m.basis.cols() != m.variance.size())
       why << "marker " << marker_names[i] << " PCA shape does not match its ring; ";
-    else if (!m.mean.allFinite() || !m.basis.allFinite() || !m.variance.allFinite() || !std::isfinite(m.residual_variance))
+    else if (m.slot_calibration.size() != rs || !(m.slot_calibration.array() > 0).all() || !(m.rigid_variance > 0))
+      why << "marker " << marker_names[i] << " calibration missing or not positive; ";
+    else if (!m.mean.allFinite() || !m.basis.allFinite() || !m.variance.allFinite() || !std::isfinite(m.residual_variance) ||
+             !(m.residual_variance > 0) || !(m.variance.array() > 0).all())
       why << "marker " << marker_names[i] << " PCA has non-finite values; ";
   }
   for (int j : ring)

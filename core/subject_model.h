@@ -20,6 +20,13 @@ struct MarkerPcaModel {
   Eigen::VectorXd variance;    // components, eigenvalues (mm^2), descending
   double residual_variance = 0.0;  // per dimension, what the kept components leave out (mm^2)
   int training_frames = 0;
+
+  // Calibration on the training take, so that estimates can be weighed against each other:
+  // per ring member, the mean squared error of reconstructing it from the rest of the ring
+  // divided by the predictive variance the model claimed (1 = honest, > 1 = optimistic) ...
+  Eigen::VectorXd slot_calibration;  // ring_size
+  // ... and the mean squared error per coordinate of the marker's own rigid estimate (eq. 2).
+  double rigid_variance = 0.0;  // mm^2
 };
 
 struct FillParameters {

@@ -15,6 +15,7 @@ struct PcaTrainingOptions {
   double variance_kept = 0.99;
   int max_frames = 6000;              // evenly spaced subsample of the usable frames
   double noise_floor_mm = 0.5;        // residual variance never below this squared
+  int calibration_frames = 300;       // frames used to calibrate the predictive variances
 };
 
 // `marker` and `ring` are channel indices of `capture`; `ring_local_reference` the eq. 1 positions.

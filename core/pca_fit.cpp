@@ -1,0 +1,40 @@
+#include "core/pca_fit.h"
+
+namespace skinstream {
+
+bool PcaFit::fit(const MarkerPcaModel& model, std::span<const int> slots, std::span<const Vec3> local) {
+  const int components = static_cast<int>(model.variance.size());
+  coefficients_.resize(components);
+  if (components == 0) return true;
+  const int rows = 3 * static_cast<int>(slots.size());
+  PcaMatrix b(rows, components);
+  PcaVector z(rows);
+  for (size_t o = 0; o < slots.size(); ++o) {
+    b.middleRows<3>(3 * o) = model.basis.middleRows<3>(3 * slots[o]);
+    z.segment<3>(3 * o) = local[o] - model.mean.segment<3>(3 * slots[o]);
+  }
+  PcaMatrix normal(components, components);
+  normal.noalias() = b.transpose() * b;
+  for (int c = 0; c < components; ++c) normal(c, c) += model.residual_variance / model.variance(c);
+  PcaVector rhs(components);
+  rhs.noalias() = b.transpose() * z;
+  llt_.compute(normal);
+  if (llt_.info() != Eigen::Success) return false;
+  coefficients_ = llt_.solve(rhs);
+  return true;
+}
+
+Vec3 PcaFit::reconstruct(const MarkerPcaModel& model, int slot) const {
+  Vec3 p = model.mean.segment<3>(3 * slot);
+  for (Eigen::Index k = 0; k < coefficients_.size(); ++k) p += model.basis.block<3, 1>(3 * slot, k) * coefficients_(k);
+  return p;
+}
+
+double PcaFit::predictive_variance(const MarkerPcaModel& model, int slot) const {
+  if (coefficients_.size() == 0) return model.residual_variance;
+  const Eigen::Matrix<double, 3, Eigen::Dynamic, 0, 3, kMaxRingDims> rows = model.basis.middleRows<3>(3 * slot);
+  const PcaMatrix solved = llt_.solve(rows.transpose());
+  return model.residual_variance * (1.0 + (rows * solved).trace() / 3.0);
+}
+
+}  // namespace skinstream

@@ -1,0 +1,40 @@
+#pragma once
+// Fitting a marker's neighbourhood PCA model to the part of its one-ring that is observed
+// (section 4.3), shared by the runtime filler and the offline calibration so both do the same.
+//
+// The coefficients c minimise |B_O c - (z_O - mean_O)|^2 / residual_variance + sum c_k^2 / variance_k:
+// least squares on the observed rows with the PCA variances as a Gaussian prior, so a ring seen
+// only in part cannot push the coefficients beyond what training saw. Allocation-free.
+
+#include <Eigen/Cholesky>
+#include <Eigen/Core>
+#include <span>
+
+#include "core/subject_model.h"
+
+namespace skinstream {
+
+constexpr int kMaxRingDims = 3 * SubjectModel::kMaxRing;
+using PcaMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxRingDims, kMaxRingDims>;
+using PcaVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxRingDims, 1>;
+
+class PcaFit {
+ public:
+  // `slots`: indices of the observed ring members; `local`: their positions in the marker's
+  // local frame (eq. 4). Returns false when the system cannot be solved.
+  bool fit(const MarkerPcaModel& model, std::span<const int> slots, std::span<const Vec3> local);
+
+  // The model's reconstruction of ring member `slot` in the local frame, and its predictive
+  // variance per coordinate (mm^2): coefficient uncertainty seen through that member's rows,
+  // plus the residual.
+  Vec3 reconstruct(const MarkerPcaModel& model, int slot) const;
+  double predictive_variance(const MarkerPcaModel& model, int slot) const;
+
+  const PcaVector& coefficients() const { return coefficients_; }
+
+ private:
+  PcaVector coefficients_;
+  Eigen::LLT<PcaMatrix> llt_;
+};
+
+}  // namespace skinstream

@@ -1,0 +1,79 @@
+#pragma once
+// Little-endian byte writing and bounds-checked reading for the project's binary formats.
+// A read past the end throws std::out_of_range; callers turn that into a FileError.
+
+#include <cstdint>
+#include <cstring>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace skinstream {
+
+class ByteWriter {
+ public:
+  template <typename T>
+  void put(T value) {
+    static_assert(std::is_arithmetic_v<T>);
+    unsigned char raw[sizeof(T)];
+    std::memcpy(raw, &value, sizeof(T));
+    bytes_.insert(bytes_.end(), raw, raw + sizeof(T));  // the project only targets little-endian hosts
+  }
+  void put_string(const std::string& s) {
+    put<uint32_t>(static_cast<uint32_t>(s.size()));
+    bytes_.insert(bytes_.end(), s.begin(), s.end());
+  }
+  void put_bytes(const void* data, size_t size) {
+    const auto* p = static_cast<const unsigned char*>(data);
+    bytes_.insert(bytes_.end(), p, p + size);
+  }
+  const std::vector<unsigned char>& bytes() const { return bytes_; }
+  std::vector<unsigned char>& bytes() { return bytes_; }
+
+ private:
+  std::vector<unsigned char> bytes_;
+};
+
+class ByteReader {
+ public:
+  ByteReader(const unsigned char* data, size_t size) : data_(data), size_(size) {}
+  template <typename T>
+  T get() {
+    static_assert(std::is_arithmetic_v<T>);
+    need(sizeof(T));
+    T value;
+    std::memcpy(&value, data_ + pos_, sizeof(T));
+    pos_ += sizeof(T);
+    return value;
+  }
+  std::string get_string(size_t max_length = 1 << 20) {
+    const uint32_t n = get<uint32_t>();
+    if (n > max_length) throw std::out_of_range("string of " + std::to_string(n) + " bytes is implausible");
+    need(n);
+    std::string s(reinterpret_cast<const char*>(data_ + pos_), n);
+    pos_ += n;
+    return s;
+  }
+  // A count that must fit in what is left, given the bytes each item takes at least.
+  uint32_t get_count(size_t min_item_bytes) {
+    const uint32_t n = get<uint32_t>();
+    if (min_item_bytes > 0 && n > remaining() / min_item_bytes)
+      throw std::out_of_range("count " + std::to_string(n) + " exceeds the data left");
+    return n;
+  }
+  size_t remaining() const { return size_ - pos_; }
+  size_t position() const { return pos_; }
+
+ private:
+  void need(size_t n) const {
+    if (n > size_ - pos_) throw std::out_of_range("truncated at byte " + std::to_string(pos_));
+  }
+  const unsigned char* data_;
+  size_t size_;
+  size_t pos_ = 0;
+};
+
+// CRC-32 (IEEE 802.3, reflected), to reject corrupted files.
+uint32_t crc32(const unsigned char* data, size_t size);
+
+}  // namespace skinstream

@@ -1,0 +1,160 @@
+#include "protocol/subject_file.h"
+
+#include <cstring>
+#include <fstream>
+#include <iterator>
+
+#include "protocol/byte_buffer.h"
+#include "protocol/file_error.h"
+
+namespace skinstream {
+namespace {
+
+constexpr char kMagic[8] = {'S', 'K', 'S', 'U', 'B', 'J', '\r', '\n'};
+
+void put_vec3(ByteWriter& w, const Vec3& v) {
+  for (int c = 0; c < 3; ++c) w.put<double>(v[c]);
+}
+Vec3 get_vec3(ByteReader& r) {
+  Vec3 v;
+  for (int c = 0; c < 3; ++c) v[c] = r.get<double>();
+  return v;
+}
+void put_ints(ByteWriter& w, const std::vector<int>& v) {
+  w.put<uint32_t>(static_cast<uint32_t>(v.size()));
+  for (int x : v) w.put<int32_t>(x);
+}
+std::vector<int> get_ints(ByteReader& r) {
+  std::vector<int> v(r.get_count(4));
+  for (int& x : v) x = r.get<int32_t>();
+  return v;
+}
+
+std::vector<unsigned char> encode(const SubjectModel& m) {
+  ByteWriter w;
+  w.put<uint32_t>(static_cast<uint32_t>(m.marker_count()));
+  for (int i = 0; i < m.marker_count(); ++i) {
+    w.put_string(m.marker_names[i]);
+    put_vec3(w, m.reference_positions[i]);
+  }
+  w.put<uint32_t>(static_cast<uint32_t>(m.triangles.size()));
+  for (const auto& t : m.triangles)
+    for (int v : t) w.put<int32_t>(v);
+  put_ints(w, m.ring_offsets);
+  put_ints(w, m.ring);
+  for (const Vec3& p : m.ring_local_reference) put_vec3(w, p);
+  for (const Eigen::Matrix3d& r : m.local_reference_frames)
+    for (int k = 0; k < 9; ++k) w.put<double>(r.data()[k]);
+  put_ints(w, m.anchor_offsets);
+  put_ints(w, m.anchors);
+  for (const MarkerPcaModel& p : m.pca) {
+    w.put<uint32_t>(static_cast<uint32_t>(p.mean.size()));
+    w.put<uint32_t>(static_cast<uint32_t>(p.variance.size()));
+    w.put<int32_t>(p.training_frames);
+    w.put<double>(p.residual_variance);
+    for (Eigen::Index k = 0; k < p.mean.size(); ++k) w.put<double>(p.mean(k));
+    for (Eigen::Index k = 0; k < p.variance.size(); ++k) w.put<double>(p.variance(k));
+    for (Eigen::Index k = 0; k < p.basis.size(); ++k) w.put<double>(p.basis.data()[k]);
+    for (Eigen::Index k = 0; k < p.slot_calibration.size(); ++k) w.put<double>(p.slot_calibration(k));
+    w.put<double>(p.rigid_variance);
+  }
+  w.put<double>(m.parameters.alpha1);
+  w.put<double>(m.parameters.alpha2);
+  return std::move(w.bytes());
+}
+
+SubjectModel decode(ByteReader& r) {
+  SubjectModel m;
+  const uint32_t n = r.get_count(4 + 24);
+  for (uint32_t i = 0; i < n; ++i) {
+    m.marker_names.push_back(r.get_string(4096));
+    m.reference_positions.push_back(get_vec3(r));
+  }
+  m.triangles.resize(r.get_count(12));
+  for (auto& t : m.triangles)
+    for (int& v : t) v = r.get<int32_t>();
+  m.ring_offsets = get_ints(r);
+  m.ring = get_ints(r);
+  if (m.ring.size() > r.remaining() / 24) throw std::out_of_range("one-ring larger than the file");
+  for (size_t k = 0; k < m.ring.size(); ++k) m.ring_local_reference.push_back(get_vec3(r));
+  for (uint32_t i = 0; i < n; ++i) {
+    Eigen::Matrix3d f;
+    for (int k = 0; k < 9; ++k) f.data()[k] = r.get<double>();
+    m.local_reference_frames.push_back(f);
+  }
+  m.anchor_offsets = get_ints(r);
+  m.anchors = get_ints(r);
+  for (uint32_t i = 0; i < n; ++i) {
+    MarkerPcaModel p;
+    const uint32_t dims = r.get<uint32_t>(), components = r.get<uint32_t>();
+    if (dims > 3 * SubjectModel::kMaxRing || dims % 3 != 0 || components > dims)
+      throw std::out_of_range("PCA model of marker " + std::to_string(i) + " has implausible shape");
+    p.training_frames = r.get<int32_t>();
+    p.residual_variance = r.get<double>();
+    p.mean.resize(dims);
+    p.variance.resize(components);
+    p.basis.resize(dims, components);
+    for (uint32_t k = 0; k < dims; ++k) p.mean(k) = r.get<double>();
+    for (uint32_t k = 0; k < components; ++k) p.variance(k) = r.get<double>();
+    for (Eigen::Index k = 0; k < p.basis.size(); ++k) p.basis.data()[k] = r.get<double>();
+    p.slot_calibration.resize(dims / 3);
+    for (uint32_t k = 0; k < dims / 3; ++k) p.slot_calibration(k) = r.get<double>();
+    p.rigid_variance = r.get<double>();
+    m.pca.push_back(std::move(p));
+  }
+  m.parameters.alpha1 = r.get<double>();
+  m.parameters.alpha2 = r.get<double>();
+  return m;
+}
+
+}  // namespace
+
+void write_subject(const SubjectModel& model, const std::string& path) {
+  const std::string problem = model.validate();
+  if (!problem.empty()) throw FileError(path, "refusing to write an inconsistent subject model: " + problem);
+  const std::vector<unsigned char> payload = encode(model);
+  ByteWriter w;
+  w.put_bytes(kMagic, sizeof kMagic);
+  w.put<uint32_t>(kSubjectFileVersion);
+  w.put<uint64_t>(payload.size());
+  w.put_bytes(payload.data(), payload.size());
+  w.put<uint32_t>(crc32(payload.data(), payload.size()));
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  if (!out) throw FileError(path, "cannot open for writing");
+  out.write(reinterpret_cast<const char*>(w.bytes().data()), static_cast<std::streamsize>(w.bytes().size()));
+  if (!out) throw FileError(path, "write failed");
+}
+
+SubjectModel read_subject(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw FileError(path, "cannot open subject file");
+  const std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (bytes.size() < 24 || std::memcmp(bytes.data(), kMagic, sizeof kMagic) != 0)
+    throw FileError(path, "not a skinstream subject file (bad magic)");
+  ByteReader header(bytes.data() + 8, 12);
+  const uint32_t version = header.get<uint32_t>();
+  if (version != kSubjectFileVersion)
+    throw FileError(path, "subject file version " + std::to_string(version) + ", this build reads version " +
+                              std::to_string(kSubjectFileVersion) + "; rebuild it with skinstream build-subject");
+  const uint64_t size = header.get<uint64_t>();
+  if (size != bytes.size() - 24)
+    throw FileError(path, "truncated or padded: header says " + std::to_string(size) + " payload bytes, file holds " +
+                              std::to_string(bytes.size() - 24));
+  const unsigned char* payload = bytes.data() + 20;
+  uint32_t stored_crc;
+  std::memcpy(&stored_crc, bytes.data() + bytes.size() - 4, 4);
+  if (crc32(payload, size) != stored_crc) throw FileError(path, "corrupt: CRC-32 mismatch");
+  SubjectModel model;
+  try {
+    ByteReader r(payload, size);
+    model = decode(r);
+    if (r.remaining() != 0) throw std::out_of_range(std::to_string(r.remaining()) + " unexpected bytes after the model");
+  } catch (const std::out_of_range& e) {
+    throw FileError(path, std::string("corrupt subject payload: ") + e.what());
+  }
+  const std::string problem = model.validate();
+  if (!problem.empty()) throw FileError(path, "inconsistent subject model: " + problem);
+  return model;
+}
+
+}  // namespace skinstream

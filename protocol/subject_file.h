@@ -1,0 +1,25 @@
+#pragma once
+// The subject file: a SubjectModel on disk.
+//
+//   bytes 0-7   magic "SKSUBJ\r\n" (the CR LF catches text-mode mangling)
+//   bytes 8-11  u32 format version (kSubjectFileVersion)
+//   bytes 12-19 u64 payload size
+//   payload     little-endian: markers, reference pose, triangles, one-rings, local frames,
+//               anchors, PCA models, fill parameters (see subject_file.cpp, in that order)
+//   last 4      u32 CRC-32 of the payload
+//
+// Another version, a bad magic, a size or CRC mismatch or an inconsistent model is rejected
+// with a FileError that says which.
+
+#include <string>
+
+#include "core/subject_model.h"
+
+namespace skinstream {
+
+inline constexpr uint32_t kSubjectFileVersion = 1;
+
+void write_subject(const SubjectModel& model, const std::string& path);
+SubjectModel read_subject(const std::string& path);
+
+}  // namespace skinstream
