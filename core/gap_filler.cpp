@@ -1,5 +1,6 @@
 #include "core/gap_filler.h"
 
+#include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -53,10 +54,40 @@ GapFiller::GapFiller(const SubjectModel& model, const GapFillerOptions& options)
   pca_slot_local_.assign(model.ring.size(), Vec3::Zero());
   pca_slot_variance_.assign(model.ring.size(), 1.0);
   rigid_support_.assign(n_, 0);
+  precompute_single_gaps();
   const size_t scratch = std::max<size_t>(n_, SubjectModel::kMaxRing);
   scratch_source_.assign(scratch, Vec3::Zero());
   scratch_target_.assign(scratch, Vec3::Zero());
   scratch_index_.assign(scratch, 0);
+}
+
+// For every ring member of every model, the PCA reconstruction when that member alone is
+// missing is a fixed linear map of the others (the normal equations depend only on which
+// members are observed): z_s = mean_s + G (z_O - mean_O), G = B_s A^-1 B_O^T. Computed once.
+void GapFiller::precompute_single_gaps() {
+  single_gap_offset_.assign(model_.ring.size(), 0);
+  single_gap_variance_.assign(model_.ring.size(), 0.0);
+  for (int j = 0; j < n_; ++j) {
+    const MarkerPcaModel& m = model_.pca[j];
+    const int d = model_.ring_size(j), components = static_cast<int>(m.variance.size());
+    for (int s = 0; s < d; ++s) {
+      const int at = model_.ring_offsets[j] + s;
+      single_gap_offset_[at] = static_cast<int>(single_gap_gain_.size());
+      Eigen::MatrixXd observed(3 * (d - 1), components);
+      for (int k = 0, o = 0; k < d; ++k)
+        if (k != s) observed.middleRows<3>(3 * o++) = m.basis.middleRows<3>(3 * k);
+      Eigen::MatrixXd normal = observed.transpose() * observed;
+      for (int c = 0; c < components; ++c) normal(c, c) += m.residual_variance / m.variance(c);
+      const Eigen::LLT<Eigen::MatrixXd> llt(normal);
+      const Eigen::MatrixXd rows = m.basis.middleRows<3>(3 * s);
+      const Eigen::MatrixXd gain = components ? Eigen::MatrixXd(rows * llt.solve(observed.transpose()))
+                                              : Eigen::MatrixXd::Zero(3, 3 * (d - 1));
+      for (int row = 0; row < 3; ++row)
+        for (int c = 0; c < gain.cols(); ++c) single_gap_gain_.push_back(gain(row, c));
+      const double spread = components ? (rows * llt.solve(rows.transpose())).trace() / 3.0 : 0.0;
+      single_gap_variance_[at] = m.residual_variance * (1.0 + spread) * m.slot_calibration(s);
+    }
+  }
 }
 
 void GapFiller::reset() {
@@ -275,6 +306,24 @@ bool GapFiller::solve_pca(int j) {
   Eigen::Matrix3d& r = pca_rotation_[j];
   fit_rotation({scratch_source_.data(), static_cast<size_t>(count)}, {scratch_target_.data(), static_cast<size_t>(count)}, r);
   for (int o = 0; o < count; ++o) scratch_source_[o] = r * scratch_source_[o];
+  if (count == ring - 1) {
+    // The common case, one member missing: the precomputed linear map of that pattern.
+    int missing_slot = 0;
+    while (observed_[model_.ring[first + missing_slot]]) ++missing_slot;
+    const int at = first + missing_slot;
+    const double* gain = &single_gap_gain_[single_gap_offset_[at]];
+    Vec3 local = m.mean.segment<3>(3 * missing_slot);
+    const int columns = 3 * count;
+    for (int o = 0; o < count; ++o) {
+      const Vec3 deviation = scratch_source_[o] - m.mean.segment<3>(3 * scratch_index_[o]);
+      for (int c = 0; c < 3; ++c)
+        for (int row = 0; row < 3; ++row) local(row) += gain[row * columns + 3 * o + c] * deviation(c);
+    }
+    pca_slot_local_[at] = local;
+    pca_slot_variance_[at] = single_gap_variance_[at];
+    pca_ok_[j] = 1;
+    return true;
+  }
   if (!pca_fit_.fit(m, {scratch_index_.data(), static_cast<size_t>(count)}, {scratch_source_.data(), static_cast<size_t>(count)}))
     return false;
   for (int k = 0; k < ring; ++k) {

@@ -81,6 +81,7 @@ class GapFiller {
   void check_labels();
   void estimate_rigid();
   void relabel();
+  void precompute_single_gaps();
   bool solve_pca(int j);
   void fill_missing();
   bool transfer_motion(int first, int last, const std::vector<int>& members, const Vec3& previous, Vec3& out);
@@ -129,6 +130,11 @@ class GapFiller {
   std::vector<Vec3> pca_slot_local_;       // parallel to model.ring: reconstruction in the local frame
   std::vector<double> pca_slot_variance_;  // parallel to model.ring: calibrated predictive variance (mm^2)
   std::vector<int> rigid_support_;         // observed ring members behind each rigid estimate
+  // One ring member missing, per ring entry: the reconstruction's linear map (3 x 3(d-1),
+  // row-major, at single_gap_offset_) and its calibrated variance.
+  std::vector<double> single_gap_gain_;
+  std::vector<int> single_gap_offset_;
+  std::vector<double> single_gap_variance_;
   std::vector<Vec3> scratch_source_, scratch_target_;
   std::vector<int> scratch_index_;
   FillStats stats_;

@@ -14,10 +14,10 @@ bool PcaFit::fit(const MarkerPcaModel& model, std::span<const int> slots, std::s
     z.segment<3>(3 * o) = local[o] - model.mean.segment<3>(3 * slots[o]);
   }
   PcaMatrix normal(components, components);
-  normal.noalias() = b.transpose() * b;
+  normal.noalias() = b.transpose().lazyProduct(b);  // small: no blocked GEMM
   for (int c = 0; c < components; ++c) normal(c, c) += model.residual_variance / model.variance(c);
   PcaVector rhs(components);
-  rhs.noalias() = b.transpose() * z;
+  rhs.noalias() = b.transpose().lazyProduct(z);
   llt_.compute(normal);
   if (llt_.info() != Eigen::Success) return false;
   coefficients_ = llt_.solve(rhs);
@@ -32,9 +32,10 @@ Vec3 PcaFit::reconstruct(const MarkerPcaModel& model, int slot) const {
 
 double PcaFit::predictive_variance(const MarkerPcaModel& model, int slot) const {
   if (coefficients_.size() == 0) return model.residual_variance;
-  const Eigen::Matrix<double, 3, Eigen::Dynamic, 0, 3, kMaxRingDims> rows = model.basis.middleRows<3>(3 * slot);
-  const PcaMatrix solved = llt_.solve(rows.transpose());
-  return model.residual_variance * (1.0 + (rows * solved).trace() / 3.0);
+  // trace(B_s A^-1 B_s^T) = |L^-1 B_s^T|^2 with A = L L^T: one triangular solve.
+  Eigen::Matrix<double, Eigen::Dynamic, 3, 0, kMaxRingDims, 3> rows = model.basis.middleRows<3>(3 * slot).transpose();
+  llt_.matrixL().solveInPlace(rows);
+  return model.residual_variance * (1.0 + rows.squaredNorm() / 3.0);
 }
 
 }  // namespace skinstream
