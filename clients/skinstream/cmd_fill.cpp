@@ -33,6 +33,9 @@ void add_fill(CLI::App& app) {
     std::vector<MarkerStatus> status;
     CaptureFillReport report;
     const auto start = std::chrono::steady_clock::now();
+    if (map_channels_to_markers(model, input) == std::vector<int>(model.marker_count(), -1))
+      throw std::runtime_error(in_path + ": none of the subject's " + std::to_string(model.marker_count()) +
+                               " marker labels is in this capture (wrong subject file?)");
     const Capture filled = fill_capture(model, input, options, &status, &report);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     write_capture(filled, out_path);
