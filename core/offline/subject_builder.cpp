@@ -49,7 +49,17 @@ SubjectModel build_subject(const Capture& training, const SubjectBuildOptions& o
   int ref = options.reference_frame;
   if (ref < 0) {
     ref = choose_reference_frame(training, channels);
-    if (ref < 0) throw std::invalid_argument("no frame has every labelled marker present; give --reference-frame after filling one");
+    if (ref < 0) {
+      int best_frame = 0, best_count = -1;
+      for (int f = 0; f < training.frame_count; ++f) {
+        int count = 0;
+        for (int c : channels) count += training.present(f, c);
+        if (count > best_count) best_count = count, best_frame = f;
+      }
+      throw std::invalid_argument("no frame has all " + std::to_string(n) + " labelled markers present (frame " +
+                                  std::to_string(best_frame) + " has " + std::to_string(best_count) +
+                                  "); the reference pose needs every marker: train on a take with one complete frame");
+    }
   } else {
     if (ref >= training.frame_count) throw std::invalid_argument("reference frame " + std::to_string(ref) + " is past the end");
     for (int c : channels)
