@@ -19,7 +19,8 @@ std::vector<int> map_channels_to_markers(const SubjectModel& model, const Captur
 }
 
 Capture fill_capture(const SubjectModel& model, const Capture& input, const CaptureFillOptions& options,
-                     std::vector<MarkerStatus>* out_status, CaptureFillReport* out_report) {
+                     std::vector<MarkerStatus>* out_status, CaptureFillReport* out_report,
+                     std::vector<int>* out_fragments) {
   CaptureFillReport report;
   const std::vector<int> channel_of = map_channels_to_markers(model, input, &report);
   std::vector<char> is_marker_channel(input.point_count(), 0);
@@ -45,7 +46,9 @@ Capture fill_capture(const SubjectModel& model, const Capture& input, const Capt
   std::vector<Vec3> measured(n), filled_frame(n), free_points, stage_positions(n), final_positions(n);
   std::vector<int> free_ids;
   std::vector<MarkerStatus> frame_status(n), stage_status(n), final_status(n);
-  const FrameOutput filler_out{filled_frame, frame_status};
+  std::vector<int> frame_fragments(n);
+  const FrameOutput filler_out{filled_frame, frame_status, frame_fragments};
+  if (out_fragments) out_fragments->assign(static_cast<size_t>(input.frame_count) * n, -1);
   const FrameOutput stage_out{stage_positions, stage_status};
   const FrameOutput final_out{final_positions, final_status};
 
@@ -77,6 +80,12 @@ Capture fill_capture(const SubjectModel& model, const Capture& input, const Capt
     report.filled += stats.filled;
     report.held += stats.held;
     report.rejected_labels += stats.rejected_labels;
+    if (out_fragments)
+      for (int m = 0; m < n; ++m) {
+        const int id = frame_fragments[m];
+        // Free ids are channel numbers; a rejected labelled point of marker j is -(j + 1).
+        (*out_fragments)[static_cast<size_t>(f) * n + m] = id == kNoFragment ? -1 : id >= 0 ? id : channel_of[-id - 1];
+      }
     long released;
     if (blender.push(filled_frame, frame_status, f, stage_out, released)) after_blend(released);
   }

@@ -35,7 +35,10 @@ std::vector<int> map_channels_to_markers(const SubjectModel& model, const Captur
 
 // The filled capture has the subject's markers as channels, in the subject's order.
 // `out_status` (frames x markers) says what was done to each sample.
+// `out_fragments` (frames x markers): the input channel whose point stood for each relabelled
+// sample (a rejected labelled channel too), -1 otherwise; see FrameOutput::fragments.
 Capture fill_capture(const SubjectModel& model, const Capture& input, const CaptureFillOptions& options,
-                     std::vector<MarkerStatus>* out_status = nullptr, CaptureFillReport* out_report = nullptr);
+                     std::vector<MarkerStatus>* out_status = nullptr, CaptureFillReport* out_report = nullptr,
+                     std::vector<int>* out_fragments = nullptr);
 
 }  // namespace skinstream

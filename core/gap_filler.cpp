@@ -8,7 +8,6 @@
 namespace skinstream {
 namespace {
 
-constexpr int kNoFragment = std::numeric_limits<int>::min();
 
 }  // namespace
 
@@ -117,7 +116,7 @@ void GapFiller::add_free_point(const Vec3& p, int id) {
 FillStats GapFiller::run(const FrameInput& in, const FrameOutput& out) {
   stats_ = FillStats{};
   if (static_cast<int>(in.labelled.size()) != n_ || static_cast<int>(out.positions.size()) != n_ ||
-      static_cast<int>(out.status.size()) != n_ ||
+      static_cast<int>(out.status.size()) != n_ || (!out.fragments.empty() && static_cast<int>(out.fragments.size()) != n_) ||
       (!in.unlabelled_ids.empty() && in.unlabelled_ids.size() != in.unlabelled.size())) {
     stats_.ok = false;
     return stats_;
@@ -147,6 +146,7 @@ FillStats GapFiller::run(const FrameInput& in, const FrameOutput& out) {
   for (int i = 0; i < n_; ++i) {
     out.positions[i] = current_[i];
     out.status[i] = status_[i];
+    if (!out.fragments.empty()) out.fragments[i] = status_[i] == MarkerStatus::Relabelled ? assigned_id_[i] : kNoFragment;
     previous_[i] = current_[i];
     previous_status_[i] = status_[i];
     switch (status_[i]) {

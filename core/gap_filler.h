@@ -22,6 +22,7 @@
 // All buffers are sized in the constructor; run() allocates nothing.
 
 #include <Eigen/Core>
+#include <limits>
 #include <span>
 #include <vector>
 
@@ -49,9 +50,16 @@ struct FrameInput {
   std::span<const int> unlabelled_ids;   // trajectory id per free point (same fragment, same id); may be empty
 };
 
+// Id of "no free point" in FrameOutput::fragments.
+inline constexpr int kNoFragment = std::numeric_limits<int>::min();
+
 struct FrameOutput {
   std::span<Vec3> positions;          // one per subject marker
   std::span<MarkerStatus> status;     // one per subject marker
+  // Optional (empty = not wanted): for a relabelled marker, the id of the free point that stands
+  // for it (a source trajectory id, or -(j + 1) for the point labelled j that was rejected);
+  // kNoFragment otherwise. What merging trajectories statistics are made of.
+  std::span<int> fragments = {};
 };
 
 struct FillStats {
