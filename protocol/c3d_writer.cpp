@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "protocol/c3d.h"
+#include "protocol/capture_checks.h"
 #include "protocol/file_error.h"
 
 namespace skinstream {
@@ -275,14 +276,7 @@ void encode_sample(uint8_t* out, const Vec3& p, float scale, const WordEncoder& 
 }
 
 void check_writable(const Capture& capture, const std::string& path) {
-  if (!(capture.rate_hz > 0.0) || !std::isfinite(capture.rate_hz))
-    throw FileError(path,
-                    "cannot write frame rate " + std::to_string(capture.rate_hz) + " (must be positive)");
-  if (capture.frame_count < 0) throw FileError(path, "negative frame count");
-  if (capture.positions.size() != static_cast<size_t>(capture.frame_count) * capture.labels.size())
-    throw FileError(path, "capture holds " + std::to_string(capture.positions.size()) + " positions for " +
-                              std::to_string(capture.frame_count) + " frames x " +
-                              std::to_string(capture.point_count()) + " points");
+  check_capture_shape(capture, path);
   if (capture.point_count() > 65535)
     throw FileError(path,
                     "C3D holds at most 65535 points, capture has " + std::to_string(capture.point_count()));

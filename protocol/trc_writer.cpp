@@ -6,6 +6,7 @@
 #include <fstream>
 #include <string>
 
+#include "protocol/capture_checks.h"
 #include "protocol/file_error.h"
 #include "protocol/trc.h"
 
@@ -19,14 +20,7 @@ void append_number(std::string& out, double value) {
 }
 
 void check_writable(const Capture& capture, const std::string& path) {
-  if (!(capture.rate_hz > 0.0) || !std::isfinite(capture.rate_hz))
-    throw FileError(path,
-                    "cannot write frame rate " + std::to_string(capture.rate_hz) + " (must be positive)");
-  if (capture.frame_count < 0) throw FileError(path, "negative frame count");
-  if (capture.positions.size() != static_cast<size_t>(capture.frame_count) * capture.labels.size())
-    throw FileError(path, "capture holds " + std::to_string(capture.positions.size()) + " positions for " +
-                              std::to_string(capture.frame_count) + " frames x " +
-                              std::to_string(capture.point_count()) + " points");
+  check_capture_shape(capture, path);
   for (const std::string& label : capture.labels)
     if (label.find_first_of("\t\r\n") != std::string::npos)
       throw FileError(path, "label '" + label + "' holds a tab or line break, which TRC cannot store");

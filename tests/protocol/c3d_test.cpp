@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "protocol/file_error.h"
+#include "support/file_error_assertion.h"
 #include "support/test_data.h"
 
 namespace skinstream {
@@ -81,26 +82,7 @@ ParameterLocation locate(const Bytes& b, const std::string& group, const std::st
   return {};
 }
 
-// The call throws a FileError whose message is one line, starts with `path` and says `fragment`.
-template <typename Call>
-::testing::AssertionResult throws_file_error(Call&& call, const std::string& path,
-                                             const std::string& fragment) {
-  try {
-    call();
-  } catch (const FileError& e) {
-    const std::string message = e.what();
-    if (message.find('\n') != std::string::npos)
-      return ::testing::AssertionFailure() << "multi-line: " << message;
-    if (message.rfind(path + ": ", 0) != 0)
-      return ::testing::AssertionFailure() << "does not name the file: " << message;
-    if (message.find(fragment) == std::string::npos)
-      return ::testing::AssertionFailure() << "lacks '" << fragment << "': " << message;
-    return ::testing::AssertionSuccess() << message;
-  } catch (const std::exception& e) {
-    return ::testing::AssertionFailure() << "threw a non-FileError: " << e.what();
-  }
-  return ::testing::AssertionFailure() << "did not throw";
-}
+using test::throws_file_error;
 
 // A patched copy of a shared capture in the scratch folder; returns its path.
 template <typename Patch>

@@ -10,6 +10,7 @@
 
 #include "protocol/c3d.h"
 #include "protocol/file_error.h"
+#include "support/file_error_assertion.h"
 #include "support/test_data.h"
 
 namespace skinstream {
@@ -28,25 +29,7 @@ std::string read_text(const std::string& path) {
   return std::string(std::istreambuf_iterator<char>(in), {});
 }
 
-template <typename Call>
-::testing::AssertionResult throws_file_error(Call&& call, const std::string& path,
-                                             const std::string& fragment) {
-  try {
-    call();
-  } catch (const FileError& e) {
-    const std::string message = e.what();
-    if (message.find('\n') != std::string::npos)
-      return ::testing::AssertionFailure() << "multi-line: " << message;
-    if (message.rfind(path + ": ", 0) != 0)
-      return ::testing::AssertionFailure() << "does not name the file: " << message;
-    if (message.find(fragment) == std::string::npos)
-      return ::testing::AssertionFailure() << "lacks '" << fragment << "': " << message;
-    return ::testing::AssertionSuccess();
-  } catch (const std::exception& e) {
-    return ::testing::AssertionFailure() << "threw a non-FileError: " << e.what();
-  }
-  return ::testing::AssertionFailure() << "did not throw";
-}
+using test::throws_file_error;
 
 void expect_identical(const Capture& expected, const Capture& actual) {
   EXPECT_EQ(actual.labels, expected.labels);
