@@ -15,5 +15,6 @@ void add_convert(CLI::App& app);
 void add_build_subject(CLI::App& app);
 void add_fill(CLI::App& app);
 void add_eval_fill(CLI::App& app);
+void add_synth(CLI::App& app);
 
 }  // namespace skinstream::cli

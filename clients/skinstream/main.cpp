@@ -18,6 +18,7 @@ int main(int argc, char** argv) {
   skinstream::cli::add_build_subject(app);
   skinstream::cli::add_fill(app);
   skinstream::cli::add_eval_fill(app);
+  skinstream::cli::add_synth(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

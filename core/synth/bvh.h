@@ -1,0 +1,44 @@
+#pragma once
+// A bounding volume hierarchy over a triangle mesh for the camera ray tests (is the segment from
+// a marker to a camera blocked by the body?) and closest-point queries. Built once per topology;
+// refit() updates the boxes when the mesh deforms (cheap, and exact: only traversal gets slower
+// as the pose drifts from the one it was built in, so callers rebuild now and then).
+#include <vector>
+
+#include "core/synth/body.h"
+
+namespace skinstream::synth {
+
+class TriangleBvh {
+ public:
+  TriangleBvh() = default;
+  // Throws std::invalid_argument for a triangle index out of range.
+  TriangleBvh(const std::vector<Vec3>& points, const std::vector<Triangle>& triangles);
+
+  void refit(const std::vector<Vec3>& points);  // same triangles, moved points
+
+  // Whether a triangle crosses the segment from -> to, ignoring hits closer than skip_mm to
+  // `from` (the marker's own surface) and closer than skip_mm to `to`.
+  bool segment_blocked(const Vec3& from, const Vec3& to, double skip_mm = 0.0) const;
+
+  // Distance from p to the surface; the closest triangle and point when asked.
+  double closest(const Vec3& p, int* triangle = nullptr, Vec3* point = nullptr) const;
+
+  int triangle_count() const { return static_cast<int>(triangles_.size()); }
+
+ private:
+  struct Node {
+    Eigen::Vector3d lo = Eigen::Vector3d::Zero(), hi = Eigen::Vector3d::Zero();
+    int first = 0;  // leaf: first index into order_; inner: index of the right child (left is next)
+    int count = 0;  // triangles in a leaf, 0 for an inner node
+  };
+  int build(int begin, int end, std::vector<Vec3>& centroids);
+  void refit_node(int node);
+
+  std::vector<Vec3> points_;
+  std::vector<Triangle> triangles_;
+  std::vector<int> order_;
+  std::vector<Node> nodes_;
+};
+
+}  // namespace skinstream::synth

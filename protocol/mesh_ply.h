@@ -1,0 +1,23 @@
+#pragma once
+// Binary little-endian PLY for meshes (the generator's per-frame truth meshes): float x y z per
+// vertex, faces as polygons (uchar count, int indices). Millimetres, as given.
+#include <string>
+#include <vector>
+
+#include "core/capture.h"
+#include "core/synth/body.h"
+
+namespace skinstream {
+
+// Throws FileError when the file cannot be written or a face index is out of range.
+void write_ply(const std::string& path, const std::vector<Vec3>& vertices,
+               const std::vector<synth::Face>& faces);
+
+// Reads back what write_ply writes (binary little-endian, float vertices, uchar/int faces).
+struct PlyMesh {
+  std::vector<Vec3> vertices;
+  std::vector<synth::Face> faces;
+};
+PlyMesh read_ply(const std::string& path);
+
+}  // namespace skinstream
