@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "clients/skinstream/commands.h"
+#include "clients/skinstream/synth_evaluation.h"
 #include "core/synth/motion.h"
 #include "core/synth/synth_capture.h"
 #include "protocol/capture_file.h"
@@ -54,6 +55,7 @@ void add_synth(CLI::App& app) {
   static std::string out, truth_out, body_dir;
   static std::vector<std::string> mesh_out;
   static bool stats = false, no_deform = false;
+  static double train_seconds = 20.0;
   static uint64_t seed = 1;
   std::string motions;
   for (const auto& m : synth::motion_names()) motions += (motions.empty() ? "" : ", ") + m;
@@ -87,7 +89,12 @@ void add_synth(CLI::App& app) {
                 "markers and meshes on the once-subdivided body (~53,500 vertices)");
   cmd->add_flag("--no-deform", no_deform, "skinning only: no muscle bulge, breathing or jiggle");
   cmd->add_option("--body", body_dir, "folder with the MakeHuman files (default: the shared data folder)");
-  cmd->add_flag("--stats", stats, "print the counts as JSON");
+  cmd->add_flag("--stats", stats,
+                "print the counts as JSON, and run skinstream's relabelling and filling on the take against its truth "
+                "(subject trained on a range-of-motion take of the same seed)");
+  cmd->add_option("--train-seconds", train_seconds, "with --stats: length of the range-of-motion training take")
+      ->check(CLI::Range(1.0, 600.0))
+      ->capture_default_str();
   cmd->callback([] {
     int mesh_every = 0;
     std::string mesh_dir;
@@ -137,6 +144,10 @@ void add_synth(CLI::App& app) {
       }
       j["channels"] = result.capture.point_count();
       j["generation_seconds"] = seconds;
+      synth::SynthOptions rom = options;
+      rom.motion = "rom";
+      rom.seconds = train_seconds;
+      j["skinstream"] = evaluate_on_synthetic(result, synth::generate(body, rom));
       std::printf("%s\n", j.dump(2).c_str());
     } else {
       std::printf(

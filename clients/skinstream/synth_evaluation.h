@@ -1,0 +1,13 @@
+#pragma once
+// Runs skinstream's own relabeller and gap filler (online, lookahead 0) over a synthetic capture
+// and judges them against its truth: Park & Hodgins' Table 1 after merging and Table 2.
+#include <nlohmann/json.hpp>
+
+#include "core/synth/synth_capture.h"
+
+namespace skinstream::cli {
+
+// `training` is a range-of-motion take of the same body and marker layout (same seed).
+nlohmann::ordered_json evaluate_on_synthetic(const synth::SynthCapture& take, const synth::SynthCapture& training);
+
+}  // namespace skinstream::cli

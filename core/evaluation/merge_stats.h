@@ -1,0 +1,29 @@
+#pragma once
+// Park & Hodgins' Table 1 after merging: how the relabeller joined the partial trajectories a
+// capture system delivered, judged against the true marker of every delivered sample (known
+// for synthetic captures).
+
+#include <vector>
+
+#include "core/capture.h"
+#include "core/marker_status.h"
+
+namespace skinstream {
+
+struct MergeStats {
+  int fragments = 0;           // partial trajectories delivered: runs of samples on one channel
+  int unmerged_fragments = 0;  // fragments no marker took a sample of
+  int trajectories_after = 0;  // markers with any observed sample + unmerged fragments
+  int wrong_fragments = 0;     // fragments with a sample given to a marker that is not its own
+  long wrong_samples = 0;
+  double wrong_rate() const { return fragments ? static_cast<double>(wrong_fragments) / fragments : 0.0; }
+};
+
+// `true_marker`: per delivered sample (frame-major, delivered.point_count() per frame) the
+// subject marker it really is, or a negative value for a ghost / no sample. `channel_of`: the
+// channel of each subject marker (-1 none). `status` and `fragments` (frames x markers) as
+// returned by fill_capture. Throws std::invalid_argument on mismatched sizes.
+MergeStats merge_stats(const Capture& delivered, const std::vector<int>& true_marker, const std::vector<int>& channel_of,
+                       const std::vector<MarkerStatus>& status, const std::vector<int>& fragments);
+
+}  // namespace skinstream
