@@ -217,8 +217,20 @@ BrokenCapture break_trajectories(const Capture& truth, const std::vector<uint8_t
   std::stable_sort(extras.begin(), extras.end(),
                    [](const Extra& a, const Extra& b) { return a.first < b.first; });
 
+  // Unlabelled fragments share channels as C3D files from real systems do: a fragment takes the
+  // first channel free since at least one frame before it starts, so two fragments never touch
+  // on one channel and each stays a trajectory of its own.
+  std::vector<int> slot_of(extras.size());
+  std::vector<int> slot_last;
+  for (size_t k = 0; k < extras.size(); ++k) {
+    int slot = 0;
+    while (slot < static_cast<int>(slot_last.size()) && slot_last[slot] >= extras[k].first - 1) ++slot;
+    if (slot == static_cast<int>(slot_last.size())) slot_last.push_back(0);
+    slot_last[slot] = extras[k].last;
+    slot_of[k] = slot;
+  }
   std::vector<std::string> labels = truth.labels;
-  for (size_t k = 0; k < extras.size(); ++k) labels.push_back("*" + std::to_string(k));
+  for (size_t k = 0; k < slot_last.size(); ++k) labels.push_back("*" + std::to_string(k));
   BrokenCapture out;
   out.capture = Capture(labels, frames, truth.rate_hz);
   out.capture.first_frame = truth.first_frame;
@@ -237,7 +249,7 @@ BrokenCapture break_trajectories(const Capture& truth, const std::vector<uint8_t
     for (size_t k = 0; k < extras.size(); ++k) {
       const Extra& e = extras[k];
       if (f < e.first || f > e.last) continue;
-      const int ch = n + static_cast<int>(k);
+      const int ch = n + slot_of[k];
       if (e.source >= 0) {
         out.capture.at(f, ch) = noisy(truth.at(f, e.source), o.noise_mm);
         out.source[static_cast<size_t>(f) * channels + ch] = e.source;
