@@ -131,5 +131,29 @@ TEST(SkinstreamCli, FillsDeletedGapsOfARealCaptureAccurately) {
   for (const Vec3& p : filled.positions) ASSERT_TRUE(p.allFinite());
 }
 
+// A short synthetic flexing take, with skinstream's relabeller and online filler judged against
+// its truth by `synth --stats`. Asserts the targets of the synthetic-data issue on this gentle
+// motion. Measured when written: 1.006 trajectories per marker after merging, 0.2% wrongly
+// labelled fragments, 0.013 mean normalised error on deleted-then-filled samples.
+TEST(SkinstreamCli, SynthStatsOnAShortFlexTakeMeetTheRelabelAndFillTargets) {
+  const ProgramRun r = run("synth --motion flex --seconds 2 --seed 3 --train-seconds 10 --stats --out " +
+                           test::scratch_path("flex.c3d") + " --body " +
+                           std::string(SKINSTREAM_SHARED_DIR) + "/data/meshes/makehuman");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto j = nlohmann::json::parse(r.output);
+  EXPECT_EQ(j["markers"], 350);
+  EXPECT_GT(j["trajectories_before_merging"].get<int>(), 350);
+  const auto& s = j["skinstream"];
+  EXPECT_LE(s["after_per_marker"].get<double>(), 1.1);
+  EXPECT_LE(s["wrongly_labelled_rate"].get<double>(), 0.003);
+  EXPECT_LE(s["deleted_then_filled_error"]["normalised"]["mean"].get<double>(), 0.015);
+}
+
+TEST(SkinstreamCli, SynthRefusesAnUnknownMotion) {
+  const ProgramRun r = run("synth --motion moonwalk --out " + test::scratch_path("m.c3d"));
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.output.find("moonwalk"), std::string::npos) << r.output;
+}
+
 }  // namespace
 }  // namespace skinstream
