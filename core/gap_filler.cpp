@@ -122,6 +122,7 @@ FillStats GapFiller::run(const FrameInput& in, const FrameOutput& out) {
     return stats_;
   }
   ++frame_;
+  ++solve_stamp_;
   free_count_ = 0;
   for (int i = 0; i < n_; ++i) {
     current_[i] = in.labelled[i];
@@ -233,7 +234,7 @@ void GapFiller::estimate_rigid() {
 
 void GapFiller::relabel() {
   bool changed = false;
-  // Fragments already standing for a marker stay while within eps2 of its estimate.
+  // Fragments already standing for a marker stay while within eps2 of where it is expected.
   for (int i : missing_) {
     const int id = assigned_id_[i];
     if (id == kNoFragment) continue;
@@ -243,52 +244,66 @@ void GapFiller::relabel() {
         found = p;
         break;
       }
-    const Vec3& expected = estimated_[i] ? estimate_[i] : previous_[i];
+    Vec3 expected = previous_[i];
+    if (found >= 0 && !expected_position(i, expected)) expected = previous_[i];
     if (found >= 0 && (free_points_[found] - expected).norm() <= eps2_[i]) {
-      free_used_[found] = 1;
-      current_[i] = free_points_[found];
-      observed_[i] = 1;
-      status_[i] = MarkerStatus::Relabelled;
+      take_free_point(i, found);
       changed = true;
     } else {
       assigned_id_[i] = kNoFragment;
     }
   }
-  // New matches: each still-missing marker's nearest free point within eps1, closest pairs first.
-  candidates_.clear();
-  for (int i : missing_) {
-    if (observed_[i] || !estimated_[i]) continue;
-    int best = -1;
-    double best_distance = eps1_[i];
-    for (int p = 0; p < free_count_; ++p) {
-      if (free_used_[p]) continue;
-      const double d = (free_points_[p] - estimate_[i]).norm();
-      if (d <= best_distance) {
-        best = p;
-        best_distance = d;
+  if (changed) refresh_estimates();
+  // New matches: each still-missing marker's nearest free point within eps1 of where it is
+  // expected, closest pairs first. Points taken at the edge of an occluded patch make the
+  // estimates inside it better, so matching repeats while it finds something.
+  for (int round = 0; round < kRelabelRounds; ++round) {
+    candidates_.clear();
+    for (int i : missing_) {
+      Vec3 expected;
+      if (observed_[i] || !expected_position(i, expected)) continue;
+      int best = -1;
+      double best_distance = eps1_[i];
+      for (int p = 0; p < free_count_; ++p) {
+        if (free_used_[p]) continue;
+        const double d = (free_points_[p] - expected).norm();
+        if (d <= best_distance) {
+          best = p;
+          best_distance = d;
+        }
       }
+      if (best >= 0) candidates_.push_back({best_distance, i, best});
     }
-    if (best >= 0) candidates_.push_back({best_distance, i, best});
+    if (candidates_.empty()) break;
+    std::sort(candidates_.begin(), candidates_.end(),
+              [](const Candidate& a, const Candidate& b) { return a.distance < b.distance; });
+    for (const Candidate& c : candidates_) {
+      if (free_used_[c.point] || observed_[c.marker]) continue;
+      take_free_point(c.marker, c.point);
+      assigned_id_[c.marker] = free_ids_[c.point];
+    }
+    refresh_estimates();
   }
-  std::sort(candidates_.begin(), candidates_.end(),
-            [](const Candidate& a, const Candidate& b) { return a.distance < b.distance; });
-  for (const Candidate& c : candidates_) {
-    if (free_used_[c.point] || observed_[c.marker]) continue;
-    free_used_[c.point] = 1;
-    current_[c.marker] = free_points_[c.point];
-    observed_[c.marker] = 1;
-    status_[c.marker] = MarkerStatus::Relabelled;
-    assigned_id_[c.marker] = free_ids_[c.point];
-    changed = true;
-  }
-  if (changed) estimate_rigid();  // the new points make better estimates for the rest
+}
+
+void GapFiller::take_free_point(int marker, int point) {
+  free_used_[point] = 1;
+  current_[marker] = free_points_[point];
+  observed_[marker] = 1;
+  status_[marker] = MarkerStatus::Relabelled;
+}
+
+// After points were taken: rigid estimates again from the new set, PCA solves redone on demand.
+void GapFiller::refresh_estimates() {
+  estimate_rigid();
+  ++solve_stamp_;
 }
 
 // Section 4.3 for the model of marker j: rotate j's observed one-ring into its local frame
 // (eq. 5), fit the PCA coefficients to it (pca_fit.h) and keep, for every ring member that is
 // not observed, its reconstruction and calibrated predictive variance.
 bool GapFiller::solve_pca(int j) {
-  pca_stamp_[j] = frame_;
+  pca_stamp_[j] = solve_stamp_;
   pca_ok_[j] = 0;
   const MarkerPcaModel& m = model_.pca[j];
   const int first = model_.ring_offsets[j];
@@ -353,35 +368,51 @@ bool GapFiller::transfer_motion(int first, int last, const std::vector<int>& mem
   return true;
 }
 
+// The neighbours' PCA estimates of marker i, each weighted by its calibrated predictive
+// variance, fused with the rigid estimate weighed likewise. Returns how many PCA models spoke.
+int GapFiller::pca_estimate(int i, Vec3& out) {
+  Vec3 sum = Vec3::Zero();
+  double weights = 0.0;
+  int count = 0;
+  for (int p = predictor_offsets_[i]; p < predictor_offsets_[i + 1]; ++p) {
+    const int j = predictor_marker_[p];
+    if (!observed_[j]) continue;
+    if (pca_stamp_[j] != solve_stamp_) solve_pca(j);
+    if (!pca_ok_[j]) continue;
+    const int at = model_.ring_offsets[j] + predictor_slot_[p];
+    const double weight = options_.weight_by_variance ? 1.0 / pca_slot_variance_[at] : 1.0;
+    sum += weight * (current_[j] + pca_rotation_[j].transpose() * pca_slot_local_[at]);
+    weights += weight;
+    ++count;
+  }
+  // The rigid estimate joins as one more opinion, weighed by its error on the training take,
+  // inflated when part of the ring it stood on was itself only estimated.
+  if (count > 0 && options_.weight_by_variance && options_.fuse_rigid && estimated_[i] && rigid_support_[i] > 0) {
+    const double variance = model_.pca[i].rigid_variance * model_.ring_size(i) / rigid_support_[i];
+    sum += estimate_[i] / variance;
+    weights += 1.0 / variance;
+  }
+  if (count > 0) out = sum / weights;
+  return count;
+}
+
+// Where the relabeller expects a missing marker: its best estimate from the neighbours alone.
+// Not the continuity offset: that comes from the marker's own past, and a fragment drifting
+// away would drag it along and be taken back. False when there is no estimate.
+bool GapFiller::expected_position(int i, Vec3& out) {
+  if (options_.use_pca && pca_estimate(i, out) > 0) return true;
+  if (!estimated_[i]) return false;
+  out = estimate_[i];
+  return true;
+}
+
 void GapFiller::fill_missing() {
   const double decay_frames = options_.continuity_seconds * options_.rate_hz;
   for (int i : missing_) {
     if (observed_[i]) continue;  // relabelled
-    Vec3 sum = Vec3::Zero();
-    double weights = 0.0;
-    int count = 0;
-    if (options_.use_pca) {
-      for (int p = predictor_offsets_[i]; p < predictor_offsets_[i + 1]; ++p) {
-        const int j = predictor_marker_[p];
-        if (!observed_[j]) continue;
-        if (pca_stamp_[j] != frame_) solve_pca(j);
-        if (!pca_ok_[j]) continue;
-        const int at = model_.ring_offsets[j] + predictor_slot_[p];
-        const double weight = options_.weight_by_variance ? 1.0 / pca_slot_variance_[at] : 1.0;
-        sum += weight * (current_[j] + pca_rotation_[j].transpose() * pca_slot_local_[at]);
-        weights += weight;
-        ++count;
-      }
-    }
-    // The rigid estimate joins as one more opinion, weighed by its error on the training take,
-    // inflated when part of the ring it stood on was itself only estimated.
-    if (count > 0 && options_.weight_by_variance && options_.fuse_rigid && estimated_[i] && rigid_support_[i] > 0) {
-      const double variance = model_.pca[i].rigid_variance * model_.ring_size(i) / rigid_support_[i];
-      sum += estimate_[i] / variance;
-      weights += 1.0 / variance;
-    }
-    if (count > 0) {
-      current_[i] = sum / weights;
+    Vec3 fused;
+    if (options_.use_pca && pca_estimate(i, fused) > 0) {
+      current_[i] = fused;
       status_[i] = MarkerStatus::FilledPca;
     } else if (estimated_[i]) {
       current_[i] = estimate_[i];

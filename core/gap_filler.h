@@ -7,9 +7,10 @@
 //      fragments look.
 //   2. Rigid estimates (eq. 2, Horn), greedy: the missing marker with the most available
 //      neighbours first, reusing earlier estimates.
-//   3. Relabelling: a tracked fragment stays with its marker while within eps2 (alpha2); a new
-//      one is taken when within eps1 (alpha1) of a missing marker's estimate (eq. 3), closest
-//      pairs first. Rigid estimates are then redone with the new points.
+//   3. Relabelling: a tracked fragment stays with its marker while within eps2 (alpha2) of
+//      where the marker is expected (its best estimate from the neighbours, step 4's fusion);
+//      a new one is taken when within eps1 (alpha1) of it (eq. 3), closest pairs first, in up
+//      to three rounds, estimates redone after each with the points taken.
 //   4. PCA fill: every observed neighbour's PCA model reconstructs the missing marker from that
 //      neighbour's observed one-ring (regularised least squares on the coefficients); the
 //      estimates are averaged, each weighted by the inverse of its predictive variance
@@ -91,6 +92,10 @@ class GapFiller {
   void relabel();
   void precompute_single_gaps();
   bool solve_pca(int j);
+  int pca_estimate(int i, Vec3& out);
+  bool expected_position(int i, Vec3& out);
+  void take_free_point(int marker, int point);
+  void refresh_estimates();
   void fill_missing();
   bool transfer_motion(int first, int last, const std::vector<int>& members, const Vec3& previous, Vec3& out);
   void add_free_point(const Vec3& p, int id);
@@ -106,8 +111,10 @@ class GapFiller {
   std::vector<double> eps1_, eps2_;
 
   // Carried from frame to frame.
+  static constexpr int kRelabelRounds = 3;
   bool has_previous_ = false;
   long frame_ = 0;
+  long solve_stamp_ = 0;  // PCA solves are valid while the observed set is unchanged
   std::vector<Vec3> previous_;
   std::vector<MarkerStatus> previous_status_;
   std::vector<int> assigned_id_;      // free-point trajectory currently standing for marker i
