@@ -95,6 +95,7 @@ class GapFiller {
   int pca_estimate(int i, Vec3& out);
   bool expected_position(int i, Vec3& out);
   void take_free_point(int marker, int point);
+  bool free_point_near(const Vec3& p, double reach) const;
   void refresh_estimates();
   void fill_missing();
   bool transfer_motion(int first, int last, const std::vector<int>& members, const Vec3& previous, Vec3& out);
@@ -112,6 +113,7 @@ class GapFiller {
 
   // Carried from frame to frame.
   static constexpr int kRelabelRounds = 3;
+  static constexpr double kPrefilterReach = 3.0;  // in eps1, around the rigid estimate
   bool has_previous_ = false;
   long frame_ = 0;
   long solve_stamp_ = 0;  // PCA solves are valid while the observed set is unchanged
