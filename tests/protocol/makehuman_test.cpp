@@ -4,7 +4,8 @@
 
 #include <gtest/gtest.h>
 
-#include <Eigen/SVD>
+#include "support/rigid_residual.h"
+
 #include <algorithm>
 #include <cmath>
 #include <fstream>
@@ -136,21 +137,7 @@ TEST(MakeHumanLoad, SubdividesToAbout53000Vertices) {
 
 // --- The generator on the MakeHuman body -------------------------------------------------------
 
-double rigid_residual(const std::vector<Vec3>& a, const std::vector<Vec3>& b) {
-  Vec3 ca = Vec3::Zero(), cb = Vec3::Zero();
-  for (size_t i = 0; i < a.size(); ++i) ca += a[i], cb += b[i];
-  ca /= a.size();
-  cb /= b.size();
-  Eigen::Matrix3d h = Eigen::Matrix3d::Zero();
-  for (size_t i = 0; i < a.size(); ++i) h += (a[i] - ca) * (b[i] - cb).transpose();
-  Eigen::JacobiSVD<Eigen::Matrix3d> svd(h, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  Eigen::Matrix3d d = Eigen::Matrix3d::Identity();
-  if ((svd.matrixV() * svd.matrixU().transpose()).determinant() < 0) d(2, 2) = -1;
-  const Eigen::Matrix3d r = svd.matrixV() * d * svd.matrixU().transpose();
-  double s = 0.0;
-  for (size_t i = 0; i < a.size(); ++i) s += (r * (a[i] - ca) + cb - b[i]).squaredNorm();
-  return std::sqrt(s / a.size());
-}
+using test::rigid_residual;
 
 std::vector<int> region(const synth::SynthCapture& c, const std::string& name) {
   std::vector<int> out;

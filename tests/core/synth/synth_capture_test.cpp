@@ -2,7 +2,8 @@
 
 #include <gtest/gtest.h>
 
-#include <Eigen/SVD>
+#include "support/rigid_residual.h"
+
 #include <cmath>
 
 #include "core/synth/bvh.h"
@@ -24,22 +25,7 @@ SynthOptions small(const std::string& motion, double seconds, int markers = 150)
   return o;
 }
 
-// RMS residual of the best rigid motion taking points a onto points b (Kabsch).
-double rigid_residual(const std::vector<Vec3>& a, const std::vector<Vec3>& b) {
-  Vec3 ca = Vec3::Zero(), cb = Vec3::Zero();
-  for (size_t i = 0; i < a.size(); ++i) ca += a[i], cb += b[i];
-  ca /= a.size();
-  cb /= b.size();
-  Eigen::Matrix3d h = Eigen::Matrix3d::Zero();
-  for (size_t i = 0; i < a.size(); ++i) h += (a[i] - ca) * (b[i] - cb).transpose();
-  Eigen::JacobiSVD<Eigen::Matrix3d> svd(h, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  Eigen::Matrix3d d = Eigen::Matrix3d::Identity();
-  if ((svd.matrixV() * svd.matrixU().transpose()).determinant() < 0) d(2, 2) = -1;
-  const Eigen::Matrix3d r = svd.matrixV() * d * svd.matrixU().transpose();
-  double s = 0.0;
-  for (size_t i = 0; i < a.size(); ++i) s += (r * (a[i] - ca) + cb - b[i]).squaredNorm();
-  return std::sqrt(s / a.size());
-}
+using test::rigid_residual;
 
 // Over the take, RMS of the per-frame rigid residual of the chosen markers against frame 0.
 double part_residual(const SynthCapture& c, const std::vector<int>& markers) {
