@@ -96,12 +96,6 @@ void GapFiller::reset() {
   std::fill(gap_offset_.begin(), gap_offset_.end(), Vec3::Zero());
 }
 
-bool GapFiller::neighbourhood_rotation(int i, Eigen::Matrix3d& out) const {
-  if (i < 0 || i >= n_ || !has_rotation_[i]) return false;
-  out = rotation_[i];
-  return true;
-}
-
 void GapFiller::add_free_point(const Vec3& p, int id) {
   if (!is_present(p) || free_count_ >= kMaxFreePoints) {
     ++stats_.ignored_points;
@@ -244,8 +238,8 @@ void GapFiller::relabel() {
         found = p;
         break;
       }
-    Vec3 expected = previous_[i];
-    if (found >= 0 && !expected_position(i, expected)) expected = previous_[i];
+    Vec3 expected;
+    if (found >= 0 && !expected_position(i, expected)) expected = previous_[i];  // no estimate: continuity
     if (found >= 0 && (free_points_[found] - expected).norm() <= eps2_[i]) {
       take_free_point(i, found);
       changed = true;

@@ -82,9 +82,6 @@ class GapFiller {
   FillStats run(const FrameInput& in, const FrameOutput& out);
   void reset();  // forget the past (new take, source reconnected)
 
-  // Rotation of marker i's neighbourhood this frame (local reference -> world), valid for
-  // markers that were filled by an estimate; used to carry corrections with the body.
-  bool neighbourhood_rotation(int i, Eigen::Matrix3d& out) const;
 
  private:
   void check_labels();
