@@ -4,6 +4,7 @@
 
 #include "core/capture_filler.h"
 #include "core/offline/subject_builder.h"
+#include "support/allocation_counter.h"
 #include "support/synthetic_limb.h"
 
 namespace skinstream {
@@ -65,6 +66,23 @@ TEST(GapEndBlender, LookaheadReducesErrorAtTheEndOfAGap) {
   const double causal = error_near_gap_end(0);
   const double blended = error_near_gap_end(8);
   EXPECT_LT(blended, causal);
+}
+
+TEST(GapEndBlender, AllocatesNothingPerFrame) {
+  const Capture truth = test::make_limb_capture();
+  const SubjectModel model = build_subject(truth, {});
+  GapEndBlender blender(model, 6);
+  const int n = model.marker_count();
+  std::vector<Vec3> in(n), out(n);
+  std::vector<MarkerStatus> status(n, MarkerStatus::Measured), out_status(n);
+  test::CountAllocations counter;
+  for (int f = 0; f < 100; ++f) {
+    for (int i = 0; i < n; ++i) in[i] = truth.at(f, i);
+    status[kMarker] = (f / 10) % 2 ? MarkerStatus::FilledPca : MarkerStatus::Measured;  // gaps end often
+    long released;
+    blender.push(in, status, f, {out, out_status}, released);
+  }
+  EXPECT_EQ(counter.count(), 0u);
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 
 #include "core/capture_filler.h"
 #include "core/offline/subject_builder.h"
+#include "support/allocation_counter.h"
 #include "support/synthetic_limb.h"
 
 namespace skinstream {
@@ -68,6 +69,22 @@ TEST(LocalSmoothing, OnlineReleasesEachFrameOnce) {
   while (smoother.drain({out, out_status}, r)) released.push_back(r);
   ASSERT_EQ(released.size(), 20u);
   for (int f = 0; f < 20; ++f) EXPECT_EQ(released[f], f);
+}
+
+TEST(LocalSmoothing, OnlineAllocatesNothingPerFrame) {
+  const Capture truth = test::make_limb_capture();
+  const SubjectModel model = build_subject(truth, {});
+  OnlineSmoother smoother(model, {});
+  const int n = model.marker_count();
+  std::vector<Vec3> in(n), out(n);
+  std::vector<MarkerStatus> status(n, MarkerStatus::Measured), out_status(n);
+  test::CountAllocations counter;
+  for (int f = 0; f < 50; ++f) {
+    for (int i = 0; i < n; ++i) in[i] = truth.at(f, i);
+    long released;
+    smoother.push(in, status, f, {out, out_status}, released);
+  }
+  EXPECT_EQ(counter.count(), 0u);
 }
 
 }  // namespace
