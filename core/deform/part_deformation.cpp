@@ -1,0 +1,91 @@
+#include "core/deform/part_deformation.h"
+
+#include <utility>
+
+#include "core/deform/rbf_kernel.h"
+
+namespace skinstream {
+
+PartDeformer::PartDeformer(PartModel model, DeformationMode mode)
+    : model_(std::move(model)),
+      mode_(mode),
+      to_local_(model_.reference_frame),
+      quadratic_(identity_quadratic_transform()),
+      local_now_(model_.local_reference),
+      centres_(model_.local_reference),
+      residuals_(Eigen::MatrixX3d::Zero(model_.member_count(), 3)),
+      weights_(Eigen::MatrixX3d::Zero(model_.member_count(), 3)),
+      kernel_(Eigen::MatrixXd::Zero(model_.member_count(), model_.member_count())),
+      kernel_lu_(model_.member_count()) {}
+
+bool PartDeformer::uses_quadratic() const {
+  return mode_ == DeformationMode::Quadratic || mode_ == DeformationMode::QuadraticRbf;
+}
+
+bool PartDeformer::uses_rbf() const {
+  return (mode_ == DeformationMode::RigidRbf || mode_ == DeformationMode::QuadraticRbf) &&
+         model_.rbf_dilation > 0.0;
+}
+
+bool PartDeformer::solve(std::span<const Vec3> member_positions_now) {
+  const int count = model_.member_count();
+  if (static_cast<int>(member_positions_now.size()) != count) return false;
+  for (const Vec3& p : member_positions_now)
+    if (!is_present(p)) return false;
+
+  // R_t, d_t: current members as close as possible to their local part reference positions.
+  fit_rigid(member_positions_now, model_.local_reference_points, to_local_);
+  for (int i = 0; i < count; ++i) local_now_.col(i) = to_local_.apply(member_positions_now[i]);
+
+  if (uses_quadratic()) {
+    // Eq. 6 written as a correction of the identity (see PartModel::reference_projection).
+    quadratic_ = identity_quadratic_transform() - model_.reference_projection;
+    quadratic_.noalias() += local_now_.lazyProduct(model_.pseudo_inverse);
+    centres_.noalias() = quadratic_.lazyProduct(model_.quadratic_reference);
+  } else {
+    quadratic_ = identity_quadratic_transform();
+    centres_ = model_.local_reference;
+  }
+
+  rbf_applied_ = false;
+  weights_.setZero();
+  if (uses_rbf()) solve_residual();
+  return true;
+}
+
+// Eq. 7: weights w with sum_i w_i phi(|p~_i - p~_j| / sigma) = r_j. The centres move every
+// frame, so the kernel is rebuilt and LU-refactored in the preallocated storage.
+void PartDeformer::solve_residual() {
+  const int count = model_.member_count();
+  const double inverse_sigma = 1.0 / model_.rbf_dilation;
+  residuals_ = (local_now_ - centres_).transpose();
+  for (int j = 0; j < count; ++j) {
+    kernel_(j, j) = cubic_bspline_kernel(0.0);
+    for (int i = j + 1; i < count; ++i) {
+      const double value = cubic_bspline_kernel((centres_.col(i) - centres_.col(j)).norm() * inverse_sigma);
+      kernel_(i, j) = value;
+      kernel_(j, i) = value;
+    }
+  }
+  kernel_lu_.compute(kernel_);
+  weights_.noalias() = kernel_lu_.solve(residuals_);
+  // Coincident centres make the kernel singular; then skip the residual rather than emit NaN.
+  rbf_applied_ = weights_.allFinite();
+  if (!rbf_applied_) weights_.setZero();
+}
+
+Vec3 PartDeformer::deform(const Vec3& reference_local_position) const {
+  Vec3 local = quadratic_ * quadratic_basis(reference_local_position);
+  if (rbf_applied_) {
+    const double inverse_sigma = 1.0 / model_.rbf_dilation;
+    Vec3 offset = Vec3::Zero();
+    for (int i = 0; i < model_.member_count(); ++i) {
+      const double value = cubic_bspline_kernel((local - centres_.col(i)).norm() * inverse_sigma);
+      if (value != 0.0) offset += value * weights_.row(i).transpose();
+    }
+    local += offset;
+  }
+  return to_local_.apply_inverse(local);
+}
+
+}  // namespace skinstream

@@ -1,0 +1,60 @@
+#pragma once
+// Per-frame deformation of one rigid part (section 5.3, eqs. 6-8): rigid transform by Horn,
+// quadratic transformation by the precomputed pseudo-inverse, RBF interpolation of the residual.
+// All buffers are sized at construction; solve() and deform() allocate nothing.
+
+#include <Eigen/Core>
+#include <Eigen/LU>
+#include <span>
+
+#include "core/absolute_orientation.h"
+#include "core/capture.h"
+#include "core/deform/part_model.h"
+#include "core/deform/quadratic_basis.h"
+
+namespace skinstream {
+
+// The paper's comparison variants (Figure 7 b-e).
+enum class DeformationMode { Rigid, Quadratic, RigidRbf, QuadraticRbf };
+
+class PartDeformer {
+ public:
+  explicit PartDeformer(PartModel model, DeformationMode mode = DeformationMode::QuadraticRbf);
+
+  // Fits the part to the members' current world positions (same order as the model's members).
+  // Returns false, leaving the previous state, when the count differs or a position is missing.
+  // Before the first successful solve the part is in its reference pose.
+  bool solve(std::span<const Vec3> member_positions_now);
+
+  // Eq. 8: local part reference position -> deformed world position at the solved frame.
+  Vec3 deform(const Vec3& reference_local_position) const;
+
+  const PartModel& model() const { return model_; }
+  DeformationMode mode() const { return mode_; }
+  const RigidTransform& to_local() const { return to_local_; }          // world -> local: R_t, d_t
+  const QuadraticTransform& quadratic_transform() const { return quadratic_; }  // A_t
+  const Eigen::Matrix3Xd& local_positions() const { return local_now_; }        // p^t
+  const Eigen::Matrix3Xd& rbf_centres() const { return centres_; }               // p~ = A_t q^0
+  const Eigen::MatrixX3d& rbf_weights() const { return weights_; }               // w_i, Y x 3
+  // False when this frame's kernel matrix was singular; the residual is then not applied.
+  bool rbf_applied() const { return rbf_applied_; }
+
+ private:
+  bool uses_quadratic() const;
+  bool uses_rbf() const;
+  void solve_residual();
+
+  PartModel model_;
+  DeformationMode mode_;
+  RigidTransform to_local_;
+  QuadraticTransform quadratic_;
+  Eigen::Matrix3Xd local_now_;
+  Eigen::Matrix3Xd centres_;
+  Eigen::MatrixX3d residuals_;
+  Eigen::MatrixX3d weights_;
+  Eigen::MatrixXd kernel_;
+  Eigen::PartialPivLU<Eigen::MatrixXd> kernel_lu_;
+  bool rbf_applied_ = false;
+};
+
+}  // namespace skinstream

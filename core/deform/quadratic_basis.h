@@ -1,0 +1,29 @@
+#pragma once
+// The 9-dimensional quadratic vector q(p) of section 5.3: linear, pure quadratic and mixed
+// quadratic terms. There is no constant term: the local part frame is centred, so translation
+// is carried by the rigid transform, not by the quadratic transformation A.
+
+#include <Eigen/Core>
+
+#include "core/capture.h"
+
+namespace skinstream {
+
+using QuadraticVector = Eigen::Matrix<double, 9, 1>;
+using QuadraticTransform = Eigen::Matrix<double, 3, 9>;  // A = [A1 A2 A3]
+
+inline QuadraticVector quadratic_basis(const Vec3& p) {
+  QuadraticVector q;
+  q << p.x(), p.y(), p.z(), p.x() * p.x(), p.y() * p.y(), p.z() * p.z(), p.x() * p.y(), p.y() * p.z(),
+      p.z() * p.x();
+  return q;
+}
+
+// A = [I 0 0]: maps every position to itself.
+inline QuadraticTransform identity_quadratic_transform() {
+  QuadraticTransform a = QuadraticTransform::Zero();
+  a.leftCols<3>().setIdentity();
+  return a;
+}
+
+}  // namespace skinstream

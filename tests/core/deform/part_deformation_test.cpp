@@ -1,0 +1,174 @@
+#include "core/deform/part_deformation.h"
+
+#include <gtest/gtest.h>
+
+#include "tests/core/deform/deform_test_support.h"
+#include "tests/support/allocation_counter.h"
+
+namespace skinstream {
+namespace {
+
+using deform_test::deform_non_rigidly;
+using deform_test::move_rigidly;
+using deform_test::random_motion;
+using deform_test::random_points;
+
+constexpr DeformationMode kAllModes[] = {DeformationMode::Rigid, DeformationMode::Quadratic,
+                                         DeformationMode::RigidRbf, DeformationMode::QuadraticRbf};
+
+double max_member_error(const PartDeformer& part, const std::vector<Vec3>& now) {
+  double worst = 0.0;
+  for (int i = 0; i < part.model().member_count(); ++i)
+    worst = std::max(worst, (part.deform(part.model().local_reference_points[i]) - now[i]).norm());
+  return worst;
+}
+
+// Octant-symmetric members (+-a, +-b, +-c) for three generators: Q0 has rank 9, and a field of
+// diagonal stretch plus mixed terms keeps the centroid and a symmetric positive cross-covariance,
+// so Horn returns the applied motion exactly and A must come back exactly.
+std::vector<Vec3> octant_symmetric_members() {
+  std::vector<Vec3> points;
+  for (const Vec3& g : {Vec3(100, 50, 20), Vec3(60, 70, 35), Vec3(30, 20, 45)})
+    for (int sx : {-1, 1})
+      for (int sy : {-1, 1})
+        for (int sz : {-1, 1}) points.push_back(Vec3(sx * g.x(), sy * g.y(), sz * g.z()) + Vec3(500, 40, 1000));
+  return points;
+}
+
+TEST(PartDeformer, SolveRejectsWrongCountAndMissingMembers) {
+  std::mt19937_64 rng(10);
+  const std::vector<Vec3> members = random_points(rng, 12, Vec3(100, 60, 40));
+  PartDeformer part(build_part_model(members));
+  const std::vector<Vec3> moved = move_rigidly(members, random_motion(rng));
+  ASSERT_TRUE(part.solve(moved));
+  const Vec3 before = part.deform(Vec3(10, 20, 30));
+
+  EXPECT_FALSE(part.solve(std::span<const Vec3>(moved).first(11)));
+  std::vector<Vec3> with_gap = members;
+  with_gap[3] = missing_point();
+  EXPECT_FALSE(part.solve(with_gap));
+  EXPECT_EQ(part.deform(Vec3(10, 20, 30)), before);  // previous frame kept
+}
+
+TEST(PartDeformer, BeforeFirstSolveIsReferencePose) {
+  std::mt19937_64 rng(11);
+  const std::vector<Vec3> members = random_points(rng, 12, Vec3(100, 60, 40));
+  const PartDeformer part(build_part_model(members));
+  const Vec3 vertex(320, -150, 880);
+  EXPECT_LT((part.deform(part.model().local_from_world(vertex)) - vertex).norm(), 1e-9);
+}
+
+TEST(PartDeformer, RigidMotionReproducedForAnyVertexInAllModes) {
+  std::mt19937_64 rng(12);
+  const std::vector<Vec3> members = random_points(rng, 20, Vec3(120, 60, 40));
+  const std::vector<Vec3> vertices = random_points(rng, 200, Vec3(200, 120, 80));  // also outside the hull
+  const RigidTransform motion = random_motion(rng);
+  for (DeformationMode mode : kAllModes) {
+    PartDeformer part(build_part_model(members), mode);
+    ASSERT_TRUE(part.solve(move_rigidly(members, motion)));
+    double worst = 0.0;
+    for (const Vec3& v : vertices)
+      worst = std::max(worst, (part.deform(part.model().local_from_world(v)) - motion.apply(v)).norm());
+    EXPECT_LT(worst, 1e-6) << static_cast<int>(mode);
+  }
+}
+
+TEST(PartDeformer, QuadraticFieldRecoveredExactly) {
+  const std::vector<Vec3> members = octant_symmetric_members();
+  const PartModel model = build_part_model(members);
+  ASSERT_EQ(model.quadratic_rank, 9);
+  QuadraticTransform truth = QuadraticTransform::Zero();
+  truth.leftCols<3>() = Eigen::Vector3d(1.05, 0.97, 1.1).asDiagonal();
+  truth.rightCols<3>() << 2e-3, -1e-3, 5e-4, 1e-3, 3e-3, -2e-3, -5e-4, 1e-3, 2e-3;  // mixed terms
+  std::mt19937_64 rng(13);
+  const RigidTransform motion = random_motion(rng);
+  std::vector<Vec3> now(members.size());
+  for (size_t i = 0; i < members.size(); ++i)
+    now[i] = motion.apply(model.reference_frame.apply_inverse(truth * model.quadratic_reference.col(i)));
+
+  PartDeformer quadratic(model, DeformationMode::Quadratic);
+  ASSERT_TRUE(quadratic.solve(now));
+  EXPECT_LT((quadratic.quadratic_transform() - truth).cwiseAbs().maxCoeff(), 1e-9);
+  EXPECT_LT(max_member_error(quadratic, now), 1e-9);
+
+  // Rigid mode leaves the non-rigid part as residual: members are missed by millimetres, and
+  // each lands exactly where the rigid fit puts its reference position.
+  PartDeformer rigid(model, DeformationMode::Rigid);
+  ASSERT_TRUE(rigid.solve(now));
+  EXPECT_GT(max_member_error(rigid, now), 1.0);
+  for (int i = 0; i < model.member_count(); ++i) {
+    const Vec3& reference = model.local_reference_points[i];
+    EXPECT_LT((rigid.deform(reference) - rigid.to_local().apply_inverse(reference)).norm(), 1e-9);
+  }
+}
+
+TEST(PartDeformer, ResidualModesInterpolateMembersExactly) {
+  std::mt19937_64 rng(14);
+  const std::vector<Vec3> members = random_points(rng, 30, Vec3(120, 60, 40));
+  const std::vector<Vec3> now = deform_non_rigidly(members, random_motion(rng));
+  for (DeformationMode mode : {DeformationMode::RigidRbf, DeformationMode::QuadraticRbf}) {
+    PartDeformer part(build_part_model(members), mode);
+    ASSERT_TRUE(part.solve(now));
+    EXPECT_TRUE(part.rbf_applied());
+    EXPECT_LT(max_member_error(part, now), 1e-6) << static_cast<int>(mode);
+  }
+  // Without residuals, quadratic follows the markers better than rigid (Figure 7 b vs c).
+  PartDeformer rigid(build_part_model(members), DeformationMode::Rigid);
+  PartDeformer quadratic(build_part_model(members), DeformationMode::Quadratic);
+  ASSERT_TRUE(rigid.solve(now));
+  ASSERT_TRUE(quadratic.solve(now));
+  EXPECT_LT(max_member_error(quadratic, now), max_member_error(rigid, now));
+}
+
+TEST(PartDeformer, DegenerateMemberSetsGiveNoNaN) {
+  std::mt19937_64 rng(15);
+  std::vector<Vec3> collinear;
+  for (int i = 0; i < 5; ++i) collinear.push_back(Vec3(1, 2, 3) * (10.0 * i));
+  const std::vector<std::vector<Vec3>> cases = {random_points(rng, 4, Vec3(50, 50, 50)),
+                                                random_points(rng, 8, Vec3(50, 40, 30)),
+                                                random_points(rng, 12, Vec3(100, 50, 0)),
+                                                collinear,
+                                                {Vec3(4, 5, 6)},
+                                                {Vec3(1, 1, 1), Vec3(1, 1, 1), Vec3(9, 1, 1)}};
+  const std::vector<Vec3> vertices = random_points(rng, 50, Vec3(150, 150, 150), Vec3::Zero());
+  const RigidTransform motion = random_motion(rng);
+  for (size_t k = 0; k < cases.size(); ++k) {
+    for (DeformationMode mode : kAllModes) {
+      PartDeformer part(build_part_model(cases[k]), mode);
+      const std::vector<Vec3> now = deform_non_rigidly(cases[k], motion);
+      ASSERT_TRUE(part.solve(now));
+      for (const Vec3& v : vertices) ASSERT_TRUE(is_present(part.deform(v))) << k << " mode " << static_cast<int>(mode);
+      // Non-coincident members are still interpolated by the full method.
+      if (mode == DeformationMode::QuadraticRbf && k < 4) {
+        EXPECT_LT(max_member_error(part, now), 1e-6) << k;
+      }
+    }
+  }
+}
+
+TEST(PartDeformer, SolveAndDeformAllocateNothing) {
+  {  // the counter must see an allocation, or a zero below proves nothing
+    test::CountAllocations control;
+    std::vector<double> buffer(16);
+    EXPECT_GT(control.count(), 0u);
+  }
+  std::mt19937_64 rng(16);
+  for (int count : {6, 40}) {  // 40 members exercises Eigen's blocked LU path
+    const std::vector<Vec3> members = random_points(rng, count, Vec3(150, 80, 50));
+    const std::vector<Vec3> now = deform_non_rigidly(members, random_motion(rng));
+    PartDeformer part(build_part_model(members));
+    Vec3 sum = Vec3::Zero();
+    size_t allocations = 0;
+    {
+      test::CountAllocations counter;
+      part.solve(now);
+      for (const Vec3& reference : part.model().local_reference_points) sum += part.deform(reference);
+      allocations = counter.count();
+    }
+    EXPECT_EQ(allocations, 0u) << count;
+    EXPECT_TRUE(is_present(sum));
+  }
+}
+
+}  // namespace
+}  // namespace skinstream
