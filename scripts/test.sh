@@ -2,5 +2,6 @@
 # Installs what is missing, builds everything and runs every test (unit, file, CLI).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-bash scripts/build.sh
+# Explicit, so a build tree configured by run.sh (tests off) gets its tests back.
+bash scripts/build.sh -DSKINSTREAM_BUILD_TESTS=ON -DSKINSTREAM_BUILD_BENCHMARKS=ON
 ctest --test-dir build --output-on-failure -j "$(nproc)" --timeout 600
