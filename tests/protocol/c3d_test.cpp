@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "protocol/file_error.h"
+#include "support/capture_assertions.h"
 #include "support/file_error_assertion.h"
 #include "support/test_data.h"
 
@@ -82,6 +83,8 @@ ParameterLocation locate(const Bytes& b, const std::string& group, const std::st
   return {};
 }
 
+using test::expect_same_capture;
+using test::missing_mask;
 using test::throws_file_error;
 
 // A patched copy of a shared capture in the scratch folder; returns its path.
@@ -99,11 +102,6 @@ std::string truncated_copy(const std::string& source, size_t size) {
                       [&](Bytes& b) { b.resize(size); });
 }
 
-std::vector<bool> missing_mask(const Capture& c) {
-  std::vector<bool> mask;
-  for (const Vec3& p : c.positions) mask.push_back(!is_present(p));
-  return mask;
-}
 
 size_t missing_count(const Capture& c) {
   const auto mask = missing_mask(c);
@@ -117,20 +115,6 @@ double max_abs_coordinate(const Capture& c) {
   return largest;
 }
 
-// Same shape and missing samples, coordinates within `tolerance` (0: identical).
-void expect_same_capture(const Capture& expected, const Capture& actual, double tolerance) {
-  EXPECT_EQ(actual.labels, expected.labels);
-  EXPECT_EQ(actual.frame_count, expected.frame_count);
-  EXPECT_EQ(actual.first_frame, expected.first_frame);
-  EXPECT_DOUBLE_EQ(actual.rate_hz, expected.rate_hz);
-  ASSERT_EQ(actual.positions.size(), expected.positions.size());
-  EXPECT_EQ(missing_mask(actual), missing_mask(expected));
-  double worst = 0.0;
-  for (size_t i = 0; i < expected.positions.size(); ++i)
-    if (is_present(expected.positions[i]) && is_present(actual.positions[i]))
-      worst = std::max(worst, (expected.positions[i] - actual.positions[i]).cwiseAbs().maxCoeff());
-  EXPECT_LE(worst, tolerance);
-}
 
 void expect_point(const Capture& c, int frame, int point, const Vec3& expected) {
   ASSERT_TRUE(c.present(frame, point));

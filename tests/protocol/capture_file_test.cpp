@@ -9,6 +9,7 @@
 #include "protocol/c3d.h"
 #include "protocol/file_error.h"
 #include "protocol/trc.h"
+#include "support/capture_assertions.h"
 #include "support/test_data.h"
 
 namespace skinstream {
@@ -27,19 +28,6 @@ std::string error_message(const std::function<void()>& call) {
   return "(no FileError)";
 }
 
-void expect_same(const Capture& a, const Capture& b) {
-  EXPECT_EQ(a.labels, b.labels);
-  EXPECT_EQ(a.frame_count, b.frame_count);
-  EXPECT_EQ(a.first_frame, b.first_frame);
-  EXPECT_DOUBLE_EQ(a.rate_hz, b.rate_hz);
-  ASSERT_EQ(a.positions.size(), b.positions.size());
-  for (size_t i = 0; i < a.positions.size(); ++i) {
-    ASSERT_EQ(is_present(a.positions[i]), is_present(b.positions[i])) << "sample " << i;
-    if (is_present(a.positions[i])) {
-      ASSERT_EQ(a.positions[i], b.positions[i]) << "sample " << i;
-    }
-  }
-}
 
 TEST(CaptureFileInvalid, MissingFile) {
   const std::string path = scratch_path("no_such_capture_file.c3d");
@@ -63,14 +51,14 @@ TEST(CaptureFileInvalid, UnknownExtension) {
 
 TEST(CaptureFile, DispatchesOnExtensionIgnoringCase) {
   const Capture direct = read_c3d(kCmu);
-  expect_same(direct, read_capture(kCmu));
+  test::expect_same_capture(direct, read_capture(kCmu));
   const std::string upper = scratch_path("capture_file_upper.C3D");
   std::filesystem::copy_file(kCmu, upper, std::filesystem::copy_options::overwrite_existing);
-  expect_same(direct, read_capture(upper));
+  test::expect_same_capture(direct, read_capture(upper));
 
   const std::string trc = scratch_path("capture_file_mixed.Trc");
   write_trc(direct, trc);
-  expect_same(direct, read_capture(trc));
+  test::expect_same_capture(direct, read_capture(trc));
 }
 
 TEST(CaptureFile, WritesEitherFormatByExtension) {
@@ -79,7 +67,7 @@ TEST(CaptureFile, WritesEitherFormatByExtension) {
     SCOPED_TRACE(name);
     const std::string path = scratch_path(name);
     write_capture(c, path);
-    expect_same(c, read_capture(path));  // 7% of the samples are gaps
+    test::expect_same_capture(c, read_capture(path));  // 7% of the samples are gaps
   }
   // The C3D really is a C3D and the TRC really is text.
   EXPECT_NO_THROW(read_c3d(scratch_path("capture_file_out.c3d")));

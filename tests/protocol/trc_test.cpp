@@ -10,6 +10,7 @@
 
 #include "protocol/c3d.h"
 #include "protocol/file_error.h"
+#include "support/capture_assertions.h"
 #include "support/file_error_assertion.h"
 #include "support/test_data.h"
 
@@ -31,19 +32,6 @@ std::string read_text(const std::string& path) {
 
 using test::throws_file_error;
 
-void expect_identical(const Capture& expected, const Capture& actual) {
-  EXPECT_EQ(actual.labels, expected.labels);
-  EXPECT_EQ(actual.frame_count, expected.frame_count);
-  EXPECT_EQ(actual.first_frame, expected.first_frame);
-  EXPECT_DOUBLE_EQ(actual.rate_hz, expected.rate_hz);
-  ASSERT_EQ(actual.positions.size(), expected.positions.size());
-  for (size_t i = 0; i < expected.positions.size(); ++i) {
-    ASSERT_EQ(is_present(actual.positions[i]), is_present(expected.positions[i])) << "sample " << i;
-    if (is_present(expected.positions[i])) {
-      ASSERT_EQ(actual.positions[i], expected.positions[i]) << "sample " << i;
-    }
-  }
-}
 
 const std::string kHeader =
     "PathFileType\t4\t(X/Y/Z)\twalk.trc\n"
@@ -227,14 +215,14 @@ TEST(TrcWrite, RoundTripIsExactWithGapsAndUnlabelledChannels) {
   c.at(39, 3) = missing_point();                               // at the end
   const std::string path = scratch_path("trc_round_trip.trc");
   write_trc(c, path);
-  expect_identical(c, read_trc(path));
+  test::expect_same_capture(c, read_trc(path));
 }
 
 TEST(TrcWrite, RealCaptureRoundTripsExactly) {
   const Capture c = read_c3d(test::shared_path("data/captures/cmu/85_02.c3d"));
   const std::string path = scratch_path("trc_cmu.trc");
   write_trc(c, path);
-  expect_identical(c, read_trc(path));
+  test::expect_same_capture(c, read_trc(path));
 }
 
 TEST(TrcWrite, C3dToTrcToC3dKeepsGaps) {
@@ -243,10 +231,10 @@ TEST(TrcWrite, C3dToTrcToC3dKeepsGaps) {
   const std::string trc = scratch_path("trc_basket.trc");
   write_trc(original, trc);
   const Capture via_trc = read_trc(trc);
-  expect_identical(original, via_trc);
+  test::expect_same_capture(original, via_trc);
   const std::string c3d = scratch_path("trc_basket_back.c3d");
   write_c3d(via_trc, c3d);
-  expect_identical(original, read_c3d(c3d));
+  test::expect_same_capture(original, read_c3d(c3d));
 }
 
 TEST(TrcWrite, RefusesWhatTrcCannotHold) {
