@@ -1,0 +1,15 @@
+#include "server/ingest/frame_source.h"
+
+namespace skinstream::server {
+
+const char* to_string(SourceState state) {
+  switch (state) {
+    case SourceState::Connecting: return "connecting";
+    case SourceState::Streaming: return "streaming";
+    case SourceState::Disconnected: return "disconnected";
+    case SourceState::Finished: return "finished";
+  }
+  return "unknown";
+}
+
+}  // namespace skinstream::server
