@@ -30,8 +30,7 @@ std::vector<int> get_ints(ByteReader& r) {
   return v;
 }
 
-std::vector<unsigned char> encode(const SubjectModel& m) {
-  ByteWriter w;
+void encode(const SubjectModel& m, ByteWriter& w) {
   w.put<uint32_t>(static_cast<uint32_t>(m.marker_count()));
   for (int i = 0; i < m.marker_count(); ++i) {
     w.put_string(m.marker_names[i]);
@@ -60,7 +59,57 @@ std::vector<unsigned char> encode(const SubjectModel& m) {
   }
   w.put<double>(m.parameters.alpha1);
   w.put<double>(m.parameters.alpha2);
-  return std::move(w.bytes());
+}
+
+void encode(const DeformationModel* d, ByteWriter& w) {
+  w.put<uint8_t>(d ? 1 : 0);
+  if (!d) return;
+  w.put<uint32_t>(static_cast<uint32_t>(d->vertex_count()));
+  for (const Vec3& v : d->reference_vertices) put_vec3(w, v);
+  w.put<uint32_t>(static_cast<uint32_t>(d->faces.size()));
+  for (const auto& f : d->faces)
+    for (int v : f) w.put<int32_t>(v);
+  w.put<uint32_t>(static_cast<uint32_t>(d->part_count()));
+  for (const std::string& name : d->part_names) w.put_string(name);
+  put_ints(w, d->part_member_offsets);
+  w.put<uint32_t>(static_cast<uint32_t>(d->part_members.size()));
+  for (const PartMember& m : d->part_members) {
+    w.put<int32_t>(m.marker);
+    w.put<double>(m.weight);
+  }
+  put_ints(w, d->vertex_influence_offsets);
+  w.put<uint32_t>(static_cast<uint32_t>(d->vertex_influences.size()));
+  for (const PartInfluence& inf : d->vertex_influences) {
+    w.put<int32_t>(inf.part);
+    w.put<double>(inf.weight);
+  }
+  w.put<double>(d->registration_rms_mm);
+}
+
+std::optional<DeformationModel> decode_deformation(ByteReader& r) {
+  if (r.get<uint8_t>() == 0) return std::nullopt;
+  DeformationModel d;
+  d.reference_vertices.resize(r.get_count(24));
+  for (Vec3& v : d.reference_vertices) v = get_vec3(r);
+  d.faces.resize(r.get_count(12));
+  for (auto& f : d.faces)
+    for (int& v : f) v = r.get<int32_t>();
+  const uint32_t parts = r.get_count(4);
+  for (uint32_t p = 0; p < parts; ++p) d.part_names.push_back(r.get_string(256));
+  d.part_member_offsets = get_ints(r);
+  d.part_members.resize(r.get_count(12));
+  for (PartMember& m : d.part_members) {
+    m.marker = r.get<int32_t>();
+    m.weight = r.get<double>();
+  }
+  d.vertex_influence_offsets = get_ints(r);
+  d.vertex_influences.resize(r.get_count(12));
+  for (PartInfluence& inf : d.vertex_influences) {
+    inf.part = r.get<int32_t>();
+    inf.weight = r.get<double>();
+  }
+  d.registration_rms_mm = r.get<double>();
+  return d;
 }
 
 SubjectModel decode(ByteReader& r) {
@@ -109,10 +158,19 @@ SubjectModel decode(ByteReader& r) {
 
 }  // namespace
 
-void write_subject(const SubjectModel& model, const std::string& path) {
+void write_subject(const SubjectModel& model, const std::string& path) { write_subject(model, nullptr, path); }
+
+void write_subject(const SubjectModel& model, const DeformationModel* deformation, const std::string& path) {
   const std::string problem = model.validate();
   if (!problem.empty()) throw FileError(path, "refusing to write an inconsistent subject model: " + problem);
-  const std::vector<unsigned char> payload = encode(model);
+  if (deformation) {
+    const std::string bad = deformation->validate(model.marker_count());
+    if (!bad.empty()) throw FileError(path, "refusing to write an inconsistent " + bad);
+  }
+  ByteWriter payload_writer;
+  encode(model, payload_writer);
+  encode(deformation, payload_writer);
+  const std::vector<unsigned char>& payload = payload_writer.bytes();
   ByteWriter w;
   w.put_bytes(kMagic, sizeof kMagic);
   w.put<uint32_t>(kSubjectFileVersion);
@@ -125,7 +183,7 @@ void write_subject(const SubjectModel& model, const std::string& path) {
   if (!out) throw FileError(path, "write failed");
 }
 
-SubjectModel read_subject(const std::string& path) {
+SubjectFile read_subject_file(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw FileError(path, "cannot open subject file");
   const std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
@@ -133,7 +191,7 @@ SubjectModel read_subject(const std::string& path) {
     throw FileError(path, "not a skinstream subject file (bad magic)");
   ByteReader header(bytes.data() + 8, 12);
   const uint32_t version = header.get<uint32_t>();
-  if (version != kSubjectFileVersion)
+  if (version != 1 && version != kSubjectFileVersion)
     throw FileError(path, "subject file version " + std::to_string(version) + ", this build reads version " +
                               std::to_string(kSubjectFileVersion) + "; rebuild it with skinstream build-subject");
   const uint64_t size = header.get<uint64_t>();
@@ -144,17 +202,24 @@ SubjectModel read_subject(const std::string& path) {
   uint32_t stored_crc;
   std::memcpy(&stored_crc, bytes.data() + bytes.size() - 4, 4);
   if (crc32(payload, size) != stored_crc) throw FileError(path, "corrupt: CRC-32 mismatch");
-  SubjectModel model;
+  SubjectFile file;
   try {
     ByteReader r(payload, size);
-    model = decode(r);
+    file.model = decode(r);
+    if (version >= 2) file.deformation = decode_deformation(r);
     if (r.remaining() != 0) throw std::out_of_range(std::to_string(r.remaining()) + " unexpected bytes after the model");
   } catch (const std::out_of_range& e) {
     throw FileError(path, std::string("corrupt subject payload: ") + e.what());
   }
-  const std::string problem = model.validate();
+  const std::string problem = file.model.validate();
   if (!problem.empty()) throw FileError(path, "inconsistent subject model: " + problem);
-  return model;
+  if (file.deformation) {
+    const std::string bad = file.deformation->validate(file.model.marker_count());
+    if (!bad.empty()) throw FileError(path, "inconsistent " + bad);
+  }
+  return file;
 }
+
+SubjectModel read_subject(const std::string& path) { return std::move(read_subject_file(path).model); }
 
 }  // namespace skinstream

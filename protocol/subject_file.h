@@ -5,21 +5,32 @@
 //   bytes 8-11  u32 format version (kSubjectFileVersion)
 //   bytes 12-19 u64 payload size
 //   payload     little-endian: markers, reference pose, triangles, one-rings, local frames,
-//               anchors, PCA models, fill parameters (see subject_file.cpp, in that order)
+//               anchors, PCA models, fill parameters (see subject_file.cpp, in that order);
+//               version 2 adds a flag byte and, when set, the deformation model of section 5
+//               (registered mesh, parts with marker weights, vertex weights)
 //   last 4      u32 CRC-32 of the payload
 //
 // Another version, a bad magic, a size or CRC mismatch or an inconsistent model is rejected
 // with a FileError that says which.
 
+#include <optional>
 #include <string>
 
+#include "core/deform/deformation_model.h"
 #include "core/subject_model.h"
 
 namespace skinstream {
 
-inline constexpr uint32_t kSubjectFileVersion = 1;
+inline constexpr uint32_t kSubjectFileVersion = 2;  // reads 1 (no deformation model) and 2
+
+struct SubjectFile {
+  SubjectModel model;
+  std::optional<DeformationModel> deformation;  // absent: built without --mesh
+};
 
 void write_subject(const SubjectModel& model, const std::string& path);
-SubjectModel read_subject(const std::string& path);
+void write_subject(const SubjectModel& model, const DeformationModel* deformation, const std::string& path);
+SubjectFile read_subject_file(const std::string& path);
+SubjectModel read_subject(const std::string& path);  // the marker model only
 
 }  // namespace skinstream
