@@ -15,13 +15,15 @@
 #include "core/capture.h"
 #include "core/deform/deformation_model.h"
 #include "core/deform/part_deformation.h"
+#include "core/subject_model.h"
 
 namespace skinstream {
 
 class MeshDeformer {
  public:
-  // Throws std::invalid_argument when the model does not validate against `marker_count`.
-  MeshDeformer(const DeformationModel& model, int marker_count,
+  // The subject gives the markers' reference positions (the parts' rest state). Throws
+  // std::invalid_argument when the model does not validate against the subject.
+  MeshDeformer(const DeformationModel& model, const SubjectModel& subject,
                DeformationMode mode = DeformationMode::QuadraticRbf);
   ~MeshDeformer();
   MeshDeformer(const MeshDeformer&) = delete;

@@ -1,0 +1,220 @@
+#include "core/deform/mesh_deformer.h"
+
+#include <gtest/gtest.h>
+
+#include "core/deform/vertex_blend.h"
+#include "tests/core/deform/deform_test_support.h"
+#include "tests/support/allocation_counter.h"
+
+namespace skinstream {
+namespace {
+
+using deform_test::deform_non_rigidly;
+using deform_test::move_rigidly;
+using deform_test::random_motion;
+using deform_test::random_points;
+
+constexpr DeformationMode kAllModes[] = {DeformationMode::Rigid, DeformationMode::Quadratic,
+                                         DeformationMode::RigidRbf, DeformationMode::QuadraticRbf};
+
+// Two overlapping parts over 30 markers (part 0: markers 0-19, part 1: 10-29) and a detailed
+// "mesh" of 200 vertices scattered over the same region, half of them blended between the parts.
+struct TwoPartScene {
+  SubjectModel subject;
+  DeformationModel model;
+
+  TwoPartScene() {
+    std::mt19937_64 rng(3);
+    const std::vector<Vec3> markers = random_points(rng, 30, Vec3(120, 80, 60));
+    for (int i = 0; i < 30; ++i) {
+      subject.marker_names.push_back("m" + std::to_string(i));
+      subject.reference_positions.push_back(markers[i]);
+    }
+    model.part_names = {"a", "b"};
+    for (int i = 0; i < 20; ++i) model.part_members.push_back({i, 1.0});
+    model.part_member_offsets.push_back(20);
+    for (int i = 10; i < 30; ++i) model.part_members.push_back({i, 1.0});
+    model.part_member_offsets.push_back(40);
+    model.reference_vertices = random_points(rng, 200, Vec3(110, 70, 50));
+    for (int v = 0; v < 200; ++v) {
+      if (v % 2 == 0) {
+        model.vertex_influences.push_back({v % 4 == 0 ? 0 : 1, 1.0});
+      } else {
+        const double beta = 0.25 + 0.5 * (v % 7) / 6.0;
+        model.vertex_influences.push_back({0, beta});
+        model.vertex_influences.push_back({1, 1.0 - beta});
+      }
+      model.vertex_influence_offsets.push_back(static_cast<int>(model.vertex_influences.size()));
+    }
+    for (int f = 0; f + 2 < 200; f += 3) model.faces.push_back({f, f + 1, f + 2});
+  }
+};
+
+std::vector<float> deform_all(MeshDeformer& deformer, const std::vector<Vec3>& markers, std::vector<float>* normals = nullptr) {
+  std::vector<float> positions(static_cast<size_t>(deformer.vertex_count()) * 3);
+  std::vector<float> unused;
+  EXPECT_TRUE(deformer.deform(markers, positions, normals ? std::span<float>(*normals) : std::span<float>(unused)));
+  return positions;
+}
+
+Vec3 vertex(const std::vector<float>& positions, int v) {
+  return Vec3(positions[v * 3], positions[v * 3 + 1], positions[v * 3 + 2]);
+}
+
+TEST(MeshDeformer, RejectsModelInconsistentWithSubject) {
+  TwoPartScene scene;
+  scene.model.part_members[3].marker = 30;  // the subject has 30 markers
+  EXPECT_THROW(MeshDeformer(scene.model, scene.subject), std::invalid_argument);
+  TwoPartScene unnormalised;
+  unnormalised.model.vertex_influences[0].weight = 0.5;
+  EXPECT_THROW(MeshDeformer(unnormalised.model, unnormalised.subject), std::invalid_argument);
+}
+
+TEST(MeshDeformer, RejectsWrongMarkerCountAndMissingMarkersKeepingThePreviousFrame) {
+  TwoPartScene scene;
+  MeshDeformer deformer(scene.model, scene.subject);
+  std::vector<float> positions(200 * 3), normals;
+  std::vector<Vec3> markers = scene.subject.reference_positions;
+  markers.pop_back();
+  EXPECT_FALSE(deformer.solve_parts(markers));
+  markers = scene.subject.reference_positions;
+  markers[5] = missing_point();
+  EXPECT_FALSE(deformer.solve_parts(markers));
+  // Still the rest pose.
+  deformer.deform_vertices(0, 200, positions);
+  for (int v = 0; v < 200; ++v) EXPECT_LT((vertex(positions, v) - scene.model.reference_vertices[v]).norm(), 1e-3);
+}
+
+TEST(MeshDeformer, RestPoseGivesReferenceVerticesInEveryMode) {
+  TwoPartScene scene;
+  for (DeformationMode mode : kAllModes) {
+    MeshDeformer deformer(scene.model, scene.subject, mode);
+    const std::vector<float> positions = deform_all(deformer, scene.subject.reference_positions);
+    for (int v = 0; v < 200; ++v)
+      EXPECT_LT((vertex(positions, v) - scene.model.reference_vertices[v]).norm(), 1e-3) << "vertex " << v;
+  }
+}
+
+// Float evaluation against the double reference of eq. 8-9 (PartDeformer + blend_vertex).
+TEST(MeshDeformer, MatchesThePerPartReferenceImplementation) {
+  TwoPartScene scene;
+  std::mt19937_64 rng(8);
+  const std::vector<Vec3> now = deform_non_rigidly(scene.subject.reference_positions, random_motion(rng));
+  for (DeformationMode mode : kAllModes) {
+    MeshDeformer deformer(scene.model, scene.subject, mode);
+    const std::vector<float> positions = deform_all(deformer, now);
+
+    std::vector<PartDeformer> parts;
+    for (int p = 0; p < 2; ++p) {
+      std::vector<Vec3> reference, current;
+      for (int k = scene.model.part_member_offsets[p]; k < scene.model.part_member_offsets[p + 1]; ++k) {
+        reference.push_back(scene.subject.reference_positions[scene.model.part_members[k].marker]);
+        current.push_back(now[scene.model.part_members[k].marker]);
+      }
+      parts.emplace_back(build_part_model(reference), mode);
+      ASSERT_TRUE(parts.back().solve(current));
+    }
+    double worst = 0.0;
+    for (int v = 0; v < 200; ++v) {
+      const auto first = scene.model.vertex_influences.begin() + scene.model.vertex_influence_offsets[v];
+      const auto last = scene.model.vertex_influences.begin() + scene.model.vertex_influence_offsets[v + 1];
+      const std::vector<PartInfluence> influences(first, last);
+      const Vec3 expected = blend_vertex(scene.model.reference_vertices[v], influences, parts);
+      worst = std::max(worst, (vertex(positions, v) - expected).norm());
+    }
+    // Float arithmetic on coordinates of ~1000 mm: a few 1e-4 mm.
+    EXPECT_LT(worst, 2e-3) << "mode " << static_cast<int>(mode);
+  }
+}
+
+TEST(MeshDeformer, RigidMotionOfAllMarkersMovesTheMeshRigidly) {
+  TwoPartScene scene;
+  std::mt19937_64 rng(21);
+  const RigidTransform motion = random_motion(rng);
+  const std::vector<Vec3> moved = move_rigidly(scene.subject.reference_positions, motion);
+  for (DeformationMode mode : kAllModes) {
+    MeshDeformer deformer(scene.model, scene.subject, mode);
+    const std::vector<float> positions = deform_all(deformer, moved);
+    for (int v = 0; v < 200; ++v)
+      EXPECT_LT((vertex(positions, v) - motion.apply(scene.model.reference_vertices[v])).norm(), 2e-3);
+  }
+}
+
+TEST(MeshDeformer, FullMethodInterpolatesTheMarkersOfASinglePart) {
+  // Vertices placed on the markers of a one-part model follow the markers exactly (RBF is an
+  // interpolant at its centres), whatever the non-rigid motion.
+  TwoPartScene scene;
+  DeformationModel on_markers;
+  on_markers.part_names = {"all"};
+  for (int i = 0; i < 30; ++i) on_markers.part_members.push_back({i, 1.0});
+  on_markers.part_member_offsets.push_back(30);
+  on_markers.reference_vertices = scene.subject.reference_positions;
+  for (int v = 0; v < 30; ++v) {
+    on_markers.vertex_influences.push_back({0, 1.0});
+    on_markers.vertex_influence_offsets.push_back(v + 1);
+  }
+  on_markers.faces = {{0, 1, 2}};
+  std::mt19937_64 rng(5);
+  const std::vector<Vec3> now = deform_non_rigidly(scene.subject.reference_positions, random_motion(rng));
+  MeshDeformer deformer(on_markers, scene.subject, DeformationMode::QuadraticRbf);
+  const std::vector<float> positions = deform_all(deformer, now);
+  for (int v = 0; v < 30; ++v) EXPECT_LT((vertex(positions, v) - now[v]).norm(), 2e-3) << "marker " << v;
+}
+
+TEST(MeshDeformer, NormalsAreUnitAndFollowTheWinding) {
+  SubjectModel subject;
+  DeformationModel model;
+  // A square in the z = 0 plane, counter-clockwise seen from +z, one part of its 4 corners.
+  const std::vector<Vec3> corners = {Vec3(0, 0, 0), Vec3(100, 0, 0), Vec3(100, 100, 0), Vec3(0, 100, 0)};
+  for (int i = 0; i < 4; ++i) {
+    subject.marker_names.push_back("c" + std::to_string(i));
+    subject.reference_positions.push_back(corners[i]);
+    model.part_members.push_back({i, 1.0});
+    model.vertex_influences.push_back({0, 1.0});
+    model.vertex_influence_offsets.push_back(i + 1);
+  }
+  model.part_names = {"square"};
+  model.part_member_offsets.push_back(4);
+  model.reference_vertices = corners;
+  model.faces = {{0, 1, 2}, {0, 2, 3}};
+  MeshDeformer deformer(model, subject, DeformationMode::Rigid);
+  std::vector<float> normals(12);
+  deform_all(deformer, corners, &normals);
+  for (int v = 0; v < 4; ++v) {
+    EXPECT_NEAR(normals[v * 3 + 2], 1.0f, 1e-6f);
+    EXPECT_NEAR(normals[v * 3], 0.0f, 1e-6f);
+  }
+}
+
+TEST(MeshDeformer, VertexAndNormalRangesComposeToTheWholeFrame) {
+  TwoPartScene scene;
+  std::mt19937_64 rng(9);
+  const std::vector<Vec3> now = deform_non_rigidly(scene.subject.reference_positions, random_motion(rng));
+  MeshDeformer whole(scene.model, scene.subject), split(scene.model, scene.subject);
+  std::vector<float> normals_whole(600), normals_split(600), positions_split(600);
+  const std::vector<float> positions_whole = deform_all(whole, now, &normals_whole);
+  ASSERT_TRUE(split.solve_parts(now));
+  split.deform_vertices(100, 200, positions_split);
+  split.deform_vertices(0, 100, positions_split);
+  split.face_normals(30, split.face_count(), positions_split);
+  split.face_normals(0, 30, positions_split);
+  split.vertex_normals(0, 77, normals_split);
+  split.vertex_normals(77, 200, normals_split);
+  EXPECT_EQ(positions_whole, positions_split);
+  EXPECT_EQ(normals_whole, normals_split);
+}
+
+TEST(MeshDeformer, PerFrameWorkAllocatesNothing) {
+  TwoPartScene scene;
+  std::mt19937_64 rng(13);
+  std::vector<std::vector<Vec3>> frames;
+  for (int f = 0; f < 20; ++f) frames.push_back(deform_non_rigidly(scene.subject.reference_positions, random_motion(rng)));
+  MeshDeformer deformer(scene.model, scene.subject);
+  std::vector<float> positions(600), normals(600);
+  test::CountAllocations count;
+  for (const auto& markers : frames) ASSERT_TRUE(deformer.deform(markers, positions, normals));
+  EXPECT_EQ(count.count(), 0u);
+}
+
+}  // namespace
+}  // namespace skinstream
