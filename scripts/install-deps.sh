@@ -7,7 +7,13 @@ packages=(
   build-essential cmake ninja-build pkg-config
   libeigen3-dev libboost-dev libboost-system-dev nlohmann-json3-dev libspdlog-dev libfmt-dev
   libopenmesh-dev libgtest-dev libgmock-dev libbenchmark-dev libcli11-dev zlib1g-dev
+  chromium
 )
+# The web viewer's build (npm) and its browser test (node + playwright-core + chromium). A
+# machine with Node.js from elsewhere (e.g. NodeSource, which bundles npm) keeps it.
+if ! command -v node >/dev/null 2>&1 || ! command -v npm >/dev/null 2>&1; then
+  packages+=(nodejs npm)
+fi
 
 missing=()
 for p in "${packages[@]}"; do

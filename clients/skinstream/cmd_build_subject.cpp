@@ -1,20 +1,54 @@
-// skinstream build-subject: training capture -> subject model file (section 4.1-4.3).
+// skinstream build-subject: training capture -> subject model file (section 4.1-4.3), and with
+// --mesh the detailed mesh registered, segmented and weighted for deformation (section 5.1-5.2).
 #include <CLI/CLI.hpp>
 #include <cstdio>
+#include <fstream>
+#include <optional>
 #include <nlohmann/json.hpp>
 
 #include "clients/skinstream/commands.h"
+#include "core/capture_filler.h"
+#include "core/offline/deformation_builder.h"
 #include "core/offline/subject_builder.h"
 #include "protocol/capture_file.h"
+#include "protocol/file_error.h"
 #include "protocol/marker_surface_obj.h"
+#include "protocol/mesh_file.h"
 #include "protocol/subject_file.h"
 
 namespace skinstream::cli {
 
+namespace {
+
+// {"marker name": number, ...} -> one number per subject marker (-1 when not listed).
+std::vector<int> read_marker_map(const std::string& path, const SubjectModel& model, const char* what) {
+  std::ifstream in(path);
+  if (!in) throw FileError(path, "cannot open");
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(in);
+  } catch (const nlohmann::json::exception& e) {
+    throw FileError(path, std::string("not valid JSON: ") + e.what());
+  }
+  if (!j.is_object()) throw FileError(path, std::string("expected an object {\"marker name\": ") + what + "}");
+  std::vector<int> out(model.marker_count(), -1);
+  for (const auto& [name, value] : j.items()) {
+    const int i = model.marker_index(name);
+    if (i < 0) throw FileError(path, "unknown marker \"" + name + "\"");
+    if (!value.is_number_integer() || value.get<int>() < 0) throw FileError(path, "\"" + name + "\": expected a non-negative integer " + what);
+    out[i] = value.get<int>();
+  }
+  return out;
+}
+
+}  // namespace
+
 void add_build_subject(CLI::App& app) {
   auto* cmd = app.add_subcommand("build-subject", "Build the subject model (marker surface, local frames, PCA) from a training capture");
-  static std::string capture_path, out_path, surface_in, surface_out;
+  static std::string capture_path, out_path, surface_in, surface_out, mesh_path, landmarks_path, parts_path;
   static SubjectBuildOptions options;
+  static DeformationBuildOptions deformation;
+  static bool no_register = false;
   cmd->add_option("--capture", capture_path, "training capture (.c3d/.trc), ideally a range-of-motion take")->required();
   cmd->add_option("--out", out_path, "subject file to write")->required();
   cmd->add_option("--reference-frame", options.reference_frame, "frame index of the reference pose (default: chosen)");
@@ -23,16 +57,55 @@ void add_build_subject(CLI::App& app) {
   cmd->add_option("--variance", options.pca.variance_kept, "PCA variance kept")->check(CLI::Range(0.5, 1.0))->capture_default_str();
   cmd->add_option("--alpha1", options.parameters.alpha1, "relabel start tolerance (eq. 3)")->capture_default_str();
   cmd->add_option("--alpha2", options.parameters.alpha2, "relabel keep tolerance")->capture_default_str();
+  cmd->add_option("--mesh", mesh_path, "detailed mesh (.obj/.ply, mm) in the reference pose: adds the deformation model");
+  cmd->add_option("--landmarks", landmarks_path, "JSON {\"marker\": vertex index} for registration (default: guessed)");
+  cmd->add_flag("--no-register", no_register, "the mesh is already registered to the marker surface");
+  cmd->add_option("--marker-offset", deformation.registration.marker_offset_mm, "markers sit this far above the skin (mm)")
+      ->capture_default_str();
+  cmd->add_option("--parts", deformation.segmentation.target_parts, "number of near-rigid parts")->capture_default_str();
+  cmd->add_option("--part-file", parts_path, "JSON {\"marker\": part index}: your segmentation instead of mean shift");
+  cmd->add_option("--bandwidth", deformation.segmentation.bandwidth_degrees, "mean-shift bandwidth (degrees)")
+      ->capture_default_str();
   cmd->callback([] {
     const Capture training = read_capture(capture_path);
     std::vector<std::array<int, 3>> triangles;
     if (!surface_in.empty()) triangles = read_marker_surface_obj(surface_in, static_cast<int>(training.labelled_points().size()));
     SubjectBuildReport report;
     const SubjectModel model = build_subject(training, options, surface_in.empty() ? nullptr : &triangles, &report);
-    write_subject(model, out_path);
+    std::optional<DeformationModel> deformation_model;
+    DeformationBuildReport deformation_report;
+    if (!mesh_path.empty()) {
+      const TriangleMesh mesh = read_mesh(mesh_path);
+      // Segmentation and weights need every marker every frame: the take filled by this model.
+      const Capture filled = fill_capture(model, training, CaptureFillOptions{});
+      const int n = model.marker_count();
+      std::vector<Vec3> positions(static_cast<size_t>(filled.frame_count) * n);
+      for (int f = 0; f < filled.frame_count; ++f)
+        for (int i = 0; i < n; ++i) positions[static_cast<size_t>(f) * n + i] = filled.at(f, i);
+      deformation.register_mesh = !no_register;
+      if (!landmarks_path.empty()) {
+        const std::vector<int> vertex = read_marker_map(landmarks_path, model, "vertex index");
+        for (int i = 0; i < n; ++i)
+          if (vertex[i] >= 0) {
+            if (vertex[i] >= static_cast<int>(mesh.vertices.size()))
+              throw FileError(landmarks_path, "vertex " + std::to_string(vertex[i]) + " is beyond the mesh's " +
+                                                  std::to_string(mesh.vertices.size()));
+            deformation.landmarks.push_back({i, vertex[i]});
+          }
+      }
+      if (!parts_path.empty()) {
+        deformation.part_assignment = read_marker_map(parts_path, model, "part index");
+        for (int i = 0; i < n; ++i)
+          if (deformation.part_assignment[i] < 0) throw FileError(parts_path, "marker " + model.marker_names[i] + " has no part");
+        deformation.assignment_kind = AssignmentKind::PerMarker;
+      }
+      deformation_model = build_deformation_model(model, positions, filled.frame_count, mesh.vertices, mesh.faces,
+                                                  deformation, &deformation_report);
+    }
+    write_subject(model, deformation_model ? &*deformation_model : nullptr, out_path);
     if (!surface_out.empty())
       write_marker_surface_obj(surface_out, model.marker_names, model.reference_positions, model.triangles);
-    nlohmann::json out = {{"subject", out_path},
+    nlohmann::ordered_json out = {{"subject", out_path},
                           {"markers", report.markers},
                           {"reference_frame", report.reference_frame},
                           {"triangles", report.triangles},
@@ -41,6 +114,21 @@ void add_build_subject(CLI::App& app) {
                           {"mean_pca_components", report.mean_pca_components},
                           {"min_training_frames", report.min_training_frames},
                           {"markers_never_complete", report.markers_never_complete}};
+    if (deformation_model) {
+      const DeformationBuildReport& d = deformation_report;
+      out["mesh"] = {{"vertices", deformation_model->vertex_count()},
+                     {"faces", deformation_model->face_count()},
+                     {"registered", d.registered},
+                     {"landmarks", d.landmarks},
+                     {"marker_surface_rms_before_mm", d.registration.before.rms},
+                     {"marker_surface_rms_after_mm", d.registration.after.rms},
+                     {"marker_surface_max_after_mm", d.registration.after.max},
+                     {"parts", d.parts},
+                     {"mean_shift_groups", d.mean_shift_groups},
+                     {"max_part_rigid_rms_mm", d.max_part_rigid_rms_mm},
+                     {"boundary_markers", d.boundary_markers},
+                     {"mean_parts_per_vertex", d.mean_influences_per_vertex}};
+    }
     std::printf("%s\n", out.dump(2).c_str());
   });
 }

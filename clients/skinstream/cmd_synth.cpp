@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "clients/skinstream/commands.h"
+#include "clients/skinstream/default_paths.h"
 #include "clients/skinstream/synth_evaluation.h"
 #include "core/synth/motion.h"
 #include "core/synth/synth_capture.h"
@@ -28,25 +29,6 @@
 
 namespace skinstream::cli {
 
-namespace {
-
-std::string default_body_dir() {
-  namespace fs = std::filesystem;
-  if (const char* d = std::getenv("SKINSTREAM_MAKEHUMAN_DIR")) return d;
-  if (const char* d = std::getenv("SKINSTREAM_SHARED_DIR")) return std::string(d) + "/data/meshes/makehuman";
-  std::vector<fs::path> tries;
-  std::error_code ec;
-  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
-  if (!ec)  // build/bin/skinstream -> <root>/../shared
-    for (fs::path p = exe.parent_path(); !p.empty() && p != p.root_path(); p = p.parent_path())
-      tries.push_back(p / "shared" / "data" / "meshes" / "makehuman");
-  tries.push_back(fs::current_path(ec) / ".." / "shared" / "data" / "meshes" / "makehuman");
-  for (const fs::path& p : tries)
-    if (fs::exists(p / "makehuman_hm08_body_only.obj", ec)) return p.string();
-  return "../shared/data/meshes/makehuman";
-}
-
-}  // namespace
 
 void add_synth(CLI::App& app) {
   auto* cmd = app.add_subcommand(

@@ -16,5 +16,7 @@ void add_build_subject(CLI::App& app);
 void add_fill(CLI::App& app);
 void add_eval_fill(CLI::App& app);
 void add_synth(CLI::App& app);
+void add_eval_deform(CLI::App& app);
+void add_deform(CLI::App& app);
 
 }  // namespace skinstream::cli

@@ -19,6 +19,8 @@ int main(int argc, char** argv) {
   skinstream::cli::add_fill(app);
   skinstream::cli::add_eval_fill(app);
   skinstream::cli::add_synth(app);
+  skinstream::cli::add_eval_deform(app);
+  skinstream::cli::add_deform(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

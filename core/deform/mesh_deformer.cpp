@@ -49,7 +49,8 @@ struct MeshDeformer::State {
   std::vector<int> influence_offsets;
   std::vector<int> influence_part;
   std::vector<float> influence_weight;
-  std::vector<float> influence_quadratic;  // 9 per influence
+  std::vector<float> influence_quadratic;  // 9 per influence, of the point clamped to the part's box
+  std::vector<float> influence_outside;    // 3 per influence: offset beyond the box (carried rigidly)
 
   std::vector<SolvedPart> solved;
   std::vector<float> centre_x, centre_y, centre_z, weight_x, weight_y, weight_z;
@@ -103,14 +104,18 @@ MeshDeformer::MeshDeformer(const DeformationModel& model, const SubjectModel& su
   s.influence_part.resize(influences);
   s.influence_weight.resize(influences);
   s.influence_quadratic.resize(influences * 9);
+  s.influence_outside.resize(influences * 3);
   for (int v = 0; v < s.vertex_count; ++v) {
     for (int k = model.vertex_influence_offsets[v]; k < model.vertex_influence_offsets[v + 1]; ++k) {
       const PartInfluence& inf = model.vertex_influences[k];
       s.influence_part[k] = inf.part;
       s.influence_weight[k] = static_cast<float>(inf.weight);
-      const QuadraticVector q =
-          quadratic_basis(s.parts[inf.part].model().local_from_world(model.reference_vertices[v]));
+      const PartModel& part = s.parts[inf.part].model();
+      const Vec3 local = part.local_from_world(model.reference_vertices[v]);
+      const Vec3 inside = part.clamp_to_bounds(local);
+      const QuadraticVector q = quadratic_basis(inside);
       for (int c = 0; c < 9; ++c) s.influence_quadratic[k * 9 + c] = static_cast<float>(q[c]);
+      for (int c = 0; c < 3; ++c) s.influence_outside[k * 3 + c] = static_cast<float>(local[c] - inside[c]);
     }
   }
 
@@ -195,8 +200,9 @@ void MeshDeformer::State::deform_vertex(int v, float* out) const {
       local[1] += oy;
       local[2] += oz;
     }
-    const float lx = local[0] - part.translation[0], ly = local[1] - part.translation[1],
-                lz = local[2] - part.translation[2];
+    const float* outside = &influence_outside[static_cast<size_t>(k) * 3];
+    const float lx = local[0] + outside[0] - part.translation[0], ly = local[1] + outside[1] - part.translation[1],
+                lz = local[2] + outside[2] - part.translation[2];
     const float beta = influence_weight[k];
     for (int r = 0; r < 3; ++r) {
       const float* row = part.inverse_rotation[r];
@@ -267,5 +273,21 @@ bool MeshDeformer::deform(std::span<const Vec3> markers, std::span<float> positi
 int MeshDeformer::vertex_count() const { return state_->vertex_count; }
 int MeshDeformer::face_count() const { return static_cast<int>(state_->faces.size()); }
 DeformationMode MeshDeformer::mode() const { return state_->mode; }
+
+size_t MeshDeformer::memory_bytes() const {
+  const State& s = *state_;
+  auto bytes = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
+  size_t total = sizeof(State) + bytes(s.faces) + bytes(s.member_offsets) + bytes(s.member_markers) +
+                 bytes(s.member_scratch) + bytes(s.influence_offsets) + bytes(s.influence_part) +
+                 bytes(s.influence_weight) + bytes(s.influence_quadratic) + bytes(s.influence_outside) + bytes(s.solved) + bytes(s.centre_x) * 6 +
+                 bytes(s.face_normal) + bytes(s.vertex_face_offsets) + bytes(s.vertex_faces);
+  for (const PartDeformer& part : s.parts) {
+    const int y = part.model().member_count();
+    // Members' reference data (points, Q0, pseudo-inverse) and the per-frame kernel and LU.
+    total += sizeof(PartDeformer) + static_cast<size_t>(y) * (3 + 3 + 9 + 9 + 3 + 3 + 3 + 3) * sizeof(double) +
+             2 * static_cast<size_t>(y) * y * sizeof(double);
+  }
+  return total;
+}
 
 }  // namespace skinstream

@@ -46,6 +46,8 @@ class MeshDeformer {
   int vertex_count() const;
   int face_count() const;
   DeformationMode mode() const;
+  // Heap bytes held by the runtime state (precomputed per-vertex data, parts, normals scratch).
+  size_t memory_bytes() const;
 
  private:
   struct State;

@@ -1,5 +1,6 @@
 #include "core/deform/part_deformation.h"
 
+#include <algorithm>
 #include <utility>
 
 #include "core/deform/rbf_kernel.h"
@@ -69,13 +70,28 @@ void PartDeformer::solve_residual() {
   }
   kernel_lu_.compute(kernel_);
   weights_.noalias() = kernel_lu_.solve(residuals_);
+  // The cubic B-spline is not positive definite as a radial function in 3D: with many members
+  // and a wide dilation the kernel matrix can be nearly singular, and the exact weights then
+  // reach thousands of times the residual and swing the surface between the members by metres.
+  // Then a ridge (smoothing interpolation) is added, the smallest of a few that tames them.
+  const double limit = kMaxWeightGain * std::max(residuals_.cwiseAbs().maxCoeff(), 1e-6);
+  double added = 0.0;
+  for (double ridge : {1e-3, 1e-2, 1e-1, 1.0}) {
+    if (weights_.allFinite() && weights_.cwiseAbs().maxCoeff() <= limit) break;
+    kernel_.diagonal().array() += ridge - added;
+    added = ridge;
+    kernel_lu_.compute(kernel_);
+    weights_.noalias() = kernel_lu_.solve(residuals_);
+  }
+  ridge_ = added;
   // Coincident centres make the kernel singular; then skip the residual rather than emit NaN.
   rbf_applied_ = weights_.allFinite();
   if (!rbf_applied_) weights_.setZero();
 }
 
 Vec3 PartDeformer::deform(const Vec3& reference_local_position) const {
-  Vec3 local = quadratic_ * quadratic_basis(reference_local_position);
+  const Vec3 inside = model_.clamp_to_bounds(reference_local_position);
+  Vec3 local = quadratic_ * quadratic_basis(inside);
   if (rbf_applied_) {
     const double inverse_sigma = 1.0 / model_.rbf_dilation;
     Vec3 offset = Vec3::Zero();
@@ -85,6 +101,7 @@ Vec3 PartDeformer::deform(const Vec3& reference_local_position) const {
     }
     local += offset;
   }
+  local += reference_local_position - inside;  // beyond the members' box: carried rigidly
   return to_local_.apply_inverse(local);
 }
 

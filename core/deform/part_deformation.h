@@ -26,7 +26,9 @@ class PartDeformer {
   // Before the first successful solve the part is in its reference pose.
   bool solve(std::span<const Vec3> member_positions_now);
 
-  // Eq. 8: local part reference position -> deformed world position at the solved frame.
+  // Eq. 8: local part reference position -> deformed world position at the solved frame. Outside
+  // the members' bounding box the field is that of the nearest box point plus the rigid offset
+  // (PartModel::clamp_to_bounds); inside, eq. 8 as written.
   Vec3 deform(const Vec3& reference_local_position) const;
 
   const PartModel& model() const { return model_; }
@@ -38,6 +40,10 @@ class PartDeformer {
   const Eigen::MatrixX3d& rbf_weights() const { return weights_; }               // w_i, Y x 3
   // False when this frame's kernel matrix was singular; the residual is then not applied.
   bool rbf_applied() const { return rbf_applied_; }
+  // The ridge added to this frame's kernel diagonal (0: exact interpolation at the members).
+  double rbf_ridge() const { return ridge_; }
+  // Weights beyond this multiple of the largest residual mean a near-singular kernel.
+  static constexpr double kMaxWeightGain = 200.0;
 
  private:
   bool uses_quadratic() const;
@@ -55,6 +61,7 @@ class PartDeformer {
   Eigen::MatrixXd kernel_;
   Eigen::PartialPivLU<Eigen::MatrixXd> kernel_lu_;
   bool rbf_applied_ = false;
+  double ridge_ = 0.0;
 };
 
 }  // namespace skinstream

@@ -86,6 +86,9 @@ PartModel build_part_model(const std::vector<Vec3>& reference_member_positions) 
   model.pseudo_inverse = scaled_pinv * row_scale.cwiseInverse().asDiagonal();  // undo the scaling
   model.reference_projection = model.local_reference * model.pseudo_inverse;
 
+  model.local_min = model.local_reference.rowwise().minCoeff();
+  model.local_max = model.local_reference.rowwise().maxCoeff();
+
   const double nearest = largest_nearest_member_distance(model.local_reference_points);
   model.rbf_dilation = nearest > 1e-9 ? 2.0 * nearest : 0.0;
   return model;

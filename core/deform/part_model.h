@@ -35,6 +35,14 @@ struct PartModel {
   // interpolated (fewer than 2 distinct members); the RBF term is then skipped.
   double rbf_dilation = 0.0;
 
+  // The members' bounding box in the local part frame. The quadratic field (and the RBF
+  // residual) are evaluated at the nearest point of this box and the rest of the offset is
+  // carried rigidly: a quadratic fitted to the members is an interpolant inside their hull but
+  // grows without bound outside it (hands, head and feet, which carry no markers, would fly off).
+  Vec3 local_min = Vec3::Zero();
+  Vec3 local_max = Vec3::Zero();
+  Vec3 clamp_to_bounds(const Vec3& local) const { return local.cwiseMax(local_min).cwiseMin(local_max); }
+
   int member_count() const { return static_cast<int>(local_reference_points.size()); }
   // World reference position -> local part reference position (where deform() takes its input).
   Vec3 local_from_world(const Vec3& world_reference_position) const {

@@ -1,0 +1,168 @@
+// Per-frame cost of the skin deformation (section 5.3) of the ~53,500-vertex subdivided body from
+// ~350 markers in ~17 parts, normals included: on one core, and split over two threads as the
+// daemon runs it (vertex range, then face normals, then vertex normals, each halved, with a
+// barrier between). A plain copy of the same output bytes (positions + normals) is the physical
+// floor: writing the buffer cannot be faster than memory bandwidth allows.
+// The subject is trained on the generator's 10 s range-of-motion take (seed 1); the frames are
+// its 5 s punching take.
+//   build/bin/deform_benchmark --benchmark_format=json
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <atomic>
+#include <barrier>
+#include <chrono>
+#include <cstring>
+#include <thread>
+
+#include "core/deform/mesh_deformer.h"
+#include "core/offline/deformation_builder.h"
+#include "core/offline/subject_builder.h"
+#include "core/synth/synth_capture.h"
+#include "protocol/makehuman.h"
+
+namespace skinstream {
+namespace {
+
+struct Scenario {
+  SubjectModel subject;
+  DeformationModel model;
+  std::vector<std::vector<Vec3>> frames;  // subject order
+};
+
+const Scenario& scenario() {
+  static const Scenario s = [] {
+    const synth::Body body = load_makehuman(std::string(SKINSTREAM_SHARED_DIR) + "/data/meshes/makehuman");
+    synth::SynthOptions rom;
+    rom.motion = "rom";
+    rom.seconds = 10.0;
+    rom.subdivided = true;
+    const synth::SynthCapture training = synth::generate(body, rom);
+    Scenario out;
+    SubjectBuildReport report;
+    out.subject = build_subject(training.truth, {}, nullptr, &report);
+    const int n = out.subject.marker_count();
+    std::vector<Vec3> positions(static_cast<size_t>(training.frame_count()) * n);
+    for (int f = 0; f < training.frame_count(); ++f)
+      for (int i = 0; i < n; ++i) positions[static_cast<size_t>(f) * n + i] = training.truth.at(f, i);
+    DeformationBuildOptions options;
+    options.register_mesh = false;  // speed of the runtime only: the truth skin is registered already
+    out.model = build_deformation_model(out.subject, positions, training.frame_count(),
+                                        training.pose_mesh(report.reference_frame, true), training.mesh_triangles(), options);
+    synth::SynthOptions punch = rom;
+    punch.motion = "punch";
+    punch.seconds = 5.0;
+    const synth::SynthCapture take = synth::generate(body, punch);
+    for (int f = 0; f < take.frame_count(); ++f) {
+      std::vector<Vec3> markers(n);
+      for (int i = 0; i < n; ++i) markers[i] = take.truth.at(f, i);
+      out.frames.push_back(std::move(markers));
+    }
+    return out;
+  }();
+  return s;
+}
+
+void report(benchmark::State& state, std::vector<double>& micros, const MeshDeformer& deformer) {
+  std::sort(micros.begin(), micros.end());
+  auto pct = [&](double q) { return micros[std::min(micros.size() - 1, static_cast<size_t>(q * micros.size()))]; };
+  state.counters["p50_us"] = pct(0.50);
+  state.counters["p99_us"] = pct(0.99);
+  state.counters["max_us"] = micros.back();
+  state.counters["vertices"] = deformer.vertex_count();
+  state.counters["parts"] = scenario().model.part_count();
+  state.counters["markers"] = scenario().subject.marker_count();
+  state.counters["runtime_bytes"] = static_cast<double>(deformer.memory_bytes());
+}
+
+void BM_DeformOneThread(benchmark::State& state) {
+  const Scenario& s = scenario();
+  MeshDeformer deformer(s.model, s.subject);
+  std::vector<float> positions(static_cast<size_t>(deformer.vertex_count()) * 3), normals(positions.size());
+  std::vector<double> micros;
+  micros.reserve(1 << 16);
+  size_t frame = 0;
+  for (auto _ : state) {
+    const auto start = std::chrono::steady_clock::now();
+    deformer.deform(s.frames[frame], positions, normals);
+    micros.push_back(std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count());
+    benchmark::DoNotOptimize(positions.data());
+    frame = (frame + 1) % s.frames.size();
+  }
+  report(state, micros, deformer);
+}
+
+// The daemon's split: the calling thread and one persistent worker, three phases per frame.
+void BM_DeformTwoThreads(benchmark::State& state) {
+  const Scenario& s = scenario();
+  MeshDeformer deformer(s.model, s.subject);
+  const int vertices = deformer.vertex_count(), faces = deformer.face_count();
+  std::vector<float> positions(static_cast<size_t>(vertices) * 3), normals(positions.size());
+  std::barrier<> sync(2);
+  std::atomic<bool> stop{false};
+  auto half = [&](int worker) {
+    deformer.deform_vertices(worker ? vertices / 2 : 0, worker ? vertices : vertices / 2, positions);
+    sync.arrive_and_wait();
+    deformer.face_normals(worker ? faces / 2 : 0, worker ? faces : faces / 2, positions);
+    sync.arrive_and_wait();
+    deformer.vertex_normals(worker ? vertices / 2 : 0, worker ? vertices : vertices / 2, normals);
+  };
+  std::thread worker([&] {
+    for (;;) {
+      sync.arrive_and_wait();  // frame start: parts solved
+      if (stop.load()) return;
+      half(1);
+      sync.arrive_and_wait();  // frame end
+    }
+  });
+  std::vector<double> micros;
+  micros.reserve(1 << 16);
+  size_t frame = 0;
+  for (auto _ : state) {
+    const auto start = std::chrono::steady_clock::now();
+    deformer.solve_parts(s.frames[frame]);
+    sync.arrive_and_wait();
+    half(0);
+    sync.arrive_and_wait();
+    micros.push_back(std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count());
+    benchmark::DoNotOptimize(positions.data());
+    frame = (frame + 1) % s.frames.size();
+  }
+  stop.store(true);
+  sync.arrive_and_wait();
+  worker.join();
+  report(state, micros, deformer);
+}
+
+void BM_SolvePartsOnly(benchmark::State& state) {
+  const Scenario& s = scenario();
+  MeshDeformer deformer(s.model, s.subject);
+  size_t frame = 0;
+  for (auto _ : state) {
+    deformer.solve_parts(s.frames[frame]);
+    frame = (frame + 1) % s.frames.size();
+  }
+}
+
+// The floor: copying the bytes one frame publishes (positions + normals, float32).
+void BM_CopyOutputBuffer(benchmark::State& state) {
+  const Scenario& s = scenario();
+  const size_t bytes = static_cast<size_t>(s.model.vertex_count()) * 6 * sizeof(float);
+  std::vector<char> from(bytes, 1), to(bytes);
+  for (auto _ : state) {
+    std::memcpy(to.data(), from.data(), bytes);
+    benchmark::DoNotOptimize(to.data());
+    benchmark::ClobberMemory();
+  }
+  state.SetBytesProcessed(static_cast<int64_t>(state.iterations() * bytes));
+}
+
+BENCHMARK(BM_DeformOneThread)->Unit(benchmark::kMicrosecond)->MinTime(3.0)->UseRealTime();
+BENCHMARK(BM_DeformTwoThreads)->Unit(benchmark::kMicrosecond)->MinTime(3.0)->UseRealTime();
+BENCHMARK(BM_SolvePartsOnly)->Unit(benchmark::kMicrosecond)->MinTime(1.0);
+BENCHMARK(BM_CopyOutputBuffer)->Unit(benchmark::kMicrosecond)->MinTime(1.0);
+
+}  // namespace
+}  // namespace skinstream
+
+BENCHMARK_MAIN();

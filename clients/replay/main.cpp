@@ -1,0 +1,155 @@
+// skinstream-replay: streams a recorded capture (C3D or TRC) as a Vicon DataStream server, so that
+// skinstreamd, benchmarks and unmodified Vicon SDK clients can run without a capture stage.
+//
+//   skinstream-replay RECORDING --port P [--rate HZ] [--speed X] [--loop | --hold] [--subject NAME]
+//                     [--multicast GROUP[:PORT]] [--multicast-ttl N] [--start-now]
+//
+// Prints one JSON line {"port": N} on stdout once listening (port 0 picks a free one); logs go to
+// stderr. Errors are one line on stderr and a non-zero exit code.
+#include <csignal>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <optional>
+#include <string>
+
+#include <CLI/CLI.hpp>
+#include <spdlog/sinks/stdout_color_sinks.h>
+#include <spdlog/spdlog.h>
+
+#include "protocol/capture_file.h"
+#include "protocol/file_error.h"
+#include "server/asio.h"
+#include "server/vicon/vicon_server.h"
+
+namespace {
+
+using namespace skinstream;
+
+struct Arguments {
+  std::string recording;
+  int port = vicon::kDefaultPort;
+  std::string bind = "0.0.0.0";
+  double rate = 0.0;
+  double speed = 1.0;
+  bool loop = false;
+  bool hold = false;
+  bool start_now = false;
+  std::string subject;
+  std::string multicast;
+  int multicast_ttl = 1;
+  int max_queued = 4;
+};
+
+// "239.1.2.3:44801" or "239.1.2.3" -> address and port.
+std::pair<std::string, uint16_t> split_address(const std::string& text) {
+  const auto colon = text.rfind(':');
+  if (colon == std::string::npos) return {text, vicon::kDefaultMulticastPort};
+  const int port = std::stoi(text.substr(colon + 1));
+  if (port <= 0 || port > 65535) throw std::invalid_argument("bad multicast port in " + text);
+  return {text.substr(0, colon), static_cast<uint16_t>(port)};
+}
+
+int run(const Arguments& args) {
+  const Capture capture = read_capture(args.recording);
+  if (capture.frame_count <= 0) throw FileError(args.recording, "holds no frames");
+  if (!(capture.rate_hz > 0.0) && !(args.rate > 0.0)) throw FileError(args.recording, "has no frame rate; pass --rate");
+
+  server::ViconServerOptions options;
+  options.bind_address = args.bind;
+  options.port = static_cast<uint16_t>(args.port);
+  options.subject_name = args.subject.empty() ? std::filesystem::path(args.recording).stem().string() : args.subject;
+  options.rate_hz = args.rate;
+  options.speed = args.speed;
+  options.loop = args.loop;
+  options.start_on_first_request = !args.start_now;
+  options.max_queued_frames = static_cast<size_t>(args.max_queued);
+  options.multicast_ttl = args.multicast_ttl;
+
+  server::asio::io_context io;
+  server::ViconServer vicon_server(io, capture, options);
+  vicon_server.start();  // throws with the address on failure
+
+  // Without --loop or --hold: once the last frame is out, wait (up to 2 s) for the clients'
+  // queues to drain, then exit 0.
+  server::asio::steady_timer drain_timer(io);
+  int drain_checks = 0;
+  std::function<void()> drain = [&] {
+    if (vicon_server.all_clients_idle() || ++drain_checks > 200) {
+      spdlog::info("recording finished: {} frames produced, {} frame packets sent, {} dropped",
+                   vicon_server.stats().frames_produced.load(), vicon_server.stats().frame_packets_sent.load(),
+                   vicon_server.stats().frames_dropped.load());
+      vicon_server.stop();
+      io.stop();
+      return;
+    }
+    drain_timer.expires_after(std::chrono::milliseconds(10));
+    drain_timer.async_wait([&](const boost::system::error_code& ec) {
+      if (!ec) drain();
+    });
+  };
+  if (!args.loop && !args.hold) vicon_server.set_on_finished(drain);
+
+  server::asio::signal_set signals(io, SIGINT, SIGTERM);
+  signals.async_wait([&](const boost::system::error_code& ec, int signal_number) {
+    if (ec) return;
+    spdlog::info("signal {}: stopping", signal_number);
+    vicon_server.stop();
+    io.stop();
+  });
+
+  if (!args.multicast.empty()) {
+    const auto [group, port] = split_address(args.multicast);
+    vicon_server.start_multicast(group, port);
+  }
+
+  std::cout << "{\"port\": " << vicon_server.port() << "}" << std::endl;
+  spdlog::info("streaming {} ({} markers, {} frames at {} Hz, speed {}) as subject '{}' on {}:{}", args.recording,
+               capture.point_count(), capture.frame_count, args.rate > 0.0 ? args.rate : capture.rate_hz, args.speed,
+               options.subject_name, args.bind, vicon_server.port());
+  io.run();
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  spdlog::set_default_logger(spdlog::stderr_color_mt("replay"));
+  Arguments args;
+  CLI::App app{"skinstream-replay: stream a recorded capture (C3D/TRC) as a Vicon DataStream server"};
+  app.add_option("RECORDING", args.recording, "capture file (.c3d or .trc)")->required();
+  app.add_option("--port", args.port, "TCP port to listen on (0: pick a free one; printed as {\"port\": N})")
+      ->check(CLI::Range(0, 65535))
+      ->capture_default_str();
+  app.add_option("--bind", args.bind, "address to listen on")->capture_default_str();
+  app.add_option("--rate", args.rate, "frame rate to announce and stream, Hz (default: the recording's)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--speed", args.speed, "wall-clock speed factor (2: twice as fast)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  auto* loop = app.add_flag("--loop", args.loop, "start again after the last frame, forever (numbers keep rising)");
+  app.add_flag("--hold", args.hold, "after the last frame, keep clients connected until SIGINT/SIGTERM")
+      ->excludes(loop);
+  app.add_flag("--start-now", args.start_now,
+               "start the recording at once instead of when the first client asks for a frame");
+  app.add_option("--subject", args.subject, "subject name (default: the recording's file stem)");
+  app.add_option("--multicast", args.multicast, "also send every frame as UDP datagrams to GROUP[:PORT]");
+  app.add_option("--multicast-ttl", args.multicast_ttl, "multicast TTL (hops)")
+      ->check(CLI::Range(0, 255))
+      ->capture_default_str();
+  app.add_option("--max-queued", args.max_queued, "frames queued per client before the oldest is dropped")
+      ->check(CLI::Range(1, 1000))
+      ->capture_default_str();
+  app.footer(
+      "The recording starts when the first client asks for a frame (RequestFrame), unless --start-now.\n"
+      "Without --loop or --hold the program exits 0 once the last frame has been sent to the connected\n"
+      "clients. SIGINT/SIGTERM stop it cleanly (exit 0).");
+  CLI11_PARSE(app, argc, argv);
+
+  try {
+    return run(args);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "error: %s\n", e.what());
+    return 1;
+  }
+}

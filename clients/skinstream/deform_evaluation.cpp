@@ -1,0 +1,220 @@
+#include "clients/skinstream/deform_evaluation.h"
+
+#include <algorithm>
+#include <chrono>
+#include <limits>
+#include <stdexcept>
+
+#include "clients/skinstream/json_output.h"
+#include "core/deform/mesh_deformer.h"
+#include "core/offline/subject_builder.h"
+#include "core/synth/subdivision.h"
+
+namespace skinstream::cli {
+namespace {
+
+using synth::SynthCapture;
+
+struct Method {
+  const char* name;
+  bool conventional;
+  DeformationMode mode;
+};
+constexpr Method kMethods[] = {
+    {"rigid", false, DeformationMode::Rigid},
+    {"quadratic", false, DeformationMode::Quadratic},
+    {"rigid_rbf", false, DeformationMode::RigidRbf},
+    {"full", false, DeformationMode::QuadraticRbf},
+    {"lbs_sparse", true, DeformationMode::Rigid},
+};
+
+// Where a marker sits on the registered mesh: its closest point in the reference pose
+// (triangle and barycentric coordinates) and its height above the surface along the normal.
+struct MarkerSiteOnMesh {
+  int triangle = -1;
+  Vec3 barycentric = Vec3::Zero();
+  double height = 0.0;
+};
+
+std::vector<MarkerSiteOnMesh> locate_markers(const std::vector<Vec3>& vertices,
+                                             const std::vector<std::array<int, 3>>& faces,
+                                             const std::vector<Vec3>& markers) {
+  std::vector<MarkerSiteOnMesh> sites(markers.size());
+  for (size_t m = 0; m < markers.size(); ++m) {
+    double best = std::numeric_limits<double>::infinity();
+    for (size_t f = 0; f < faces.size(); ++f) {
+      const auto& t = faces[f];
+      Vec3 bary;
+      const Vec3 p = synth::closest_point_on_triangle(markers[m], vertices[t[0]], vertices[t[1]], vertices[t[2]], &bary);
+      const double d = (p - markers[m]).squaredNorm();
+      if (d < best) {
+        best = d;
+        sites[m].triangle = static_cast<int>(f);
+        sites[m].barycentric = bary;
+        sites[m].height =
+            (markers[m] - p).dot(synth::triangle_normal(vertices[t[0]], vertices[t[1]], vertices[t[2]]));
+      }
+    }
+  }
+  return sites;
+}
+
+Vec3 vertex_at(const std::vector<float>& positions, int v) {
+  return Vec3(positions[static_cast<size_t>(v) * 3], positions[static_cast<size_t>(v) * 3 + 1],
+              positions[static_cast<size_t>(v) * 3 + 2]);
+}
+
+Vec3 site_position(const std::vector<float>& positions, const std::vector<std::array<int, 3>>& faces,
+                   const MarkerSiteOnMesh& site) {
+  const auto& t = faces[site.triangle];
+  const Vec3 a = vertex_at(positions, t[0]), b = vertex_at(positions, t[1]), c = vertex_at(positions, t[2]);
+  const Vec3 on_surface = site.barycentric[0] * a + site.barycentric[1] * b + site.barycentric[2] * c;
+  return on_surface + site.height * synth::triangle_normal(a, b, c);
+}
+
+// Vertices the markers cover: within `reach` of the reference marker surface. The dense set has
+// no markers on the head, hands and feet; no marker-driven method can know how those move.
+std::vector<char> covered_vertices(const DeformationModel& model, const SubjectModel& subject, double reach) {
+  std::vector<char> covered(model.vertex_count(), 0);
+  for (int v = 0; v < model.vertex_count(); ++v) {
+    const Vec3& p = model.reference_vertices[v];
+    for (const auto& t : subject.triangles) {
+      const Vec3 q = synth::closest_point_on_triangle(p, subject.reference_positions[t[0]],
+                                                      subject.reference_positions[t[1]], subject.reference_positions[t[2]]);
+      if ((q - p).squaredNorm() <= reach * reach) {
+        covered[v] = 1;
+        break;
+      }
+    }
+  }
+  return covered;
+}
+
+std::vector<Vec3> markers_in_subject_order(const SynthCapture& take, const std::vector<int>& subject_to_truth, int frame) {
+  std::vector<Vec3> markers(subject_to_truth.size());
+  for (size_t i = 0; i < markers.size(); ++i) markers[i] = take.truth.at(frame, subject_to_truth[i]);
+  return markers;
+}
+
+}  // namespace
+
+DeformationSetup prepare_deformation(const synth::Body& body, const SynthCapture& training,
+                                     const DeformEvaluationOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  DeformationSetup setup;
+  SubjectBuildReport subject_report;
+  setup.subject = build_subject(training.truth, SubjectBuildOptions{}, nullptr, &subject_report);
+  const int n = setup.subject.marker_count();
+  for (int i = 0; i < n; ++i) {
+    const auto& labels = training.truth.labels;
+    const auto it = std::find(labels.begin(), labels.end(), setup.subject.marker_names[i]);
+    if (it == labels.end()) throw std::logic_error("subject marker missing from the truth: " + setup.subject.marker_names[i]);
+    setup.subject_to_truth.push_back(static_cast<int>(it - labels.begin()));
+  }
+  std::vector<Vec3> positions(static_cast<size_t>(training.frame_count()) * n);
+  for (int f = 0; f < training.frame_count(); ++f)
+    for (int i = 0; i < n; ++i) positions[static_cast<size_t>(f) * n + i] = training.truth.at(f, setup.subject_to_truth[i]);
+
+  // The artist's model: the subject's skin in the reference pose, without the frame's bulges,
+  // breathing and jiggle; registration pulls it onto the markers. Landmarks: the mesh vertex
+  // each marker was placed at.
+  const std::vector<Vec3> artist_mesh = training.pose_mesh(subject_report.reference_frame, /*skin_only=*/true);
+  const auto& faces = training.mesh_triangles();
+  DeformationBuildOptions build;
+  build.registration.marker_offset_mm = options.marker_offset_mm;
+  for (int i = 0; i < n; ++i) {
+    const synth::MarkerSite& site = training.markers[setup.subject_to_truth[i]];
+    int corner = 0;
+    site.barycentric.maxCoeff(&corner);
+    build.landmarks.push_back({i, faces[site.triangle][corner]});
+  }
+  const std::vector<Vec3> truth_skin = training.pose_mesh(subject_report.reference_frame);
+  const std::vector<Vec3> registered = register_mesh(artist_mesh, faces, setup.subject.reference_positions,
+                                                     build.landmarks, build.registration, &setup.registration);
+  for (size_t v = 0; v < registered.size(); ++v)
+    setup.registration_vertex_error_mm += (registered[v] - truth_skin[v]).norm() / static_cast<double>(registered.size());
+  build.register_mesh = false;
+  setup.deformation = build_deformation_model(setup.subject, positions, training.frame_count(),
+                                              options.deform_registered_mesh ? registered : truth_skin, faces, build,
+                                              &setup.build);
+
+  const synth::SkinWeights weights =
+      training.mesh_vertex_count() == body.vertex_count() ? body.weights : synth::subdivide(body).weights;
+  setup.conventional = synth::choose_conventional_markers(body, training, weights);
+  // Its markers in subject order.
+  for (auto& segment : setup.conventional.skinning.segment_markers)
+    for (int& m : segment)
+      m = static_cast<int>(std::find(setup.subject_to_truth.begin(), setup.subject_to_truth.end(), m) -
+                           setup.subject_to_truth.begin());
+  setup.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return setup;
+}
+
+nlohmann::ordered_json evaluate_deformation(const DeformationSetup& setup, const SynthCapture& take,
+                                            const std::string& motion, const DeformEvaluationOptions& options) {
+  const DeformationModel& model = setup.deformation;
+  const int vertices = model.vertex_count();
+  if (take.mesh_vertex_count() != vertices)
+    throw std::invalid_argument("the take's mesh has " + std::to_string(take.mesh_vertex_count()) +
+                                " vertices, the subject's " + std::to_string(vertices));
+  const std::vector<MarkerSiteOnMesh> sites =
+      locate_markers(model.reference_vertices, model.faces, setup.subject.reference_positions);
+
+  const int method_count = static_cast<int>(std::size(kMethods));
+  std::vector<std::unique_ptr<MeshDeformer>> deformers;
+  for (const Method& m : kMethods)
+    deformers.push_back(m.conventional ? nullptr : std::make_unique<MeshDeformer>(model, setup.subject, m.mode));
+  SegmentSkinning skinning(setup.conventional.skinning, setup.subject.reference_positions, model.reference_vertices);
+
+  const std::vector<char> covered = covered_vertices(model, setup.subject, options.covered_reach_mm);
+  int covered_count = 0;
+  for (char c : covered) covered_count += c;
+  std::vector<std::vector<double>> vertex_errors(method_count), all_vertex_errors(method_count), marker_errors(method_count);
+  std::vector<double> seconds(method_count, 0.0);
+  std::vector<float> positions(static_cast<size_t>(vertices) * 3);
+  int frames = 0;
+  for (int f = 0; f < take.frame_count(); f += options.frame_stride, ++frames) {
+    const std::vector<Vec3> markers = markers_in_subject_order(take, setup.subject_to_truth, f);
+    const std::vector<Vec3> truth = take.pose_mesh(f);
+    for (int k = 0; k < method_count; ++k) {
+      const auto start = std::chrono::steady_clock::now();
+      if (kMethods[k].conventional) {
+        if (!skinning.solve(markers)) throw std::logic_error("conventional markers missing from the truth");
+        skinning.deform(positions);
+      } else if (!deformers[k]->deform(markers, positions, {})) {
+        throw std::logic_error("markers missing from the truth");
+      }
+      seconds[k] += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      for (int v = 0; v < vertices; ++v) {
+        const double e = (vertex_at(positions, v) - truth[v]).norm();
+        all_vertex_errors[k].push_back(e);
+        if (covered[v]) vertex_errors[k].push_back(e);
+      }
+      for (size_t i = 0; i < sites.size(); ++i)
+        marker_errors[k].push_back((site_position(positions, model.faces, sites[i]) - markers[i]).norm());
+    }
+  }
+
+  nlohmann::ordered_json rows = nlohmann::ordered_json::array();
+  for (int k = 0; k < method_count; ++k) {
+    const ErrorStats v = summarize_errors(std::move(vertex_errors[k]));
+    const ErrorStats m = summarize_errors(std::move(marker_errors[k]));
+    const ErrorStats all = summarize_errors(std::move(all_vertex_errors[k]));
+    rows.push_back({{"method", kMethods[k].name},
+                    {"vertex_mean_mm", v.mean},
+                    {"vertex_p95_mm", v.p95},
+                    {"vertex_max_mm", v.max},
+                    {"all_vertex_mean_mm", all.mean},
+                    {"all_vertex_max_mm", all.max},
+                    {"marker_mean_mm", m.mean},
+                    {"marker_max_mm", m.max},
+                    {"ms_per_frame_single_thread", 1000.0 * seconds[k] / frames}});
+  }
+  return {{"motion", motion},
+          {"frames_evaluated", frames},
+          {"vertices", vertices},
+          {"covered_vertices", covered_count},
+          {"methods", rows}};
+}
+
+}  // namespace skinstream::cli

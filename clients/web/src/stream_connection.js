@@ -1,0 +1,88 @@
+// The WebSocket to the daemon's /stream: sends Hello first, hands each binary message to the
+// listener, and reconnects with exponential backoff whenever the socket closes.
+import { encodeHello, ProtocolError } from './protocol.js';
+
+export const ConnectionState = Object.freeze({ CONNECTING: 'connecting', OPEN: 'open', CLOSED: 'closed' });
+
+const FIRST_RETRY_MS = 250;
+const MAX_RETRY_MS = 5000;
+
+export class StreamConnection {
+  // listener: { onOpen(), onMessage(ArrayBuffer), onClose(reason, retryInMs) }
+  constructor(url, wants, listener) {
+    this.url = url;
+    this.hello = encodeHello(wants);
+    this.listener = listener;
+    this.state = ConnectionState.CLOSED;
+    this.retryMs = FIRST_RETRY_MS;
+    this.reconnects = 0;
+    this.socket = null;
+    this.retryTimer = 0;
+  }
+
+  start() {
+    this.open();
+  }
+
+  // A good message proves the link works: the next failure starts the backoff from the bottom.
+  confirmHealthy() {
+    this.retryMs = FIRST_RETRY_MS;
+  }
+
+  // Closes on a protocol violation, as the spec asks of a receiver; the backoff then reconnects.
+  abort(error) {
+    if (this.socket) this.socket.close(4000, String(error.message).slice(0, 120));
+  }
+
+  open() {
+    this.state = ConnectionState.CONNECTING;
+    let socket;
+    try {
+      socket = new WebSocket(this.url);
+    } catch (error) {
+      this.scheduleRetry(`cannot open ${this.url}: ${error.message}`);
+      return;
+    }
+    socket.binaryType = 'arraybuffer';
+    this.socket = socket;
+    socket.onopen = () => {
+      this.state = ConnectionState.OPEN;
+      socket.send(this.hello);
+      this.listener.onOpen();
+    };
+    socket.onmessage = (event) => {
+      if (!(event.data instanceof ArrayBuffer)) {
+        this.abort(new ProtocolError('text message on a binary protocol'));
+        return;
+      }
+      try {
+        this.listener.onMessage(event.data);
+      } catch (error) {
+        if (!(error instanceof ProtocolError)) throw error;
+        console.error(`skinstream: ${error.message}; closing the connection`);
+        this.lastError = error.message;
+        this.abort(error);
+      }
+    };
+    socket.onclose = (event) => {
+      if (this.socket !== socket) return;
+      this.socket = null;
+      const reason = this.lastError || event.reason || `code ${event.code}`;
+      this.lastError = '';
+      this.scheduleRetry(reason);
+    };
+    // onerror is always followed by onclose, which does the work.
+  }
+
+  scheduleRetry(reason) {
+    this.state = ConnectionState.CLOSED;
+    const delay = this.retryMs;
+    this.retryMs = Math.min(MAX_RETRY_MS, this.retryMs * 2);
+    this.listener.onClose(reason, delay);
+    clearTimeout(this.retryTimer);
+    this.retryTimer = setTimeout(() => {
+      ++this.reconnects;
+      this.open();
+    }, delay);
+  }
+}

@@ -1,0 +1,50 @@
+#pragma once
+// Raw detailed mesh + training take -> DeformationModel (section 5.1-5.2), offline and once per
+// subject: registers the mesh to the reference marker surface, segments the marker surface into
+// near-rigid parts, weighs the markers (alpha) and the vertices (beta).
+
+#include <array>
+#include <span>
+#include <vector>
+
+#include "core/deform/deformation_model.h"
+#include "core/offline/marker_part_weights.h"
+#include "core/offline/mesh_registration.h"
+#include "core/offline/part_segmentation.h"
+#include "core/subject_model.h"
+
+namespace skinstream {
+
+struct DeformationBuildOptions {
+  bool register_mesh = true;  // false: the mesh is already registered (used as given)
+  RegistrationOptions registration;
+  std::vector<RegistrationLandmark> landmarks;  // empty: guess_landmarks (mesh close to the markers)
+  LandmarkGuessOptions landmark_guess;
+  SegmentationOptions segmentation;
+  std::vector<int> part_assignment;  // a user's parts (per marker or per triangle); empty: mean shift
+  AssignmentKind assignment_kind = AssignmentKind::PerMarker;
+  MarkerWeightOptions weights;
+};
+
+struct DeformationBuildReport {
+  bool registered = false;
+  int landmarks = 0;
+  RegistrationReport registration;
+  int parts = 0;
+  int mean_shift_groups = 0;
+  double max_part_rigid_rms_mm = 0.0;
+  int boundary_markers = 0;
+  int markers_added_for_min_members = 0;
+  double mean_influences_per_vertex = 0.0;
+};
+
+// subject: the marker model (reference pose and marker surface); training: frame_count x
+// markers, frame-major, all present (a filled range-of-motion take, subject order); mesh: the
+// detailed surface in the reference pose (mm). Throws std::invalid_argument on unusable input.
+DeformationModel build_deformation_model(const SubjectModel& subject, std::span<const Vec3> training, int frame_count,
+                                         std::span<const Vec3> mesh_vertices,
+                                         std::span<const std::array<int, 3>> mesh_faces,
+                                         const DeformationBuildOptions& options = {},
+                                         DeformationBuildReport* out_report = nullptr);
+
+}  // namespace skinstream

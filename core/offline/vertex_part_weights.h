@@ -1,0 +1,33 @@
+#pragma once
+// Section 5.2, last step: the vertex weights beta_{j,p}. Each detailed vertex (registered,
+// reference pose) is projected onto its nearest marker-surface triangle (reference pose; a
+// bounding volume hierarchy finds it), the barycentric coordinates of the projection (clamped
+// to the triangle) interpolate the three markers' alpha vectors, zeros are dropped and the
+// result normalised.
+
+#include <array>
+#include <span>
+#include <vector>
+
+#include "core/capture.h"
+#include "core/deform/deformation_model.h"
+#include "core/deform/vertex_blend.h"
+
+namespace skinstream {
+
+struct VertexPartWeights {
+  std::vector<int> vertex_influence_offsets{0};  // CSR over vertices, as in DeformationModel
+  std::vector<PartInfluence> vertex_influences;  // beta_{j,p} > 0, sorted by part, sum 1 per vertex
+};
+
+// vertices: #V detailed-mesh vertex positions in the reference pose (mm); markers: #M marker
+// reference positions (mm); triangles: #T x 3 marker indices (the marker surface, at least one);
+// part_member_offsets / part_members: alpha as CSR over parts (marker_part_weights.h), where
+// every marker of a triangle must be a member of some part. Throws std::invalid_argument for an
+// index out of range, a non-finite position, a negative weight or a triangle whose three markers
+// have no weight at all.
+VertexPartWeights vertex_part_weights(std::span<const Vec3> vertices, std::span<const Vec3> markers,
+                                      std::span<const std::array<int, 3>> triangles,
+                                      std::span<const int> part_member_offsets, std::span<const PartMember> part_members);
+
+}  // namespace skinstream

@@ -1,0 +1,386 @@
+#include "server/ingest/vicon_source.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <unordered_map>
+
+#include "protocol/vicon_packet_framer.h"
+#include "protocol/vicon_packet_writer.h"
+
+namespace skinstream::server {
+namespace {
+
+namespace type = vicon::object_type;
+
+int64_t system_now_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+uint64_t marker_key(uint32_t subject_id, uint32_t marker_id) {
+  return (static_cast<uint64_t>(subject_id) << 32) | marker_id;
+}
+
+// The types this client reads; the answer to ObjectEnums is their intersection with the offer.
+constexpr uint32_t kWantedTypes[] = {type::StreamInfo,      type::SubjectInfo, type::FrameInfo, type::LabeledRecons,
+                                     type::UnlabeledRecons, type::Timecode,    type::Contents};
+
+}  // namespace
+
+// ---------------------------------------------------------------- ViconFrameAssembler
+
+ViconFrameAssembler::ViconFrameAssembler(std::vector<std::string> marker_names, FrameSink& sink)
+    : marker_names_(std::move(marker_names)), sink_(sink), frame_(static_cast<int>(marker_names_.size())) {
+  labeled_.reserve(marker_names_.size() + 64);
+  unlabeled_.reserve(256);
+}
+
+void ViconFrameAssembler::reset() {
+  frame_period_ticks_ = 0;
+  saw_object_enums_ = false;
+  offered_.types.clear();
+  marker_map_.clear();
+  subject_bytes_.clear();
+}
+
+bool ViconFrameAssembler::update_subjects(const std::vector<vicon::ObjectView>& objects, std::string& out_error) {
+  subject_bytes_scratch_.clear();
+  bool any = false;
+  for (const vicon::ObjectView& o : objects) {
+    if (o.type != type::SubjectInfo) continue;
+    any = true;
+    const auto length = static_cast<uint32_t>(o.payload.size());
+    const auto* raw = reinterpret_cast<const unsigned char*>(&length);
+    subject_bytes_scratch_.insert(subject_bytes_scratch_.end(), raw, raw + 4);
+    subject_bytes_scratch_.insert(subject_bytes_scratch_.end(), o.payload.begin(), o.payload.end());
+  }
+  if (!any || subject_bytes_scratch_ == subject_bytes_) return true;  // unchanged: nothing to redo
+
+  std::unordered_map<std::string, int> index_of;
+  for (size_t i = 0; i < marker_names_.size(); ++i) index_of.emplace(marker_names_[i], static_cast<int>(i));
+  std::vector<std::pair<uint64_t, int>> map;
+  for (const vicon::ObjectView& o : objects) {
+    if (o.type != type::SubjectInfo) continue;
+    vicon::SubjectInfo subject;
+    if (!vicon::decode(o.payload, subject, out_error)) return false;
+    const bool matches = std::any_of(subject.markers.begin(), subject.markers.end(),
+                                     [&](const vicon::SubjectMarker& m) { return index_of.count(m.name) > 0; });
+    for (const vicon::SubjectMarker& m : subject.markers) {
+      int index = kIgnored;
+      if (matches) {
+        const auto it = index_of.find(m.name);
+        index = it != index_of.end() ? it->second : kUnknownLabel;
+        if (index == kUnknownLabel && reported_labels_.insert(m.name).second) sink_.on_unknown_label(m.name);
+      }
+      map.emplace_back(marker_key(subject.subject_id, m.marker_id), index);
+    }
+  }
+  std::sort(map.begin(), map.end());
+  marker_map_ = std::move(map);
+  subject_bytes_.swap(subject_bytes_scratch_);
+  return true;
+}
+
+ViconFrameAssembler::Result ViconFrameAssembler::handle(const std::vector<vicon::ObjectView>& objects,
+                                                        int64_t receive_time_ns, std::string& out_error) {
+  for (const vicon::ObjectView& o : objects) {
+    if (o.type == type::ObjectEnums) {
+      if (!vicon::decode(o.payload, offered_, out_error)) return Result::Malformed;
+      saw_object_enums_ = true;
+    } else if (o.type == type::StreamInfo) {
+      vicon::StreamInfo info;
+      if (!vicon::decode(o.payload, info, out_error)) return Result::Malformed;
+      frame_period_ticks_ = info.frame_period_ticks;
+    }
+  }
+  if (!update_subjects(objects, out_error)) return Result::Malformed;
+
+  frame_.clear();
+  bool has_frame = false;
+  uint32_t frame_id = 0;
+  auto add_unlabelled = [this](const std::array<double, 3>& p, uint32_t id) {
+    const Vec3 point(p[0], p[1], p[2]);
+    if (!is_present(point) || frame_.unlabelled_count >= MarkerFrame::kMaxUnlabelled) {
+      ++frame_.rejected_points;
+      return;
+    }
+    frame_.unlabelled[static_cast<size_t>(frame_.unlabelled_count)] = point;
+    frame_.unlabelled_ids[static_cast<size_t>(frame_.unlabelled_count)] =
+        id <= static_cast<uint32_t>(INT32_MAX) ? static_cast<int>(id) : -1;
+    ++frame_.unlabelled_count;
+  };
+  for (const vicon::ObjectView& o : objects) {
+    switch (o.type) {
+      case type::FrameInfo: {
+        vicon::FrameInfo info;
+        if (!vicon::decode(o.payload, info, out_error)) return Result::Malformed;
+        frame_id = info.frame_id;
+        has_frame = true;
+        break;
+      }
+      case type::LabeledRecons: {
+        if (!vicon::decode(o.payload, labeled_, out_error)) return Result::Malformed;
+        for (const vicon::LabeledRecon& r : labeled_) {
+          const uint64_t key = marker_key(r.subject_id, r.marker_id);
+          const auto it = std::lower_bound(marker_map_.begin(), marker_map_.end(), std::make_pair(key, INT32_MIN));
+          const int index = (it != marker_map_.end() && it->first == key) ? it->second : kUnknownLabel;
+          if (index == kIgnored) continue;
+          if (index == kUnknownLabel) {
+            ++frame_.unknown_labels;
+            add_unlabelled(r.position, r.trajectory_id);
+            continue;
+          }
+          const Vec3 point(r.position[0], r.position[1], r.position[2]);
+          if (is_present(point))
+            frame_.labelled[static_cast<size_t>(index)] = point;
+          else
+            ++frame_.rejected_points;
+        }
+        break;
+      }
+      case type::UnlabeledRecons: {
+        if (!vicon::decode(o.payload, unlabeled_, out_error)) return Result::Malformed;
+        for (const vicon::UnlabeledRecon& r : unlabeled_) add_unlabelled(r.position, r.trajectory_id);
+        break;
+      }
+      case type::Timecode: {  // validated; the capture time comes from the frame number
+        vicon::Timecode timecode;
+        if (!vicon::decode(o.payload, timecode, out_error)) return Result::Malformed;
+        break;
+      }
+      case type::ObjectEnums:
+      case type::StreamInfo:
+      case type::SubjectInfo:
+      case type::Contents:
+      case type::Ping:
+        break;
+      default:
+        if (reported_types_.insert(o.type).second)
+          sink_.on_bad_input("unknown_object", "skipping Vicon object type " + std::to_string(o.type) +
+                                                   " (reported once)");
+        break;
+    }
+  }
+  if (!has_frame) return Result::NoFrame;
+  frame_.frame_number = frame_id + 1;  // as the Vicon SDK numbers frames
+  frame_.source_rate_hz = vicon::rate_from_period(frame_period_ticks_);
+  // ticks / 135 MHz in ns = ticks * 200 / 27, split so that a long take cannot overflow.
+  const int64_t ticks = static_cast<int64_t>(frame_id) * frame_period_ticks_;
+  frame_.source_time_ns = ticks / 27 * 200 + ticks % 27 * 200 / 27;
+  frame_.receive_time_ns = receive_time_ns;
+  return Result::Frame;
+}
+
+// ---------------------------------------------------------------- ViconSource
+
+struct ViconSource::State : std::enable_shared_from_this<ViconSource::State> {
+  State(asio::io_context& io_context, ViconSourceOptions opts, std::vector<std::string> marker_names,
+        FrameSink& frame_sink)
+      : io(io_context),
+        options(std::move(opts)),
+        sink(frame_sink),
+        assembler(std::move(marker_names), frame_sink),
+        socket(io),
+        resolver(io),
+        timer(io),
+        backoff(options.initial_backoff_seconds) {
+    pull_request = vicon::encode_packet(vicon::RequestFrame{false});
+    out_pending.reserve(256);
+    out_inflight.reserve(256);
+  }
+
+  asio::io_context& io;
+  ViconSourceOptions options;
+  FrameSink& sink;
+  ViconFrameAssembler assembler;
+  tcp::socket socket;
+  tcp::resolver resolver;
+  asio::steady_timer timer;
+  vicon::PacketFramer framer;
+  std::vector<unsigned char> pull_request;
+  std::vector<unsigned char> out_pending;   // bytes waiting for the write in flight
+  std::vector<unsigned char> out_inflight;
+  bool writing = false;
+  bool handshake_sent = false;
+  bool streaming = false;
+  bool disconnected_reported = false;
+  uint64_t generation = 0;  // bumps on every new connection: stale handlers see a different one
+  double backoff;
+  std::atomic<bool> stopped{false};
+
+  std::string where() const { return options.host + ":" + std::to_string(options.port); }
+
+  void connect() {
+    if (stopped) return;
+    const uint64_t gen = ++generation;
+    framer.reset();
+    assembler.reset();
+    handshake_sent = false;
+    streaming = false;
+    writing = false;
+    out_pending.clear();
+    resolver.async_resolve(options.host, std::to_string(options.port),
+                           [self = shared_from_this(), gen](const boost::system::error_code& ec,
+                                                            const tcp::resolver::results_type& results) {
+                             if (self->stopped || gen != self->generation) return;
+                             if (ec) return self->fail(gen, "cannot resolve " + self->where() + ": " + ec.message());
+                             asio::async_connect(self->socket, results,
+                                                 [self, gen](const boost::system::error_code& ec2, const tcp::endpoint&) {
+                                                   if (self->stopped || gen != self->generation) return;
+                                                   if (ec2)
+                                                     return self->fail(gen, "cannot connect to " + self->where() + ": " +
+                                                                                ec2.message());
+                                                   boost::system::error_code ignored;
+                                                   self->socket.set_option(tcp::no_delay(true), ignored);
+                                                   self->socket.non_blocking(true, ignored);
+                                                   self->read(gen);
+                                                 });
+                           });
+  }
+
+  void read(uint64_t gen) {
+    const auto room = framer.prepare(64 * 1024);
+    socket.async_read_some(asio::buffer(room.data(), room.size()),
+                           [self = shared_from_this(), gen](const boost::system::error_code& ec, size_t n) {
+                             self->on_read(gen, ec, n);
+                           });
+  }
+
+  void on_read(uint64_t gen, const boost::system::error_code& ec, size_t n) {
+    if (stopped || gen != generation) return;
+    if (ec) {
+      fail(gen, (ec == asio::error::eof ? std::string("the server closed the connection")
+                                        : "connection lost: " + ec.message()) +
+                    " (" + where() + ")");
+      return;
+    }
+    framer.commit(n);
+    vicon::Bytes packet;
+    for (;;) {
+      const auto status = framer.next(packet);
+      if (status == vicon::PacketFramer::Status::NeedMore) break;
+      if (status == vicon::PacketFramer::Status::Error) {
+        sink.on_bad_input("malformed_packet", framer.error());
+        fail(gen, "malformed packet from " + where() + ": " + framer.error());
+        return;
+      }
+      std::string error;
+      const auto result = assembler.handle(framer.objects(), system_now_ns(), error);
+      if (stopped) return;
+      if (result == ViconFrameAssembler::Result::Malformed) {
+        sink.on_bad_input("malformed_packet", error);
+        fail(gen, "malformed packet from " + where() + ": " + error);
+        return;
+      }
+      if (!handshake_sent && assembler.saw_object_enums()) send_handshake(gen);
+      if (result == ViconFrameAssembler::Result::Frame) {
+        if (!streaming) {
+          streaming = true;
+          disconnected_reported = false;
+          backoff = options.initial_backoff_seconds;
+          sink.on_source_state(SourceState::Streaming, where());
+        }
+        sink.on_frame(assembler.frame());
+        if (stopped) return;
+        if (options.mode == ViconSourceOptions::Mode::ClientPull) send(gen, pull_request);
+      }
+    }
+    read(gen);
+  }
+
+  void send_handshake(uint64_t gen) {
+    handshake_sent = true;
+    vicon::ObjectEnums wanted;
+    for (uint32_t t : kWantedTypes)
+      if (std::find(assembler.offered().types.begin(), assembler.offered().types.end(), t) !=
+          assembler.offered().types.end())
+        wanted.types.push_back(t);
+    std::sort(wanted.types.begin(), wanted.types.end());
+    const bool push = options.mode == ViconSourceOptions::Mode::ServerPush;
+    send(gen, vicon::encode_packet(wanted, vicon::RequestFrame{push}));
+  }
+
+  // A request is a few bytes into an empty send buffer: written at once without an asynchronous
+  // operation (which would allocate per frame next to the pending read); queued only if it cannot.
+  void send(uint64_t gen, const std::vector<unsigned char>& bytes) {
+    size_t written = 0;
+    if (!writing && out_pending.empty()) {
+      boost::system::error_code ec;
+      written = socket.write_some(asio::buffer(bytes), ec);
+      if (ec == asio::error::would_block || ec == asio::error::try_again) {
+        written = 0;
+      } else if (ec) {
+        fail(gen, "cannot send to " + where() + ": " + ec.message());
+        return;
+      }
+    }
+    out_pending.insert(out_pending.end(), bytes.begin() + static_cast<long>(written), bytes.end());
+    flush(gen);
+  }
+
+  void flush(uint64_t gen) {
+    if (writing || out_pending.empty()) return;
+    writing = true;
+    out_inflight.swap(out_pending);
+    out_pending.clear();
+    asio::async_write(socket, asio::buffer(out_inflight),
+                      [self = shared_from_this(), gen](const boost::system::error_code& ec, size_t) {
+                        if (self->stopped || gen != self->generation) return;
+                        self->writing = false;
+                        self->out_inflight.clear();
+                        if (ec) return self->fail(gen, "cannot send to " + self->where() + ": " + ec.message());
+                        self->flush(gen);
+                      });
+  }
+
+  void close_socket() {
+    boost::system::error_code ignored;
+    resolver.cancel();
+    socket.shutdown(tcp::socket::shutdown_both, ignored);
+    socket.close(ignored);
+  }
+
+  void fail(uint64_t gen, const std::string& reason) {
+    if (stopped || gen != generation) return;
+    ++generation;  // whatever is still pending for this connection is now stale
+    close_socket();
+    streaming = false;
+    if (!disconnected_reported) {
+      disconnected_reported = true;
+      sink.on_source_state(SourceState::Disconnected, reason);
+    }
+    timer.expires_after(std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+        std::chrono::duration<double>(backoff)));
+    backoff = std::min(backoff * 2.0, options.max_backoff_seconds);
+    timer.async_wait([self = shared_from_this()](const boost::system::error_code& ec) {
+      if (!ec && !self->stopped) self->connect();
+    });
+  }
+};
+
+ViconSource::ViconSource(asio::io_context& io, ViconSourceOptions options, std::vector<std::string> marker_names,
+                         FrameSink& sink)
+    : state_(std::make_shared<State>(io, std::move(options), std::move(marker_names), sink)) {}
+
+ViconSource::~ViconSource() { stop(); }
+
+void ViconSource::start() {
+  asio::post(state_->io, [state = state_] {
+    if (state->stopped) return;
+    state->sink.on_source_state(SourceState::Connecting, state->where());
+    state->connect();
+  });
+}
+
+void ViconSource::stop() {
+  if (state_->stopped.exchange(true)) return;
+  asio::post(state_->io, [state = state_] {
+    state->timer.cancel();
+    state->close_socket();
+  });
+}
+
+}  // namespace skinstream::server

@@ -1,0 +1,442 @@
+#include "server/vicon/vicon_server.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <deque>
+#include <stdexcept>
+#include <vector>
+
+#include <spdlog/spdlog.h>
+
+#include "protocol/vicon_capture_encoder.h"
+#include "protocol/vicon_packet_framer.h"
+#include "protocol/vicon_packet_reader.h"
+#include "protocol/vicon_packet_writer.h"
+
+namespace skinstream::server {
+namespace {
+
+using Packet = std::shared_ptr<const std::vector<unsigned char>>;
+using Clock = std::chrono::steady_clock;
+
+int64_t system_now_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+Packet copy_packet(std::span<const unsigned char> bytes) {
+  return std::make_shared<const std::vector<unsigned char>>(bytes.begin(), bytes.end());
+}
+
+bool contains(const std::vector<uint32_t>& set, uint32_t type) {
+  return std::find(set.begin(), set.end(), type) != set.end();
+}
+
+// The packet with only the objects of the wanted types (the client's ObjectEnums answer).
+Packet filter_packet(const Packet& packet, const std::vector<uint32_t>& wanted) {
+  std::vector<vicon::ObjectView> objects;
+  std::string error;
+  if (!vicon::split_objects(*packet, objects, error)) return packet;  // our own packets are well formed
+  if (std::all_of(objects.begin(), objects.end(), [&](const auto& o) { return contains(wanted, o.type); }))
+    return packet;
+  vicon::PacketWriter writer;
+  for (const auto& o : objects)
+    if (contains(wanted, o.type)) writer.add_raw(o.type, o.payload);
+  return copy_packet(writer.finish());
+}
+
+}  // namespace
+
+struct ViconServer::State : std::enable_shared_from_this<ViconServer::State> {
+  struct Session;
+
+  State(asio::io_context& io_context, const Capture& capture_in, ViconServerOptions opts)
+      : io(io_context),
+        capture(capture_in),
+        options(std::move(opts)),
+        encoder(capture, options.subject_name, options.rate_hz),
+        acceptor(io),
+        timer(io),
+        multicast_socket(io) {}
+
+  asio::io_context& io;
+  const Capture& capture;
+  ViconServerOptions options;
+  vicon::CaptureFrameEncoder encoder;
+  vicon::PacketWriter writer;
+  tcp::acceptor acceptor;
+  asio::steady_timer timer;
+  udp::socket multicast_socket;
+  std::vector<udp::endpoint> multicast_destinations;
+  std::vector<std::shared_ptr<Session>> sessions;
+  Packet object_enums_packet;
+
+  bool running = false;
+  bool timeline_started = false;
+  bool done = false;
+  Clock::time_point timeline_start;
+  uint64_t next_sequence = 0;      // k of the next frame to produce
+  uint64_t latest_sequence = 0;    // k of the newest produced frame (valid when produced > 0)
+  Packet latest_plain;             // the newest frame without static objects
+  Packet latest_with_static;       // ... and with them (made when a client first needs it)
+
+  FrameHook frame_hook;
+  std::function<void()> on_finished;
+  ViconServerStats stats;
+
+  // ---- one TCP client ----
+  struct Session : std::enable_shared_from_this<Session> {
+    Session(State& owner, tcp::socket s) : state(owner), socket(std::move(s)) {}
+
+    State& state;  // sessions never outlive State: State closes them in stop()
+    tcp::socket socket;
+    vicon::PacketFramer framer;
+    struct Outgoing {
+      Packet packet;
+      bool is_frame;
+    };
+    std::deque<Outgoing> queue;  // front is being written while `writing`
+    bool writing = false;
+    bool open = true;
+    bool push = false;
+    int pull_requests = 0;
+    bool sent_any_frame = false;
+    bool has_last_sent = false;
+    uint64_t last_sent_sequence = 0;
+    std::vector<uint32_t> wanted;  // empty: everything offered
+
+    void begin() {
+      enqueue(state.object_enums_packet, false);
+      read();
+    }
+
+    void read() {
+      auto self = shared_from_this();
+      const auto room = framer.prepare(16 * 1024);
+      socket.async_read_some(asio::buffer(room.data(), room.size()),
+                             [self](const boost::system::error_code& ec, size_t n) { self->on_read(ec, n); });
+    }
+
+    void on_read(const boost::system::error_code& ec, size_t n) {
+      if (!open) return;
+      if (ec) {
+        if (ec != asio::error::eof && ec != asio::error::operation_aborted)
+          spdlog::debug("vicon server: client read: {}", ec.message());
+        close();
+        return;
+      }
+      framer.commit(n);
+      vicon::Bytes packet;
+      for (;;) {
+        const auto status = framer.next(packet);
+        if (status == vicon::PacketFramer::Status::NeedMore) break;
+        std::string error;
+        if (status == vicon::PacketFramer::Status::Error || !handle(framer.objects(), error)) {
+          reject(status == vicon::PacketFramer::Status::Error ? framer.error() : error);
+          return;
+        }
+      }
+      read();
+    }
+
+    bool handle(const std::vector<vicon::ObjectView>& objects, std::string& error) {
+      namespace type = vicon::object_type;
+      for (const vicon::ObjectView& object : objects) {
+        switch (object.type) {
+          case type::ObjectEnums: {
+            vicon::ObjectEnums asked;
+            if (!vicon::decode(object.payload, asked, error)) return false;
+            wanted = asked.types;
+            break;
+          }
+          case type::RequestFrame: {
+            vicon::RequestFrame request;
+            if (!vicon::decode(object.payload, request, error)) return false;
+            push = request.streaming;
+            if (!push) ++pull_requests;
+            state.client_wants_frames(*this);
+            break;
+          }
+          case type::RequestNextFrame: {
+            vicon::RequestNextFrame request;
+            if (!vicon::decode(object.payload, request, error)) return false;
+            ++pull_requests;
+            state.client_wants_frames(*this);
+            break;
+          }
+          case type::Ping: {
+            vicon::Ping ping;
+            if (!vicon::decode(object.payload, ping, error)) return false;
+            enqueue(copy_packet(vicon::encode_packet(ping)), false);
+            break;
+          }
+          case type::StartMulticastSender: {
+            vicon::StartMulticastSender request;
+            if (!vicon::decode(object.payload, request, error)) return false;
+            state.add_multicast(udp::endpoint(asio::ip::address_v4(request.multicast_address), request.port));
+            break;
+          }
+          case type::StopMulticastSender:
+            state.multicast_destinations.clear();
+            break;
+          case type::Filter: {  // accepted; a single-subject stream has nothing to filter
+            vicon::Filter filter;
+            if (!vicon::decode(object.payload, filter, error)) return false;
+            break;
+          }
+          default:  // Contents, KeepAlive, haptics and types of newer SDKs: nothing to do
+            break;
+        }
+      }
+      return true;
+    }
+
+    // Queues a packet; frames beyond the bound push out the oldest waiting frame.
+    void enqueue(Packet packet, bool is_frame) {
+      if (!open) return;
+      if (is_frame) {
+        size_t waiting = 0;
+        for (size_t i = writing ? 1 : 0; i < queue.size(); ++i) waiting += queue[i].is_frame ? 1 : 0;
+        if (waiting >= std::max<size_t>(1, state.options.max_queued_frames)) {
+          for (auto it = queue.begin() + (writing ? 1 : 0); it != queue.end(); ++it)
+            if (it->is_frame) {
+              queue.erase(it);
+              ++state.stats.frames_dropped;
+              break;
+            }
+        }
+      }
+      queue.push_back({std::move(packet), is_frame});
+      write();
+    }
+
+    void write() {
+      if (writing || queue.empty() || !open) return;
+      writing = true;
+      auto self = shared_from_this();
+      const Packet& packet = queue.front().packet;
+      asio::async_write(socket, asio::buffer(*packet), [self](const boost::system::error_code& ec, size_t) {
+        self->writing = false;
+        if (!self->open) return;
+        if (ec) {
+          self->close();
+          return;
+        }
+        if (self->queue.front().is_frame) ++self->state.stats.frame_packets_sent;
+        self->queue.pop_front();
+        self->write();
+      });
+    }
+
+    void reject(const std::string& reason) {
+      ++state.stats.bad_clients;
+      spdlog::warn("vicon server: closing a client that sent malformed input: {}", reason);
+      close();
+    }
+
+    void close() {
+      if (!open) return;
+      open = false;
+      boost::system::error_code ignored;
+      socket.shutdown(tcp::socket::shutdown_both, ignored);
+      socket.close(ignored);
+      queue.clear();
+      --state.stats.clients_open;
+      state.forget(this);
+    }
+  };
+
+  void forget(Session* session) {
+    // Posted: the session may be in the middle of its own handler.
+    asio::post(io, [self = shared_from_this(), session] {
+      auto& s = self->sessions;
+      s.erase(std::remove_if(s.begin(), s.end(), [session](const auto& p) { return p.get() == session; }), s.end());
+    });
+  }
+
+  void start() {
+    const auto address = asio::ip::make_address(options.bind_address);
+    const tcp::endpoint endpoint(address, options.port);
+    boost::system::error_code ec;
+    acceptor.open(endpoint.protocol(), ec);
+    if (!ec) acceptor.set_option(tcp::acceptor::reuse_address(true), ec);
+    if (!ec) acceptor.bind(endpoint, ec);
+    if (!ec) acceptor.listen(asio::socket_base::max_listen_connections, ec);
+    if (ec)
+      throw std::runtime_error("cannot listen on " + options.bind_address + ":" + std::to_string(options.port) + ": " +
+                               ec.message());
+    object_enums_packet = copy_packet(vicon::encode_packet(vicon::CaptureFrameEncoder::offered_types()));
+    running = true;
+    accept();
+    if (!options.start_on_first_request) start_timeline();
+  }
+
+  void accept() {
+    acceptor.async_accept([self = shared_from_this()](const boost::system::error_code& ec, tcp::socket socket) {
+      if (!self->running) return;
+      if (!ec) {
+        boost::system::error_code ignored;
+        socket.set_option(tcp::no_delay(true), ignored);
+        if (self->options.socket_send_buffer_bytes > 0)
+          socket.set_option(asio::socket_base::send_buffer_size(self->options.socket_send_buffer_bytes), ignored);
+        auto session = std::make_shared<Session>(*self, std::move(socket));
+        self->sessions.push_back(session);
+        ++self->stats.clients_accepted;
+        ++self->stats.clients_open;
+        session->begin();
+      } else if (ec == asio::error::operation_aborted) {
+        return;
+      }
+      self->accept();
+    });
+  }
+
+  void stop() {
+    if (!running) return;
+    running = false;
+    boost::system::error_code ignored;
+    acceptor.close(ignored);
+    timer.cancel();
+    multicast_socket.close(ignored);
+    for (auto& session : std::vector<std::shared_ptr<Session>>(sessions)) session->close();
+    sessions.clear();
+  }
+
+  void client_wants_frames(Session& session) {
+    if (!timeline_started) {
+      start_timeline();
+      return;  // the first frame goes out at once from the timer
+    }
+    serve(session);
+  }
+
+  void start_timeline() {
+    if (timeline_started || !running || capture.frame_count <= 0) return;
+    timeline_started = true;
+    timeline_start = Clock::now();
+    schedule();
+  }
+
+  Clock::duration deadline_offset(uint64_t sequence) const {
+    const double rate = encoder.rate_hz() * (options.speed > 0.0 ? options.speed : 1.0);
+    const double seconds = static_cast<double>(sequence) / rate;
+    return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
+  }
+
+  void schedule() {
+    timer.expires_at(timeline_start + deadline_offset(next_sequence));
+    timer.async_wait([self = shared_from_this()](const boost::system::error_code& ec) {
+      if (ec || !self->running) return;
+      self->produce();
+    });
+  }
+
+  void produce() {
+    const uint64_t sequence = next_sequence++;
+    const int index = static_cast<int>(sequence % static_cast<uint64_t>(capture.frame_count));
+    const auto frame_number = static_cast<uint32_t>(static_cast<int64_t>(capture.first_frame) + static_cast<int64_t>(sequence));
+    encoder.encode_frame(index, frame_number, false, writer);
+    latest_plain = copy_packet(writer.finish());
+    latest_with_static.reset();
+    latest_sequence = sequence;
+    latest_index = index;
+    latest_frame_number = frame_number;
+    ++stats.frames_produced;
+
+    for (auto& session : std::vector<std::shared_ptr<Session>>(sessions)) serve(*session);
+    send_multicast();
+    if (frame_hook) frame_hook(frame_number, system_now_ns());
+
+    if (!options.loop && next_sequence >= static_cast<uint64_t>(capture.frame_count)) {
+      done = true;
+      if (on_finished) on_finished();
+      return;
+    }
+    schedule();
+  }
+
+  const Packet& with_static() {
+    if (!latest_with_static) {
+      encoder.encode_frame(latest_index, latest_frame_number, true, writer);
+      latest_with_static = copy_packet(writer.finish());
+    }
+    return latest_with_static;
+  }
+
+  // Sends the newest frame to a client that wants it and has not had it.
+  void serve(Session& session) {
+    if (!session.open || stats.frames_produced == 0) return;
+    if (!session.push && session.pull_requests <= 0) return;
+    if (session.has_last_sent && session.last_sent_sequence >= latest_sequence) return;
+    Packet packet = session.sent_any_frame ? latest_plain : with_static();
+    if (!session.wanted.empty()) packet = filter_packet(packet, session.wanted);
+    session.sent_any_frame = true;
+    session.has_last_sent = true;
+    session.last_sent_sequence = latest_sequence;
+    if (!session.push) --session.pull_requests;
+    session.enqueue(std::move(packet), true);
+  }
+
+  void add_multicast(const udp::endpoint& destination) {
+    boost::system::error_code ec;
+    if (!multicast_socket.is_open()) {
+      multicast_socket.open(udp::v4(), ec);
+      if (!ec) multicast_socket.set_option(asio::ip::multicast::hops(options.multicast_ttl), ec);
+      if (!ec) multicast_socket.set_option(asio::ip::multicast::enable_loopback(true), ec);
+      if (ec) {
+        spdlog::warn("vicon server: cannot open the multicast socket: {}", ec.message());
+        return;
+      }
+    }
+    if (std::find(multicast_destinations.begin(), multicast_destinations.end(), destination) ==
+        multicast_destinations.end())
+      multicast_destinations.push_back(destination);
+    spdlog::info("vicon server: multicasting to {}:{}", destination.address().to_string(), destination.port());
+    start_timeline();
+  }
+
+  void send_multicast() {
+    if (multicast_destinations.empty() || !multicast_socket.is_open()) return;
+    const Packet packet = with_static();  // datagrams are independent: each carries everything
+    if (packet->size() > 65507) {
+      ++stats.datagrams_too_large;
+      return;
+    }
+    for (const udp::endpoint& destination : multicast_destinations) {
+      multicast_socket.async_send_to(asio::buffer(*packet), destination,
+                                     [self = shared_from_this(), packet](const boost::system::error_code& ec, size_t) {
+                                       if (!ec) ++self->stats.datagrams_sent;
+                                     });
+    }
+  }
+
+  int latest_index = 0;
+  uint32_t latest_frame_number = 0;
+};
+
+ViconServer::ViconServer(asio::io_context& io, const Capture& capture, ViconServerOptions options)
+    : state_(std::make_shared<State>(io, capture, std::move(options))) {}
+
+ViconServer::~ViconServer() { stop(); }
+
+void ViconServer::start() { state_->start(); }
+void ViconServer::stop() { state_->stop(); }
+uint16_t ViconServer::port() const {
+  boost::system::error_code ec;
+  const auto endpoint = state_->acceptor.local_endpoint(ec);
+  return ec ? 0 : endpoint.port();
+}
+void ViconServer::set_frame_hook(FrameHook hook) { state_->frame_hook = std::move(hook); }
+void ViconServer::set_on_finished(std::function<void()> on_finished) { state_->on_finished = std::move(on_finished); }
+void ViconServer::start_multicast(const std::string& address, uint16_t port) {
+  state_->add_multicast(udp::endpoint(asio::ip::make_address(address), port));
+}
+bool ViconServer::finished() const { return state_->done; }
+bool ViconServer::all_clients_idle() const {
+  return std::all_of(state_->sessions.begin(), state_->sessions.end(),
+                     [](const auto& s) { return s->queue.empty() && !s->writing; });
+}
+const ViconServerStats& ViconServer::stats() const { return state_->stats; }
+
+}  // namespace skinstream::server

@@ -1,0 +1,116 @@
+#include "core/offline/marker_part_weights.h"
+
+#include <gtest/gtest.h>
+
+#include <limits>
+
+#include "core/offline/part_segmentation.h"
+#include "tests/core/offline/offline_test_support.h"
+
+namespace skinstream {
+namespace {
+
+using test::ArticulatedLimb;
+using test::make_articulated_limb;
+
+constexpr int kFrames = 240;
+
+// The limb cut by its segments: a triangle spanning a joint goes with two of its markers, so the
+// last ring before a joint and the first after it are the boundary markers.
+struct Fixture {
+  ArticulatedLimb limb = make_articulated_limb(3, kFrames);
+  std::vector<int> triangle_part =
+      segmentation_from_assignment(limb.reference, limb.triangles, limb.positions, kFrames, limb.segment, AssignmentKind::PerMarker)
+          .triangle_part;
+};
+
+std::vector<double> row_sums(const MarkerPartWeights& w, int markers) {
+  std::vector<double> sum(markers, 0.0);
+  for (const PartMember& m : w.part_members) sum[m.marker] += m.weight;
+  return sum;
+}
+
+TEST(MarkerPartWeights, RejectsBadInputs) {
+  const Fixture f;
+  const auto& l = f.limb;
+  EXPECT_THROW(marker_part_weights(l.reference, l.triangles, std::vector<int>(3, 0), 3, l.positions, kFrames), std::invalid_argument);
+  std::vector<int> out_of_range = f.triangle_part;
+  out_of_range[5] = 3;
+  EXPECT_THROW(marker_part_weights(l.reference, l.triangles, out_of_range, 3, l.positions, kFrames), std::invalid_argument);
+  EXPECT_THROW(marker_part_weights(l.reference, l.triangles, f.triangle_part, 4, l.positions, kFrames),
+               std::invalid_argument);  // part 3 has no triangle
+  EXPECT_THROW(marker_part_weights(l.reference, l.triangles, f.triangle_part, 3, l.positions, kFrames - 1), std::invalid_argument);
+  auto nan = l.positions;
+  nan[100].y() = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(marker_part_weights(l.reference, l.triangles, f.triangle_part, 3, nan, kFrames), std::invalid_argument);
+  MarkerWeightOptions o;
+  o.threshold = 1.0;
+  EXPECT_THROW(marker_part_weights(l.reference, l.triangles, f.triangle_part, 3, l.positions, kFrames, o), std::invalid_argument);
+}
+
+TEST(MarkerPartWeights, InsideMarkersWeighOneAndBoundaryMarkersFollowTheirSegment) {
+  const Fixture f;
+  const auto& l = f.limb;
+  const int m = static_cast<int>(l.reference.size());
+  const MarkerPartWeights w = marker_part_weights(l.reference, l.triangles, f.triangle_part, 3, l.positions, kFrames);
+  ASSERT_EQ(w.part_member_offsets.size(), 4u);
+  for (double s : row_sums(w, m)) EXPECT_NEAR(s, 1.0, 1e-12);
+  EXPECT_EQ(w.boundary_markers, 4 * l.around);  // the rings on either side of the two joints
+  EXPECT_EQ(w.markers_added_for_min_members, 0);
+  for (int ring = 0; ring < 12; ++ring)
+    for (int a = 0; a < l.around; ++a) {
+      const int i = l.marker(ring, a);
+      const int seg = l.segment[i];
+      const bool boundary = ring == 3 || ring == 4 || ring == 7 || ring == 8;
+      if (!boundary) {
+        EXPECT_EQ(w.weight(i, seg), 1.0) << "inside marker " << i;  // exactly
+      } else {
+        // Moves exactly with its own segment: (almost) all of its weight goes there.
+        EXPECT_GT(w.weight(i, seg), 0.999) << "boundary marker " << i;
+      }
+    }
+  for (int p = 0; p < 3; ++p) EXPECT_EQ(w.part_sigma_mm[p], 1.0);  // rigid parts: the floor
+  // Deterministic.
+  const MarkerPartWeights again = marker_part_weights(l.reference, l.triangles, f.triangle_part, 3, l.positions, kFrames);
+  ASSERT_EQ(again.part_members.size(), w.part_members.size());
+  for (size_t k = 0; k < w.part_members.size(); ++k) EXPECT_EQ(again.part_members[k].weight, w.part_members[k].weight);
+}
+
+// A boundary marker moving halfway between its two parts gets half of each; a threshold above
+// one half keeps only the stronger (then weight 1).
+TEST(MarkerPartWeights, SplitsAMarkerBetweenPartsAndRespectsTheThreshold) {
+  Fixture f;
+  auto& l = f.limb;
+  const int m = static_cast<int>(l.reference.size());
+  const int i = l.marker(3, 2);  // last ring of segment 0, boundary of parts 0 and 1
+  test::move_halfway(l, i, 5, kFrames);  // segment 1's ring 5
+  const MarkerPartWeights w = marker_part_weights(l.reference, l.triangles, f.triangle_part, 3, l.positions, kFrames);
+  for (double s : row_sums(w, m)) EXPECT_NEAR(s, 1.0, 1e-12);
+  EXPECT_NEAR(w.weight(i, 0), 0.5, 1e-6);
+  EXPECT_NEAR(w.weight(i, 1), 0.5, 1e-6);
+  for (const PartMember& member : w.part_members) EXPECT_GT(member.weight, 0.2);
+
+  MarkerWeightOptions strict;
+  strict.threshold = 0.6;
+  const MarkerPartWeights one = marker_part_weights(l.reference, l.triangles, f.triangle_part, 3, l.positions, kFrames, strict);
+  EXPECT_EQ(one.weight(i, 0) + one.weight(i, 1), 1.0);
+  EXPECT_TRUE(one.weight(i, 0) == 0.0 || one.weight(i, 1) == 0.0);
+  for (double s : row_sums(one, m)) EXPECT_NEAR(s, 1.0, 1e-12);
+}
+
+// A part of a single triangle has 3 markers: a fourth (the nearest) is added.
+TEST(MarkerPartWeights, EveryPartKeepsFourMembers) {
+  const Fixture f;
+  const auto& l = f.limb;
+  const int m = static_cast<int>(l.reference.size());
+  std::vector<int> parts(l.triangles.size(), 0);
+  parts[20] = 1;
+  const MarkerPartWeights w = marker_part_weights(l.reference, l.triangles, parts, 2, l.positions, kFrames);
+  EXPECT_EQ(w.part_member_offsets[2] - w.part_member_offsets[1], 4);
+  EXPECT_EQ(w.markers_added_for_min_members, 1);
+  for (double s : row_sums(w, m)) EXPECT_NEAR(s, 1.0, 1e-12);
+  for (const PartMember& member : w.part_members) EXPECT_GT(member.weight, 0.0);
+}
+
+}  // namespace
+}  // namespace skinstream

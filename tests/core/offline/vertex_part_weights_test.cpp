@@ -1,0 +1,106 @@
+#include "core/offline/vertex_part_weights.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <random>
+
+#include "core/offline/marker_part_weights.h"
+#include "core/offline/part_segmentation.h"
+#include "tests/core/offline/offline_test_support.h"
+
+namespace skinstream {
+namespace {
+
+constexpr int kFrames = 120;
+
+struct Fixture {
+  test::ArticulatedLimb limb = test::make_articulated_limb(3, kFrames);
+  MarkerPartWeights alpha;
+  Fixture() {
+    // A boundary marker of parts 0 and 1 moved halfway, so that some vertices blend two parts.
+    const std::vector<int> parts = segmentation_from_assignment(limb.reference, limb.triangles, limb.positions, kFrames,
+                                                                limb.segment, AssignmentKind::PerMarker)
+                                       .triangle_part;
+    test::move_halfway(limb, limb.marker(3, 2), 5, kFrames);
+    alpha = marker_part_weights(limb.reference, limb.triangles, parts, 3, limb.positions, kFrames);
+  }
+  VertexPartWeights weights(const std::vector<Vec3>& vertices) const {
+    return vertex_part_weights(vertices, limb.reference, limb.triangles, alpha.part_member_offsets, alpha.part_members);
+  }
+};
+
+double beta(const VertexPartWeights& w, int vertex, int part) {
+  for (int k = w.vertex_influence_offsets[vertex]; k < w.vertex_influence_offsets[vertex + 1]; ++k)
+    if (w.vertex_influences[k].part == part) return w.vertex_influences[k].weight;
+  return 0.0;
+}
+
+TEST(VertexPartWeights, RejectsBadInputs) {
+  const Fixture f;
+  const auto& l = f.limb;
+  const std::vector<Vec3> vertices{Vec3(40, 0, 100)};
+  EXPECT_THROW(vertex_part_weights(vertices, l.reference, {}, f.alpha.part_member_offsets, f.alpha.part_members),
+               std::invalid_argument);
+  auto bad = l.triangles;
+  bad[0][2] = -1;
+  EXPECT_THROW(vertex_part_weights(vertices, l.reference, bad, f.alpha.part_member_offsets, f.alpha.part_members),
+               std::invalid_argument);
+  const std::vector<Vec3> nan{Vec3(std::numeric_limits<double>::quiet_NaN(), 0, 0)};
+  EXPECT_THROW(f.weights(nan), std::invalid_argument);
+  std::vector<PartMember> negative = f.alpha.part_members;
+  negative[0].weight = -0.5;
+  EXPECT_THROW(vertex_part_weights(vertices, l.reference, l.triangles, f.alpha.part_member_offsets, negative),
+               std::invalid_argument);
+  const std::vector<int> short_offsets{0, 3};
+  EXPECT_THROW(vertex_part_weights(vertices, l.reference, l.triangles, short_offsets, f.alpha.part_members),
+               std::invalid_argument);
+}
+
+TEST(VertexPartWeights, SumToOneAndFollowTheNearestTriangle) {
+  const Fixture f;
+  const auto& l = f.limb;
+  const int split = l.marker(3, 2);
+  ASSERT_GT(f.alpha.weight(split, 0), 0.3);
+  ASSERT_GT(f.alpha.weight(split, 1), 0.3);
+
+  std::vector<Vec3> vertices;
+  // 1: on every marker, 5 mm outside the surface.
+  for (const Vec3& p : l.reference) vertices.push_back(p + 5.0 * Vec3(p.x(), p.y(), 0.0).normalized());
+  const size_t on_markers = vertices.size();
+  // 2: random points around the limb, near and far from the surface.
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> angle(0.0, 2.0 * M_PI), height(-50.0, 650.0), radius(20.0, 60.0);
+  for (int k = 0; k < 2000; ++k) {
+    const double a = angle(rng), r = radius(rng);
+    vertices.emplace_back(r * std::cos(a), r * std::sin(a), height(rng));
+  }
+  const VertexPartWeights w = f.weights(vertices);
+  ASSERT_EQ(w.vertex_influence_offsets.size(), vertices.size() + 1);
+  for (size_t j = 0; j < vertices.size(); ++j) {
+    double sum = 0.0;
+    for (int k = w.vertex_influence_offsets[j]; k < w.vertex_influence_offsets[j + 1]; ++k) {
+      EXPECT_GT(w.vertex_influences[k].weight, 0.0);
+      sum += w.vertex_influences[k].weight;
+    }
+    EXPECT_NEAR(sum, 1.0, 1e-12) << "vertex " << j;
+  }
+  // A vertex on a marker gets that marker's weights.
+  for (size_t i = 0; i < on_markers; ++i)
+    for (int p = 0; p < 3; ++p) EXPECT_NEAR(beta(w, static_cast<int>(i), p), f.alpha.weight(static_cast<int>(i), p), 1e-9) << i;
+  // Inside a part (between rings 1 and 2 of segment 0, or rings 9 and 10 of segment 2): weight 1.
+  const std::vector<Vec3> inside{Vec3(45.0, 3.0, 70.0), Vec3(-30.0, -30.0, 520.0)};
+  const VertexPartWeights wi = f.weights(inside);
+  EXPECT_EQ(wi.vertex_influence_offsets[1], 1);
+  EXPECT_EQ(beta(wi, 0, 0), 1.0);
+  EXPECT_EQ(beta(wi, 1, 2), 1.0);
+  // Between the split marker and its ring neighbours the vertex blends parts 0 and 1.
+  const Vec3 near_split = 0.8 * l.reference[split] + 0.2 * l.reference[l.marker(3, 3)];
+  const VertexPartWeights ws = f.weights({near_split});
+  EXPECT_GT(beta(ws, 0, 0), 0.0);
+  EXPECT_GT(beta(ws, 0, 1), 0.0);
+}
+
+}  // namespace
+}  // namespace skinstream

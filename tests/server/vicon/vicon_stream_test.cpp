@@ -1,0 +1,480 @@
+// The Vicon DataStream server engine and the daemon's ViconSource / ViconMulticastSource over real
+// loopback sockets: push and pull, exact positions, occlusion, unlabelled points, reconnection,
+// garbage, stalled and malformed clients, multicast datagrams, and no allocation per frame.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <condition_variable>
+#include <functional>
+#include <future>
+#include <mutex>
+#include <optional>
+#include <thread>
+
+#include "protocol/capture_file.h"
+#include "protocol/vicon_packet_writer.h"
+#include "server/asio.h"
+#include "server/ingest/vicon_multicast_source.h"
+#include "server/ingest/vicon_source.h"
+#include "server/vicon/vicon_server.h"
+#include "support/allocation_counter.h"
+#include "support/test_data.h"
+
+namespace skinstream::server {
+namespace {
+
+using namespace std::chrono_literals;
+constexpr auto kPatience = 20s;  // only bounds a failing test; passing ones never wait this long
+
+// An io_context running on its own thread; call() runs a function there and waits for it.
+class IoThread {
+ public:
+  IoThread() : guard_(asio::make_work_guard(io)), thread_([this] { io.run(); }) {}
+  ~IoThread() {
+    guard_.reset();
+    io.stop();
+    thread_.join();
+  }
+  template <typename F>
+  auto call(F&& f) {
+    std::packaged_task<decltype(f())()> task(std::forward<F>(f));
+    auto result = task.get_future();
+    asio::post(io, [&task] { task(); });
+    return result.get();
+  }
+  asio::io_context io;
+
+ private:
+  asio::executor_work_guard<asio::io_context::executor_type> guard_;
+  std::thread thread_;
+};
+
+struct ReceivedFrame {
+  uint32_t number = 0;
+  int64_t source_time_ns = 0;
+  double rate = 0.0;
+  std::vector<Vec3> labelled;
+  std::vector<std::pair<int, Vec3>> unlabelled;  // id, position
+  int unknown_labels = 0;
+};
+
+class RecordingSink : public FrameSink {
+ public:
+  void on_frame(const MarkerFrame& frame) override {
+    ReceivedFrame r;
+    r.number = frame.frame_number;
+    r.source_time_ns = frame.source_time_ns;
+    r.rate = frame.source_rate_hz;
+    r.labelled = frame.labelled;
+    for (int i = 0; i < frame.unlabelled_count; ++i)
+      r.unlabelled.emplace_back(frame.unlabelled_ids[static_cast<size_t>(i)], frame.unlabelled[static_cast<size_t>(i)]);
+    r.unknown_labels = frame.unknown_labels;
+    std::lock_guard lock(mutex_);
+    frames_.push_back(std::move(r));
+    changed_.notify_all();
+  }
+  void on_source_state(SourceState state, std::string_view detail) override {
+    std::lock_guard lock(mutex_);
+    states_.emplace_back(state, std::string(detail));
+    changed_.notify_all();
+  }
+  void on_bad_input(std::string_view what, std::string_view) override {
+    std::lock_guard lock(mutex_);
+    bad_inputs_.emplace_back(what);
+    changed_.notify_all();
+  }
+  void on_unknown_label(std::string_view name) override {
+    std::lock_guard lock(mutex_);
+    unknown_labels_.emplace_back(name);
+  }
+
+  bool wait(const std::function<bool()>& done) {
+    std::unique_lock lock(mutex_);
+    return changed_.wait_for(lock, kPatience, done);
+  }
+  bool wait_frames(size_t n) {
+    return wait([&] { return frames_.size() >= n; });
+  }
+  size_t count_state(SourceState s) const {
+    size_t n = 0;
+    for (const auto& [state, detail] : states_) n += state == s ? 1 : 0;
+    return n;
+  }
+  template <typename F>
+  auto with_lock(F&& f) {
+    std::lock_guard lock(mutex_);
+    return f();
+  }
+
+  std::mutex mutex_;
+  std::condition_variable changed_;
+  std::vector<ReceivedFrame> frames_;
+  std::vector<std::pair<SourceState, std::string>> states_;
+  std::vector<std::string> bad_inputs_;
+  std::vector<std::string> unknown_labels_;
+};
+
+// A small capture with labelled, occluded, "*N" and "" channels and non-round coordinates.
+Capture synthetic_capture(int frames = 90) {
+  Capture c({"A", "B", "C", "*3", ""}, frames, 120.0);
+  c.first_frame = 100;
+  for (int f = 0; f < frames; ++f)
+    for (int p = 0; p < c.point_count(); ++p)
+      c.at(f, p) = Vec3(std::sin(0.1 * f + p) * 1000.0 / 3.0, p * 17.25 + f / 7.0, std::cos(0.05 * f) * 1e3 + 1e-9 * f);
+  for (int f = 0; f < frames; f += 3) c.at(f, 1) = missing_point();   // B occluded every third frame
+  for (int f = 0; f < frames; f += 2) c.at(f, 4) = missing_point();   // the "" point comes and goes
+  return c;
+}
+
+void expect_frame_matches(const Capture& capture, const std::vector<std::string>& markers, const ReceivedFrame& r) {
+  const int index = static_cast<int>(r.number) - capture.first_frame;
+  ASSERT_GE(index, 0);
+  ASSERT_LT(index, capture.frame_count);
+  for (size_t m = 0; m < markers.size(); ++m) {
+    const int channel = capture.label_index(markers[m]);
+    const Vec3 expected = channel >= 0 ? capture.at(index, channel) : missing_point();
+    if (is_present(expected)) {
+      EXPECT_EQ(r.labelled[m], expected) << "frame " << r.number << " marker " << markers[m];  // float64: exact
+    } else {
+      EXPECT_FALSE(is_present(r.labelled[m])) << "frame " << r.number << " marker " << markers[m] << " not occluded";
+    }
+  }
+}
+
+struct Loopback {
+  IoThread server_io;
+  IoThread client_io;
+  std::unique_ptr<ViconServer> server;
+  uint16_t port = 0;
+
+  void start_server(const Capture& capture, ViconServerOptions options) {
+    server_io.call([&] {
+      server = std::make_unique<ViconServer>(server_io.io, capture, options);
+      server->start();
+      port = server->port();
+    });
+  }
+  void stop_server() {
+    server_io.call([&] { server.reset(); });
+  }
+};
+
+ViconServerOptions fast_options(double speed = 4.0) {
+  ViconServerOptions o;
+  o.bind_address = "127.0.0.1";
+  o.port = 0;
+  o.subject_name = "test";
+  o.speed = speed;
+  return o;
+}
+
+TEST(ViconStream, PushDeliversEveryFrameInOrderWithExactPositions) {
+  const Capture whole = read_capture(test::source_path("replay_data/cmu/85_02.c3d"));
+  std::vector<int> channels(static_cast<size_t>(whole.point_count()));
+  for (int i = 0; i < whole.point_count(); ++i) channels[static_cast<size_t>(i)] = i;
+  const Capture capture = whole.select(channels, 0, std::min(240, whole.frame_count));
+  const std::vector<std::string> markers(capture.labels.begin(), capture.labels.end());
+
+  Loopback net;
+  std::vector<std::pair<uint32_t, int64_t>> hooked;
+  std::mutex hook_mutex;
+  net.start_server(capture, fast_options(8.0));
+  net.server_io.call([&] {
+    net.server->set_frame_hook([&](uint32_t number, int64_t ns) {
+      std::lock_guard lock(hook_mutex);
+      hooked.emplace_back(number, ns);
+    });
+  });
+  RecordingSink sink;
+  ViconSource source(net.client_io.io, {.host = "127.0.0.1", .port = net.port}, markers, sink);
+  source.start();
+  ASSERT_TRUE(sink.wait_frames(static_cast<size_t>(capture.frame_count))) << sink.frames_.size() << " frames";
+  source.stop();
+
+  sink.with_lock([&] {
+    ASSERT_EQ(sink.frames_.size(), static_cast<size_t>(capture.frame_count));
+    for (size_t i = 0; i < sink.frames_.size(); ++i) {
+      const ReceivedFrame& r = sink.frames_[i];
+      ASSERT_EQ(r.number, static_cast<uint32_t>(capture.first_frame) + i);
+      EXPECT_DOUBLE_EQ(r.rate, capture.rate_hz);
+      expect_frame_matches(capture, markers, r);
+    }
+    EXPECT_EQ(sink.count_state(SourceState::Streaming), 1u);
+    EXPECT_TRUE(sink.bad_inputs_.empty());
+    // source time = (number - 1) periods of 1/120 s
+    EXPECT_NEAR(static_cast<double>(sink.frames_[10].source_time_ns - sink.frames_[9].source_time_ns), 1e9 / 120.0, 1.0);
+  });
+  std::lock_guard lock(hook_mutex);
+  ASSERT_EQ(hooked.size(), static_cast<size_t>(capture.frame_count));
+  EXPECT_EQ(hooked.front().first, static_cast<uint32_t>(capture.first_frame));
+  for (size_t i = 1; i < hooked.size(); ++i) EXPECT_GE(hooked[i].second, hooked[i - 1].second);
+}
+
+TEST(ViconStream, PullDeliversOneFramePerRequestInOrder) {
+  const Capture capture = synthetic_capture();
+  const std::vector<std::string> markers = {"A", "B", "C"};
+  Loopback net;
+  net.start_server(capture, fast_options(1.0));
+  RecordingSink sink;
+  ViconSource source(net.client_io.io,
+                     {.host = "127.0.0.1", .port = net.port, .mode = ViconSourceOptions::Mode::ClientPull}, markers,
+                     sink);
+  source.start();
+  ASSERT_TRUE(sink.wait([&] { return !sink.frames_.empty() && sink.frames_.back().number >= 189; }));
+  source.stop();
+  sink.with_lock([&] {
+    EXPECT_GT(sink.frames_.size(), 30u);  // one per request; the newest when the client lags
+    for (size_t i = 0; i < sink.frames_.size(); ++i) {
+      const ReceivedFrame& r = sink.frames_[i];
+      if (i > 0) {
+        EXPECT_GT(r.number, sink.frames_[i - 1].number);
+      }
+      expect_frame_matches(capture, markers, r);
+      const int index = static_cast<int>(r.number) - capture.first_frame;
+      // Unlabelled: "*3" keeps id 3; "" (channel 4) gets its channel index, present on odd frames.
+      ASSERT_EQ(r.unlabelled.size(), index % 2 ? 2u : 1u) << r.number;
+      EXPECT_EQ(r.unlabelled[0].first, 3);
+      EXPECT_EQ(r.unlabelled[0].second, capture.at(index, 3));
+      if (index % 2) {
+        EXPECT_EQ(r.unlabelled[1].first, 4);
+      }
+    }
+  });
+}
+
+TEST(ViconStream, UnknownLabelsAreReportedOnceAndPassedAsUnlabelled) {
+  const Capture capture = synthetic_capture(30);
+  const std::vector<std::string> markers = {"A", "B", "Z"};  // C unknown to the subject, Z never streamed
+  Loopback net;
+  net.start_server(capture, fast_options(4.0));
+  RecordingSink sink;
+  ViconSource source(net.client_io.io, {.host = "127.0.0.1", .port = net.port}, markers, sink);
+  source.start();
+  ASSERT_TRUE(sink.wait_frames(30));
+  source.stop();
+  sink.with_lock([&] {
+    EXPECT_EQ(sink.unknown_labels_, std::vector<std::string>{"C"});
+    for (const ReceivedFrame& r : sink.frames_) {
+      const int index = static_cast<int>(r.number) - capture.first_frame;
+      EXPECT_FALSE(is_present(r.labelled[2]));
+      EXPECT_EQ(r.unknown_labels, 1);
+      ASSERT_FALSE(r.unlabelled.empty());
+      EXPECT_EQ(r.unlabelled[0].second, capture.at(index, 2));  // C, as an unlabelled point
+      EXPECT_EQ(r.unlabelled[0].first, 2);                        // with its trajectory id
+    }
+  });
+}
+
+TEST(ViconStream, ServerGoneThenBackGivesDisconnectedThenStreaming) {
+  const Capture capture = synthetic_capture();
+  ViconServerOptions options = fast_options(1.0);
+  options.loop = true;
+  Loopback net;
+  net.start_server(capture, options);
+  RecordingSink sink;
+  ViconSource source(net.client_io.io, {.host = "127.0.0.1", .port = net.port}, {"A", "B", "C"}, sink);
+  source.start();
+  ASSERT_TRUE(sink.wait_frames(5));
+  net.stop_server();
+  ASSERT_TRUE(sink.wait([&] { return sink.count_state(SourceState::Disconnected) >= 1; }));
+  const size_t before = sink.with_lock([&] { return sink.frames_.size(); });
+  options.port = net.port;  // the same port again
+  net.start_server(capture, options);
+  ASSERT_TRUE(sink.wait([&] { return sink.count_state(SourceState::Streaming) >= 2; }));
+  ASSERT_TRUE(sink.wait_frames(before + 5));
+  source.stop();
+  sink.with_lock([&] {
+    EXPECT_EQ(sink.states_.front().first, SourceState::Connecting);
+    EXPECT_EQ(sink.count_state(SourceState::Disconnected), 1u);  // reported once per outage
+    EXPECT_NE(sink.states_[2].second.find("127.0.0.1"), std::string::npos) << sink.states_[2].second;
+  });
+}
+
+TEST(ViconStream, GarbageFromTheServerIsCountedNotFatal) {
+  IoThread server_io, client_io;
+  tcp::acceptor acceptor(server_io.io, tcp::endpoint(asio::ip::make_address("127.0.0.1"), 0));
+  const uint16_t port = acceptor.local_endpoint().port();
+  std::atomic<int> served{0};
+  std::function<void()> serve_garbage = [&] {
+    acceptor.async_accept([&](const boost::system::error_code& ec, tcp::socket socket) {
+      if (ec) return;
+      auto s = std::make_shared<tcp::socket>(std::move(socket));
+      static const char kGarbage[] = "HTTP/1.1 400 Bad Request\r\n\r\n";
+      asio::async_write(*s, asio::buffer(kGarbage, sizeof(kGarbage) - 1), [s](auto, auto) {});
+      ++served;
+      serve_garbage();
+    });
+  };
+  server_io.call([&] { serve_garbage(); });
+  RecordingSink sink;
+  ViconSourceOptions options{.host = "127.0.0.1", .port = port};
+  options.initial_backoff_seconds = 0.01;
+  ViconSource source(client_io.io, options, {"A"}, sink);
+  source.start();
+  ASSERT_TRUE(sink.wait([&] { return sink.bad_inputs_.size() >= 2; }));  // and it kept retrying
+  source.stop();
+  server_io.call([&] { acceptor.close(); });
+  sink.with_lock([&] {
+    EXPECT_EQ(sink.bad_inputs_[0], "malformed_packet");
+    EXPECT_TRUE(sink.frames_.empty());
+    EXPECT_EQ(sink.count_state(SourceState::Disconnected), 1u);
+    EXPECT_NE(sink.states_[1].second.find("bad packet magic"), std::string::npos) << sink.states_[1].second;
+  });
+  EXPECT_GE(served.load(), 2);
+}
+
+// A raw client that asks for frames and then never reads.
+tcp::socket stalled_client(asio::io_context& io, uint16_t port) {
+  tcp::socket socket(io);
+  socket.open(tcp::v4());
+  socket.set_option(asio::socket_base::receive_buffer_size(2048));
+  socket.connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), port));
+  const auto request = vicon::encode_packet(vicon::RequestFrame{true});
+  asio::write(socket, asio::buffer(request));
+  return socket;
+}
+
+TEST(ViconStream, StalledClientDoesNotStopAnother) {
+  const Capture capture = synthetic_capture();
+  ViconServerOptions options = fast_options(4.0);
+  options.loop = true;
+  options.max_queued_frames = 2;
+  options.socket_send_buffer_bytes = 4096;
+  Loopback net;
+  net.start_server(capture, options);
+  asio::io_context raw_io;
+  tcp::socket stalled = stalled_client(raw_io, net.port);
+  RecordingSink sink;
+  ViconSource source(net.client_io.io, {.host = "127.0.0.1", .port = net.port}, {"A", "B", "C"}, sink);
+  source.start();
+  ASSERT_TRUE(sink.wait_frames(300));
+  source.stop();
+  sink.with_lock([&] {
+    for (size_t i = 1; i < 300; ++i) ASSERT_EQ(sink.frames_[i].number, sink.frames_[i - 1].number + 1) << i;
+  });
+  EXPECT_GT(net.server->stats().frames_dropped.load(), 0u);  // the stalled client's, newest winning
+}
+
+TEST(ViconStream, MalformedClientIsClosedAndCountedOthersGoOn) {
+  const Capture capture = synthetic_capture();
+  ViconServerOptions options = fast_options(2.0);
+  options.loop = true;
+  Loopback net;
+  net.start_server(capture, options);
+  RecordingSink sink;
+  ViconSource source(net.client_io.io, {.host = "127.0.0.1", .port = net.port}, {"A", "B", "C"}, sink);
+  source.start();
+  ASSERT_TRUE(sink.wait_frames(3));
+
+  asio::io_context raw_io;
+  tcp::socket bad(raw_io);
+  bad.connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), net.port));
+  const std::string garbage = "GET / HTTP/1.0\r\n\r\n";
+  asio::write(bad, asio::buffer(garbage));
+  // The server closes it: reading ends (after the ObjectEnums it sent first).
+  boost::system::error_code ec;
+  std::vector<unsigned char> sink_bytes(4096);
+  while (!ec) bad.read_some(asio::buffer(sink_bytes), ec);
+  const size_t before = sink.with_lock([&] { return sink.frames_.size(); });
+  ASSERT_TRUE(sink.wait_frames(before + 10));
+  source.stop();
+  EXPECT_EQ(net.server->stats().bad_clients.load(), 1u);
+}
+
+TEST(ViconStream, MulticastRequestSendsWholePacketsAsDatagrams) {
+  const Capture capture = synthetic_capture();
+  Loopback net;
+  net.start_server(capture, fast_options(2.0));
+  RecordingSink sink;
+  // 127.0.0.1 unicast: always available in a sandbox (a group is tried in the next test).
+  ViconMulticastSource receiver(net.client_io.io, {.group = "127.0.0.1", .port = 0}, {"A", "B", "C"}, sink);
+  receiver.start();
+  ASSERT_TRUE(sink.wait([&] { return receiver.bound_port() != 0; }));
+
+  // Ask as an SDK client does: StartMulticastSender over the TCP connection.
+  asio::io_context raw_io;
+  tcp::socket client(raw_io);
+  client.connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), net.port));
+  vicon::StartMulticastSender request;
+  request.multicast_address = asio::ip::make_address_v4("127.0.0.1").to_uint();
+  request.source_address = request.multicast_address;
+  request.port = receiver.bound_port();
+  asio::write(client, asio::buffer(vicon::encode_packet(request)));
+
+  ASSERT_TRUE(sink.wait_frames(static_cast<size_t>(capture.frame_count)));
+  receiver.stop();
+  sink.with_lock([&] {
+    for (size_t i = 0; i < sink.frames_.size(); ++i) {
+      EXPECT_EQ(sink.frames_[i].number, static_cast<uint32_t>(capture.first_frame) + i);
+      expect_frame_matches(capture, {"A", "B", "C"}, sink.frames_[i]);
+    }
+    EXPECT_EQ(sink.count_state(SourceState::Streaming), 1u);
+  });
+  EXPECT_GE(net.server->stats().datagrams_sent.load(), static_cast<uint64_t>(capture.frame_count));
+}
+
+TEST(ViconStream, MulticastGroupOnLoopback) {
+  const Capture capture = synthetic_capture();
+  ViconServerOptions options = fast_options(2.0);
+  options.start_on_first_request = false;
+  options.loop = true;
+  Loopback net;
+  RecordingSink sink;
+  ViconMulticastSource receiver(net.client_io.io, {.group = "239.255.42.77", .port = 0, .interface_address = "127.0.0.1"},
+                                {"A", "B", "C"}, sink);
+  receiver.start();
+  ASSERT_TRUE(sink.wait([&] { return receiver.bound_port() != 0 || !sink.states_.empty(); }));
+  if (receiver.bound_port() == 0) GTEST_SKIP() << "cannot join a multicast group here: " << sink.states_[0].second;
+  net.start_server(capture, options);
+  net.server_io.call([&] { net.server->start_multicast("239.255.42.77", receiver.bound_port()); });
+  std::unique_lock lock(sink.mutex_);  // a short bounded wait: only decides whether to skip
+  const bool got = sink.changed_.wait_for(lock, 3s, [&] { return sink.frames_.size() >= 10; });
+  lock.unlock();
+  receiver.stop();
+  if (!got) GTEST_SKIP() << "multicast datagrams are not looped back in this sandbox";
+  sink.with_lock([&] { expect_frame_matches(capture, {"A", "B", "C"}, sink.frames_.back()); });
+}
+
+// Counts heap allocations on the client's io thread between frames 40 and 160.
+class AllocationCheckingSink : public FrameSink {
+ public:
+  void on_frame(const MarkerFrame&) override {
+    ++frames;
+    if (frames == 40) counter.emplace();
+    if (frames == 160) {
+      allocations = counter->count();
+      counter.reset();
+      done.set_value();
+    }
+  }
+  void on_source_state(SourceState, std::string_view) override {}
+  void on_bad_input(std::string_view, std::string_view) override {}
+  void on_unknown_label(std::string_view) override {}
+  int frames = 0;
+  std::optional<test::CountAllocations> counter;
+  size_t allocations = 0;
+  std::promise<void> done;
+};
+
+TEST(ViconStream, ReceivingFramesAllocatesNothingAfterTheFirst) {
+  const Capture capture = synthetic_capture();
+  ViconServerOptions options = fast_options(4.0);
+  options.loop = true;
+  for (auto mode : {ViconSourceOptions::Mode::ServerPush, ViconSourceOptions::Mode::ClientPull}) {
+    Loopback net;
+    net.start_server(capture, options);
+    AllocationCheckingSink sink;
+    auto done = sink.done.get_future();
+    ViconSource source(net.client_io.io, {.host = "127.0.0.1", .port = net.port, .mode = mode}, {"A", "B", "C"},
+                       sink);
+    source.start();
+    ASSERT_EQ(done.wait_for(kPatience), std::future_status::ready);
+    source.stop();
+    EXPECT_EQ(sink.allocations, 0u) << (mode == ViconSourceOptions::Mode::ServerPush ? "push" : "pull");
+  }
+}
+
+}  // namespace
+}  // namespace skinstream::server
