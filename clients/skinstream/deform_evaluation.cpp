@@ -2,12 +2,16 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
+#include <filesystem>
 #include <limits>
 #include <stdexcept>
 
 #include "clients/skinstream/json_output.h"
 #include "core/deform/mesh_deformer.h"
 #include "core/offline/subject_builder.h"
+#include "core/render/software_rasterizer.h"
+#include "protocol/png_file.h"
 #include "core/synth/subdivision.h"
 
 namespace skinstream::cli {
@@ -17,16 +21,18 @@ using synth::SynthCapture;
 
 struct Method {
   const char* name;
+  const char* caption;
   bool conventional;
   DeformationMode mode;
 };
 constexpr Method kMethods[] = {
-    {"rigid", false, DeformationMode::Rigid},
-    {"quadratic", false, DeformationMode::Quadratic},
-    {"rigid_rbf", false, DeformationMode::RigidRbf},
-    {"full", false, DeformationMode::QuadraticRbf},
-    {"lbs_sparse", true, DeformationMode::Rigid},
+    {"rigid", "rigid", false, DeformationMode::Rigid},
+    {"quadratic", "quadratic", false, DeformationMode::Quadratic},
+    {"rigid_rbf", "rigid+rbf", false, DeformationMode::RigidRbf},
+    {"full", "full", false, DeformationMode::QuadraticRbf},
+    {"lbs_sparse", "lbs sparse", true, DeformationMode::Rigid},
 };
+constexpr double kHeatMaxMm = 20.0;  // the render's colour scale: blue 0 .. red 20 mm
 
 // Where a marker sits on the registered mesh: its closest point in the reference pose
 // (triangle and barycentric coordinates) and its height above the surface along the normal.
@@ -195,6 +201,50 @@ nlohmann::ordered_json evaluate_deformation(const DeformationSetup& setup, const
     }
   }
 
+  // A few frames drawn side by side: the truth, then every method coloured by its vertex error.
+  std::vector<std::string> rendered;
+  if (!options.render_dir.empty()) {
+    std::filesystem::create_directories(options.render_dir);
+    for (int r = 1; r <= options.render_frames; ++r) {
+      const int f = r * (take.frame_count() - 1) / (options.render_frames + 1);
+      const std::vector<Vec3> markers = markers_in_subject_order(take, setup.subject_to_truth, f);
+      const std::vector<Vec3> truth = take.pose_mesh(f);
+      const render::Camera camera = render::frame_view(truth, render::View::front, 300, 480);
+      std::vector<render::Image> images;
+      std::vector<std::string> captions = {"truth"};
+      render::RenderMesh truth_mesh;
+      truth_mesh.vertices = truth;
+      truth_mesh.faces = model.faces;
+      images.push_back(render::render_mesh(truth_mesh, camera));
+      for (int k = 0; k < method_count; ++k) {
+        if (kMethods[k].conventional) {
+          skinning.solve(markers);
+          skinning.deform(positions);
+        } else {
+          deformers[k]->deform(markers, positions, {});
+        }
+        std::vector<Vec3> mesh(vertices);
+        std::vector<double> error(vertices);
+        for (int v = 0; v < vertices; ++v) {
+          mesh[v] = vertex_at(positions, v);
+          error[v] = (mesh[v] - truth[v]).norm();
+        }
+        const std::vector<render::Rgb> colours = render::heat_colours(error, kHeatMaxMm);
+        render::RenderMesh view;
+        view.vertices = mesh;
+        view.faces = model.faces;
+        view.colours = colours;
+        images.push_back(render::render_mesh(view, camera));
+        captions.push_back(kMethods[k].caption);
+      }
+      char name[96];
+      std::snprintf(name, sizeof name, "%s_frame%04d.png", motion.c_str(), f);
+      const std::string path = (std::filesystem::path(options.render_dir) / name).string();
+      write_png(path, render::compose_side_by_side(images, captions));
+      rendered.push_back(path);
+    }
+  }
+
   nlohmann::ordered_json rows = nlohmann::ordered_json::array();
   for (int k = 0; k < method_count; ++k) {
     const ErrorStats v = summarize_errors(std::move(vertex_errors[k]));
@@ -214,6 +264,7 @@ nlohmann::ordered_json evaluate_deformation(const DeformationSetup& setup, const
           {"frames_evaluated", frames},
           {"vertices", vertices},
           {"covered_vertices", covered_count},
+          {"renders", rendered},
           {"methods", rows}};
 }
 
