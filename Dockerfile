@@ -1,11 +1,16 @@
-# skinstream on Debian 12, built with the same install script the README uses.
+# skinstream on Debian 12, built with the same scripts the README uses: the daemon replaying the
+# bundled 350-marker capture with the demo subject, the web viewer on 8480, TCP subscribers on
+# 8481. docker run -p 8480:8480 -p 8481:8481 skinstream, then open http://localhost:8480/.
 FROM debian:12
 WORKDIR /src/skinstream
 COPY scripts/install-deps.sh scripts/install-deps.sh
 RUN bash scripts/install-deps.sh && rm -rf /var/lib/apt/lists/*
 COPY . .
 RUN cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DSKINSTREAM_BUILD_TESTS=OFF -DSKINSTREAM_BUILD_BENCHMARKS=OFF \
- && cmake --build build -j "$(nproc)"
+ && cmake --build build -j "$(nproc)" \
+ && bash clients/web/build.sh build/web \
+ && bash scripts/make-demo.sh build/bin/skinstream build/demo
 ENV PATH=/src/skinstream/build/bin:$PATH
-# Until the daemon lands: the bundled gap-filling demo.
-CMD ["bash", "-c", "skinstream build-subject --capture replay_data/cmu/85_12.c3d --out /tmp/s.subject && skinstream eval-fill --capture replay_data/cmu/85_02.c3d --train replay_data/cmu/85_12.c3d"]
+EXPOSE 8480 8481
+CMD ["skinstreamd", "--subject", "build/demo/subject.sksubj", "--replay", "build/demo/live.c3d", "--loop", \
+     "--web-root", "build/web", "--bind", "0.0.0.0", "--http-port", "8480", "--sub-port", "8481"]

@@ -1,14 +1,23 @@
 #!/usr/bin/env bash
-# The main job on the bundled data: build a subject model from one real take, then delete
-# seeded gaps from another take and fill them online, side by side with the baselines.
+# The main job on bundled data: installs what is missing, builds, makes the demo subject
+# (markers + the ~53,500-vertex MakeHuman mesh), builds the web viewer, then runs skinstreamd
+# replaying a bundled 350-marker capture in a loop. Open the printed URL to watch the deforming
+# body; Ctrl-C stops it. RUN_SECONDS=N stops it after N seconds (scripts, CI).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/build.sh -DSKINSTREAM_BUILD_TESTS=OFF -DSKINSTREAM_BUILD_BENCHMARKS=OFF
-out=build/run
-mkdir -p "$out"
-echo "== subject model from replay_data/cmu/85_12.c3d"
-build/bin/skinstream build-subject --capture replay_data/cmu/85_12.c3d --out "$out/cmu85.subject" \
-  --surface-out "$out/cmu85_marker_surface.obj"
-echo "== gap filling on replay_data/cmu/85_02.c3d (seeded gaps, every method)"
-build/bin/skinstream eval-fill --capture replay_data/cmu/85_02.c3d --train replay_data/cmu/85_12.c3d --ablations
-echo "== outputs in $out (marker surface OBJ, subject file)"
+bash clients/web/build.sh build/web
+bash scripts/make-demo.sh build/bin/skinstream build/demo
+http_port=${HTTP_PORT:-8480}
+sub_port=${SUB_PORT:-8481}
+echo
+echo "== skinstreamd: replaying build/demo/live.c3d (350 markers, 120 Hz, looped)"
+echo "== open http://localhost:${http_port}/ in a browser (TCP subscribers: port ${sub_port};"
+echo "   metrics: http://localhost:${http_port}/metrics)"
+echo
+cmd=(build/bin/skinstreamd --subject build/demo/subject.sksubj --replay build/demo/live.c3d --loop
+     --web-root build/web --http-port "$http_port" --sub-port "$sub_port")
+if [ -n "${RUN_SECONDS:-}" ]; then
+  exec timeout --signal=INT --preserve-status "$RUN_SECONDS" "${cmd[@]}"
+fi
+exec "${cmd[@]}"

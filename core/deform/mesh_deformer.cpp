@@ -61,6 +61,8 @@ struct MeshDeformer::State {
   std::vector<int> vertex_face_offsets;
   std::vector<int> vertex_faces;
 
+  std::vector<int64_t> cumulative_cost;  // per vertex, for balanced_vertex_split
+
   void store_solved(int p);
   void deform_vertex(int v, float* out) const;
 };
@@ -130,6 +132,16 @@ MeshDeformer::MeshDeformer(const DeformationModel& model, const SubjectModel& su
     for (int c : s.faces[f]) s.vertex_faces[fill[c]++] = static_cast<int>(f);
 
   for (int p = 0; p < part_count; ++p) s.store_solved(p);  // rest pose until the first solve
+
+  // Work per vertex: the quadratic and rotation, plus one kernel term per RBF centre.
+  const bool rbf = mode == DeformationMode::RigidRbf || mode == DeformationMode::QuadraticRbf;
+  s.cumulative_cost.assign(static_cast<size_t>(s.vertex_count) + 1, 0);
+  for (int v = 0; v < s.vertex_count; ++v) {
+    int64_t cost = 0;
+    for (int k = s.influence_offsets[v]; k < s.influence_offsets[v + 1]; ++k)
+      cost += 16 + (rbf ? s.solved[s.influence_part[k]].centre_count : 0);
+    s.cumulative_cost[v + 1] = s.cumulative_cost[v] + cost;
+  }
 }
 
 MeshDeformer::~MeshDeformer() = default;
@@ -175,7 +187,7 @@ bool MeshDeformer::solve_parts(std::span<const Vec3> markers) {
 }
 
 // Eq. 8 in every influencing part, blended by eq. 9.
-void MeshDeformer::State::deform_vertex(int v, float* out) const {
+inline __attribute__((always_inline)) void MeshDeformer::State::deform_vertex(int v, float* out) const {
   float result[3] = {0.0f, 0.0f, 0.0f};
   for (int k = influence_offsets[v]; k < influence_offsets[v + 1]; ++k) {
     const SolvedPart& part = solved[influence_part[k]];
@@ -189,6 +201,7 @@ void MeshDeformer::State::deform_vertex(int v, float* out) const {
     if (part.rbf) {
       float ox = 0.0f, oy = 0.0f, oz = 0.0f;
       const int first = part.first_centre, last = first + part.centre_count;
+#pragma omp simd reduction(+ : ox, oy, oz)
       for (int i = first; i < last; ++i) {
         const float dx = local[0] - centre_x[i], dy = local[1] - centre_y[i], dz = local[2] - centre_z[i];
         const float phi = bspline(std::sqrt(dx * dx + dy * dy + dz * dz) * part.inverse_sigma);
@@ -214,6 +227,17 @@ void MeshDeformer::State::deform_vertex(int v, float* out) const {
   out[2] = result[2];
 }
 
+int MeshDeformer::balanced_vertex_split(int index, int parts) const {
+  const State& s = *state_;
+  if (parts <= 0 || index <= 0) return 0;
+  if (index >= parts) return s.vertex_count;
+  const int64_t target = s.cumulative_cost.back() * index / parts;
+  return static_cast<int>(std::lower_bound(s.cumulative_cost.begin(), s.cumulative_cost.end(), target) -
+                          s.cumulative_cost.begin());
+}
+
+// Compiled twice (AVX2 + FMA and the baseline); the loader picks the one the CPU runs.
+__attribute__((target_clones("arch=haswell", "default")))
 void MeshDeformer::deform_vertices(int begin, int end, std::span<float> positions) const {
   const State& s = *state_;
   end = std::min(end, s.vertex_count);

@@ -43,6 +43,10 @@ class MeshDeformer {
   // All stages on the calling thread. `normals` may be empty (not wanted).
   bool deform(std::span<const Vec3> markers, std::span<float> positions, std::span<float> normals);
 
+  // Where to cut the vertices into `parts` ranges of equal work (vertices in big parts with the
+  // RBF residual cost more than others): the start of range `index` (index == parts: the end).
+  int balanced_vertex_split(int index, int parts) const;
+
   int vertex_count() const;
   int face_count() const;
   DeformationMode mode() const;

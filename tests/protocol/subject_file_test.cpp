@@ -102,3 +102,70 @@ TEST_F(SubjectFile, RoundTripsExactly) {
 
 }  // namespace
 }  // namespace skinstream
+
+namespace skinstream {
+namespace {
+
+// A small deformation model over the limb subject: one part of all markers, the mesh = the
+// markers themselves (vertex i on marker i), one triangle.
+DeformationModel limb_deformation(const SubjectModel& model) {
+  DeformationModel d;
+  d.reference_vertices = model.reference_positions;
+  d.faces = {{0, 1, 2}};
+  d.part_names = {"limb"};
+  for (int i = 0; i < model.marker_count(); ++i) d.part_members.push_back({i, 1.0});
+  d.part_member_offsets.push_back(model.marker_count());
+  for (int v = 0; v < model.marker_count(); ++v) {
+    d.vertex_influences.push_back({0, 1.0});
+    d.vertex_influence_offsets.push_back(v + 1);
+  }
+  d.registration_rms_mm = 0.25;
+  return d;
+}
+
+TEST_F(SubjectFile, DeformationModelRoundTripsExactly) {
+  const DeformationModel d = limb_deformation(model_);
+  const std::string path = test::scratch_path("limb_mesh.subject");
+  write_subject(model_, &d, path);
+  const SubjectFile back = read_subject_file(path);
+  ASSERT_TRUE(back.deformation.has_value());
+  EXPECT_EQ(back.deformation->reference_vertices, d.reference_vertices);
+  EXPECT_EQ(back.deformation->faces, d.faces);
+  EXPECT_EQ(back.deformation->part_names, d.part_names);
+  EXPECT_EQ(back.deformation->part_member_offsets, d.part_member_offsets);
+  EXPECT_EQ(back.deformation->vertex_influence_offsets, d.vertex_influence_offsets);
+  EXPECT_EQ(back.deformation->registration_rms_mm, 0.25);
+  EXPECT_EQ(back.model.marker_names, model_.marker_names);
+  // Without a mesh: no deformation model, and read_subject still gives the markers.
+  EXPECT_FALSE(read_subject_file(path_).deformation.has_value());
+  EXPECT_EQ(read_subject(path).marker_names, model_.marker_names);
+}
+
+TEST_F(SubjectFile, RefusesToWriteADeformationModelOfAnotherSubject) {
+  DeformationModel d = limb_deformation(model_);
+  d.part_members.back().marker = model_.marker_count() + 5;  // a marker this subject lacks
+  try {
+    write_subject(model_, &d, test::scratch_path("mismatch.subject"));
+    FAIL() << "wrote a mismatched deformation model";
+  } catch (const FileError& e) {
+    EXPECT_NE(std::string(e.what()).find("part member marker"), std::string::npos) << e.what();
+  }
+}
+
+TEST_F(SubjectFile, CorruptDeformationSectionIsRejected) {
+  const DeformationModel d = limb_deformation(model_);
+  const std::string path = test::scratch_path("limb_mesh_corrupt.subject");
+  write_subject(model_, &d, path);
+  std::vector<char> bytes = slurp(path);
+  // Truncated inside the deformation section (the header's size no longer matches).
+  std::vector<char> cut(bytes.begin(), bytes.end() - 40);
+  spit(path, cut);
+  EXPECT_NE(message_of(path).find("truncated"), std::string::npos) << message_of(path);
+  // A flipped byte inside the deformation section: the CRC catches it.
+  bytes[bytes.size() - 60] ^= 0x5a;
+  spit(path, bytes);
+  EXPECT_NE(message_of(path).find("CRC"), std::string::npos) << message_of(path);
+}
+
+}  // namespace
+}  // namespace skinstream

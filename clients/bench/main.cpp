@@ -1,0 +1,335 @@
+// skinstream-bench: end-to-end latency and cost of the real skinstreamd, fed over the network as
+// in production. In this process: the Vicon DataStream server engine (server/vicon/vicon_server.h)
+// loops the recording on an ephemeral loopback port and notes when each frame number left it,
+// and N subscribers (one thread each, the blocking client of server/client/) note when each frame
+// arrived. The daemon is the real skinstreamd, a child process started with --vicon.
+//
+//   end to end        = subscriber arrival - replay send time of the same frame number
+//   daemon processing = publish_time_ns - receive_time_ns (both from the frame header)
+//
+// Every clock is the same machine's system clock, so the differences need no synchronisation.
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <csignal>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <mutex>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <sys/wait.h>
+#include <thread>
+#include <unistd.h>
+
+#include "protocol/capture_file.h"
+#include "protocol/file_error.h"
+#include "server/client/subscriber_client.h"
+#include "server/vicon/vicon_server.h"
+
+namespace {
+
+using namespace skinstream;
+namespace fs = std::filesystem;
+
+struct Samples {
+  std::vector<double> ms;
+  nlohmann::json summary() {
+    std::sort(ms.begin(), ms.end());
+    auto at = [&](double q) { return ms.empty() ? 0.0 : ms[std::min(ms.size() - 1, static_cast<size_t>(q * (ms.size() - 1) + 0.5))]; };
+    return {{"p50_ms", at(0.5)}, {"p99_ms", at(0.99)}, {"p99_9_ms", at(0.999)}, {"max_ms", ms.empty() ? 0.0 : ms.back()}, {"count", ms.size()}};
+  }
+};
+
+// Send times by frame number, written by the replay server's io thread and read by the
+// subscriber threads. A ring of the last kSlots frames (34 s at 120 Hz): a frame still in flight
+// after that long is reported as unmatched rather than given a wrong send time.
+class SendTimes {
+ public:
+  void record(uint32_t frame_number, int64_t send_ns) {
+    std::lock_guard lock(mutex_);
+    slots_[frame_number % kSlots] = {frame_number, send_ns};
+  }
+  // 0 when the frame number was never sent (or is too old).
+  int64_t find(uint32_t frame_number) const {
+    std::lock_guard lock(mutex_);
+    const Slot& slot = slots_[frame_number % kSlots];
+    return slot.frame_number == frame_number ? slot.send_ns : 0;
+  }
+
+ private:
+  static constexpr uint32_t kSlots = 4096;
+  struct Slot {
+    uint32_t frame_number = 0;
+    int64_t send_ns = 0;
+  };
+  mutable std::mutex mutex_;
+  std::array<Slot, kSlots> slots_{};
+};
+
+fs::path own_folder() { return fs::read_symlink("/proc/self/exe").parent_path(); }
+
+pid_t launch(const std::vector<std::string>& arguments, const std::string& log_path) {
+  const pid_t pid = fork();
+  if (pid < 0) throw std::runtime_error("fork failed");
+  if (pid == 0) {
+    FILE* log = std::fopen(log_path.c_str(), "w");
+    if (log) {
+      dup2(fileno(log), STDOUT_FILENO);
+      dup2(fileno(log), STDERR_FILENO);
+    }
+    std::vector<char*> argv;
+    for (const std::string& a : arguments) argv.push_back(const_cast<char*>(a.c_str()));
+    argv.push_back(nullptr);
+    execv(argv[0], argv.data());
+    _exit(127);
+  }
+  return pid;
+}
+
+std::string file_text(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+// Waits for the daemon's ports file; fails when the daemon exits first.
+nlohmann::json wait_for_ports(const std::string& path, pid_t pid, const std::string& log_path) {
+  for (int i = 0; i < 300; ++i) {
+    std::ifstream in(path);
+    if (in) return nlohmann::json::parse(in);
+    int status = 0;
+    if (waitpid(pid, &status, WNOHANG) == pid) throw std::runtime_error("skinstreamd exited before listening:\n" + file_text(log_path));
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  throw std::runtime_error("skinstreamd did not write its ports file within 15 s");
+}
+
+// CPU seconds (user + system) and peak RSS (kB) of a running process.
+std::pair<double, long> process_usage(pid_t pid) {
+  std::ifstream stat("/proc/" + std::to_string(pid) + "/stat");
+  std::string text((std::istreambuf_iterator<char>(stat)), std::istreambuf_iterator<char>());
+  double cpu = 0;
+  const size_t close = text.rfind(')');
+  if (close != std::string::npos) {
+    std::istringstream fields(text.substr(close + 2));
+    std::string field;
+    long utime = 0, stime = 0;
+    for (int i = 3; fields >> field; ++i) {  // field 3 is the state
+      if (i == 14) utime = std::stol(field);
+      if (i == 15) {
+        stime = std::stol(field);
+        break;
+      }
+    }
+    cpu = static_cast<double>(utime + stime) / static_cast<double>(sysconf(_SC_CLK_TCK));
+  }
+  long hwm = 0;
+  std::ifstream status("/proc/" + std::to_string(pid) + "/status");
+  for (std::string line; std::getline(status, line);)
+    if (line.rfind("VmHWM:", 0) == 0) hwm = std::stol(line.substr(6));
+  return {cpu, hwm};
+}
+
+// GET /health from the daemon's HTTP port.
+nlohmann::json fetch_health(int http_port) {
+  server::asio::io_context io;
+  server::tcp::socket socket(io);
+  socket.connect({server::asio::ip::make_address("127.0.0.1"), static_cast<unsigned short>(http_port)});
+  const std::string request = "GET /health HTTP/1.1\r\nHost: 127.0.0.1\r\nConnection: close\r\n\r\n";
+  server::asio::write(socket, server::asio::buffer(request));
+  std::string response;
+  boost::system::error_code ec;
+  std::array<char, 4096> buffer;
+  while (size_t n = socket.read_some(server::asio::buffer(buffer), ec)) response.append(buffer.data(), n);
+  const size_t body = response.find("\r\n\r\n");
+  return nlohmann::json::parse(body == std::string::npos ? "{}" : response.substr(body + 4));
+}
+
+// Waits until /health says the source is streaming (the daemon has connected to the replay).
+void wait_for_streaming(int http_port, pid_t pid, const std::string& log_path) {
+  for (int i = 0; i < 300; ++i) {
+    if (fetch_health(http_port)["source"]["state"] == "streaming") return;
+    if (waitpid(pid, nullptr, WNOHANG) == pid) throw std::runtime_error("skinstreamd exited:\n" + file_text(log_path));
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  throw std::runtime_error("skinstreamd did not start streaming from the replay server within 15 s:\n" + file_text(log_path));
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"skinstream-bench: end-to-end latency and cost of the real skinstreamd fed by a Vicon DataStream replay"};
+  double seconds = 10;
+  int subscriber_count = 1, deform_threads = 2;
+  std::string recording = "replay_data/cmu/85_12.c3d", subject, vicon_subject_name;
+  bool json = false, normals = false;
+  app.add_option("--seconds", seconds, "how long to measure")->check(CLI::Range(0.5, 3600.0))->capture_default_str();
+  app.add_option("--subscribers", subscriber_count, "subscribers connected in-process, one thread each")->check(CLI::Range(1, 256))->capture_default_str();
+  app.add_option("--recording", recording, "capture the Vicon replay server streams, looped")->capture_default_str();
+  app.add_option("--subject", subject, "subject file for the recording's performer")->required();
+  app.add_option("--deform-threads", deform_threads, "skinstreamd --deform-threads")->check(CLI::Range(1, 64))->capture_default_str();
+  app.add_option("--vicon-subject-name", vicon_subject_name, "subject name the replay announces (default: the recording's file name)");
+  app.add_flag("--normals", normals, "subscribers ask for normals too");
+  app.add_flag("--json", json, "print the report as JSON");
+  CLI11_PARSE(app, argc, argv);
+
+  const fs::path daemon_path = own_folder() / "skinstreamd";
+  const std::string work = (fs::temp_directory_path() / ("skinstream-bench-" + std::to_string(getpid()))).string();
+  const std::string ports_path = work + "/ports.json", log_path = work + "/skinstreamd.log";
+  pid_t pid = -1;
+  server::asio::io_context replay_io;
+  std::thread replay_thread;
+  auto stop_replay = [&] {
+    replay_io.stop();
+    if (replay_thread.joinable()) replay_thread.join();
+  };
+  try {
+    if (!fs::exists(daemon_path)) throw std::runtime_error(daemon_path.string() + ": skinstreamd not found next to skinstream-bench");
+    const Capture capture = read_capture(recording);
+    if (capture.frame_count <= 0) throw FileError(recording, "holds no frames");
+    if (!(capture.rate_hz > 0)) throw FileError(recording, "has no frame rate");
+    fs::create_directories(work);
+
+    // The replay server: looping, timeline from the daemon's first frame request.
+    server::ViconServerOptions replay_options;
+    replay_options.bind_address = "127.0.0.1";
+    replay_options.port = 0;
+    replay_options.loop = true;
+    replay_options.subject_name = vicon_subject_name.empty() ? fs::path(recording).stem().string() : vicon_subject_name;
+    server::ViconServer replay(replay_io, capture, replay_options);
+    SendTimes send_times;
+    replay.set_frame_hook([&send_times](uint32_t frame_number, int64_t send_ns) { send_times.record(frame_number, send_ns); });
+    replay.start();
+    replay_thread = std::thread([&replay_io] {
+      auto guard = server::asio::make_work_guard(replay_io);
+      replay_io.run();
+    });
+    // Declared after `replay`, so it is destroyed first: the io thread never outlives the server.
+    struct ReplayThreadStop {
+      std::function<void()> stop;
+      ~ReplayThreadStop() { stop(); }
+    } replay_thread_stop{stop_replay};
+
+    pid = launch({daemon_path.string(), "--subject", subject, "--vicon", "127.0.0.1:" + std::to_string(replay.port()),
+                  "--deform-threads", std::to_string(deform_threads), "--http-port", "0", "--sub-port", "0", "--bind", "127.0.0.1",
+                  "--ports-file", ports_path, "--log-level", "warn"},
+                 log_path);
+    const nlohmann::json ports = wait_for_ports(ports_path, pid, log_path);
+    const int sub_port = ports.at("sub"), http_port = ports.at("http");
+    wait_for_streaming(http_port, pid, log_path);
+    const nlohmann::json health_before = fetch_health(http_port);
+    const uint64_t sent_before = replay.stats().frame_packets_sent.load();
+    const uint64_t replay_dropped_before = replay.stats().frames_dropped.load();
+    const double cpu_before = process_usage(pid).first;  // startup (loading the subject) is not counted
+
+    std::mutex mutex;
+    Samples end_to_end, processing;
+    std::vector<long> received(subscriber_count, 0), unmatched(subscriber_count, 0), out_of_order(subscriber_count, 0);
+    std::vector<uint32_t> dropped_first(subscriber_count, 0), dropped_last(subscriber_count, 0);
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+    const uint32_t wants = normals ? subscriber::kWantNormals : 0u;
+    std::vector<std::thread> threads;
+    std::vector<std::string> errors(subscriber_count);
+    for (int s = 0; s < subscriber_count; ++s)
+      threads.emplace_back([&, s] {
+        try {
+          sub::SubscriberClient client("127.0.0.1", std::to_string(sub_port), wants);
+          std::vector<double> local_e2e, local_processing;
+          local_e2e.reserve(static_cast<size_t>(seconds * capture.rate_hz * 1.2) + 16);
+          local_processing.reserve(local_e2e.capacity());
+          int64_t last_frame = -1;
+          client.run([&](subscriber::MessageType type, std::span<const unsigned char> payload, int64_t now) {
+            if (type == subscriber::MessageType::Frame) {
+              const subscriber::FrameInfo info = subscriber::decode_frame(payload).info;
+              const int64_t sent = send_times.find(info.frame_number);
+              if (sent > 0) local_e2e.push_back((now - sent) * 1e-6);
+              else ++unmatched[s];
+              local_processing.push_back((info.publish_time_ns - info.receive_time_ns) * 1e-6);
+              if (static_cast<int64_t>(info.frame_number) <= last_frame) ++out_of_order[s];
+              last_frame = info.frame_number;
+              if (received[s]++ == 0) dropped_first[s] = info.subscriber_dropped;
+              dropped_last[s] = info.subscriber_dropped;
+            }
+            return std::chrono::steady_clock::now() < deadline;
+          });
+          std::lock_guard lock(mutex);
+          end_to_end.ms.insert(end_to_end.ms.end(), local_e2e.begin(), local_e2e.end());
+          processing.ms.insert(processing.ms.end(), local_processing.begin(), local_processing.end());
+        } catch (const std::exception& e) {
+          errors[s] = e.what();
+        }
+      });
+    for (std::thread& t : threads) t.join();
+    const nlohmann::json health = fetch_health(http_port);
+    const uint64_t sent = replay.stats().frame_packets_sent.load() - sent_before;
+    const uint64_t replay_dropped = replay.stats().frames_dropped.load() - replay_dropped_before;
+    const auto [cpu_total, peak_rss_kb] = process_usage(pid);
+    const double cpu_seconds = cpu_total - cpu_before;
+    kill(pid, SIGTERM);
+    int status = 0;
+    waitpid(pid, &status, 0);
+    pid = -1;
+    stop_replay();
+    for (const std::string& e : errors)
+      if (!e.empty()) throw std::runtime_error("subscriber: " + e);
+
+    long total_received = 0, total_dropped = 0, total_unmatched = 0, total_out_of_order = 0;
+    for (int s = 0; s < subscriber_count; ++s) {
+      total_received += received[s];
+      total_dropped += dropped_last[s] - dropped_first[s];
+      total_unmatched += unmatched[s];
+      total_out_of_order += out_of_order[s];
+    }
+    auto delta = [&](const char* key) { return health["frames"][key].get<uint64_t>() - health_before["frames"][key].get<uint64_t>(); };
+    // CPU: the measured window only; peak RSS: the daemon's whole life.
+    const nlohmann::json report = {
+        {"mode", "Vicon DataStream replay (in-process, loopback) -> skinstreamd --vicon -> subscribers"},
+        {"seconds", seconds},
+        {"subscribers", subscriber_count},
+        {"deform_threads", deform_threads},
+        {"recording", recording},
+        {"vertices", health["subject"]["vertices"]},
+        {"markers", health["subject"]["markers"]},
+        {"end_to_end", end_to_end.summary()},
+        {"daemon_processing", processing.summary()},
+        {"frames", {{"sent_by_replay", sent},
+                    {"dropped_by_replay", replay_dropped},
+                    {"received_by_daemon", delta("received")},
+                    {"processed", delta("processed")},
+                    {"published", delta("published")},
+                    {"dropped_in_pipeline", delta("dropped")},
+                    {"received_by_subscribers", total_received},
+                    {"dropped_for_subscribers", total_dropped},
+                    {"out_of_order", total_out_of_order},
+                    {"without_send_time", total_unmatched}}},
+        {"daemon", {{"cpu_seconds", cpu_seconds}, {"cpu_share_of_one_core", cpu_seconds / seconds}, {"peak_rss_kb", peak_rss_kb},
+                    {"exit_status", WIFEXITED(status) ? WEXITSTATUS(status) : -1}}}};
+    if (json) {
+      std::printf("%s\n", report.dump(2).c_str());
+    } else {
+      auto line = [&](const char* name, const nlohmann::json& s) {
+        std::printf("%-20s p50 %.3f ms  p99 %.3f ms  p99.9 %.3f ms  max %.3f ms  (%zu samples)\n", name, s["p50_ms"].get<double>(),
+                    s["p99_ms"].get<double>(), s["p99_9_ms"].get<double>(), s["max_ms"].get<double>(), s["count"].get<size_t>());
+      };
+      std::printf("%s\n", report["mode"].get<std::string>().c_str());
+      line("end to end", report["end_to_end"]);
+      line("daemon processing", report["daemon_processing"]);
+      std::printf("frames: %s\n", report["frames"].dump().c_str());
+      std::printf("daemon: %.2f s CPU (%.0f%% of one core), peak RSS %ld kB\n", cpu_seconds, 100 * cpu_seconds / seconds, peak_rss_kb);
+    }
+    fs::remove_all(work);
+    return 0;
+  } catch (const std::exception& e) {
+    if (pid > 0) {
+      kill(pid, SIGTERM);
+      waitpid(pid, nullptr, 0);
+    }
+    stop_replay();
+    std::fprintf(stderr, "skinstream-bench: error: %s\n", e.what());
+    return 1;
+  }
+}

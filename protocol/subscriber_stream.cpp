@@ -1,0 +1,367 @@
+#include "protocol/subscriber_stream.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+
+#include "protocol/byte_buffer.h"
+
+namespace skinstream::subscriber {
+namespace {
+
+// Writes little-endian values at a cursor in a caller's span (the frame path, no allocation).
+class SpanWriter {
+ public:
+  explicit SpanWriter(std::span<unsigned char> out) : out_(out) {}
+  template <typename T>
+  void put(T value) {
+    std::memcpy(out_.data() + pos_, &value, sizeof(T));
+    pos_ += sizeof(T);
+  }
+  void zeros(size_t n) {
+    std::memset(out_.data() + pos_, 0, n);
+    pos_ += n;
+  }
+  size_t position() const { return pos_; }
+
+ private:
+  std::span<unsigned char> out_;
+  size_t pos_ = 0;
+};
+
+void put_header(ByteWriter& w, MessageType type, size_t payload) {
+  w.put<uint32_t>(kMagic);
+  w.put<uint16_t>(kProtocolVersion);
+  w.put<uint16_t>(static_cast<uint16_t>(type));
+  w.put<uint32_t>(static_cast<uint32_t>(payload));
+}
+
+// Messages other than Frame: payload built first, then the header in front.
+std::vector<unsigned char> with_header(MessageType type, const ByteWriter& payload) {
+  ByteWriter w;
+  put_header(w, type, payload.bytes().size());
+  w.put_bytes(payload.bytes().data(), payload.bytes().size());
+  return std::move(w.bytes());
+}
+
+size_t padding_to_4(size_t n) { return (4 - n % 4) % 4; }
+
+// Runs a payload decoder, turning a read past the end into a DecodeError naming the message.
+template <typename F>
+auto decode_payload(const char* what, std::span<const unsigned char> payload, F&& body) {
+  ByteReader r(payload.data(), payload.size());
+  try {
+    auto result = body(r);
+    if (r.remaining() != 0)
+      throw DecodeError(std::string(what) + ": " + std::to_string(r.remaining()) + " bytes left over after the message");
+    return result;
+  } catch (const std::out_of_range& e) {
+    throw DecodeError(std::string(what) + ": " + e.what());
+  }
+}
+
+void get_floats(ByteReader& r, std::vector<float>& out, size_t count) {
+  out.resize(count);
+  for (size_t i = 0; i < count; ++i) out[i] = r.get<float>();
+}
+
+}  // namespace
+
+const char* to_string(MessageType type) {
+  switch (type) {
+    case MessageType::Hello: return "Hello";
+    case MessageType::MeshInfo: return "MeshInfo";
+    case MessageType::Frame: return "Frame";
+    case MessageType::Status: return "Status";
+  }
+  return "unknown";
+}
+
+uint32_t frame_flags_for(uint32_t wants, bool has_mesh) {
+  const bool positions = has_mesh && !(wants & kWantNoMesh);
+  uint32_t flags = 0;
+  if (!positions) flags |= kFrameNoPositions;
+  if (positions && (wants & kWantNormals)) flags |= kFrameNormals;
+  if (positions && (wants & kWantQuantised)) flags |= kFrameQuantised;
+  if (wants & kWantMarkers) flags |= kFrameMarkers;
+  return flags;
+}
+
+std::vector<unsigned char> encode_hello(const Hello& hello) {
+  ByteWriter p;
+  p.put<uint32_t>(hello.wants);
+  return with_header(MessageType::Hello, p);
+}
+
+std::vector<unsigned char> encode_mesh_info(const MeshInfo& info) {
+  ByteWriter p;
+  p.put<uint32_t>(info.vertex_count);
+  p.put<uint32_t>(static_cast<uint32_t>(info.faces.size()));
+  p.put<uint32_t>(info.marker_count);
+  p.put<uint32_t>(info.part_count);
+  p.put<float>(info.source_rate_hz);
+  for (const auto& f : info.faces)
+    for (uint32_t v : f) p.put<uint32_t>(v);
+  for (uint32_t v = 0; v < info.vertex_count; ++v)
+    p.put<uint8_t>(v < info.dominant_part.size() ? info.dominant_part[v] : uint8_t{255});
+  p.put<uint32_t>(static_cast<uint32_t>(info.marker_triangles.size()));
+  for (const auto& t : info.marker_triangles)
+    for (uint32_t m : t) p.put<uint32_t>(m);
+  for (const std::string& name : info.marker_names) {
+    const size_t n = std::min<size_t>(name.size(), std::numeric_limits<uint16_t>::max());
+    p.put<uint16_t>(static_cast<uint16_t>(n));
+    p.put_bytes(name.data(), n);
+  }
+  return with_header(MessageType::MeshInfo, p);
+}
+
+std::vector<unsigned char> encode_status(const Status& status) {
+  ByteWriter p;
+  p.put<uint32_t>(static_cast<uint32_t>(status.state));
+  p.put<float>(status.source_rate_hz);
+  p.put<uint64_t>(status.frames_received);
+  p.put<uint64_t>(status.frames_published);
+  const size_t n = std::min<size_t>(status.detail.size(), std::numeric_limits<uint16_t>::max());
+  p.put<uint16_t>(static_cast<uint16_t>(n));
+  p.put_bytes(status.detail.data(), n);
+  return with_header(MessageType::Status, p);
+}
+
+size_t frame_message_bytes(uint32_t flags, uint32_t vertex_count, uint32_t marker_count) {
+  size_t bytes = kHeaderBytes + kFrameInfoBytes;
+  const size_t v3 = 3 * static_cast<size_t>(vertex_count);
+  const bool quantised = flags & kFrameQuantised;
+  // Quantised blocks are padded to 4 bytes so the floats after them stay aligned (JS typed arrays).
+  if (!(flags & kFrameNoPositions)) bytes += quantised ? 24 + 2 * v3 + padding_to_4(2 * v3) : 4 * v3;
+  if (flags & kFrameNormals) bytes += quantised ? 2 * v3 + padding_to_4(2 * v3) : 4 * v3;
+  if (flags & kFrameMarkers) bytes += 12 * static_cast<size_t>(marker_count) + marker_count + padding_to_4(marker_count);
+  return bytes;
+}
+
+void encode_frame(const FrameInfo& in, std::span<const float> positions, std::span<const float> normals,
+                  std::span<const float> markers, std::span<const uint8_t> marker_status, std::span<unsigned char> out) {
+  FrameInfo info = in;
+  const bool has_positions = !(info.flags & kFrameNoPositions);
+  const bool has_normals = info.flags & kFrameNormals;
+  const bool has_markers = info.flags & kFrameMarkers;
+  const bool quantised = info.flags & kFrameQuantised;
+  if (!has_positions) info.vertex_count = 0;
+  if (!has_markers) info.marker_count = 0;
+  const size_t v3 = 3 * static_cast<size_t>(info.vertex_count);
+  const size_t total = frame_message_bytes(info.flags, info.vertex_count, info.marker_count);
+  if (out.size() != total || (has_positions && positions.size() < v3) || (has_normals && normals.size() < v3) ||
+      (has_markers && (markers.size() < 3 * size_t{info.marker_count} || marker_status.size() < info.marker_count)))
+    throw std::invalid_argument("encode_frame: buffer sizes do not match the frame's counts");
+
+  SpanWriter w(out);
+  w.put<uint32_t>(kMagic);
+  w.put<uint16_t>(kProtocolVersion);
+  w.put<uint16_t>(static_cast<uint16_t>(MessageType::Frame));
+  w.put<uint32_t>(static_cast<uint32_t>(total - kHeaderBytes));
+  w.put<uint32_t>(info.frame_number);
+  w.put<uint32_t>(info.flags);
+  w.put<int64_t>(info.source_time_ns);
+  w.put<int64_t>(info.receive_time_ns);
+  w.put<int64_t>(info.publish_time_ns);
+  w.put<uint32_t>(info.vertex_count);
+  w.put<uint32_t>(info.marker_count);
+  w.put<uint16_t>(info.markers_filled);
+  w.put<uint16_t>(info.markers_relabelled);
+  w.put<uint32_t>(info.pipeline_dropped);
+  w.put<uint32_t>(info.subscriber_dropped);
+
+  if (has_positions && !quantised) {
+    for (size_t i = 0; i < v3; ++i) w.put<float>(positions[i]);
+  } else if (has_positions) {
+    float lo[3], hi[3], step[3];
+    for (int a = 0; a < 3; ++a) lo[a] = std::numeric_limits<float>::max(), hi[a] = std::numeric_limits<float>::lowest();
+    for (size_t i = 0; i < v3; ++i) {
+      const int a = static_cast<int>(i % 3);
+      if (!std::isfinite(positions[i])) continue;
+      lo[a] = std::min(lo[a], positions[i]);
+      hi[a] = std::max(hi[a], positions[i]);
+    }
+    for (int a = 0; a < 3; ++a) {
+      if (lo[a] > hi[a]) lo[a] = hi[a] = 0.0f;  // no finite value on this axis
+      step[a] = (hi[a] - lo[a]) / 65535.0f;
+    }
+    for (int a = 0; a < 3; ++a) w.put<float>(lo[a]);
+    for (int a = 0; a < 3; ++a) w.put<float>(step[a]);
+    for (size_t i = 0; i < v3; ++i) {
+      const int a = static_cast<int>(i % 3);
+      const double q = step[a] > 0 && std::isfinite(positions[i]) ? std::round((positions[i] - lo[a]) / step[a]) : 0.0;
+      w.put<uint16_t>(static_cast<uint16_t>(std::clamp(q, 0.0, 65535.0)));
+    }
+    w.zeros(padding_to_4(2 * v3));
+  }
+  if (has_normals && !quantised) {
+    for (size_t i = 0; i < v3; ++i) w.put<float>(normals[i]);
+  } else if (has_normals) {
+    for (size_t i = 0; i < v3; ++i) {
+      const float n = std::isfinite(normals[i]) ? std::clamp(normals[i], -1.0f, 1.0f) : 0.0f;
+      w.put<int16_t>(static_cast<int16_t>(std::lround(n * 32767.0f)));
+    }
+    w.zeros(padding_to_4(2 * v3));
+  }
+  if (has_markers) {
+    for (size_t i = 0; i < 3 * size_t{info.marker_count}; ++i) w.put<float>(markers[i]);
+    for (uint32_t m = 0; m < info.marker_count; ++m) w.put<uint8_t>(marker_status[m]);
+    w.zeros(padding_to_4(info.marker_count));
+  }
+}
+
+void patch_subscriber_dropped(std::span<unsigned char> frame_message, uint32_t dropped) {
+  if (frame_message.size() < kSubscriberDroppedOffset + 4) throw std::invalid_argument("patch_subscriber_dropped: not a frame message");
+  std::memcpy(frame_message.data() + kSubscriberDroppedOffset, &dropped, 4);
+}
+
+MessageHeader decode_header(std::span<const unsigned char> bytes, uint32_t max_payload) {
+  if (bytes.size() < kHeaderBytes)
+    throw DecodeError("message header truncated: " + std::to_string(bytes.size()) + " of 12 bytes");
+  ByteReader r(bytes.data(), kHeaderBytes);
+  const uint32_t magic = r.get<uint32_t>();
+  const uint16_t version = r.get<uint16_t>();
+  const uint16_t type = r.get<uint16_t>();
+  const uint32_t payload = r.get<uint32_t>();
+  if (magic != kMagic) throw DecodeError("bad magic (not a skinstream subscriber stream)");
+  if (version != kProtocolVersion)
+    throw DecodeError("unsupported protocol version " + std::to_string(version) + " (this side speaks 1)");
+  if (type < 1 || type > 4) throw DecodeError("unknown message type " + std::to_string(type));
+  if (payload > max_payload)
+    throw DecodeError("payload of " + std::to_string(payload) + " bytes exceeds the limit of " + std::to_string(max_payload));
+  return {static_cast<MessageType>(type), payload};
+}
+
+Hello decode_hello(std::span<const unsigned char> payload) {
+  return decode_payload("Hello", payload, [](ByteReader& r) {
+    Hello hello{r.get<uint32_t>()};
+    if (hello.wants & ~kWantAll) throw DecodeError("Hello: reserved wants bits set (" + std::to_string(hello.wants) + ")");
+    return hello;
+  });
+}
+
+MeshInfo decode_mesh_info(std::span<const unsigned char> payload) {
+  return decode_payload("MeshInfo", payload, [](ByteReader& r) {
+    MeshInfo info;
+    info.vertex_count = r.get<uint32_t>();
+    const uint32_t face_count = r.get<uint32_t>();
+    info.marker_count = r.get<uint32_t>();
+    info.part_count = r.get<uint32_t>();
+    info.source_rate_hz = r.get<float>();
+    if (face_count > r.remaining() / 12 || info.vertex_count > r.remaining())
+      throw std::out_of_range("vertex or face count exceeds the data left");
+    info.faces.resize(face_count);
+    for (auto& f : info.faces)
+      for (uint32_t& v : f) {
+        v = r.get<uint32_t>();
+        if (v >= info.vertex_count) throw DecodeError("MeshInfo: face index " + std::to_string(v) + " out of range");
+      }
+    info.dominant_part.resize(info.vertex_count);
+    for (uint8_t& p : info.dominant_part) p = r.get<uint8_t>();
+    info.marker_triangles.resize(r.get_count(12));
+    for (auto& t : info.marker_triangles)
+      for (uint32_t& m : t) {
+        m = r.get<uint32_t>();
+        if (m >= info.marker_count) throw DecodeError("MeshInfo: marker triangle index " + std::to_string(m) + " out of range");
+      }
+    if (info.marker_count > r.remaining() / 2) throw std::out_of_range("marker count exceeds the data left");
+    info.marker_names.resize(info.marker_count);
+    for (std::string& name : info.marker_names) {
+      const uint16_t n = r.get<uint16_t>();
+      if (n > r.remaining()) throw std::out_of_range("marker name truncated");
+      name.resize(n);
+      for (char& c : name) c = r.get<char>();
+    }
+    return info;
+  });
+}
+
+Frame decode_frame(std::span<const unsigned char> payload) {
+  return decode_payload("Frame", payload, [](ByteReader& r) {
+    Frame frame;
+    FrameInfo& info = frame.info;
+    info.frame_number = r.get<uint32_t>();
+    info.flags = r.get<uint32_t>();
+    info.source_time_ns = r.get<int64_t>();
+    info.receive_time_ns = r.get<int64_t>();
+    info.publish_time_ns = r.get<int64_t>();
+    info.vertex_count = r.get<uint32_t>();
+    info.marker_count = r.get<uint32_t>();
+    info.markers_filled = r.get<uint16_t>();
+    info.markers_relabelled = r.get<uint16_t>();
+    info.pipeline_dropped = r.get<uint32_t>();
+    info.subscriber_dropped = r.get<uint32_t>();
+    if (info.flags & ~uint32_t{0xF}) throw DecodeError("Frame: reserved flag bits set (" + std::to_string(info.flags) + ")");
+    const bool has_positions = !(info.flags & kFrameNoPositions);
+    if (!has_positions && info.vertex_count != 0) throw DecodeError("Frame: vertex count with \"no positions\"");
+    if (!has_positions && (info.flags & kFrameNormals)) throw DecodeError("Frame: normals without positions");
+    if (!(info.flags & kFrameMarkers) && info.marker_count != 0) throw DecodeError("Frame: marker count without markers");
+    // Sizes first, so a corrupt count is refused before anything is allocated for it.
+    const size_t expected = frame_message_bytes(info.flags, info.vertex_count, info.marker_count) - kHeaderBytes - kFrameInfoBytes;
+    if (expected != r.remaining())
+      throw DecodeError("Frame: counts say " + std::to_string(expected) + " bytes of data, the payload holds " +
+                        std::to_string(r.remaining()));
+    const size_t v3 = 3 * size_t{info.vertex_count};
+    const bool quantised = info.flags & kFrameQuantised;
+    if (has_positions && !quantised) get_floats(r, frame.positions, v3);
+    if (has_positions && quantised) {
+      for (float& o : frame.origin) o = r.get<float>();
+      for (float& s : frame.step) s = r.get<float>();
+      frame.positions.resize(v3);
+      for (size_t i = 0; i < v3; ++i) frame.positions[i] = frame.origin[i % 3] + r.get<uint16_t>() * frame.step[i % 3];
+      for (size_t i = 0; i < padding_to_4(2 * v3); ++i) r.get<uint8_t>();
+    }
+    if ((info.flags & kFrameNormals) && !quantised) get_floats(r, frame.normals, v3);
+    if ((info.flags & kFrameNormals) && quantised) {
+      frame.normals.resize(v3);
+      for (float& n : frame.normals) n = r.get<int16_t>() / 32767.0f;
+      for (size_t i = 0; i < padding_to_4(2 * v3); ++i) r.get<uint8_t>();
+    }
+    if (info.flags & kFrameMarkers) {
+      get_floats(r, frame.markers, 3 * size_t{info.marker_count});
+      frame.marker_status.resize(info.marker_count);
+      for (uint8_t& s : frame.marker_status) {
+        s = r.get<uint8_t>();
+        if (s > 4) throw DecodeError("Frame: marker status " + std::to_string(s) + " is not one of 0-4");
+      }
+      for (size_t i = 0; i < padding_to_4(info.marker_count); ++i) r.get<uint8_t>();
+    }
+    return frame;
+  });
+}
+
+Status decode_status(std::span<const unsigned char> payload) {
+  return decode_payload("Status", payload, [](ByteReader& r) {
+    Status status;
+    const uint32_t state = r.get<uint32_t>();
+    if (state > 3) throw DecodeError("Status: unknown source state " + std::to_string(state));
+    status.state = static_cast<SourceStateCode>(state);
+    status.source_rate_hz = r.get<float>();
+    status.frames_received = r.get<uint64_t>();
+    status.frames_published = r.get<uint64_t>();
+    status.detail.resize(r.get<uint16_t>());
+    for (char& c : status.detail) c = r.get<char>();
+    return status;
+  });
+}
+
+void StreamDecoder::feed(std::span<const unsigned char> bytes) {
+  // Drop what was consumed before growing, so the buffer holds at most one partial message.
+  if (consumed_ > 0) {
+    buffer_.erase(buffer_.begin(), buffer_.begin() + static_cast<std::ptrdiff_t>(consumed_));
+    consumed_ = 0;
+  }
+  buffer_.insert(buffer_.end(), bytes.begin(), bytes.end());
+}
+
+std::optional<RawMessage> StreamDecoder::next() {
+  const std::span<const unsigned char> pending(buffer_.data() + consumed_, buffer_.size() - consumed_);
+  if (pending.size() < kHeaderBytes) return std::nullopt;
+  const MessageHeader header = decode_header(pending, max_payload_);
+  if (pending.size() - kHeaderBytes < header.payload_bytes) return std::nullopt;
+  consumed_ += kHeaderBytes + header.payload_bytes;
+  return RawMessage{header.type, pending.subspan(kHeaderBytes, header.payload_bytes)};
+}
+
+}  // namespace skinstream::subscriber

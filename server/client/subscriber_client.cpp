@@ -1,0 +1,45 @@
+#include "server/client/subscriber_client.h"
+
+#include <array>
+#include <stdexcept>
+
+namespace skinstream::sub {
+
+std::pair<std::string, std::string> split_host_port(const std::string& address) {
+  const size_t colon = address.rfind(':');
+  if (colon == std::string::npos || colon == 0 || colon + 1 == address.size())
+    throw std::invalid_argument("\"" + address + "\" is not HOST:PORT");
+  return {address.substr(0, colon), address.substr(colon + 1)};
+}
+
+int64_t wall_clock_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch()).count();
+}
+
+SubscriberClient::SubscriberClient(const std::string& host, const std::string& port, uint32_t wants) : socket_(io_) {
+  server::tcp::resolver resolver(io_);
+  boost::system::error_code ec;
+  const auto endpoints = resolver.resolve(host, port, ec);
+  if (ec) throw std::runtime_error(host + ":" + port + ": " + ec.message());
+  server::asio::connect(socket_, endpoints, ec);
+  if (ec) throw std::runtime_error(host + ":" + port + ": " + ec.message());
+  socket_.set_option(server::tcp::no_delay(true));
+  const std::vector<unsigned char> hello = subscriber::encode_hello({wants});
+  server::asio::write(socket_, server::asio::buffer(hello));
+}
+
+bool SubscriberClient::run(
+    const std::function<bool(subscriber::MessageType, std::span<const unsigned char>, int64_t)>& on_message) {
+  std::array<unsigned char, 1 << 16> buffer;
+  for (;;) {
+    boost::system::error_code ec;
+    const size_t n = socket_.read_some(server::asio::buffer(buffer), ec);
+    if (ec) return false;
+    const int64_t now = wall_clock_ns();
+    decoder_.feed(std::span(buffer).first(n));
+    while (auto message = decoder_.next())
+      if (!on_message(message->type, message->payload, now)) return true;
+  }
+}
+
+}  // namespace skinstream::sub

@@ -1,0 +1,171 @@
+#include "server/config.h"
+
+#include <CLI/CLI.hpp>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+namespace skinstream::server {
+namespace {
+
+template <typename T>
+void take(const nlohmann::json& json, const char* key, T& out, const std::string& origin) {
+  const auto it = json.find(key);
+  if (it == json.end()) return;
+  try {
+    out = it->get<T>();
+  } catch (const nlohmann::json::exception&) {
+    throw ConfigError(origin + ": key \"" + key + "\" has the wrong type (" + it->type_name() + ")");
+  }
+}
+
+}  // namespace
+
+void apply_json(const nlohmann::json& json, DaemonConfig& c, const std::string& origin) {
+  if (!json.is_object()) throw ConfigError(origin + ": the configuration must be a JSON object");
+  static const char* const kKeys[] = {"subject", "replay", "loop", "speed", "vicon", "vicon_pull", "bind_address",
+                                      "http_port", "sub_port", "web_root", "lookahead", "deform_threads",
+                                      "continuity_seconds", "use_pca", "ports_file", "log_level", "hello_timeout_ms",
+                                      "subscriber_queue_frames", "status_interval_ms", "default_rate_hz"};
+  for (const auto& [key, value] : json.items()) {
+    bool known = false;
+    for (const char* k : kKeys) known = known || key == k;
+    if (!known) throw ConfigError(origin + ": unknown key \"" + key + "\"");
+  }
+  take(json, "subject", c.subject, origin);
+  take(json, "replay", c.replay, origin);
+  take(json, "loop", c.loop, origin);
+  take(json, "speed", c.speed, origin);
+  take(json, "vicon", c.vicon, origin);
+  take(json, "vicon_pull", c.vicon_pull, origin);
+  take(json, "bind_address", c.bind_address, origin);
+  take(json, "http_port", c.http_port, origin);
+  take(json, "sub_port", c.sub_port, origin);
+  take(json, "web_root", c.web_root, origin);
+  take(json, "lookahead", c.lookahead, origin);
+  take(json, "deform_threads", c.deform_threads, origin);
+  take(json, "continuity_seconds", c.continuity_seconds, origin);
+  take(json, "use_pca", c.use_pca, origin);
+  take(json, "ports_file", c.ports_file, origin);
+  take(json, "log_level", c.log_level, origin);
+  take(json, "hello_timeout_ms", c.hello_timeout_ms, origin);
+  take(json, "subscriber_queue_frames", c.subscriber_queue_frames, origin);
+  take(json, "status_interval_ms", c.status_interval_ms, origin);
+  take(json, "default_rate_hz", c.default_rate_hz, origin);
+}
+
+DaemonConfig load_config_file(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw ConfigError(path + ": cannot open the configuration file");
+  std::stringstream text;
+  text << in.rdbuf();
+  nlohmann::json json;
+  try {
+    json = nlohmann::json::parse(text.str(), nullptr, true, /*ignore_comments=*/true);
+  } catch (const nlohmann::json::parse_error& e) {
+    throw ConfigError(path + ": not valid JSON (byte " + std::to_string(e.byte) + ")");
+  }
+  DaemonConfig config;
+  apply_json(json, config, path);
+  return config;
+}
+
+nlohmann::json to_json(const DaemonConfig& c) {
+  return {{"subject", c.subject},
+          {"replay", c.replay},
+          {"loop", c.loop},
+          {"speed", c.speed},
+          {"vicon", c.vicon},
+          {"vicon_pull", c.vicon_pull},
+          {"bind_address", c.bind_address},
+          {"http_port", c.http_port},
+          {"sub_port", c.sub_port},
+          {"web_root", c.web_root},
+          {"lookahead", c.lookahead},
+          {"deform_threads", c.deform_threads},
+          {"continuity_seconds", c.continuity_seconds},
+          {"use_pca", c.use_pca},
+          {"ports_file", c.ports_file},
+          {"log_level", c.log_level},
+          {"hello_timeout_ms", c.hello_timeout_ms},
+          {"subscriber_queue_frames", c.subscriber_queue_frames},
+          {"status_interval_ms", c.status_interval_ms},
+          {"default_rate_hz", c.default_rate_hz}};
+}
+
+void validate(const DaemonConfig& c) {
+  auto fail = [](const std::string& what) { throw ConfigError("configuration: " + what); };
+  if (!c.replay.empty() && !c.vicon.empty()) fail("give either a replay file or a Vicon server, not both");
+  if (!(c.speed > 0 && c.speed <= 100)) fail("speed must be in (0, 100]");
+  if (c.http_port < 0 || c.http_port > 65535) fail("http_port must be 0-65535");
+  if (c.sub_port < 0 || c.sub_port > 65535) fail("sub_port must be 0-65535");
+  if (c.lookahead < 0 || c.lookahead > 240) fail("lookahead must be 0-240 frames");
+  if (c.deform_threads < 1 || c.deform_threads > 64) fail("deform_threads must be 1-64");
+  if (c.continuity_seconds < 0) fail("continuity_seconds must be >= 0");
+  if (c.hello_timeout_ms < 0) fail("hello_timeout_ms must be >= 0");
+  if (c.subscriber_queue_frames < 1 || c.subscriber_queue_frames > 64) fail("subscriber_queue_frames must be 1-64");
+  if (c.status_interval_ms < 10) fail("status_interval_ms must be >= 10");
+  if (!(c.default_rate_hz > 0)) fail("default_rate_hz must be > 0");
+  static const char* const kLevels[] = {"trace", "debug", "info", "warn", "error", "critical", "off"};
+  bool level_ok = false;
+  for (const char* l : kLevels) level_ok = level_ok || c.log_level == l;
+  if (!level_ok) fail("log_level must be one of trace, debug, info, warn, error, critical, off");
+  if (!c.vicon.empty()) {
+    const size_t colon = c.vicon.rfind(':');
+    const std::string port = colon == std::string::npos ? std::string() : c.vicon.substr(colon + 1);
+    const bool digits = !port.empty() && port.size() <= 5 && port.find_first_not_of("0123456789") == std::string::npos;
+    if (colon == 0 || !digits || std::stoi(port) < 1 || std::stoi(port) > 65535)
+      fail("vicon must be HOST:PORT with a port of 1-65535 (Vicon's default is 801), not \"" + c.vicon + "\"");
+  }
+}
+
+std::optional<CommandLine> parse_command_line(int argc, const char* const* argv, int& out_exit_code) {
+  CLI::App app{"skinstreamd: live marker frames in, gap-filled deforming skin meshes out to every subscriber"};
+  std::string config_path;
+  DaemonConfig flags;  // values of the flags; only those given are applied
+  CommandLine result;
+  app.add_option("--config", config_path, "JSON configuration file (see config/skinstreamd.reference.json)");
+  auto* subject = app.add_option("--subject", flags.subject, "subject file (skinstream build-subject)");
+  auto* replay = app.add_option("--replay", flags.replay, "replay a capture file (C3D/TRC) as the source");
+  auto* loop = app.add_flag("--loop", flags.loop, "replay: start again at the end");
+  auto* speed = app.add_option("--speed", flags.speed, "replay: multiple of the capture rate");
+  auto* vicon = app.add_option("--vicon", flags.vicon, "Vicon DataStream server HOST:PORT as the source");
+  auto* vicon_pull = app.add_flag("--vicon-pull", flags.vicon_pull, "Vicon: ask for each frame (ClientPull) instead of the server pushing them");
+  auto* bind = app.add_option("--bind", flags.bind_address, "address to listen on");
+  auto* http_port = app.add_option("--http-port", flags.http_port, "HTTP/WebSocket port (0 = ephemeral)");
+  auto* sub_port = app.add_option("--sub-port", flags.sub_port, "TCP subscriber port (0 = ephemeral)");
+  auto* web_root = app.add_option("--web-root", flags.web_root, "folder of static files served at /");
+  auto* lookahead = app.add_option("--lookahead", flags.lookahead, "gap-end blend lookahead in frames (adds latency)");
+  auto* threads = app.add_option("--deform-threads", flags.deform_threads, "threads deforming the mesh (pipeline thread included)");
+  auto* ports_file = app.add_option("--ports-file", flags.ports_file, "write {\"http\":N,\"sub\":N} here once listening");
+  auto* log_level = app.add_option("--log-level", flags.log_level, "trace, debug, info, warn, error, critical, off");
+  app.add_flag("--print-config", result.print_config, "print the effective configuration as JSON and exit");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    out_exit_code = app.exit(e);
+    return std::nullopt;
+  }
+  DaemonConfig& c = result.config;
+  if (!config_path.empty()) c = load_config_file(config_path);
+  auto given = [](const CLI::Option* o) { return o->count() > 0; };
+  if (given(subject)) c.subject = flags.subject;
+  if (given(replay)) c.replay = flags.replay, c.vicon.clear();
+  if (given(loop)) c.loop = flags.loop;
+  if (given(speed)) c.speed = flags.speed;
+  if (given(vicon)) c.vicon = flags.vicon, c.replay = given(replay) ? flags.replay : std::string();
+  if (given(vicon_pull)) c.vicon_pull = flags.vicon_pull;
+  if (given(bind)) c.bind_address = flags.bind_address;
+  if (given(http_port)) c.http_port = flags.http_port;
+  if (given(sub_port)) c.sub_port = flags.sub_port;
+  if (given(web_root)) c.web_root = flags.web_root;
+  if (given(lookahead)) c.lookahead = flags.lookahead;
+  if (given(threads)) c.deform_threads = flags.deform_threads;
+  if (given(ports_file)) c.ports_file = flags.ports_file;
+  if (given(log_level)) c.log_level = flags.log_level;
+  validate(c);
+  out_exit_code = 0;
+  return result;
+}
+
+}  // namespace skinstream::server

@@ -1,0 +1,59 @@
+#pragma once
+// skinstreamd's configuration: a JSON file (config/skinstreamd.reference.json documents every
+// key), then command-line flags on top. Everything the daemon is told comes through here.
+
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json_fwd.hpp>
+
+namespace skinstream::server {
+
+struct DaemonConfig {
+  std::string subject;            // subject file; empty = none
+  std::string replay;             // capture file to replay (C3D/TRC); empty = none
+  bool loop = false;              // replay: start again at the end
+  double speed = 1.0;             // replay: multiple of the capture rate
+  std::string vicon;              // HOST:PORT of a Vicon DataStream server; empty = none
+  bool vicon_pull = false;        // Vicon: ask for each frame instead of server push
+  std::string bind_address = "0.0.0.0";
+  int http_port = 8480;           // 0 = ephemeral
+  int sub_port = 8481;            // 0 = ephemeral
+  std::string web_root;           // static files served at /; empty = none
+  int lookahead = 0;              // gap-end blend lookahead, frames
+  int deform_threads = 2;         // the pipeline thread plus deform_threads - 1 workers
+  double continuity_seconds = 1.0;
+  bool use_pca = true;
+  std::string ports_file;         // written as {"http":N,"sub":N} once listening
+  std::string log_level = "info";
+  int hello_timeout_ms = 2000;    // subscribers that say nothing get positions only
+  int subscriber_queue_frames = 2;  // per subscriber, newest wins
+  int status_interval_ms = 1000;
+  double default_rate_hz = 120.0;  // until the source says its rate
+};
+
+// Thrown for a bad config file, a bad key or value, or conflicting flags: one line, says which.
+class ConfigError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// Applies a JSON object's keys onto `config`. Unknown keys and wrong types are errors (typos
+// would otherwise be ignored silently). `origin` names the file in messages.
+void apply_json(const nlohmann::json& json, DaemonConfig& config, const std::string& origin);
+DaemonConfig load_config_file(const std::string& path);  // throws ConfigError
+nlohmann::json to_json(const DaemonConfig& config);
+// Range and consistency checks; throws ConfigError.
+void validate(const DaemonConfig& config);
+
+struct CommandLine {
+  DaemonConfig config;
+  bool print_config = false;
+};
+// Parses argv: --config FILE first, then every flag given overrides it. Throws ConfigError for
+// config problems; CLI11 parse errors are returned as an exit code via `out_exit_code`.
+std::optional<CommandLine> parse_command_line(int argc, const char* const* argv, int& out_exit_code);
+
+}  // namespace skinstream::server

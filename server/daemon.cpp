@@ -1,0 +1,313 @@
+#include "server/daemon.h"
+
+#include <spdlog/spdlog.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "protocol/file_error.h"
+#include "server/http/http_server.h"
+#include "server/ingest/file_replay_source.h"
+#include "server/ingest/vicon_source.h"
+#include "server/listener.h"
+#include "server/publish/subscriber_hub.h"
+#include "server/publish/tcp_subscriber.h"
+
+namespace skinstream::server {
+namespace {
+
+SubjectFile load_subject(const DaemonConfig& config) {
+  if (config.subject.empty()) throw ConfigError("no subject file given (--subject FILE or \"subject\" in the config)");
+  return read_subject_file(config.subject);
+}
+
+subscriber::MeshInfo mesh_info_of(const SubjectFile& subject) {
+  subscriber::MeshInfo info;
+  const SubjectModel& model = subject.model;
+  info.marker_count = static_cast<uint32_t>(model.marker_count());
+  info.marker_names = model.marker_names;
+  for (const auto& t : model.triangles)
+    info.marker_triangles.push_back({static_cast<uint32_t>(t[0]), static_cast<uint32_t>(t[1]), static_cast<uint32_t>(t[2])});
+  if (subject.deformation) {
+    const DeformationModel& d = *subject.deformation;
+    info.vertex_count = static_cast<uint32_t>(d.vertex_count());
+    info.part_count = static_cast<uint32_t>(d.part_count());
+    for (const auto& f : d.faces)
+      info.faces.push_back({static_cast<uint32_t>(f[0]), static_cast<uint32_t>(f[1]), static_cast<uint32_t>(f[2])});
+    info.dominant_part.resize(info.vertex_count);
+    for (int v = 0; v < d.vertex_count(); ++v) {
+      const int p = d.dominant_part(v);
+      info.dominant_part[v] = p >= 0 && p < 255 ? static_cast<uint8_t>(p) : uint8_t{255};
+    }
+  }
+  return info;
+}
+
+// "HOST:PORT" (validate() has checked the colon) -> the ViconSource's options.
+ViconSourceOptions vicon_options_of(const DaemonConfig& config) {
+  const size_t colon = config.vicon.rfind(':');
+  ViconSourceOptions options;
+  options.host = config.vicon.substr(0, colon);
+  int port = 0;
+  try {
+    port = std::stoi(config.vicon.substr(colon + 1));
+  } catch (const std::exception&) {
+    port = 0;
+  }
+  if (options.host.empty() || port <= 0 || port > 65535)
+    throw ConfigError("--vicon " + config.vicon + ": expected HOST:PORT with a port of 1-65535");
+  options.port = static_cast<uint16_t>(port);
+  options.mode = config.vicon_pull ? ViconSourceOptions::Mode::ClientPull : ViconSourceOptions::Mode::ServerPush;
+  return options;
+}
+
+subscriber::SourceStateCode code_of(SourceState s) { return static_cast<subscriber::SourceStateCode>(static_cast<uint32_t>(s)); }
+
+}  // namespace
+
+Daemon::Daemon(const DaemonConfig& config)
+    : config_(config),
+      subject_(load_subject(config)),
+      mailbox_(subject_.model.marker_count()),
+      status_timer_(io_) {
+  const SubjectModel& model = subject_.model;
+  if (!subject_.deformation)
+    spdlog::warn("{}: no deformation model (built without --mesh): publishing markers only (MeshInfo with V = 0)",
+                 config.subject);
+  HubOptions hub_options;
+  hub_options.queue_frames = config.subscriber_queue_frames;
+  hub_options.hello_timeout = std::chrono::milliseconds(config.hello_timeout_ms);
+  hub_ = std::make_unique<SubscriberHub>(metrics_, hub_options, mesh_info_of(subject_), subject_.deformation.has_value());
+
+  PipelineOptions pipeline_options;
+  pipeline_options.lookahead = config.lookahead;
+  pipeline_options.deform_threads = config.deform_threads;
+  pipeline_options.default_rate_hz = config.default_rate_hz;
+  pipeline_options.filler.continuity_seconds = config.continuity_seconds;
+  pipeline_options.filler.use_pca = config.use_pca;
+  try {
+    pipeline_ = std::make_unique<Pipeline>(model, subject_.deformation ? &*subject_.deformation : nullptr, pipeline_options,
+                                           mailbox_, *hub_, metrics_);
+  } catch (const std::invalid_argument& e) {
+    throw FileError(config.subject, std::string("deformation model unusable: ") + e.what());
+  }
+
+  if (!config.replay.empty()) {
+    source_ = std::make_unique<FileReplaySource>(io_, model, config.replay, static_cast<FrameSink&>(*this), ReplayOptions{config.loop, config.speed});
+  } else if (!config.vicon.empty()) {
+    ViconSourceOptions options = vicon_options_of(config);
+    spdlog::info("source: Vicon DataStream {}:{} ({})", options.host, options.port,
+                 options.mode == ViconSourceOptions::Mode::ClientPull ? "client pull" : "server push");
+    source_ = std::make_unique<ViconSource>(io_, std::move(options), model.marker_names, static_cast<FrameSink&>(*this));
+  } else {
+    spdlog::warn("no source configured (--replay FILE or --vicon HOST:PORT): serving subscribers without frames");
+  }
+
+  sub_listener_ = std::make_unique<Listener>(io_, config.bind_address, config.sub_port, "subscriber port", [this](tcp::socket socket) {
+    boost::system::error_code ec;
+    const auto endpoint = socket.remote_endpoint(ec);
+    const std::string remote = ec ? "?" : endpoint.address().to_string() + ":" + std::to_string(endpoint.port());
+    auto subscriber = std::make_shared<TcpSubscriber>(io_, *hub_, std::move(socket), remote);
+    hub_->add(subscriber);
+    subscriber->start();
+  });
+  HttpRoutes routes;
+  routes.health_json = [this] { return health_json(); };
+  routes.metrics_text = [this] { return metrics_.render_prometheus(hub_->subscriber_metrics()); };
+  routes.web_root = config.web_root;
+  if (!config.web_root.empty() && !std::filesystem::is_directory(config.web_root))
+    throw FileError(config.web_root, "web root is not a directory");
+  http_ = std::make_unique<HttpServer>(io_, config.bind_address, config.http_port, *hub_, std::move(routes));
+}
+
+Daemon::~Daemon() { stop(); }
+
+int Daemon::http_port() const { return http_->port(); }
+int Daemon::sub_port() const { return sub_listener_->port(); }
+
+SourceState Daemon::source_state() const {
+  std::lock_guard lock(state_mutex_);
+  return state_;
+}
+
+void Daemon::start() {
+  start_serving();
+  start_source();
+}
+
+void Daemon::start_source() {
+  if (source_) asio::post(io_, [this] { if (!stopping_.load()) source_->start(); });
+}
+
+void Daemon::start_serving() {
+  if (started_.exchange(true)) return;
+  pipeline_->start();
+  sub_listener_->start();
+  http_->start();
+  schedule_status();
+  write_ports_file();
+  spdlog::info("skinstreamd: subject {} ({} markers, {} vertices), HTTP port {}, subscriber port {}", config_.subject,
+               subject_.model.marker_count(), pipeline_->vertex_count(), http_port(), sub_port());
+  io_thread_ = std::thread([this] {
+    auto guard = asio::make_work_guard(io_);
+    io_.run();
+  });
+}
+
+void Daemon::request_stop() {
+  if (stopping_.exchange(true)) return;
+  asio::post(io_, [this] {
+    spdlog::info("skinstreamd: stopping");
+    if (source_) source_->stop();
+    sub_listener_->stop();
+    http_->stop();
+    status_timer_.cancel();
+    pipeline_->stop();  // no more frames published after this
+    hub_->close_all();
+    io_.stop();
+  });
+}
+
+void Daemon::wait() {
+  std::lock_guard lock(stop_mutex_);
+  if (io_thread_.joinable()) io_thread_.join();
+  if (!stopped_) {
+    stopped_ = true;
+    pipeline_->stop();
+  }
+}
+
+void Daemon::stop() {
+  if (started_.load()) request_stop();
+  wait();
+}
+
+void Daemon::on_frame(const MarkerFrame& in) {
+  metrics_.frames_received.fetch_add(1, std::memory_order_relaxed);
+  MarkerFrame& out = mailbox_.writable();
+  if (in.labelled.size() != out.labelled.size()) {
+    metrics_.count_bad_input("wrong_marker_count");
+    bad_input_log_.warn("wrong_marker_count", "frame " + std::to_string(in.frame_number) + " has " +
+                                                  std::to_string(in.labelled.size()) + " labelled markers, the subject " +
+                                                  std::to_string(out.labelled.size()));
+    return;
+  }
+  out.clear();
+  out.frame_number = in.frame_number;
+  out.source_time_ns = in.source_time_ns;
+  out.receive_time_ns = in.receive_time_ns;
+  out.source_rate_hz = in.source_rate_hz;
+  out.unknown_labels = in.unknown_labels;
+  int non_finite = 0;
+  for (size_t m = 0; m < in.labelled.size(); ++m) {
+    const Vec3& p = in.labelled[m];
+    if (is_present(p)) out.labelled[m] = p;
+    else if (!p.array().isNaN().all()) ++non_finite;  // NaN is "missing"; anything else is broken
+  }
+  const int count = std::clamp(in.unlabelled_count, 0, static_cast<int>(std::min(in.unlabelled.size(), in.unlabelled_ids.size())));
+  for (int i = 0; i < count; ++i) {
+    if (!is_present(in.unlabelled[i])) {
+      ++non_finite;
+      continue;
+    }
+    out.unlabelled[out.unlabelled_count] = in.unlabelled[i];
+    out.unlabelled_ids[out.unlabelled_count] = in.unlabelled_ids[i];
+    ++out.unlabelled_count;
+  }
+  if (non_finite > 0) {
+    metrics_.count_bad_input("non_finite_point");
+    bad_input_log_.warn("non_finite_point", "frame " + std::to_string(in.frame_number) + ": " + std::to_string(non_finite) +
+                                                " non-finite points ignored");
+  }
+  if (in.source_rate_hz > 0 && in.source_rate_hz != source_rate_hz_) {
+    {
+      std::lock_guard lock(state_mutex_);
+      source_rate_hz_ = in.source_rate_hz;
+    }
+    hub_->set_source_rate(static_cast<float>(in.source_rate_hz));
+  }
+  uint64_t generation;
+  {
+    std::lock_guard lock(state_mutex_);
+    generation = generation_;
+  }
+  mailbox_.post(generation);
+}
+
+void Daemon::on_source_state(SourceState state, std::string_view detail) {
+  {
+    std::lock_guard lock(state_mutex_);
+    // Every start of streaming (first connect, reconnect, replay loop) is a new take for the filler.
+    if (state == SourceState::Streaming) ++generation_;
+    state_ = state;
+    state_detail_ = std::string(detail);
+  }
+  spdlog::info("source: {} ({})", to_string(state), detail);
+  broadcast_status();
+}
+
+void Daemon::on_bad_input(std::string_view what, std::string_view detail) {
+  metrics_.count_bad_input(what);
+  bad_input_log_.warn(what, detail);
+}
+
+void Daemon::on_unknown_label(std::string_view name) {
+  metrics_.count_bad_input("unknown_label");
+  spdlog::info("source: label \"{}\" is not a marker of the subject: used as an unlabelled point", name);
+}
+
+void Daemon::broadcast_status() {
+  subscriber::Status status;
+  {
+    std::lock_guard lock(state_mutex_);
+    status.state = code_of(state_);
+    status.source_rate_hz = static_cast<float>(source_rate_hz_);
+    status.detail = state_detail_;
+  }
+  status.frames_received = metrics_.frames_received.load();
+  status.frames_published = metrics_.frames_published.load();
+  hub_->broadcast_status(status);
+}
+
+void Daemon::schedule_status() {
+  status_timer_.expires_after(std::chrono::milliseconds(config_.status_interval_ms));
+  status_timer_.async_wait([this](const boost::system::error_code& ec) {
+    if (ec || stopping_.load()) return;
+    broadcast_status();
+    schedule_status();
+  });
+}
+
+std::string Daemon::health_json() const {
+  nlohmann::json source;
+  {
+    std::lock_guard lock(state_mutex_);
+    source = {{"state", to_string(state_)}, {"detail", state_detail_}, {"rate_hz", source_rate_hz_}};
+  }
+  const nlohmann::json health = {
+      {"status", "ok"},
+      {"source", source},
+      {"frames",
+       {{"received", metrics_.frames_received.load()},
+        {"processed", metrics_.frames_processed.load()},
+        {"published", metrics_.frames_published.load()},
+        {"dropped", metrics_.frames_dropped.load()}}},
+      {"subscribers", hub_->subscriber_count()},
+      {"subject", {{"markers", subject_.model.marker_count()}, {"vertices", pipeline_->vertex_count()}}}};
+  return health.dump();
+}
+
+void Daemon::write_ports_file() const {
+  if (config_.ports_file.empty()) return;
+  const std::string temporary = config_.ports_file + ".tmp";
+  {
+    std::ofstream out(temporary);
+    out << nlohmann::json{{"http", http_port()}, {"sub", sub_port()}}.dump() << "\n";
+    if (!out) throw FileError(config_.ports_file, "cannot write the ports file");
+  }
+  std::filesystem::rename(temporary, config_.ports_file);  // readers never see half a file
+}
+
+}  // namespace skinstream::server

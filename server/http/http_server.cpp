@@ -1,0 +1,112 @@
+#include "server/http/http_server.h"
+
+#include <fstream>
+#include <sstream>
+
+#include "server/beast.h"
+#include "server/http/static_files.h"
+#include "server/http/websocket_subscriber.h"
+
+namespace skinstream::server {
+namespace {
+
+std::string remote_of(const tcp::socket& socket) {
+  boost::system::error_code ec;
+  const auto endpoint = socket.remote_endpoint(ec);
+  return ec ? "?" : endpoint.address().to_string() + ":" + std::to_string(endpoint.port());
+}
+
+// One HTTP connection: requests one after another (keep-alive) until it upgrades or closes.
+class HttpSession : public std::enable_shared_from_this<HttpSession> {
+ public:
+  HttpSession(asio::io_context& io, tcp::socket socket, SubscriberHub& hub, std::shared_ptr<const HttpRoutes> routes)
+      : io_(io), stream_(std::move(socket)), hub_(hub), routes_(std::move(routes)) {}
+
+  void read_next() {
+    request_ = {};
+    stream_.expires_after(std::chrono::seconds(30));
+    http::async_read(stream_, buffer_, request_, [self = shared_from_this()](const boost::system::error_code& ec, size_t) {
+      if (ec) return self->shutdown();
+      self->handle();
+    });
+  }
+
+ private:
+  void handle() {
+    const std::string target(request_.target());
+    if (websocket::is_upgrade(request_)) {
+      if (target != "/stream") return respond(error(http::status::not_found, "WebSocket subscribers connect to /stream\n"));
+      stream_.expires_never();
+      tcp::socket socket = stream_.release_socket();
+      const std::string remote = remote_of(socket);
+      auto subscriber = std::make_shared<WebSocketSubscriber>(io_, hub_, std::move(socket), remote);
+      hub_.add(subscriber);
+      subscriber->accept(std::move(request_));
+      return;
+    }
+    if (request_.method() != http::verb::get && request_.method() != http::verb::head)
+      return respond(error(http::status::method_not_allowed, "only GET and HEAD\n"));
+    const std::string path = target.substr(0, target.find('?'));
+    if (path == "/health") return respond(text(routes_->health_json(), "application/json"));
+    if (path == "/metrics") return respond(text(routes_->metrics_text(), "text/plain; version=0.0.4; charset=utf-8"));
+    if (const auto file = resolve_static_file(routes_->web_root, target)) {
+      std::ifstream in(*file, std::ios::binary);
+      std::stringstream body;
+      body << in.rdbuf();
+      if (in) return respond(text(body.str(), content_type_for(*file)));
+    }
+    respond(error(http::status::not_found, "not found\n"));
+  }
+
+  http::response<http::string_body> text(std::string body, std::string_view type) {
+    http::response<http::string_body> res{http::status::ok, request_.version()};
+    res.set(http::field::content_type, std::string(type));
+    res.set(http::field::cache_control, "no-store");
+    res.body() = std::move(body);
+    return res;
+  }
+
+  http::response<http::string_body> error(http::status status, std::string body) {
+    http::response<http::string_body> res{status, request_.version()};
+    res.set(http::field::content_type, "text/plain; charset=utf-8");
+    res.body() = std::move(body);
+    return res;
+  }
+
+  void respond(http::response<http::string_body> res) {
+    res.keep_alive(request_.keep_alive());
+    res.prepare_payload();
+    if (request_.method() == http::verb::head) res.body().clear();
+    response_ = std::make_shared<http::response<http::string_body>>(std::move(res));
+    http::async_write(stream_, *response_, [self = shared_from_this()](const boost::system::error_code& ec, size_t) {
+      if (ec || !self->response_->keep_alive()) return self->shutdown();
+      self->response_.reset();
+      self->read_next();
+    });
+  }
+
+  void shutdown() {
+    boost::system::error_code ignored;
+    stream_.socket().shutdown(tcp::socket::shutdown_send, ignored);
+  }
+
+  asio::io_context& io_;
+  beast::tcp_stream stream_;
+  beast::flat_buffer buffer_;
+  http::request<http::string_body> request_;
+  std::shared_ptr<http::response<http::string_body>> response_;
+  SubscriberHub& hub_;
+  std::shared_ptr<const HttpRoutes> routes_;
+};
+
+}  // namespace
+
+HttpServer::HttpServer(asio::io_context& io, const std::string& address, int port, SubscriberHub& hub, HttpRoutes routes)
+    : io_(io),
+      hub_(hub),
+      routes_(std::make_shared<const HttpRoutes>(std::move(routes))),
+      listener_(io, address, port, "HTTP port", [this](tcp::socket socket) {
+        std::make_shared<HttpSession>(io_, std::move(socket), hub_, routes_)->read_next();
+      }) {}
+
+}  // namespace skinstream::server

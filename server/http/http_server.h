@@ -1,0 +1,35 @@
+#pragma once
+// The daemon's HTTP port (Boost.Beast): /health (JSON), /metrics (Prometheus text), WebSocket
+// subscribers at /stream, static files from the web root at /, 404 otherwise.
+
+#include <filesystem>
+#include <functional>
+#include <memory>
+#include <string>
+
+#include "server/listener.h"
+#include "server/publish/subscriber_hub.h"
+
+namespace skinstream::server {
+
+struct HttpRoutes {
+  std::function<std::string()> health_json;
+  std::function<std::string()> metrics_text;
+  std::filesystem::path web_root;  // empty: no static files
+};
+
+class HttpServer {
+ public:
+  HttpServer(asio::io_context& io, const std::string& address, int port, SubscriberHub& hub, HttpRoutes routes);
+  void start() { listener_.start(); }
+  void stop() { listener_.stop(); }
+  int port() const { return listener_.port(); }
+
+ private:
+  asio::io_context& io_;
+  SubscriberHub& hub_;
+  std::shared_ptr<const HttpRoutes> routes_;
+  Listener listener_;
+};
+
+}  // namespace skinstream::server

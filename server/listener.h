@@ -1,0 +1,30 @@
+#pragma once
+// Accepts TCP connections on one port and hands each socket to a callback (io thread). Binding
+// happens in the constructor, so a port in use fails at startup with a clear message.
+
+#include <functional>
+#include <string>
+
+#include "server/asio.h"
+
+namespace skinstream::server {
+
+class Listener {
+ public:
+  using Accept = std::function<void(tcp::socket socket)>;
+  // Throws std::runtime_error naming the address and port when it cannot listen.
+  Listener(asio::io_context& io, const std::string& address, int port, std::string name, Accept on_accept);
+  void start();
+  void stop();
+  int port() const { return port_; }
+
+ private:
+  void accept_next();
+  asio::io_context& io_;
+  tcp::acceptor acceptor_;
+  std::string name_;
+  Accept on_accept_;
+  int port_ = 0;
+};
+
+}  // namespace skinstream::server

@@ -1,0 +1,39 @@
+// skinstreamd: the streaming daemon. Live (or replayed) marker frames in; gap-filled markers and
+// the deformed skin mesh out to every subscriber (TCP and WebSocket), with /health and /metrics.
+// Errors at startup print one line and exit 1; SIGINT/SIGTERM stop cleanly with exit code 0.
+#include <spdlog/spdlog.h>
+
+#include <csignal>
+#include <cstdio>
+#include <nlohmann/json.hpp>
+
+#include "server/config.h"
+#include "server/daemon.h"
+#include "server/logging.h"
+
+int main(int argc, char** argv) {
+  using namespace skinstream::server;
+  try {
+    int exit_code = 0;
+    const std::optional<CommandLine> command_line = parse_command_line(argc, argv, exit_code);
+    if (!command_line) return exit_code;
+    if (command_line->print_config) {
+      std::printf("%s\n", to_json(command_line->config).dump(2).c_str());
+      return 0;
+    }
+    set_log_level(command_line->config.log_level);
+    Daemon daemon(command_line->config);
+    asio::signal_set signals(daemon.io(), SIGINT, SIGTERM);
+    signals.async_wait([&daemon](const boost::system::error_code& ec, int signal) {
+      if (ec) return;
+      spdlog::info("skinstreamd: signal {}", signal);
+      daemon.request_stop();
+    });
+    daemon.start();
+    daemon.wait();
+    return 0;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "skinstreamd: error: %s\n", e.what());
+    return 1;
+  }
+}

@@ -1,0 +1,106 @@
+#include "server/metrics/metrics.h"
+
+#include <cstdio>
+
+namespace skinstream::server {
+namespace {
+
+void counter(std::string& out, const char* name, const char* help, uint64_t value) {
+  out += "# HELP skinstream_" + std::string(name) + " " + help + "\n# TYPE skinstream_" + name + " counter\nskinstream_" +
+         name + " " + std::to_string(value) + "\n";
+}
+
+// Prometheus label values escape backslash, quote and newline.
+std::string label_value(std::string_view v) {
+  std::string out;
+  for (char c : v) {
+    if (c == '\\' || c == '"') out += '\\', out += c;
+    else if (c == '\n') out += "\\n";
+    else out += c;
+  }
+  return out;
+}
+
+std::string number(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.9g", v);
+  return text;
+}
+
+}  // namespace
+
+void LatencyHistogram::observe_ns(int64_t ns) {
+  const double seconds = ns * 1e-9;
+  size_t b = 0;
+  while (b < kBounds.size() && seconds > kBounds[b]) ++b;
+  if (b < kBounds.size()) buckets_[b].fetch_add(1, std::memory_order_relaxed);
+  count_.fetch_add(1, std::memory_order_relaxed);
+  sum_ns_.fetch_add(ns, std::memory_order_relaxed);
+}
+
+void LatencyHistogram::render(std::string& out, std::string_view name, std::string_view help) const {
+  const std::string n = "skinstream_" + std::string(name);
+  out += "# HELP " + n + " " + std::string(help) + "\n# TYPE " + n + " histogram\n";
+  uint64_t cumulative = 0;
+  for (size_t b = 0; b < kBounds.size(); ++b) {
+    cumulative += buckets_[b].load(std::memory_order_relaxed);
+    out += n + "_bucket{le=\"" + number(kBounds[b]) + "\"} " + std::to_string(cumulative) + "\n";
+  }
+  const uint64_t total = count_.load(std::memory_order_relaxed);
+  out += n + "_bucket{le=\"+Inf\"} " + std::to_string(total) + "\n";
+  out += n + "_sum " + number(sum_ns_.load(std::memory_order_relaxed) * 1e-9) + "\n";
+  out += n + "_count " + std::to_string(total) + "\n";
+}
+
+void Metrics::count_bad_input(std::string_view category) {
+  std::lock_guard lock(bad_input_mutex_);
+  auto it = bad_input_.find(category);
+  if (it == bad_input_.end()) it = bad_input_.emplace(std::string(category), 0).first;
+  ++it->second;
+}
+
+uint64_t Metrics::bad_input(std::string_view category) const {
+  std::lock_guard lock(bad_input_mutex_);
+  const auto it = bad_input_.find(category);
+  return it == bad_input_.end() ? 0 : it->second;
+}
+
+std::string Metrics::render_prometheus(const std::vector<SubscriberMetrics>& subscribers) const {
+  std::string out;
+  counter(out, "frames_received_total", "Marker frames received from the source.", frames_received);
+  counter(out, "frames_processed_total", "Frames through the gap filler.", frames_processed);
+  counter(out, "frames_published_total", "Frames handed to the publishers.", frames_published);
+  counter(out, "frames_dropped_total", "Frames overwritten by a newer one before the pipeline took them.", frames_dropped);
+  counter(out, "markers_filled_total", "Marker samples filled (PCA, rigid or held).", markers_filled);
+  counter(out, "markers_relabelled_total", "Marker samples taken from unlabelled points.", markers_relabelled);
+  counter(out, "markers_held_total", "Marker samples held relative to their anchors.", markers_held);
+  counter(out, "bad_subscriber_messages_total", "Subscriber messages that broke the protocol.", bad_subscriber_messages);
+  counter(out, "subscribers_accepted_total", "Subscriber connections accepted.", subscribers_connected);
+  counter(out, "frame_buffers_allocated_total", "Encoded frame buffers created (steady state: constant).", frame_buffers_allocated);
+  out += "# HELP skinstream_bad_input_total Source input dropped, by category.\n# TYPE skinstream_bad_input_total counter\n";
+  {
+    std::lock_guard lock(bad_input_mutex_);
+    for (const auto& [category, count] : bad_input_)
+      out += "skinstream_bad_input_total{category=\"" + label_value(category) + "\"} " + std::to_string(count) + "\n";
+  }
+  fill.render(out, "fill_seconds", "Gap filler time per frame.");
+  deform.render(out, "deform_seconds", "Mesh deformation time per frame (parts and vertices).");
+  normals.render(out, "normals_seconds", "Normal computation time per frame.");
+  encode.render(out, "encode_seconds", "Frame encoding time per frame.");
+  receive_to_publish.render(out, "receive_to_publish_seconds", "From frame received to handed to the publishers.");
+  out += "# HELP skinstream_subscriber_frames_sent_total Frames written to each subscriber.\n"
+         "# TYPE skinstream_subscriber_frames_sent_total counter\n";
+  for (const SubscriberMetrics& s : subscribers)
+    out += "skinstream_subscriber_frames_sent_total{id=\"" + std::to_string(s.id) + "\",transport=\"" + s.transport +
+           "\",remote=\"" + label_value(s.remote) + "\"} " + std::to_string(s.sent) + "\n";
+  out += "# HELP skinstream_subscriber_frames_dropped_total Frames dropped for each subscriber (its queue was full).\n"
+         "# TYPE skinstream_subscriber_frames_dropped_total counter\n";
+  for (const SubscriberMetrics& s : subscribers)
+    out += "skinstream_subscriber_frames_dropped_total{id=\"" + std::to_string(s.id) + "\",transport=\"" + s.transport +
+           "\",remote=\"" + label_value(s.remote) + "\"} " + std::to_string(s.dropped) + "\n";
+  out += "# HELP skinstream_subscribers Subscribers connected now.\n# TYPE skinstream_subscribers gauge\nskinstream_subscribers " +
+         std::to_string(subscribers.size()) + "\n";
+  return out;
+}
+
+}  // namespace skinstream::server

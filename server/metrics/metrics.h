@@ -1,0 +1,64 @@
+#pragma once
+// The daemon's counters and latency histograms, updated lock-free from the pipeline and io
+// threads and rendered as Prometheus text for /metrics.
+
+#include <array>
+#include <atomic>
+#include <cstdint>
+#include <map>
+#include <mutex>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace skinstream::server {
+
+// Fixed buckets (seconds) so observing never allocates.
+class LatencyHistogram {
+ public:
+  static constexpr std::array<double, 14> kBounds = {10e-6, 25e-6, 50e-6, 100e-6, 250e-6, 500e-6, 1e-3,
+                                                     2.5e-3, 5e-3, 10e-3, 25e-3, 50e-3, 100e-3, 1.0};
+  void observe_ns(int64_t ns);
+  void render(std::string& out, std::string_view name, std::string_view help) const;
+  uint64_t count() const { return count_.load(std::memory_order_relaxed); }
+
+ private:
+  std::array<std::atomic<uint64_t>, kBounds.size()> buckets_{};  // non-cumulative
+  std::atomic<uint64_t> count_{0};
+  std::atomic<int64_t> sum_ns_{0};
+};
+
+struct SubscriberMetrics {
+  uint64_t id = 0;
+  std::string transport;  // "tcp" or "websocket"
+  std::string remote;
+  uint64_t sent = 0;
+  uint64_t dropped = 0;
+};
+
+class Metrics {
+ public:
+  std::atomic<uint64_t> frames_received{0};
+  std::atomic<uint64_t> frames_processed{0};
+  std::atomic<uint64_t> frames_published{0};
+  std::atomic<uint64_t> frames_dropped{0};  // overwritten in the mailbox before the pipeline took them
+  std::atomic<uint64_t> markers_filled{0};
+  std::atomic<uint64_t> markers_relabelled{0};
+  std::atomic<uint64_t> markers_held{0};
+  std::atomic<uint64_t> bad_subscriber_messages{0};
+  std::atomic<uint64_t> subscribers_connected{0};  // total accepted
+  std::atomic<uint64_t> frame_buffers_allocated{0};
+
+  LatencyHistogram fill, deform, normals, encode, receive_to_publish;
+
+  void count_bad_input(std::string_view category);
+  uint64_t bad_input(std::string_view category) const;
+
+  std::string render_prometheus(const std::vector<SubscriberMetrics>& subscribers) const;
+
+ private:
+  mutable std::mutex bad_input_mutex_;
+  std::map<std::string, uint64_t, std::less<>> bad_input_;
+};
+
+}  // namespace skinstream::server

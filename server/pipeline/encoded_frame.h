@@ -1,0 +1,77 @@
+#pragma once
+// A published frame: the Frame message in every encoding a subscriber asked for, immutable once
+// published and shared by all subscribers through a reference count. The buffers come from a
+// pool and go back to it when the last subscriber has written them, so steady state allocates
+// nothing (the pool only grows while the number of frames held at once grows).
+
+#include <array>
+#include <atomic>
+#include <cstdint>
+#include <mutex>
+#include <span>
+#include <vector>
+
+namespace skinstream::server {
+
+class FramePool;
+
+struct EncodedFrame {
+  static constexpr int kEncodings = 16;  // one per combination of subscriber frame flags
+
+  uint32_t frame_number = 0;
+  int64_t publish_time_ns = 0;
+  uint32_t encoded_mask = 0;  // bit f: messages[f] holds the frame with flags f
+  std::array<std::vector<unsigned char>, kEncodings> messages;  // sized on first use, then reused
+
+  std::span<const unsigned char> message(uint32_t flags) const { return messages[flags]; }
+  bool has(uint32_t flags) const { return (encoded_mask >> flags) & 1u; }
+
+ private:
+  friend class FramePool;
+  friend class FrameRef;
+  std::atomic<int> refs_{0};
+  FramePool* pool_ = nullptr;
+};
+
+// Shared ownership of a pooled frame (intrusive: copying allocates nothing).
+class FrameRef {
+ public:
+  FrameRef() = default;
+  FrameRef(const FrameRef& other);
+  FrameRef(FrameRef&& other) noexcept : frame_(other.frame_) { other.frame_ = nullptr; }
+  FrameRef& operator=(FrameRef other) noexcept;
+  ~FrameRef();
+
+  explicit operator bool() const { return frame_ != nullptr; }
+  const EncodedFrame& operator*() const { return *frame_; }
+  const EncodedFrame* operator->() const { return frame_; }
+  EncodedFrame* mutable_frame() { return frame_; }  // only while the producer still fills it
+  void reset();
+
+ private:
+  friend class FramePool;
+  explicit FrameRef(EncodedFrame* frame);
+  EncodedFrame* frame_ = nullptr;
+};
+
+class FramePool {
+ public:
+  FramePool() = default;
+  FramePool(const FramePool&) = delete;
+  FramePool& operator=(const FramePool&) = delete;
+  ~FramePool();  // every FrameRef must be gone by then
+
+  // A free frame (its mask cleared), or a new one when all are in use.
+  FrameRef acquire();
+  size_t allocated() const;
+
+ private:
+  friend class FrameRef;
+  void release(EncodedFrame* frame);
+
+  mutable std::mutex mutex_;
+  std::vector<EncodedFrame*> all_;
+  std::vector<EncodedFrame*> free_;
+};
+
+}  // namespace skinstream::server

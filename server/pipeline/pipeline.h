@@ -1,0 +1,98 @@
+#pragma once
+// The pipeline thread: takes the newest marker frame from the mailbox, fills it (GapFiller, then
+// the optional lookahead blend of GapEndBlender, as core/capture_filler.cpp does), deforms the
+// mesh (MeshDeformer over DeformWorkers), encodes the Frame message in every encoding someone
+// subscribed to into a pooled buffer, and hands it to the publishers. Allocates nothing per
+// frame in steady state; never waits for a subscriber.
+
+#include <atomic>
+#include <memory>
+#include <optional>
+#include <thread>
+#include <vector>
+
+#include "core/deform/deformation_model.h"
+#include "core/deform/mesh_deformer.h"
+#include "core/gap_end_blender.h"
+#include "core/gap_filler.h"
+#include "core/subject_model.h"
+#include "server/metrics/metrics.h"
+#include "server/pipeline/deform_workers.h"
+#include "server/pipeline/encoded_frame.h"
+#include "server/pipeline/frame_mailbox.h"
+
+namespace skinstream::server {
+
+// Where encoded frames go (the publishers).
+class FrameConsumer {
+ public:
+  virtual ~FrameConsumer() = default;
+  // Bit f set: some subscriber receives frames with flags f (subscriber::frame_flags_for).
+  virtual uint32_t wanted_encodings() const = 0;
+  // Called on the pipeline thread; must not block.
+  virtual void publish(const FrameRef& frame) = 0;
+};
+
+struct PipelineOptions {
+  int lookahead = 0;
+  int deform_threads = 2;
+  double default_rate_hz = 120.0;
+  GapFillerOptions filler;
+};
+
+class Pipeline {
+ public:
+  // `deformation` may be null (markers only: frames carry no positions). The models must
+  // outlive the pipeline. Throws std::invalid_argument when the deformation model does not fit.
+  Pipeline(const SubjectModel& model, const DeformationModel* deformation, const PipelineOptions& options,
+           FrameMailbox& mailbox, FrameConsumer& consumer, Metrics& metrics);
+  ~Pipeline();
+
+  void start();
+  void stop();  // joins the thread; safe to call twice
+
+  bool has_mesh() const { return deformer_ != nullptr; }
+  uint32_t vertex_count() const { return deformer_ ? static_cast<uint32_t>(deformer_->vertex_count()) : 0; }
+  uint64_t frames_published() const { return published_.load(); }
+
+ private:
+  struct Released {
+    uint32_t frame_number = 0;
+    int64_t source_time_ns = 0;
+    int64_t receive_time_ns = 0;
+    uint16_t filled = 0;
+    uint16_t relabelled = 0;
+  };
+  void run();
+  void process(const MarkerFrame& frame, uint64_t generation);
+  void publish(const Released& meta, std::span<const Vec3> positions, std::span<const MarkerStatus> status);
+
+  const SubjectModel& model_;
+  PipelineOptions options_;
+  FrameMailbox& mailbox_;
+  FrameConsumer& consumer_;
+  Metrics& metrics_;
+  FramePool pool_;
+
+  std::optional<GapFiller> filler_;
+  double filler_rate_hz_ = 0.0;
+  GapEndBlender blender_;
+  std::unique_ptr<MeshDeformer> deformer_;
+  std::unique_ptr<DeformWorkers> workers_;
+
+  std::vector<Vec3> filled_, released_positions_;
+  std::vector<MarkerStatus> filled_status_, released_status_;
+  std::vector<Released> held_;  // lookahead + 1 frames of metadata, by sequence number
+  long sequence_ = 0;
+  uint64_t generation_ = 0;
+  bool has_generation_ = false;
+  std::vector<float> marker_floats_;
+  std::vector<uint8_t> marker_status_bytes_;
+  std::vector<float> positions_, normals_;
+
+  std::atomic<bool> running_{false};
+  std::atomic<uint64_t> published_{0};
+  std::thread thread_;
+};
+
+}  // namespace skinstream::server

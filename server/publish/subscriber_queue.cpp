@@ -1,0 +1,63 @@
+#include "server/publish/subscriber_queue.h"
+
+#include <algorithm>
+
+namespace skinstream::server {
+
+SubscriberQueue::SubscriberQueue(int frame_capacity) : ring_(static_cast<size_t>(std::max(1, frame_capacity))) {}
+
+void SubscriberQueue::push_frame(const FrameRef& frame) {
+  FrameRef evicted;  // released outside the lock
+  std::lock_guard lock(mutex_);
+  if (count_ == ring_.size()) {
+    evicted = std::move(ring_[head_]);
+    head_ = (head_ + 1) % ring_.size();
+    --count_;
+    ++dropped_;
+  }
+  ring_[(head_ + count_) % ring_.size()] = frame;
+  ++count_;
+}
+
+void SubscriberQueue::push_control(ControlMessage message) {
+  std::lock_guard lock(mutex_);
+  if (control_.size() >= kMaxControl) {
+    // Drop the oldest Status (byte 6 of a message is its type); a MeshInfo must get through.
+    auto status = std::find_if(control_.begin(), control_.end(), [](const ControlMessage& m) { return m->size() > 6 && (*m)[6] == 4; });
+    control_.erase(status != control_.end() ? status : control_.begin());
+  }
+  control_.push_back(std::move(message));
+}
+
+bool SubscriberQueue::pop(Item& out) {
+  std::lock_guard lock(mutex_);
+  if (!control_.empty()) {
+    out.control = std::move(control_.front());
+    control_.pop_front();
+    out.frame.reset();
+    return true;
+  }
+  if (count_ == 0) return false;
+  out.control.reset();
+  out.frame = std::move(ring_[head_]);
+  head_ = (head_ + 1) % ring_.size();
+  --count_;
+  return true;
+}
+
+bool SubscriberQueue::empty() const {
+  std::lock_guard lock(mutex_);
+  return control_.empty() && count_ == 0;
+}
+
+uint64_t SubscriberQueue::frames_dropped() const {
+  std::lock_guard lock(mutex_);
+  return dropped_;
+}
+
+size_t SubscriberQueue::frames_queued() const {
+  std::lock_guard lock(mutex_);
+  return count_;
+}
+
+}  // namespace skinstream::server

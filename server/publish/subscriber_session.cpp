@@ -1,0 +1,125 @@
+#include "server/publish/subscriber_session.h"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <cstring>
+
+#include "protocol/subscriber_stream.h"
+#include "server/publish/subscriber_hub.h"
+
+namespace skinstream::server {
+namespace {
+std::atomic<uint64_t> next_id{1};
+}
+
+SubscriberSession::SubscriberSession(asio::io_context& io, SubscriberHub& hub, std::string transport, std::string remote)
+    : io_(io),
+      hub_(hub),
+      id_(next_id.fetch_add(1)),
+      transport_(std::move(transport)),
+      remote_(std::move(remote)),
+      queue_(hub.options().queue_frames),
+      hello_timer_(io) {}
+
+void SubscriberSession::offer(const FrameRef& frame) {
+  if (!frame->has(flags_.load())) return;  // encoding not ready in this frame (wants just changed)
+  queue_.push_frame(frame);
+  kick();
+}
+
+void SubscriberSession::offer_control(ControlMessage message) {
+  queue_.push_control(std::move(message));
+  kick();
+}
+
+SubscriberMetrics SubscriberSession::stats() const {
+  return {id_, transport_, remote_, sent_.load(), queue_.frames_dropped()};
+}
+
+void SubscriberSession::start_hello_timer(std::chrono::milliseconds timeout) {
+  hello_timer_.expires_after(timeout);
+  hello_timer_.async_wait([self = shared_from_this()](const boost::system::error_code& ec) {
+    if (ec || self->greeted_ || self->closed_) return;
+    spdlog::info("subscriber {} ({} {}): no Hello within the timeout, sending positions only", self->id_, self->transport_,
+                 self->remote_);
+    self->on_hello(0);
+  });
+}
+
+void SubscriberSession::on_hello(uint32_t wants) {
+  if (closed_) return;
+  const uint32_t flags = subscriber::frame_flags_for(wants, hub_.has_mesh());
+  const bool changed = !greeted_ || flags != flags_.load();
+  greeted_ = true;
+  hello_timer_.cancel();
+  if (!changed) return;
+  flags_.store(flags);
+  offer_control(hub_.mesh_info_message(flags));
+  offer_control(hub_.status_message());
+  hub_.activate(*this, flags);
+  spdlog::info("subscriber {} ({} {}): wants {:#x}, frame flags {:#x}", id_, transport_, remote_, wants, flags);
+}
+
+void SubscriberSession::on_protocol_error(const std::string& reason) {
+  hub_.metrics().bad_subscriber_messages.fetch_add(1, std::memory_order_relaxed);
+  spdlog::warn("subscriber {} ({} {}): {}; closing", id_, transport_, remote_, reason);
+  close();
+}
+
+void SubscriberSession::on_disconnected(const std::string& reason) {
+  if (closed_) return;
+  closed_ = true;
+  hello_timer_.cancel();
+  spdlog::info("subscriber {} ({} {}) gone: {} (sent {}, dropped {})", id_, transport_, remote_, reason, sent_.load(),
+               queue_.frames_dropped());
+  hub_.remove(*this);
+}
+
+void SubscriberSession::kick() {
+  if (pump_scheduled_.exchange(true)) return;
+  asio::post(io_, [self = shared_from_this()] { self->pump(); });
+}
+
+void SubscriberSession::pump() {
+  for (;;) {
+    if (writing_ || closed_) {
+      pump_scheduled_.store(false);
+      return;
+    }
+    if (queue_.pop(in_flight_)) {
+      if (in_flight_.control || in_flight_.frame->has(flags_.load())) break;
+      in_flight_.frame.reset();  // encoded for this subscriber's previous wants
+      continue;
+    }
+    pump_scheduled_.store(false);
+    // A push between pop() and the store above saw the flag set and did not post: look again.
+    if (queue_.empty() || pump_scheduled_.exchange(true)) return;
+  }
+  pump_scheduled_.store(false);
+  writing_ = true;
+  if (in_flight_.control) {
+    start_write({asio::buffer(*in_flight_.control), asio::const_buffer()});
+    return;
+  }
+  const std::span<const unsigned char> message = in_flight_.frame->message(flags_.load());
+  const size_t prefix = std::min(frame_prefix_.size(), message.size());
+  std::memcpy(frame_prefix_.data(), message.data(), prefix);
+  subscriber::patch_subscriber_dropped(std::span(frame_prefix_).first(prefix), static_cast<uint32_t>(queue_.frames_dropped()));
+  start_write({asio::buffer(frame_prefix_.data(), prefix), asio::buffer(message.data() + prefix, message.size() - prefix)});
+}
+
+void SubscriberSession::write_done(const boost::system::error_code& ec) {
+  writing_ = false;
+  const bool was_frame = static_cast<bool>(in_flight_.frame);
+  in_flight_.frame.reset();
+  in_flight_.control.reset();
+  if (ec) {
+    if (ec != asio::error::operation_aborted) on_disconnected(ec.message());
+    return;
+  }
+  if (was_frame) sent_.fetch_add(1, std::memory_order_relaxed);
+  pump();
+}
+
+}  // namespace skinstream::server

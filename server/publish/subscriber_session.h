@@ -1,0 +1,64 @@
+#pragma once
+// What the TCP and WebSocket subscribers share: the Hello handshake (2 s default, then
+// positions only), the bounded queue, one write in flight, and the per-subscriber counters.
+// Everything but offer() runs on the io thread; offer() is called by the pipeline thread.
+
+#include <array>
+#include <atomic>
+#include <memory>
+#include <string>
+
+#include "server/asio.h"
+#include "server/metrics/metrics.h"
+#include "server/publish/subscriber_queue.h"
+
+namespace skinstream::server {
+
+class SubscriberHub;
+
+class SubscriberSession : public std::enable_shared_from_this<SubscriberSession> {
+ public:
+  SubscriberSession(asio::io_context& io, SubscriberHub& hub, std::string transport, std::string remote);
+  virtual ~SubscriberSession() = default;
+
+  // Pipeline thread: queue a frame (newest wins) and make sure a write is under way.
+  void offer(const FrameRef& frame);
+  void offer_control(ControlMessage message);
+
+  uint32_t frame_flags() const { return flags_.load(); }
+  SubscriberMetrics stats() const;
+  uint64_t id() const { return id_; }
+  virtual void close() = 0;  // io thread; idempotent
+
+ protected:
+  // For the transports (io thread).
+  void start_hello_timer(std::chrono::milliseconds timeout);
+  void on_hello(uint32_t wants);
+  void on_protocol_error(const std::string& reason);
+  void on_disconnected(const std::string& reason);
+  // Writes the buffers as one protocol message, then calls write_done().
+  virtual void start_write(const std::array<asio::const_buffer, 2>& buffers) = 0;
+  void write_done(const boost::system::error_code& ec);
+
+  asio::io_context& io_;
+  SubscriberHub& hub_;
+
+ private:
+  void kick();
+  void pump();
+
+  uint64_t id_;
+  std::string transport_, remote_;
+  SubscriberQueue queue_;
+  asio::steady_timer hello_timer_;
+  bool greeted_ = false;  // Hello received or timed out
+  bool closed_ = false;
+  bool writing_ = false;
+  std::atomic<bool> pump_scheduled_{false};
+  std::atomic<uint32_t> flags_{0};
+  std::atomic<uint64_t> sent_{0};
+  SubscriberQueue::Item in_flight_;
+  std::array<unsigned char, 64> frame_prefix_{};  // the frame's first bytes with this subscriber's drop count
+};
+
+}  // namespace skinstream::server

@@ -1,0 +1,27 @@
+#pragma once
+// A subscriber on the plain TCP port: reads its Hello from the byte stream, writes messages
+// back to back.
+
+#include <array>
+
+#include "protocol/subscriber_stream.h"
+#include "server/publish/subscriber_session.h"
+
+namespace skinstream::server {
+
+class TcpSubscriber : public SubscriberSession {
+ public:
+  TcpSubscriber(asio::io_context& io, SubscriberHub& hub, tcp::socket socket, std::string remote);
+  void start();
+  void close() override;
+
+ private:
+  void read_next();
+  void start_write(const std::array<asio::const_buffer, 2>& buffers) override;
+
+  tcp::socket socket_;
+  std::array<unsigned char, 1024> read_buffer_{};
+  subscriber::StreamDecoder decoder_{1024};  // subscribers only ever send a 4-byte Hello
+};
+
+}  // namespace skinstream::server

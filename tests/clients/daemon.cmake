@@ -1,0 +1,33 @@
+# skinstreamd, skinstream-sub and skinstream-replay as a user runs them, on loopback sockets: a
+# replayed take through the real daemon to the real subscriber, compared with the offline
+# `skinstream fill`; a Vicon DataStream source (skinstream-replay) going away and coming back;
+# the demo subject's vertex buffers against `skinstream fill` + `deform`; bad paths fail clearly.
+if(TARGET skinstreamd AND TARGET skinstream-sub AND TARGET skinstream-replay)
+  add_executable(daemon_tests ${CMAKE_CURRENT_LIST_DIR}/daemon_e2e_test.cpp ${PROJECT_SOURCE_DIR}/tests/support/test_data.cpp)
+  target_include_directories(daemon_tests PRIVATE ${PROJECT_SOURCE_DIR}/tests)
+  # skinstream_server for the blocking subscriber client (server/client/) the tests subscribe with.
+  target_link_libraries(daemon_tests PRIVATE skinstream_server skinstream_protocol skinstream_core nlohmann_json::nlohmann_json GTest::gtest_main)
+  target_compile_definitions(daemon_tests PRIVATE
+    SKINSTREAMD="$<TARGET_FILE:skinstreamd>"
+    SKINSTREAM_SUB="$<TARGET_FILE:skinstream-sub>"
+    SKINSTREAM_REPLAY="$<TARGET_FILE:skinstream-replay>"
+    SKINSTREAM_CLI="$<TARGET_FILE:skinstream>"
+    SKINSTREAM_DEMO_DIR="${CMAKE_BINARY_DIR}/demo"
+    SKINSTREAM_SHARED_DIR="${SKINSTREAM_SHARED_DIR}"
+    SKINSTREAM_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
+    SKINSTREAM_TEST_TMP_DIR="${CMAKE_BINARY_DIR}/test_tmp/daemon")
+  add_dependencies(daemon_tests skinstreamd skinstream-sub skinstream-replay skinstream)
+  gtest_discover_tests(daemon_tests TEST_FILTER "-DaemonDemo.*" DISCOVERY_TIMEOUT 60 PROPERTIES LABELS clients TIMEOUT 120)
+  # The demo subject's tests need the demo_subject fixture (tests/clients/CMakeLists.txt).
+  gtest_discover_tests(daemon_tests TEST_FILTER "DaemonDemo.*" DISCOVERY_TIMEOUT 60
+    PROPERTIES LABELS clients TIMEOUT 300 FIXTURES_REQUIRED demo_subject)
+
+  # Usage errors of the programs themselves.
+  add_test(NAME daemon.unknown_flag COMMAND skinstreamd --no-such-flag)
+  add_test(NAME daemon.without_subject COMMAND skinstreamd --http-port 0 --sub-port 0)
+  add_test(NAME daemon.vicon_without_port COMMAND skinstreamd --vicon 127.0.0.1 --print-config)
+  add_test(NAME sub.without_address COMMAND skinstream-sub)
+  add_test(NAME sub.bad_address COMMAND skinstream-sub nohost)
+  set_tests_properties(daemon.unknown_flag daemon.without_subject daemon.vicon_without_port sub.without_address sub.bad_address
+    PROPERTIES WILL_FAIL TRUE LABELS clients)
+endif()

@@ -1,0 +1,283 @@
+#include "protocol/subscriber_stream.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Core>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <iterator>
+#include <random>
+
+#include "support/test_data.h"
+
+namespace skinstream::subscriber {
+namespace {
+
+// The golden files were written independently of this encoder (byte by byte from the spec).
+std::vector<unsigned char> fixture(const std::string& name) {
+  const std::string path = test::source_path("tests/protocol/fixtures/subscriber/" + name);
+  std::ifstream in(path, std::ios::binary);
+  EXPECT_TRUE(in) << path;
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+std::span<const unsigned char> payload_of(const std::vector<unsigned char>& message) {
+  return std::span<const unsigned char>(message).subspan(kHeaderBytes);
+}
+
+const std::vector<float> kPositions = {0, 100, 5, 65535, 131170, 5, 0, 2100, 5};
+const std::vector<float> kNormals = {1, 0, 0, 0, -1, 0, 0, 0, 1};
+const std::vector<float> kMarkers = {1.5f, 2.5f, 3.5f, -4.0f, 5.0f, 6.25f};
+const std::vector<uint8_t> kStatus = {0, 2};
+
+FrameInfo fixture_info(uint32_t flags, uint32_t vertex_count) {
+  FrameInfo info;
+  info.frame_number = 1234;
+  info.flags = flags;
+  info.source_time_ns = 10'000'000;
+  info.receive_time_ns = 1'700'000'000'000'000'000;
+  info.publish_time_ns = 1'700'000'000'001'000'000;
+  info.vertex_count = vertex_count;
+  info.marker_count = 2;
+  info.markers_filled = 3;
+  info.markers_relabelled = 1;
+  info.pipeline_dropped = 7;
+  info.subscriber_dropped = 2;
+  return info;
+}
+
+std::vector<unsigned char> encode(const FrameInfo& info) {
+  std::vector<unsigned char> out(frame_message_bytes(info.flags, info.vertex_count, info.marker_count));
+  encode_frame(info, kPositions, kNormals, kMarkers, kStatus, out);
+  return out;
+}
+
+MeshInfo fixture_mesh_info() {
+  MeshInfo info;
+  info.vertex_count = 4;
+  info.marker_count = 3;
+  info.part_count = 2;
+  info.source_rate_hz = 120.0f;
+  info.faces = {{0, 1, 2}, {0, 2, 3}};
+  info.dominant_part = {0, 1, 255, 1};
+  info.marker_triangles = {{0, 1, 2}};
+  info.marker_names = {"LSHO", "RSHO", "C7"};
+  return info;
+}
+
+TEST(SubscriberStream, HeaderRejectsBadMagicVersionTypeAndSize) {
+  std::vector<unsigned char> good = fixture("hello.bin");
+  EXPECT_NO_THROW(decode_header(good));
+  auto expect_reject = [&](size_t at, unsigned char value, const char* reason) {
+    std::vector<unsigned char> bad = good;
+    bad[at] = value;
+    try {
+      decode_header(bad);
+      FAIL() << "accepted a header with " << reason;
+    } catch (const DecodeError& e) {
+      EXPECT_NE(std::string(e.what()).find(reason), std::string::npos) << e.what();
+    }
+  };
+  expect_reject(0, 'X', "bad magic");
+  expect_reject(4, 2, "version 2");
+  expect_reject(6, 9, "unknown message type 9");
+  expect_reject(11, 0x10, "exceeds the limit");
+  EXPECT_THROW(decode_header(std::span(good).first(11)), DecodeError);
+}
+
+TEST(SubscriberStream, HelloMatchesGoldenBytes) {
+  EXPECT_EQ(encode_hello({kWantNormals | kWantMarkers}), fixture("hello.bin"));
+  EXPECT_EQ(decode_hello(payload_of(fixture("hello.bin"))).wants, kWantNormals | kWantMarkers);
+  const std::vector<unsigned char> reserved = encode_hello({0x10});
+  EXPECT_THROW(decode_hello(payload_of(reserved)), DecodeError);
+}
+
+TEST(SubscriberStream, MeshInfoMatchesGoldenBytes) {
+  const std::vector<unsigned char> golden = fixture("mesh_info.bin");
+  EXPECT_EQ(encode_mesh_info(fixture_mesh_info()), golden);
+  const MeshInfo decoded = decode_mesh_info(payload_of(golden));
+  EXPECT_EQ(decoded.vertex_count, 4u);
+  EXPECT_EQ(decoded.faces, fixture_mesh_info().faces);
+  EXPECT_EQ(decoded.dominant_part, fixture_mesh_info().dominant_part);
+  EXPECT_EQ(decoded.marker_triangles, fixture_mesh_info().marker_triangles);
+  EXPECT_EQ(decoded.marker_names, fixture_mesh_info().marker_names);
+  EXPECT_EQ(decoded.source_rate_hz, 120.0f);
+}
+
+TEST(SubscriberStream, MeshInfoRejectsOutOfRangeIndices) {
+  MeshInfo info = fixture_mesh_info();
+  info.faces[1][2] = 4;
+  EXPECT_THROW(decode_mesh_info(payload_of(encode_mesh_info(info))), DecodeError);
+  info = fixture_mesh_info();
+  info.marker_triangles[0][0] = 3;
+  EXPECT_THROW(decode_mesh_info(payload_of(encode_mesh_info(info))), DecodeError);
+}
+
+TEST(SubscriberStream, FloatFrameMatchesGoldenBytes) {
+  const std::vector<unsigned char> golden = fixture("frame_float.bin");
+  EXPECT_EQ(encode(fixture_info(kFrameNormals | kFrameMarkers, 3)), golden);
+  const Frame frame = decode_frame(payload_of(golden));
+  EXPECT_EQ(frame.info.frame_number, 1234u);
+  EXPECT_EQ(frame.info.receive_time_ns, 1'700'000'000'000'000'000);
+  EXPECT_EQ(frame.info.publish_time_ns, 1'700'000'000'001'000'000);
+  EXPECT_EQ(frame.info.markers_filled, 3);
+  EXPECT_EQ(frame.info.pipeline_dropped, 7u);
+  EXPECT_EQ(frame.info.subscriber_dropped, 2u);
+  EXPECT_EQ(frame.positions, kPositions);
+  EXPECT_EQ(frame.normals, kNormals);
+  EXPECT_EQ(frame.markers, kMarkers);
+  EXPECT_EQ(frame.marker_status, kStatus);
+}
+
+TEST(SubscriberStream, QuantisedFrameMatchesGoldenBytes) {
+  const std::vector<unsigned char> golden = fixture("frame_quantised.bin");
+  EXPECT_EQ(encode(fixture_info(kFrameNormals | kFrameMarkers | kFrameQuantised, 3)), golden);
+  const Frame frame = decode_frame(payload_of(golden));
+  EXPECT_EQ(frame.positions, kPositions);  // this fixture's values are exact on the grid
+  EXPECT_EQ(frame.normals, kNormals);
+  EXPECT_EQ(frame.step[1], 2.0f);
+}
+
+TEST(SubscriberStream, MarkersOnlyFrameMatchesGoldenBytes) {
+  const std::vector<unsigned char> golden = fixture("frame_markers_only.bin");
+  EXPECT_EQ(encode(fixture_info(kFrameNoPositions | kFrameMarkers, 0)), golden);
+  const Frame frame = decode_frame(payload_of(golden));
+  EXPECT_TRUE(frame.positions.empty());
+  EXPECT_EQ(frame.markers, kMarkers);
+}
+
+TEST(SubscriberStream, EveryFrameBlockStaysFourByteAligned) {
+  // Receivers view blocks in place (JavaScript Float32Array needs offsets that are multiples of 4).
+  for (uint32_t flags = 0; flags < 16; ++flags)
+    for (uint32_t v : {1u, 2u, 3u, 5u})
+      for (uint32_t m : {1u, 2u, 3u})
+        EXPECT_EQ(frame_message_bytes(flags, v, m) % 4, 0u) << flags << " " << v << " " << m;
+}
+
+TEST(SubscriberStream, StatusMatchesGoldenBytes) {
+  Status status{SourceStateCode::Disconnected, 119.88f, 1000, 990, "vicon 127.0.0.1:801: connection refused"};
+  const std::vector<unsigned char> golden = fixture("status.bin");
+  EXPECT_EQ(encode_status(status), golden);
+  const Status decoded = decode_status(payload_of(golden));
+  EXPECT_EQ(decoded.state, SourceStateCode::Disconnected);
+  EXPECT_EQ(decoded.frames_received, 1000u);
+  EXPECT_EQ(decoded.frames_published, 990u);
+  EXPECT_EQ(decoded.detail, status.detail);
+}
+
+TEST(SubscriberStream, PatchingSubscriberDropsChangesOnlyThatField) {
+  std::vector<unsigned char> message = fixture("frame_float.bin");
+  patch_subscriber_dropped(message, 99);
+  EXPECT_EQ(decode_frame(payload_of(message)).info.subscriber_dropped, 99u);
+  patch_subscriber_dropped(message, 2);
+  EXPECT_EQ(message, fixture("frame_float.bin"));
+}
+
+TEST(SubscriberStream, FlagsFollowWants) {
+  EXPECT_EQ(frame_flags_for(0, true), 0u);
+  EXPECT_EQ(frame_flags_for(kWantNormals | kWantQuantised, true), kFrameNormals | kFrameQuantised);
+  EXPECT_EQ(frame_flags_for(kWantNormals, false), kFrameNoPositions);
+  EXPECT_EQ(frame_flags_for(kWantNoMesh | kWantMarkers, true), kFrameNoPositions | kFrameMarkers);
+}
+
+TEST(SubscriberStream, EveryTruncationOfEveryMessageIsRejected) {
+  for (const char* name : {"hello.bin", "mesh_info.bin", "frame_float.bin", "frame_quantised.bin", "frame_markers_only.bin", "status.bin"}) {
+    const std::vector<unsigned char> message = fixture(name);
+    const MessageHeader header = decode_header(message);
+    for (size_t n = kHeaderBytes; n < message.size(); ++n) {
+      const std::span<const unsigned char> cut = std::span(message).subspan(kHeaderBytes, n - kHeaderBytes);
+      auto decode = [&] {
+        switch (header.type) {
+          case MessageType::Hello: decode_hello(cut); break;
+          case MessageType::MeshInfo: decode_mesh_info(cut); break;
+          case MessageType::Frame: decode_frame(cut); break;
+          case MessageType::Status: decode_status(cut); break;
+        }
+      };
+      EXPECT_THROW(decode(), DecodeError) << name << " cut at " << n;
+    }
+    // A byte too many is refused as well.
+    std::vector<unsigned char> longer(message.begin() + kHeaderBytes, message.end());
+    longer.push_back(0);
+    if (header.type == MessageType::Frame) EXPECT_THROW(decode_frame(longer), DecodeError) << name;
+    if (header.type == MessageType::Hello) EXPECT_THROW(decode_hello(longer), DecodeError) << name;
+  }
+}
+
+TEST(SubscriberStream, CorruptFrameCountsAndFlagsAreRejected) {
+  const std::vector<unsigned char> golden = fixture("frame_float.bin");
+  auto corrupt = [&](size_t payload_offset, uint32_t value) {
+    std::vector<unsigned char> bad(golden.begin() + kHeaderBytes, golden.end());
+    std::memcpy(bad.data() + payload_offset, &value, 4);
+    return bad;
+  };
+  EXPECT_THROW(decode_frame(corrupt(32, 1'000'000'000)), DecodeError);  // vertex count
+  EXPECT_THROW(decode_frame(corrupt(36, 0xFFFFFFFF)), DecodeError);     // marker count
+  EXPECT_THROW(decode_frame(corrupt(4, 0x10)), DecodeError);            // reserved flag
+  std::vector<unsigned char> bad_status(golden.begin() + kHeaderBytes, golden.end());
+  bad_status[bad_status.size() - 4] = 9;  // first marker status byte
+  EXPECT_THROW(decode_frame(bad_status), DecodeError);
+}
+
+TEST(SubscriberStream, StreamDecoderCutsMessagesAtAnyBoundary) {
+  std::vector<unsigned char> stream;
+  for (const char* name : {"status.bin", "mesh_info.bin", "frame_float.bin", "frame_quantised.bin"}) {
+    const std::vector<unsigned char> m = fixture(name);
+    stream.insert(stream.end(), m.begin(), m.end());
+  }
+  for (size_t chunk : {size_t{1}, size_t{5}, size_t{13}, stream.size()}) {
+    StreamDecoder decoder;
+    std::vector<MessageType> types;
+    for (size_t at = 0; at < stream.size(); at += chunk) {
+      decoder.feed(std::span(stream).subspan(at, std::min(chunk, stream.size() - at)));
+      while (auto message = decoder.next()) {
+        types.push_back(message->type);
+        if (message->type == MessageType::Frame) EXPECT_EQ(decode_frame(message->payload).info.frame_number, 1234u);
+      }
+    }
+    EXPECT_EQ(types, (std::vector<MessageType>{MessageType::Status, MessageType::MeshInfo, MessageType::Frame, MessageType::Frame}))
+        << "chunk " << chunk;
+    EXPECT_EQ(decoder.buffered(), 0u);
+  }
+}
+
+TEST(SubscriberStream, StreamDecoderRejectsGarbageAndOversizedPayloads) {
+  StreamDecoder decoder(1024);
+  const std::vector<unsigned char> garbage = {'G', 'E', 'T', ' ', '/', ' ', 'H', 'T', 'T', 'P', '/', '1'};
+  decoder.feed(garbage);
+  EXPECT_THROW(decoder.next(), DecodeError);
+
+  StreamDecoder small(16);
+  small.feed(fixture("mesh_info.bin"));  // 80-byte payload
+  EXPECT_THROW(small.next(), DecodeError);
+}
+
+TEST(SubscriberStream, QuantisedPositionsAreWithinHalfAStep) {
+  std::mt19937 random(7);
+  std::uniform_real_distribution<float> coordinate(-1500.0f, 1800.0f);
+  std::normal_distribution<float> component(0.0f, 1.0f);
+  const uint32_t v = 2000;
+  std::vector<float> positions(3 * v), normals(3 * v);
+  for (float& x : positions) x = coordinate(random);
+  for (uint32_t i = 0; i < v; ++i) {
+    Eigen::Vector3f n(component(random), component(random), component(random));
+    n.normalize();
+    for (int a = 0; a < 3; ++a) normals[3 * i + a] = n[a];
+  }
+  FrameInfo info;
+  info.flags = kFrameQuantised | kFrameNormals;
+  info.vertex_count = v;
+  std::vector<unsigned char> message(frame_message_bytes(info.flags, v, 0));
+  encode_frame(info, positions, normals, {}, {}, message);
+  EXPECT_LT(message.size(), frame_message_bytes(kFrameNormals, v, 0) / 2 + 100);  // halves the bytes
+  const Frame frame = decode_frame(payload_of(message));
+  for (size_t i = 0; i < positions.size(); ++i) {
+    const float half_step = 0.5f * frame.step[i % 3];
+    ASSERT_LE(std::abs(frame.positions[i] - positions[i]), half_step * 1.001f + 1e-4f) << i;
+    ASSERT_LE(std::abs(frame.normals[i] - normals[i]), 0.5f / 32767.0f + 1e-6f) << i;
+  }
+}
+
+}  // namespace
+}  // namespace skinstream::subscriber

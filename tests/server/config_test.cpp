@@ -1,0 +1,89 @@
+#include "server/config.h"
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "support/test_data.h"
+
+namespace skinstream::server {
+namespace {
+
+std::string write_file(const std::string& name, const std::string& text) {
+  const std::string path = test::scratch_path(name);
+  std::ofstream(path) << text;
+  return path;
+}
+
+std::optional<CommandLine> parse(std::vector<std::string> arguments) {
+  arguments.insert(arguments.begin(), "skinstreamd");
+  std::vector<const char*> argv;
+  for (const std::string& a : arguments) argv.push_back(a.c_str());
+  int exit_code = -1;
+  return parse_command_line(static_cast<int>(argv.size()), argv.data(), exit_code);
+}
+
+std::string error_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(Config, ReferenceConfigParsesToTheDefaults) {
+  const DaemonConfig config = load_config_file(test::source_path("config/skinstreamd.reference.json"));
+  EXPECT_EQ(to_json(config), to_json(DaemonConfig{}));
+}
+
+TEST(Config, BadJsonIsAClearError) {
+  const std::string path = write_file("bad.json", "{\"http_port\": 80,,}");
+  const std::string error = error_of([&] { load_config_file(path); });
+  EXPECT_NE(error.find(path), std::string::npos) << error;
+  EXPECT_NE(error.find("not valid JSON"), std::string::npos) << error;
+}
+
+TEST(Config, UnknownKeysAndWrongTypesAreErrors) {
+  const std::string typo = write_file("typo.json", "{\"http_prot\": 80}");
+  EXPECT_NE(error_of([&] { load_config_file(typo); }).find("unknown key \"http_prot\""), std::string::npos);
+  const std::string wrong = write_file("wrong.json", "{\"http_port\": \"eighty\"}");
+  EXPECT_NE(error_of([&] { load_config_file(wrong); }).find("\"http_port\" has the wrong type"), std::string::npos);
+  EXPECT_NE(error_of([&] { load_config_file(test::scratch_path("absent.json")); }).find("cannot open"), std::string::npos);
+}
+
+TEST(Config, FlagsOverrideTheFile) {
+  const std::string path = write_file("base.json", R"({"subject": "a.sks", "http_port": 9000, "sub_port": 9001, "lookahead": 4,
+                                                       "replay": "take.c3d", "loop": true})");
+  const auto parsed = parse({"--config", path, "--http-port", "0", "--lookahead", "6"});
+  ASSERT_TRUE(parsed);
+  EXPECT_EQ(parsed->config.subject, "a.sks");
+  EXPECT_EQ(parsed->config.http_port, 0);
+  EXPECT_EQ(parsed->config.sub_port, 9001);
+  EXPECT_EQ(parsed->config.lookahead, 6);
+  EXPECT_TRUE(parsed->config.loop);
+  // A source given on the command line replaces the file's.
+  const auto vicon = parse({"--config", path, "--vicon", "localhost:801"});
+  ASSERT_TRUE(vicon);
+  EXPECT_EQ(vicon->config.vicon, "localhost:801");
+  EXPECT_TRUE(vicon->config.replay.empty());
+}
+
+TEST(Config, OutOfRangeValuesAndConflictsAreErrors) {
+  EXPECT_NE(error_of([] { parse({"--deform-threads", "0"}); }).find("deform_threads"), std::string::npos);
+  EXPECT_NE(error_of([] { parse({"--http-port", "70000"}); }).find("http_port"), std::string::npos);
+  EXPECT_NE(error_of([] { parse({"--replay", "a.c3d", "--vicon", "h:1"}); }).find("not both"), std::string::npos);
+  EXPECT_NE(error_of([] { parse({"--log-level", "loud"}); }).find("log_level"), std::string::npos);
+  EXPECT_NE(error_of([] { parse({"--vicon", "nohost"}); }).find("HOST:PORT"), std::string::npos);
+}
+
+TEST(Config, PrintConfigIsAFlag) {
+  const auto parsed = parse({"--print-config", "--sub-port", "1234"});
+  ASSERT_TRUE(parsed);
+  EXPECT_TRUE(parsed->print_config);
+  EXPECT_EQ(to_json(parsed->config)["sub_port"], 1234);
+}
+
+}  // namespace
+}  // namespace skinstream::server
