@@ -47,7 +47,8 @@ ProgramRun run(const std::string& command_line) {
 class DaemonProcess {
  public:
   explicit DaemonProcess(const std::string& arguments) {
-    ports_path_ = test::scratch_path("ports_" + std::to_string(counter_++) + ".json");
+    // The process id too: ctest runs each test as its own process, several at once.
+    ports_path_ = test::scratch_path("ports_" + std::to_string(getpid()) + "_" + std::to_string(counter_++) + ".json");
     std::remove(ports_path_.c_str());
     log_path_ = ports_path_ + ".log";
     pid_ = fork();
@@ -105,7 +106,7 @@ class ReplayProcess {
  public:
   // port 0: any free port (see port).
   ReplayProcess(const std::string& recording, int port) {
-    out_path_ = test::scratch_path("replay_" + std::to_string(counter_++) + ".out");
+    out_path_ = test::scratch_path("replay_" + std::to_string(getpid()) + "_" + std::to_string(counter_++) + ".out");
     std::remove(out_path_.c_str());
     pid_ = fork();
     if (pid_ == 0) {
@@ -235,8 +236,10 @@ class BackgroundSubscriber {
 class DaemonProgram : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    subject_ = test::scratch_path("subject.sks");
-    take_ = test::scratch_path("take.c3d");
+    // Per process: ctest runs the tests of this suite as separate processes, two at a time.
+    const std::string own = std::to_string(getpid());
+    subject_ = test::scratch_path("subject_" + own + ".sks");
+    take_ = test::scratch_path("take_" + own + ".c3d");
     const ProgramRun built = run(std::string(SKINSTREAM_CLI) + " build-subject --capture " +
                                  test::source_path("replay_data/cmu/85_02.c3d") + " --out " + subject_);
     ASSERT_EQ(built.exit_code, 0) << built.output;
@@ -244,6 +247,10 @@ class DaemonProgram : public ::testing::Test {
     std::vector<int> channels(full.point_count());
     for (int c = 0; c < full.point_count(); ++c) channels[c] = c;
     write_capture(full.select(channels, 0, kTakeFrames), take_);
+  }
+  static void TearDownTestSuite() {
+    std::remove(subject_.c_str());
+    std::remove(take_.c_str());
   }
   static constexpr int kTakeFrames = 240;
   static inline std::string subject_, take_;
@@ -308,46 +315,57 @@ TEST_F(DaemonProgram, PrintConfigShowsFlagsOverTheFile) {
 
 TEST_F(DaemonProgram, SubscriberReceivesTheOfflineFillInOrder) {
   // Offline: the causal fill of the same take.
-  const std::string filled_path = test::scratch_path("take_filled.c3d");
+  const std::string filled_path = test::scratch_path("take_filled_" + std::to_string(getpid()) + ".c3d");
   const ProgramRun fill = run(std::string(SKINSTREAM_CLI) + " fill --subject " + subject_ + " " + take_ + " --out " + filled_path);
   ASSERT_EQ(fill.exit_code, 0) << fill.output;
   const Capture offline = read_capture(filled_path);
 
   // Live: the daemon loops the take; every loop starts a new take for the filler, so a whole pass
-  // after the first restart must equal the offline fill frame by frame.
-  DaemonProcess daemon("--subject " + subject_ + " --replay " + take_ + " --loop --speed 2");
-  const ProgramRun sub = run(std::string(SKINSTREAM_SUB) + " 127.0.0.1:" + std::to_string(daemon.sub_port) +
-                             " --markers --json --frames " + std::to_string(3 * kTakeFrames));
-  EXPECT_EQ(daemon.stop(), 0) << daemon.log();
-  ASSERT_EQ(sub.exit_code, 0) << sub.output;
-
+  // after the first restart must equal the offline fill frame by frame. A frame the daemon drops
+  // (newest wins when the machine is busy) changes the fill history: one retry, then a failure.
   std::vector<nlohmann::json> frames;
-  std::istringstream lines(sub.output);
-  for (std::string line; std::getline(lines, line);) {
-    const nlohmann::json j = nlohmann::json::parse(line);
-    if (j.contains("frame")) frames.push_back(j);
-    else EXPECT_EQ(j["summary"]["frames"], 3 * kTakeFrames);
-  }
-  ASSERT_EQ(frames.size(), static_cast<size_t>(3 * kTakeFrames));
-  // In order: numbers rise by one except where the replay starts again.
   size_t pass_start = 0;
-  for (size_t i = 1; i < frames.size(); ++i) {
-    const int previous = frames[i - 1]["frame"], current = frames[i]["frame"];
-    if (current == offline.first_frame) {
-      if (pass_start == 0) pass_start = i;
-      continue;
+  std::string dropped;
+  for (int attempt = 0; attempt < 2; ++attempt) {
+    DaemonProcess daemon("--subject " + subject_ + " --replay " + take_ + " --loop");
+    const ProgramRun sub = run(std::string(SKINSTREAM_SUB) + " 127.0.0.1:" + std::to_string(daemon.sub_port) +
+                               " --markers --json --frames " + std::to_string(3 * kTakeFrames));
+    EXPECT_EQ(daemon.stop(), 0) << daemon.log();
+    ASSERT_EQ(sub.exit_code, 0) << sub.output;
+
+    frames.clear();
+    std::istringstream lines(sub.output);
+    for (std::string line; std::getline(lines, line);) {
+      const nlohmann::json j = nlohmann::json::parse(line);
+      if (j.contains("frame")) frames.push_back(j);
+      else EXPECT_EQ(j["summary"]["frames"], 3 * kTakeFrames);
     }
-    EXPECT_GT(current, previous) << "frame " << i;
+    ASSERT_EQ(frames.size(), static_cast<size_t>(3 * kTakeFrames));
+    // In order: numbers rise by one except where the replay starts again.
+    pass_start = 0;
+    for (size_t i = 1; i < frames.size(); ++i) {
+      const int previous = frames[i - 1]["frame"], current = frames[i]["frame"];
+      if (current == offline.first_frame) {
+        if (pass_start == 0) pass_start = i;
+        continue;
+      }
+      EXPECT_GT(current, previous) << "frame " << i;
+    }
+    ASSERT_GT(pass_start, 0u);
+    ASSERT_LE(pass_start + kTakeFrames, frames.size());
+    dropped.clear();
+    for (int f = 0; f < kTakeFrames && dropped.empty(); ++f)
+      if (frames[pass_start + f]["pipeline_dropped"] != frames[pass_start]["pipeline_dropped"] ||
+          frames[pass_start + f]["frame"].get<int>() != offline.first_frame + f)
+        dropped = "the daemon dropped a frame before frame " + std::to_string(offline.first_frame + f);
+    if (dropped.empty()) break;
+    std::printf("attempt %d: %s\n", attempt + 1, dropped.c_str());
   }
-  ASSERT_GT(pass_start, 0u);
-  ASSERT_LE(pass_start + kTakeFrames, frames.size());
+  ASSERT_TRUE(dropped.empty()) << dropped << " in both attempts: the fill history differs from the offline run";
   const int markers = offline.point_count();
   int compared = 0;
   for (int f = 0; f < kTakeFrames; ++f) {
     const nlohmann::json& frame = frames[pass_start + f];
-    if (frame["pipeline_dropped"] != frames[pass_start]["pipeline_dropped"]) {
-      GTEST_SKIP() << "the daemon dropped a frame in this pass (machine too busy); the fill history differs";
-    }
     ASSERT_EQ(frame["frame"].get<int>(), offline.first_frame + f);
     const std::vector<float> live = frame["markers"];
     ASSERT_EQ(live.size(), static_cast<size_t>(3 * markers));
@@ -460,8 +478,8 @@ TEST_F(DaemonProgram, ViconSourceDisconnectsAndReturns) {
   const size_t statuses_before = subscriber.status_count();
   EXPECT_TRUE(eventually([&] { return subscriber.saw_status(subscriber::SourceStateCode::Disconnected, statuses_before); }))
       << daemon.log();
-  const nlohmann::json health = fetch_health(daemon.http_port);  // still serving HTTP
-  EXPECT_EQ(health["source"]["state"], "disconnected") << health.dump();
+  // Still serving HTTP. Between retries the state is "connecting" for a moment, hence the polling.
+  EXPECT_TRUE(eventually([&] { return fetch_health(daemon.http_port)["source"]["state"] == "disconnected"; })) << daemon.log();
   EXPECT_FALSE(subscriber.closed()) << subscriber.error();
   const long frames_while_gone = subscriber.frames();
 

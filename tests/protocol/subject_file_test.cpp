@@ -127,7 +127,7 @@ TEST_F(SubjectFile, DeformationModelRoundTripsExactly) {
   const DeformationModel d = limb_deformation(model_);
   const std::string path = test::scratch_path("limb_mesh.subject");
   write_subject(model_, &d, path);
-  const SubjectFile back = read_subject_file(path);
+  const auto back = read_subject_file(path);
   ASSERT_TRUE(back.deformation.has_value());
   EXPECT_EQ(back.deformation->reference_vertices, d.reference_vertices);
   EXPECT_EQ(back.deformation->faces, d.faces);

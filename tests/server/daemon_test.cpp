@@ -4,6 +4,7 @@
 #include "server/daemon.h"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <nlohmann/json.hpp>
 #include <thread>
@@ -30,8 +31,10 @@ struct Fixture {
 const Fixture& fixture() {
   static const Fixture f = [] {
     Fixture out;
-    out.subject_path = test::scratch_path("daemon_subject.sks");
-    out.take_path = test::scratch_path("daemon_take.c3d");
+    // Per process: ctest runs each test in its own process, several at once.
+    const std::string own = std::to_string(getpid());
+    out.subject_path = test::scratch_path("daemon_subject_" + own + ".sks");
+    out.take_path = test::scratch_path("daemon_take_" + own + ".c3d");
     out.model = build_subject(read_capture(test::source_path("replay_data/cmu/85_02.c3d")), {});
     write_subject(out.model, out.subject_path);
     const Capture full = read_capture(test::source_path("replay_data/cmu/85_12.c3d"));
