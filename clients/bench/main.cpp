@@ -24,6 +24,7 @@
 #include <thread>
 #include <unistd.h>
 
+#include "server/client/health_probe.h"
 #include "protocol/capture_file.h"
 #include "protocol/file_error.h"
 #include "server/client/subscriber_client.h"
@@ -134,25 +135,11 @@ std::pair<double, long> process_usage(pid_t pid) {
   return {cpu, hwm};
 }
 
-// GET /health from the daemon's HTTP port.
-nlohmann::json fetch_health(int http_port) {
-  server::asio::io_context io;
-  server::tcp::socket socket(io);
-  socket.connect({server::asio::ip::make_address("127.0.0.1"), static_cast<unsigned short>(http_port)});
-  const std::string request = "GET /health HTTP/1.1\r\nHost: 127.0.0.1\r\nConnection: close\r\n\r\n";
-  server::asio::write(socket, server::asio::buffer(request));
-  std::string response;
-  boost::system::error_code ec;
-  std::array<char, 4096> buffer;
-  while (size_t n = socket.read_some(server::asio::buffer(buffer), ec)) response.append(buffer.data(), n);
-  const size_t body = response.find("\r\n\r\n");
-  return nlohmann::json::parse(body == std::string::npos ? "{}" : response.substr(body + 4));
-}
 
 // Waits until /health says the source is streaming (the daemon has connected to the replay).
 void wait_for_streaming(int http_port, pid_t pid, const std::string& log_path) {
   for (int i = 0; i < 300; ++i) {
-    if (fetch_health(http_port)["source"]["state"] == "streaming") return;
+    if (server::fetch_health(http_port)["source"]["state"] == "streaming") return;
     if (waitpid(pid, nullptr, WNOHANG) == pid) throw std::runtime_error("skinstreamd exited:\n" + file_text(log_path));
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
   }
@@ -221,7 +208,7 @@ int main(int argc, char** argv) {
     const nlohmann::json ports = wait_for_ports(ports_path, pid, log_path);
     const int sub_port = ports.at("sub"), http_port = ports.at("http");
     wait_for_streaming(http_port, pid, log_path);
-    const nlohmann::json health_before = fetch_health(http_port);
+    const nlohmann::json health_before = server::fetch_health(http_port);
     const uint64_t sent_before = replay.stats().frame_packets_sent.load();
     const uint64_t replay_dropped_before = replay.stats().frames_dropped.load();
     const double cpu_before = process_usage(pid).first;  // startup (loading the subject) is not counted
@@ -264,7 +251,7 @@ int main(int argc, char** argv) {
         }
       });
     for (std::thread& t : threads) t.join();
-    const nlohmann::json health = fetch_health(http_port);
+    const nlohmann::json health = server::fetch_health(http_port);
     const uint64_t sent = replay.stats().frame_packets_sent.load() - sent_before;
     const uint64_t replay_dropped = replay.stats().frames_dropped.load() - replay_dropped_before;
     const auto [cpu_total, peak_rss_kb] = process_usage(pid);

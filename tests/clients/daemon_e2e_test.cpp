@@ -21,6 +21,7 @@
 #include <cmath>
 #include <mutex>
 
+#include "server/client/health_probe.h"
 #include "protocol/capture_file.h"
 #include "protocol/point_cache.h"
 #include "server/client/subscriber_client.h"
@@ -146,20 +147,6 @@ class ReplayProcess {
   std::string out_path_;
 };
 
-// GET /health from the daemon.
-nlohmann::json fetch_health(int http_port) {
-  server::asio::io_context io;
-  server::tcp::socket socket(io);
-  socket.connect({server::asio::ip::make_address("127.0.0.1"), static_cast<unsigned short>(http_port)});
-  const std::string request = "GET /health HTTP/1.1\r\nHost: 127.0.0.1\r\nConnection: close\r\n\r\n";
-  server::asio::write(socket, server::asio::buffer(request));
-  std::string response;
-  boost::system::error_code ec;
-  std::array<char, 4096> buffer;
-  while (size_t n = socket.read_some(server::asio::buffer(buffer), ec)) response.append(buffer.data(), n);
-  const size_t body = response.find("\r\n\r\n");
-  return nlohmann::json::parse(body == std::string::npos ? "{}" : response.substr(body + 4));
-}
 
 // Polls `condition` every 20 ms for up to `limit`: a bound on a hang, not a timing assertion.
 bool eventually(const std::function<bool()>& condition, std::chrono::seconds limit = std::chrono::seconds(20)) {
@@ -398,7 +385,7 @@ void expect_vicon_stream_in_order(const std::string& subject, const std::string&
   constexpr int kFrames = 120;
   const ProgramRun sub = run(std::string(SKINSTREAM_SUB) + " 127.0.0.1:" + std::to_string(daemon.sub_port) +
                              " --markers --json --frames " + std::to_string(kFrames));
-  const nlohmann::json health = fetch_health(daemon.http_port);
+  const nlohmann::json health = server::fetch_health(daemon.http_port);
   EXPECT_EQ(daemon.stop(), 0) << daemon.log();
   ASSERT_EQ(sub.exit_code, 0) << sub.output << daemon.log();
   EXPECT_EQ(health["source"]["state"], "streaming") << health.dump();
@@ -450,7 +437,7 @@ TEST_F(DaemonProgram, ViconUnreachableIsReportedAndServingGoesOn) {
   getsockname(holder, reinterpret_cast<sockaddr*>(&address), &length);
   close(holder);
   DaemonProcess daemon("--subject " + subject_ + " --vicon 127.0.0.1:" + std::to_string(ntohs(address.sin_port)));
-  EXPECT_TRUE(eventually([&] { return fetch_health(daemon.http_port)["source"]["state"] == "disconnected"; })) << daemon.log();
+  EXPECT_TRUE(eventually([&] { return server::fetch_health(daemon.http_port)["source"]["state"] == "disconnected"; })) << daemon.log();
   BackgroundSubscriber subscriber(daemon.sub_port, subscriber::kWantMarkers | subscriber::kWantNoMesh);
   EXPECT_TRUE(eventually([&] { return subscriber.saw_status(subscriber::SourceStateCode::Disconnected); })) << subscriber.error();
   EXPECT_FALSE(subscriber.closed()) << subscriber.error();
@@ -479,7 +466,7 @@ TEST_F(DaemonProgram, ViconSourceDisconnectsAndReturns) {
   EXPECT_TRUE(eventually([&] { return subscriber.saw_status(subscriber::SourceStateCode::Disconnected, statuses_before); }))
       << daemon.log();
   // Still serving HTTP. Between retries the state is "connecting" for a moment, hence the polling.
-  EXPECT_TRUE(eventually([&] { return fetch_health(daemon.http_port)["source"]["state"] == "disconnected"; })) << daemon.log();
+  EXPECT_TRUE(eventually([&] { return server::fetch_health(daemon.http_port)["source"]["state"] == "disconnected"; })) << daemon.log();
   EXPECT_FALSE(subscriber.closed()) << subscriber.error();
   const long frames_while_gone = subscriber.frames();
 
@@ -488,7 +475,7 @@ TEST_F(DaemonProgram, ViconSourceDisconnectsAndReturns) {
   const size_t statuses_gone = subscriber.status_count();
   EXPECT_TRUE(eventually([&] { return subscriber.frames() >= frames_while_gone + 20; })) << subscriber.error() << daemon.log();
   EXPECT_TRUE(subscriber.saw_status(subscriber::SourceStateCode::Streaming, statuses_gone)) << daemon.log();
-  EXPECT_EQ(fetch_health(daemon.http_port)["source"]["state"], "streaming");
+  EXPECT_EQ(server::fetch_health(daemon.http_port)["source"]["state"], "streaming");
   EXPECT_FALSE(subscriber.closed()) << subscriber.error();
   EXPECT_EQ(daemon.stop(), 0) << daemon.log();
 }
