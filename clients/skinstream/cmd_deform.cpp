@@ -71,10 +71,9 @@ void add_deform(CLI::App& app) {
     int written = 0, skipped = 0;
     for (int f = 0; f < capture.frame_count; ++f) {
       for (int i = 0; i < n; ++i) markers[i] = capture.at(f, channel[i]);
-      if (!deformer.deform(markers, positions, normal_buffer)) {
-        ++skipped;  // a marker missing: the previous frame's shape is kept for the cache
-        deformer.deform_vertices(0, model.vertex_count(), positions);
-      }
+      // A marker missing: deform() leaves the buffers alone, so the previous frame's shape is
+      // written again.
+      if (!deformer.deform(markers, positions, normal_buffer)) ++skipped;
       for (int v = 0; v < model.vertex_count(); ++v) {
         vertices[v] = Vec3(positions[v * 3], positions[v * 3 + 1], positions[v * 3 + 2]);
         normals[v] = Vec3(normal_buffer[v * 3], normal_buffer[v * 3 + 1], normal_buffer[v * 3 + 2]);
