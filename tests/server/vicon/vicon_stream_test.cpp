@@ -159,6 +159,11 @@ struct Loopback {
   void stop_server() {
     server_io.call([&] { server.reset(); });
   }
+  // The server belongs to its io thread: destroying it from the test thread raced the
+  // session handlers (a double free seen once in CI).
+  ~Loopback() {
+    if (server) stop_server();
+  }
 };
 
 ViconServerOptions fast_options(double speed = 4.0) {
