@@ -1,7 +1,6 @@
 // Per-frame cost of the skin deformation (section 5.3) of the ~53,500-vertex subdivided body from
-// ~350 markers in ~17 parts, normals included: on one core, and split over two threads as the
-// daemon runs it (vertex range, then face normals, then vertex normals, each halved, with a
-// barrier between). A plain copy of the same output bytes (positions + normals) is the physical
+// ~350 markers in ~17 parts, normals included: on one core, and split over threads exactly as
+// the daemon runs it (server/pipeline/deform_workers). A plain copy of the same output bytes (positions + normals) is the physical
 // floor: writing the buffer cannot be faster than memory bandwidth allows.
 // The subject is trained on the generator's 10 s range-of-motion take (seed 1); the frames are
 // its 5 s punching take.
@@ -9,17 +8,15 @@
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
-#include <atomic>
-#include <barrier>
 #include <chrono>
 #include <cstring>
-#include <thread>
 
 #include "core/deform/mesh_deformer.h"
 #include "core/offline/deformation_builder.h"
 #include "core/offline/subject_builder.h"
 #include "core/synth/synth_capture.h"
 #include "protocol/makehuman.h"
+#include "server/pipeline/deform_workers.h"
 
 namespace skinstream {
 namespace {
@@ -93,46 +90,24 @@ void BM_DeformOneThread(benchmark::State& state) {
   report(state, micros, deformer);
 }
 
-// The daemon's split: the calling thread and one persistent worker, three phases per frame.
-void BM_DeformTwoThreads(benchmark::State& state) {
+// The daemon's split (server/pipeline/deform_workers): the calling thread and persistent
+// workers, one range of each stage apiece, barriers between stages. Argument: threads.
+void BM_DeformThreads(benchmark::State& state) {
   const Scenario& s = scenario();
   MeshDeformer deformer(s.model, s.subject);
-  const int vertices = deformer.vertex_count(), faces = deformer.face_count();
-  std::vector<float> positions(static_cast<size_t>(vertices) * 3), normals(positions.size());
-  std::barrier<> sync(2);
-  std::atomic<bool> stop{false};
-  const int split = deformer.balanced_vertex_split(1, 2);  // equal work, not equal counts
-  auto half = [&](int worker) {
-    deformer.deform_vertices(worker ? split : 0, worker ? vertices : split, positions);
-    sync.arrive_and_wait();
-    deformer.face_normals(worker ? faces / 2 : 0, worker ? faces : faces / 2, positions);
-    sync.arrive_and_wait();
-    deformer.vertex_normals(worker ? vertices / 2 : 0, worker ? vertices : vertices / 2, normals);
-  };
-  std::thread worker([&] {
-    for (;;) {
-      sync.arrive_and_wait();  // frame start: parts solved
-      if (stop.load()) return;
-      half(1);
-      sync.arrive_and_wait();  // frame end
-    }
-  });
+  std::vector<float> positions(static_cast<size_t>(deformer.vertex_count()) * 3), normals(positions.size());
+  server::DeformWorkers workers(deformer, static_cast<int>(state.range(0)));
   std::vector<double> micros;
   micros.reserve(1 << 16);
   size_t frame = 0;
   for (auto _ : state) {
     const auto start = std::chrono::steady_clock::now();
     deformer.solve_parts(s.frames[frame]);
-    sync.arrive_and_wait();
-    half(0);
-    sync.arrive_and_wait();
+    workers.run(positions, normals);
     micros.push_back(std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count());
     benchmark::DoNotOptimize(positions.data());
     frame = (frame + 1) % s.frames.size();
   }
-  stop.store(true);
-  sync.arrive_and_wait();
-  worker.join();
   report(state, micros, deformer);
 }
 
@@ -160,7 +135,7 @@ void BM_CopyOutputBuffer(benchmark::State& state) {
 }
 
 BENCHMARK(BM_DeformOneThread)->Arg(3)->Arg(1)->Arg(0)->Unit(benchmark::kMicrosecond)->MinTime(3.0)->UseRealTime();
-BENCHMARK(BM_DeformTwoThreads)->Unit(benchmark::kMicrosecond)->MinTime(3.0)->UseRealTime();
+BENCHMARK(BM_DeformThreads)->Arg(1)->Arg(2)->Unit(benchmark::kMicrosecond)->MinTime(3.0)->UseRealTime();
 BENCHMARK(BM_SolvePartsOnly)->Unit(benchmark::kMicrosecond)->MinTime(1.0);
 BENCHMARK(BM_CopyOutputBuffer)->Unit(benchmark::kMicrosecond)->MinTime(1.0);
 

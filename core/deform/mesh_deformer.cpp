@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <stdexcept>
 
 #include "core/deform/part_model.h"
@@ -23,11 +24,66 @@ struct SolvedPart {
   int centre_count = 0;
 };
 
-// The cubic B-spline of rbf_kernel.h without branches: max() clamps both pieces to zero.
-inline float bspline(float r) {
-  const float far = std::max(2.0f - r, 0.0f);
-  const float near = std::max(1.0f - r, 0.0f);
+// The cubic B-spline of rbf_kernel.h without branches (selects, not std::max). Everything the
+// AVX2 clone of deform_vertices calls is always_inline builtins: GCC does not inline
+// default-target functions such as std::max or std::sqrt there, and a call in the loop stops it
+// vectorising (the loop ran scalar until this was found in the disassembly).
+inline __attribute__((always_inline)) float bspline(float r) {
+  const float far = r < 2.0f ? 2.0f - r : 0.0f;
+  const float near = r < 1.0f ? 1.0f - r : 0.0f;
   return (far * far * far - 4.0f * near * near * near) * (1.0f / 6.0f);
+}
+
+// A few influences of one part close together in the reference pose.
+struct RbfCluster {
+  int part = 0;
+  int first = 0;  // into cluster_influences
+  int count = 0;
+};
+constexpr int kClusterSize = 32;
+// Centres gathered per cluster live on the stack; parts with more members than this are
+// evaluated against all their centres instead (never the case for ~350 markers in 17 parts).
+constexpr int kMaxGatheredCentres = 1024;
+
+// The quadratic field of eq. 8: A_t q^0 for one influence.
+inline __attribute__((always_inline)) void apply_quadratic(const float (&a)[3][9], const float* q, float* out) {
+  for (int r = 0; r < 3; ++r) {
+    float sum = 0.0f;
+    for (int c = 0; c < 9; ++c) sum += a[r][c] * q[c];
+    out[r] = sum;
+  }
+}
+
+// sum_i w_i phi(|x - c_i| / sigma) over n centres (structure of arrays).
+inline __attribute__((always_inline)) void sum_rbf(const float* __restrict cx, const float* __restrict cy,
+                                                   const float* __restrict cz, const float* __restrict wx,
+                                                   const float* __restrict wy, const float* __restrict wz, int n,
+                                                   const float* x, float inverse_sigma, float* out) {
+  float ox = 0.0f, oy = 0.0f, oz = 0.0f;
+  const float x0 = x[0], x1 = x[1], x2 = x[2];
+  for (int i = 0; i < n; ++i) {
+    const float dx = x0 - cx[i], dy = x1 - cy[i], dz = x2 - cz[i];
+    const float phi = bspline(__builtin_sqrtf(dx * dx + dy * dy + dz * dz) * inverse_sigma);
+    ox += phi * wx[i];
+    oy += phi * wy[i];
+    oz += phi * wz[i];
+  }
+  out[0] = ox;
+  out[1] = oy;
+  out[2] = oz;
+}
+
+// Interleaves the bits of three 10-bit integers: nearby points get nearby codes.
+uint32_t morton3(uint32_t x, uint32_t y, uint32_t z) {
+  auto spread = [](uint32_t v) {
+    v &= 0x3ff;
+    v = (v | (v << 16)) & 0x30000ff;
+    v = (v | (v << 8)) & 0x300f00f;
+    v = (v | (v << 4)) & 0x30c30c3;
+    v = (v | (v << 2)) & 0x9249249;
+    return v;
+  };
+  return spread(x) | (spread(y) << 1) | (spread(z) << 2);
 }
 
 }  // namespace
@@ -55,6 +111,15 @@ struct MeshDeformer::State {
   std::vector<SolvedPart> solved;
   std::vector<float> centre_x, centre_y, centre_z, weight_x, weight_y, weight_z;
 
+  // The RBF term of eq. 8 is evaluated per cluster of nearby influences of one part (sorted
+  // along a Morton curve of their reference positions): per frame the cluster's deformed
+  // bounding sphere selects the centres whose kernel can be non-zero for any of its members
+  // (the B-spline vanishes beyond 2 sigma), exactly, without bounds on how the field stretches.
+  std::vector<RbfCluster> clusters;
+  std::vector<int> cluster_influences;  // influence indices, cluster by cluster
+  std::vector<float> rbf_offset;        // 3 per influence: this frame's RBF term, local frame
+  std::vector<int64_t> cumulative_cluster_cost;
+
   // Normals: area-weighted face normals gathered per vertex through a vertex -> face CSR, so
   // vertex ranges can run on different threads without write conflicts.
   std::vector<float> face_normal;  // 3 per face
@@ -64,7 +129,9 @@ struct MeshDeformer::State {
   std::vector<int64_t> cumulative_cost;  // per vertex, for balanced_vertex_split
 
   void store_solved(int p);
+  void build_rbf_clusters(const std::vector<Vec3>& influence_local);
   void deform_vertex(int v, float* out) const;
+  void rbf_cluster(int c);
 };
 
 MeshDeformer::MeshDeformer(const DeformationModel& model, const SubjectModel& subject, DeformationMode mode)
@@ -103,6 +170,7 @@ MeshDeformer::MeshDeformer(const DeformationModel& model, const SubjectModel& su
 
   s.influence_offsets = model.vertex_influence_offsets;
   const size_t influences = model.vertex_influences.size();
+  std::vector<Vec3> influence_local(influences);
   s.influence_part.resize(influences);
   s.influence_weight.resize(influences);
   s.influence_quadratic.resize(influences * 9);
@@ -115,6 +183,7 @@ MeshDeformer::MeshDeformer(const DeformationModel& model, const SubjectModel& su
       const PartModel& part = s.parts[inf.part].model();
       const Vec3 local = part.local_from_world(model.reference_vertices[v]);
       const Vec3 inside = part.clamp_to_bounds(local);
+      influence_local[k] = inside;
       const QuadraticVector q = quadratic_basis(inside);
       for (int c = 0; c < 9; ++c) s.influence_quadratic[k * 9 + c] = static_cast<float>(q[c]);
       for (int c = 0; c < 3; ++c) s.influence_outside[k * 3 + c] = static_cast<float>(local[c] - inside[c]);
@@ -133,14 +202,43 @@ MeshDeformer::MeshDeformer(const DeformationModel& model, const SubjectModel& su
 
   for (int p = 0; p < part_count; ++p) s.store_solved(p);  // rest pose until the first solve
 
-  // Work per vertex: the quadratic and rotation, plus one kernel term per RBF centre.
-  const bool rbf = mode == DeformationMode::RigidRbf || mode == DeformationMode::QuadraticRbf;
+  // Work per vertex: the quadratic and rotation of each influence.
   s.cumulative_cost.assign(static_cast<size_t>(s.vertex_count) + 1, 0);
-  for (int v = 0; v < s.vertex_count; ++v) {
-    int64_t cost = 0;
-    for (int k = s.influence_offsets[v]; k < s.influence_offsets[v + 1]; ++k)
-      cost += 16 + (rbf ? s.solved[s.influence_part[k]].centre_count : 0);
-    s.cumulative_cost[v + 1] = s.cumulative_cost[v] + cost;
+  for (int v = 0; v < s.vertex_count; ++v)
+    s.cumulative_cost[v + 1] = s.cumulative_cost[v] + (s.influence_offsets[v + 1] - s.influence_offsets[v]);
+
+  s.rbf_offset.assign(influences * 3, 0.0f);
+  if (mode == DeformationMode::RigidRbf || mode == DeformationMode::QuadraticRbf) s.build_rbf_clusters(influence_local);
+  s.cumulative_cluster_cost.assign(s.clusters.size() + 1, 0);
+  for (size_t c = 0; c < s.clusters.size(); ++c)  // at most every centre for every influence
+    s.cumulative_cluster_cost[c + 1] = s.cumulative_cluster_cost[c] +
+                                       static_cast<int64_t>(s.clusters[c].count) * (8 + s.solved[s.clusters[c].part].centre_count);
+}
+
+void MeshDeformer::State::build_rbf_clusters(const std::vector<Vec3>& influence_local) {
+  std::vector<std::vector<int>> by_part(parts.size());
+  for (size_t k = 0; k < influence_part.size(); ++k) by_part[influence_part[k]].push_back(static_cast<int>(k));
+  for (size_t p = 0; p < parts.size(); ++p) {
+    std::vector<int>& members = by_part[p];
+    if (members.empty()) continue;
+    const PartModel& model = parts[p].model();
+    const Vec3 extent = (model.local_max - model.local_min).cwiseMax(Vec3::Constant(1e-6));
+    std::vector<std::pair<uint32_t, int>> keyed;
+    keyed.reserve(members.size());
+    for (int k : members) {
+      const Vec3 unit = (influence_local[k] - model.local_min).cwiseQuotient(extent);
+      auto cell = [&](int a) { return static_cast<uint32_t>(std::clamp(unit[a], 0.0, 1.0) * 1023.0); };
+      keyed.emplace_back(morton3(cell(0), cell(1), cell(2)), k);
+    }
+    std::sort(keyed.begin(), keyed.end());
+    for (size_t i = 0; i < keyed.size(); i += kClusterSize) {
+      RbfCluster cluster;
+      cluster.part = static_cast<int>(p);
+      cluster.first = static_cast<int>(cluster_influences.size());
+      cluster.count = static_cast<int>(std::min<size_t>(kClusterSize, keyed.size() - i));
+      for (int j = 0; j < cluster.count; ++j) cluster_influences.push_back(keyed[i + j].second);
+      clusters.push_back(cluster);
+    }
   }
 }
 
@@ -186,32 +284,18 @@ bool MeshDeformer::solve_parts(std::span<const Vec3> markers) {
   return true;
 }
 
-// Eq. 8 in every influencing part, blended by eq. 9.
+// Eq. 8 in every influencing part (the RBF term from rbf_cluster), blended by eq. 9.
 inline __attribute__((always_inline)) void MeshDeformer::State::deform_vertex(int v, float* out) const {
   float result[3] = {0.0f, 0.0f, 0.0f};
   for (int k = influence_offsets[v]; k < influence_offsets[v + 1]; ++k) {
     const SolvedPart& part = solved[influence_part[k]];
-    const float* q = &influence_quadratic[static_cast<size_t>(k) * 9];
     float local[3];
-    for (int r = 0; r < 3; ++r) {
-      float sum = 0.0f;
-      for (int c = 0; c < 9; ++c) sum += part.quadratic[r][c] * q[c];
-      local[r] = sum;
-    }
+    apply_quadratic(part.quadratic, &influence_quadratic[static_cast<size_t>(k) * 9], local);
     if (part.rbf) {
-      float ox = 0.0f, oy = 0.0f, oz = 0.0f;
-      const int first = part.first_centre, last = first + part.centre_count;
-#pragma omp simd reduction(+ : ox, oy, oz)
-      for (int i = first; i < last; ++i) {
-        const float dx = local[0] - centre_x[i], dy = local[1] - centre_y[i], dz = local[2] - centre_z[i];
-        const float phi = bspline(std::sqrt(dx * dx + dy * dy + dz * dz) * part.inverse_sigma);
-        ox += phi * weight_x[i];
-        oy += phi * weight_y[i];
-        oz += phi * weight_z[i];
-      }
-      local[0] += ox;
-      local[1] += oy;
-      local[2] += oz;
+      const float* rbf = &rbf_offset[static_cast<size_t>(k) * 3];
+      local[0] += rbf[0];
+      local[1] += rbf[1];
+      local[2] += rbf[2];
     }
     const float* outside = &influence_outside[static_cast<size_t>(k) * 3];
     const float lx = local[0] + outside[0] - part.translation[0], ly = local[1] + outside[1] - part.translation[1],
@@ -227,6 +311,81 @@ inline __attribute__((always_inline)) void MeshDeformer::State::deform_vertex(in
   out[2] = result[2];
 }
 
+// The RBF term of eq. 8 for one cluster's influences. Centres farther than 2 sigma from every
+// deformed influence of the cluster add exactly zero, so only the others are gathered (padded
+// with zero weights to whole vectors) and summed.
+inline __attribute__((always_inline)) void MeshDeformer::State::rbf_cluster(int c) {
+  const RbfCluster& cluster = clusters[c];
+  const SolvedPart& part = solved[cluster.part];
+  if (!part.rbf) return;  // deform_vertex does not read the offsets then
+  float deformed[kClusterSize][3];
+  float low[3] = {1e30f, 1e30f, 1e30f}, high[3] = {-1e30f, -1e30f, -1e30f};
+  for (int j = 0; j < cluster.count; ++j) {
+    const int k = cluster_influences[cluster.first + j];
+    apply_quadratic(part.quadratic, &influence_quadratic[static_cast<size_t>(k) * 9], deformed[j]);
+    for (int a = 0; a < 3; ++a) {
+      low[a] = deformed[j][a] < low[a] ? deformed[j][a] : low[a];
+      high[a] = deformed[j][a] > high[a] ? deformed[j][a] : high[a];
+    }
+  }
+  const float* cx = &centre_x[part.first_centre];
+  const float* cy = &centre_y[part.first_centre];
+  const float* cz = &centre_z[part.first_centre];
+  const float* wx = &weight_x[part.first_centre];
+  const float* wy = &weight_y[part.first_centre];
+  const float* wz = &weight_z[part.first_centre];
+  int n = part.centre_count;
+  alignas(32) float gx[kMaxGatheredCentres], gy[kMaxGatheredCentres], gz[kMaxGatheredCentres];
+  alignas(32) float gwx[kMaxGatheredCentres], gwy[kMaxGatheredCentres], gwz[kMaxGatheredCentres];
+  if (n <= kMaxGatheredCentres - 8) {
+    const float mid[3] = {0.5f * (low[0] + high[0]), 0.5f * (low[1] + high[1]), 0.5f * (low[2] + high[2])};
+    const float hx = 0.5f * (high[0] - low[0]), hy = 0.5f * (high[1] - low[1]), hz = 0.5f * (high[2] - low[2]);
+    // Support 2 sigma plus the box's half diagonal, and a hair for rounding.
+    const float reach = (2.0f / part.inverse_sigma + __builtin_sqrtf(hx * hx + hy * hy + hz * hz)) * 1.0001f + 1e-3f;
+    int m = 0;
+    for (int i = 0; i < n; ++i) {
+      const float dx = cx[i] - mid[0], dy = cy[i] - mid[1], dz = cz[i] - mid[2];
+      if (dx * dx + dy * dy + dz * dz >= reach * reach) continue;
+      gx[m] = cx[i];
+      gy[m] = cy[i];
+      gz[m] = cz[i];
+      gwx[m] = wx[i];
+      gwy[m] = wy[i];
+      gwz[m] = wz[i];
+      ++m;
+    }
+    for (; m % 8 != 0; ++m) {  // whole vectors: zero weights add nothing
+      gx[m] = mid[0];
+      gy[m] = mid[1];
+      gz[m] = mid[2];
+      gwx[m] = gwy[m] = gwz[m] = 0.0f;
+    }
+    cx = gx, cy = gy, cz = gz, wx = gwx, wy = gwy, wz = gwz, n = m;
+  }
+  for (int j = 0; j < cluster.count; ++j) {
+    const int k = cluster_influences[cluster.first + j];
+    sum_rbf(cx, cy, cz, wx, wy, wz, n, deformed[j], part.inverse_sigma, &rbf_offset[static_cast<size_t>(k) * 3]);
+  }
+}
+
+__attribute__((target_clones("arch=x86-64-v3", "default")))
+void MeshDeformer::rbf_residuals(int begin, int end) {
+  State& s = *state_;
+  end = std::min(end, rbf_cluster_count());
+  for (int c = std::max(begin, 0); c < end; ++c) s.rbf_cluster(c);
+}
+
+int MeshDeformer::rbf_cluster_count() const { return static_cast<int>(state_->clusters.size()); }
+
+int MeshDeformer::balanced_cluster_split(int index, int parts) const {
+  const State& s = *state_;
+  if (parts <= 0 || index <= 0) return 0;
+  if (index >= parts) return rbf_cluster_count();
+  const int64_t target = s.cumulative_cluster_cost.back() * index / parts;
+  return static_cast<int>(std::lower_bound(s.cumulative_cluster_cost.begin(), s.cumulative_cluster_cost.end(), target) -
+                          s.cumulative_cluster_cost.begin());
+}
+
 int MeshDeformer::balanced_vertex_split(int index, int parts) const {
   const State& s = *state_;
   if (parts <= 0 || index <= 0) return 0;
@@ -236,8 +395,10 @@ int MeshDeformer::balanced_vertex_split(int index, int parts) const {
                           s.cumulative_cost.begin());
 }
 
-// Compiled twice (AVX2 + FMA and the baseline); the loader picks the one the CPU runs.
-__attribute__((target_clones("arch=haswell", "default")))
+// Compiled twice (AVX2 + FMA and the baseline); the loader picks the one the CPU runs. The
+// clone is named by ISA level: "arch=haswell" dispatches on the CPU model, so AMD processors
+// with AVX2 ran the baseline (measured 1.9x slower on this EPYC).
+__attribute__((target_clones("arch=x86-64-v3", "default")))
 void MeshDeformer::deform_vertices(int begin, int end, std::span<float> positions) const {
   const State& s = *state_;
   end = std::min(end, s.vertex_count);
@@ -286,6 +447,7 @@ void MeshDeformer::vertex_normals(int begin, int end, std::span<float> normals) 
 
 bool MeshDeformer::deform(std::span<const Vec3> markers, std::span<float> positions, std::span<float> normals) {
   if (!solve_parts(markers)) return false;
+  rbf_residuals(0, rbf_cluster_count());
   deform_vertices(0, vertex_count(), positions);
   if (!normals.empty()) {
     face_normals(0, face_count(), positions);
@@ -304,7 +466,8 @@ size_t MeshDeformer::memory_bytes() const {
   size_t total = sizeof(State) + bytes(s.faces) + bytes(s.member_offsets) + bytes(s.member_markers) +
                  bytes(s.member_scratch) + bytes(s.influence_offsets) + bytes(s.influence_part) +
                  bytes(s.influence_weight) + bytes(s.influence_quadratic) + bytes(s.influence_outside) + bytes(s.solved) + bytes(s.centre_x) * 6 +
-                 bytes(s.face_normal) + bytes(s.vertex_face_offsets) + bytes(s.vertex_faces);
+                 bytes(s.face_normal) + bytes(s.vertex_face_offsets) + bytes(s.vertex_faces) + bytes(s.clusters) +
+                 bytes(s.cluster_influences) + bytes(s.rbf_offset) + bytes(s.cumulative_cluster_cost) + bytes(s.cumulative_cost);
   for (const PartDeformer& part : s.parts) {
     const int y = part.model().member_count();
     // Members' reference data (points, Q0, pseudo-inverse) and the per-frame kernel and LU.

@@ -3,9 +3,10 @@
 // markers (rigid by Horn, quadratic by eq. 6, RBF residual by eq. 7), then moves each vertex by
 // eq. 8 in every part that influences it and blends them by eq. 9, and computes vertex normals.
 //
-// Split in stages so a caller with threads can share the vertex and normal work out by ranges
-// (core/ has no threads itself): solve_parts() once, then deform_vertices() over disjoint vertex
-// ranges, then face_normals() over face ranges, then vertex_normals() over vertex ranges.
+// Split in stages so a caller with threads can share the work out by ranges (core/ has no
+// threads itself): solve_parts() once, then rbf_residuals() over disjoint cluster ranges, then
+// deform_vertices() over vertex ranges, then face_normals() over face ranges, then
+// vertex_normals() over vertex ranges; each stage reads what the one before wrote.
 // Buffers are sized at construction; no stage allocates.
 
 #include <memory>
@@ -33,6 +34,11 @@ class MeshDeformer {
   // previous fit, when the count is wrong or a marker is not finite.
   bool solve_parts(std::span<const Vec3> markers);
 
+  // The RBF term of eq. 8 for the influences of clusters [begin, end) (a no-op in the modes
+  // without RBF). Influences are grouped in clusters of nearby vertices of one part so that
+  // only the centres within the kernel's support are summed.
+  void rbf_residuals(int begin, int end);
+  int rbf_cluster_count() const;
   // Vertices [begin, end) into `positions` (3 floats per vertex, the whole mesh's buffer).
   void deform_vertices(int begin, int end, std::span<float> positions) const;
   // Face normals of faces [begin, end) from the deformed positions (into an internal buffer).
@@ -46,6 +52,8 @@ class MeshDeformer {
   // Where to cut the vertices into `parts` ranges of equal work (vertices in big parts with the
   // RBF residual cost more than others): the start of range `index` (index == parts: the end).
   int balanced_vertex_split(int index, int parts) const;
+  // The same for the clusters of rbf_residuals().
+  int balanced_cluster_split(int index, int parts) const;
 
   int vertex_count() const;
   int face_count() const;

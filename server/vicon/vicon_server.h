@@ -63,7 +63,8 @@ class ViconServer {
  public:
   using FrameHook = std::function<void(uint32_t frame_number, int64_t send_time_ns)>;
 
-  // The capture must outlive the server.
+  // The capture must outlive the server. Everything but stats() runs on the io_context's
+  // thread (or before it runs / after it stopped), destruction included: the sessions live there.
   ViconServer(asio::io_context& io, const Capture& capture, ViconServerOptions options);
   ~ViconServer();
   ViconServer(const ViconServer&) = delete;

@@ -127,6 +127,57 @@ TEST(MeshDeformer, MatchesThePerPartReferenceImplementation) {
   }
 }
 
+// A limb-like strip 1 m long with markers every 25 mm: sigma is ~100 mm, so most centres lie
+// beyond the kernel's support from most vertices and the cluster stage leaves them out. The
+// sums must still be eq. 8's over all centres (the double reference evaluates every one).
+TEST(MeshDeformer, SupportCullingKeepsEveryNonZeroKernelTerm) {
+  std::mt19937_64 rng(21);
+  std::uniform_real_distribution<double> jitter(-4.0, 4.0);
+  SubjectModel subject;
+  DeformationModel model;
+  model.part_names = {"strip"};
+  for (int i = 0; i <= 40; ++i)
+    for (int row = 0; row < 2; ++row) {
+      const int index = static_cast<int>(subject.reference_positions.size());
+      subject.marker_names.push_back("m" + std::to_string(index));
+      subject.reference_positions.push_back(Vec3(25.0 * i, 30.0 * row + jitter(rng), 10.0 * ((i + row) % 2) + jitter(rng)));
+      model.part_members.push_back({index, 1.0});
+    }
+  model.part_member_offsets.push_back(static_cast<int>(model.part_members.size()));
+  model.reference_vertices = random_points(rng, 3000, Vec3(500, 20, 8), Vec3(500, 15, 5));
+  for (int v = 0; v < 3000; ++v) {
+    model.vertex_influences.push_back({0, 1.0});
+    model.vertex_influence_offsets.push_back(v + 1);
+  }
+  for (int f = 0; f + 2 < 3000; f += 3) model.faces.push_back({f, f + 1, f + 2});
+
+  const PartModel part_model = build_part_model(subject.reference_positions);
+  long beyond = 0;
+  for (const Vec3& v : model.reference_vertices)
+    for (const Vec3& m : subject.reference_positions) beyond += (v - m).norm() > 3.0 * part_model.rbf_dilation;
+  ASSERT_GT(beyond, 3000L * 82 / 2) << "the scene must put most centres out of reach";
+
+  // Bend the strip (a few mm per 100 mm, more than the test of the small scene) and move it.
+  std::vector<Vec3> now;
+  const RigidTransform motion = random_motion(rng);
+  for (const Vec3& p : subject.reference_positions)
+    now.push_back(motion.apply(p + Vec3(0.0, 2e-5 * p.x() * p.x() + 3.0 * std::sin(p.x() / 60.0), 4.0 * std::cos(p.x() / 45.0))));
+  MeshDeformer deformer(model, subject);
+  ASSERT_GT(deformer.rbf_cluster_count(), 10);
+  const std::vector<float> positions = deform_all(deformer, now);
+  PartDeformer reference(part_model);
+  ASSERT_TRUE(reference.solve(now));
+  ASSERT_TRUE(reference.rbf_applied());
+  double worst = 0.0, largest_rbf = 0.0;
+  for (int v = 0; v < 3000; ++v) {
+    const Vec3 expected = reference.deform(part_model.local_from_world(model.reference_vertices[v]));
+    worst = std::max(worst, (vertex(positions, v) - expected).norm());
+  }
+  largest_rbf = reference.rbf_weights().cwiseAbs().maxCoeff();
+  ASSERT_GT(largest_rbf, 0.1) << "the residual must be non-trivial for the comparison to mean something";
+  EXPECT_LT(worst, 2e-3);
+}
+
 TEST(MeshDeformer, RigidMotionOfAllMarkersMovesTheMeshRigidly) {
   TwoPartScene scene;
   std::mt19937_64 rng(21);
@@ -194,6 +245,10 @@ TEST(MeshDeformer, VertexAndNormalRangesComposeToTheWholeFrame) {
   std::vector<float> normals_whole(600), normals_split(600), positions_split(600);
   const std::vector<float> positions_whole = deform_all(whole, now, &normals_whole);
   ASSERT_TRUE(split.solve_parts(now));
+  const int clusters = split.rbf_cluster_count();
+  ASSERT_GT(clusters, 1);
+  split.rbf_residuals(clusters / 2, clusters);
+  split.rbf_residuals(0, clusters / 2);
   split.deform_vertices(100, 200, positions_split);
   split.deform_vertices(0, 100, positions_split);
   split.face_normals(30, split.face_count(), positions_split);
