@@ -39,6 +39,7 @@ struct RbfCluster {
   int part = 0;
   int first = 0;  // into cluster_influences
   int count = 0;
+  int64_t rest_cost = 0;  // work at the rest pose: gather test plus the kernel terms kept
 };
 constexpr int kClusterSize = 32;
 // Centres gathered per cluster live on the stack; parts with more members than this are
@@ -210,9 +211,8 @@ MeshDeformer::MeshDeformer(const DeformationModel& model, const SubjectModel& su
   s.rbf_offset.assign(influences * 3, 0.0f);
   if (mode == DeformationMode::RigidRbf || mode == DeformationMode::QuadraticRbf) s.build_rbf_clusters(influence_local);
   s.cumulative_cluster_cost.assign(s.clusters.size() + 1, 0);
-  for (size_t c = 0; c < s.clusters.size(); ++c)  // at most every centre for every influence
-    s.cumulative_cluster_cost[c + 1] = s.cumulative_cluster_cost[c] +
-                                       static_cast<int64_t>(s.clusters[c].count) * (8 + s.solved[s.clusters[c].part].centre_count);
+  for (size_t c = 0; c < s.clusters.size(); ++c)
+    s.cumulative_cluster_cost[c + 1] = s.cumulative_cluster_cost[c] + s.clusters[c].rest_cost;
 }
 
 void MeshDeformer::State::build_rbf_clusters(const std::vector<Vec3>& influence_local) {
@@ -236,7 +236,18 @@ void MeshDeformer::State::build_rbf_clusters(const std::vector<Vec3>& influence_
       cluster.part = static_cast<int>(p);
       cluster.first = static_cast<int>(cluster_influences.size());
       cluster.count = static_cast<int>(std::min<size_t>(kClusterSize, keyed.size() - i));
-      for (int j = 0; j < cluster.count; ++j) cluster_influences.push_back(keyed[i + j].second);
+      Vec3 low = Vec3::Constant(1e30), high = Vec3::Constant(-1e30);
+      for (int j = 0; j < cluster.count; ++j) {
+        cluster_influences.push_back(keyed[i + j].second);
+        low = low.cwiseMin(influence_local[keyed[i + j].second]);
+        high = high.cwiseMax(influence_local[keyed[i + j].second]);
+      }
+      // What rbf_cluster does at the rest pose (A = I): the split by this cost is balanced
+      // where the culling removes more terms in big parts than in small ones.
+      const double reach = 2.0 * model.rbf_dilation + 0.5 * (high - low).norm();
+      int kept = 0;
+      for (const Vec3& centre : model.local_reference_points) kept += (centre - 0.5 * (low + high)).norm() < reach;
+      cluster.rest_cost = model.member_count() + static_cast<int64_t>(cluster.count) * (16 + (kept + 7) / 8 * 8);
       clusters.push_back(cluster);
     }
   }
