@@ -71,6 +71,7 @@ void get_floats(ByteReader& r, std::vector<float>& out, size_t count) {
 const char* to_string(MessageType type) {
   switch (type) {
     case MessageType::Hello: return "Hello";
+    case MessageType::Ack: return "Ack";
     case MessageType::MeshInfo: return "MeshInfo";
     case MessageType::Frame: return "Frame";
     case MessageType::Status: return "Status";
@@ -92,6 +93,12 @@ std::vector<unsigned char> encode_hello(const Hello& hello) {
   ByteWriter p;
   p.put<uint32_t>(hello.wants);
   return with_header(MessageType::Hello, p);
+}
+
+std::vector<unsigned char> encode_ack(const Ack& ack) {
+  ByteWriter p;
+  p.put<uint32_t>(ack.frame_number);
+  return with_header(MessageType::Ack, p);
 }
 
 std::vector<unsigned char> encode_mesh_info(const MeshInfo& info) {
@@ -227,7 +234,7 @@ MessageHeader decode_header(std::span<const unsigned char> bytes, uint32_t max_p
   if (magic != kMagic) throw DecodeError("bad magic (not a skinstream subscriber stream)");
   if (version != kProtocolVersion)
     throw DecodeError("unsupported protocol version " + std::to_string(version) + " (this side speaks 1)");
-  if (type < 1 || type > 4) throw DecodeError("unknown message type " + std::to_string(type));
+  if (type < 1 || type > 5) throw DecodeError("unknown message type " + std::to_string(type));
   if (payload > max_payload)
     throw DecodeError("payload of " + std::to_string(payload) + " bytes exceeds the limit of " + std::to_string(max_payload));
   return {static_cast<MessageType>(type), payload};
@@ -239,6 +246,10 @@ Hello decode_hello(std::span<const unsigned char> payload) {
     if (hello.wants & ~kWantAll) throw DecodeError("Hello: reserved wants bits set (" + std::to_string(hello.wants) + ")");
     return hello;
   });
+}
+
+Ack decode_ack(std::span<const unsigned char> payload) {
+  return decode_payload("Ack", payload, [](ByteReader& r) { return Ack{r.get<uint32_t>()}; });
 }
 
 MeshInfo decode_mesh_info(std::span<const unsigned char> payload) {

@@ -21,7 +21,7 @@ inline constexpr uint16_t kProtocolVersion = 1;
 inline constexpr size_t kHeaderBytes = 12;
 inline constexpr uint32_t kMaxPayloadBytes = 64u << 20;
 
-enum class MessageType : uint16_t { Hello = 1, MeshInfo = 2, Frame = 3, Status = 4 };
+enum class MessageType : uint16_t { Hello = 1, MeshInfo = 2, Frame = 3, Status = 4, Ack = 5 };
 const char* to_string(MessageType type);
 
 // Hello "wants" bits.
@@ -29,7 +29,13 @@ inline constexpr uint32_t kWantNormals = 1u << 0;
 inline constexpr uint32_t kWantQuantised = 1u << 1;
 inline constexpr uint32_t kWantMarkers = 1u << 2;
 inline constexpr uint32_t kWantNoMesh = 1u << 3;
-inline constexpr uint32_t kWantAll = 0xF;
+// Paced: the subscriber sends Ack for every Frame it takes, and the daemon keeps at most
+// kPacedWindow Frames unacknowledged (newer ones wait in its newest-wins queue). Bounds the
+// latency of a reader slower than the stream (a browser) to the window instead of whatever the
+// socket buffers hold.
+inline constexpr uint32_t kWantPaced = 1u << 4;
+inline constexpr uint32_t kWantAll = 0x1F;
+inline constexpr int kPacedWindow = 2;
 
 // Frame flags.
 inline constexpr uint32_t kFrameNormals = 1u << 0;
@@ -56,6 +62,10 @@ struct MessageHeader {
 
 struct Hello {
   uint32_t wants = 0;
+};
+
+struct Ack {
+  uint32_t frame_number = 0;  // of the Frame taken (informative; every Ack frees one slot)
 };
 
 struct MeshInfo {
@@ -108,6 +118,7 @@ struct Status {
 
 // ---- encoding ----
 std::vector<unsigned char> encode_hello(const Hello& hello);
+std::vector<unsigned char> encode_ack(const Ack& ack);
 std::vector<unsigned char> encode_mesh_info(const MeshInfo& info);
 std::vector<unsigned char> encode_status(const Status& status);
 
@@ -123,6 +134,7 @@ void patch_subscriber_dropped(std::span<unsigned char> frame_message, uint32_t d
 // ---- decoding (each throws DecodeError naming what is wrong) ----
 MessageHeader decode_header(std::span<const unsigned char> bytes, uint32_t max_payload = kMaxPayloadBytes);
 Hello decode_hello(std::span<const unsigned char> payload);
+Ack decode_ack(std::span<const unsigned char> payload);
 MeshInfo decode_mesh_info(std::span<const unsigned char> payload);
 Frame decode_frame(std::span<const unsigned char> payload);
 Status decode_status(std::span<const unsigned char> payload);

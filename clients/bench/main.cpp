@@ -110,6 +110,14 @@ nlohmann::json wait_for_ports(const std::string& path, pid_t pid, const std::str
 }
 
 // CPU seconds (user + system) and peak RSS (kB) of a running process.
+// Resident set now (VmRSS, kB): sampled through the run to show whether memory stays flat.
+long resident_kb(pid_t pid) {
+  std::ifstream status("/proc/" + std::to_string(pid) + "/status");
+  for (std::string line; std::getline(status, line);)
+    if (line.rfind("VmRSS:", 0) == 0) return std::stol(line.substr(6));
+  return 0;
+}
+
 std::pair<double, long> process_usage(pid_t pid) {
   std::ifstream stat("/proc/" + std::to_string(pid) + "/stat");
   std::string text((std::istreambuf_iterator<char>(stat)), std::istreambuf_iterator<char>());
@@ -250,6 +258,13 @@ int main(int argc, char** argv) {
           errors[s] = e.what();
         }
       });
+    // RSS once a second: the first sample after warm-up against the last.
+    std::vector<long> rss_samples;
+    const auto first_sample = std::chrono::steady_clock::now() + std::chrono::seconds(1);
+    for (auto next = first_sample; next < deadline; next += std::chrono::seconds(1)) {
+      std::this_thread::sleep_until(next);
+      rss_samples.push_back(resident_kb(pid));
+    }
     for (std::thread& t : threads) t.join();
     const nlohmann::json health = server::fetch_health(http_port);
     const uint64_t sent = replay.stats().frame_packets_sent.load() - sent_before;
@@ -294,6 +309,9 @@ int main(int argc, char** argv) {
                     {"out_of_order", total_out_of_order},
                     {"without_send_time", total_unmatched}}},
         {"daemon", {{"cpu_seconds", cpu_seconds}, {"cpu_share_of_one_core", cpu_seconds / seconds}, {"peak_rss_kb", peak_rss_kb},
+                    {"rss_kb_after_1s", rss_samples.empty() ? 0 : rss_samples.front()},
+                    {"rss_kb_at_end", rss_samples.empty() ? 0 : rss_samples.back()},
+                    {"rss_kb_max_sampled", rss_samples.empty() ? 0 : *std::max_element(rss_samples.begin(), rss_samples.end())},
                     {"exit_status", WIFEXITED(status) ? WEXITSTATUS(status) : -1}}}};
     if (json) {
       std::printf("%s\n", report.dump(2).c_str());
@@ -306,7 +324,9 @@ int main(int argc, char** argv) {
       line("end to end", report["end_to_end"]);
       line("daemon processing", report["daemon_processing"]);
       std::printf("frames: %s\n", report["frames"].dump().c_str());
-      std::printf("daemon: %.2f s CPU (%.0f%% of one core), peak RSS %ld kB\n", cpu_seconds, 100 * cpu_seconds / seconds, peak_rss_kb);
+      std::printf("daemon: %.2f s CPU (%.0f%% of one core), peak RSS %ld kB, RSS %ld kB after 1 s and %ld kB at the end\n",
+                  cpu_seconds, 100 * cpu_seconds / seconds, peak_rss_kb, rss_samples.empty() ? 0L : rss_samples.front(),
+                  rss_samples.empty() ? 0L : rss_samples.back());
     }
     fs::remove_all(work);
     return 0;

@@ -43,9 +43,7 @@ void WebSocketSubscriber::read_next() {
       const subscriber::MessageHeader header = subscriber::decode_header(bytes, 1024);
       if (header.payload_bytes != bytes.size() - subscriber::kHeaderBytes)
         throw subscriber::DecodeError("WebSocket message is not exactly one protocol message");
-      if (header.type != subscriber::MessageType::Hello)
-        throw subscriber::DecodeError(std::string("unexpected ") + to_string(header.type) + " from a subscriber");
-      self->on_hello(subscriber::decode_hello(bytes.subspan(subscriber::kHeaderBytes)).wants);
+      self->on_subscriber_message(header.type, bytes.subspan(subscriber::kHeaderBytes));
     } catch (const subscriber::DecodeError& e) {
       self->on_protocol_error(e.what());
       return;

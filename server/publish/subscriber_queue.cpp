@@ -29,7 +29,18 @@ void SubscriberQueue::push_control(ControlMessage message) {
   control_.push_back(std::move(message));
 }
 
-bool SubscriberQueue::pop(Item& out) {
+bool SubscriberQueue::pop(Item& out, Take take) {
+  if (take == Take::NewestFrame) {
+    for (;;) {  // the older frames go, one at a time, each released outside the lock
+      FrameRef older;
+      std::lock_guard lock(mutex_);
+      if (count_ <= 1 || !control_.empty()) break;
+      older = std::move(ring_[head_]);
+      head_ = (head_ + 1) % ring_.size();
+      --count_;
+      ++dropped_;
+    }
+  }
   std::lock_guard lock(mutex_);
   if (!control_.empty()) {
     out.control = std::move(control_.front());
@@ -37,12 +48,17 @@ bool SubscriberQueue::pop(Item& out) {
     out.frame.reset();
     return true;
   }
-  if (count_ == 0) return false;
+  if (count_ == 0 || take == Take::ControlOnly) return false;
   out.control.reset();
   out.frame = std::move(ring_[head_]);
   head_ = (head_ + 1) % ring_.size();
   --count_;
   return true;
+}
+
+bool SubscriberQueue::has_control() const {
+  std::lock_guard lock(mutex_);
+  return !control_.empty();
 }
 
 bool SubscriberQueue::empty() const {

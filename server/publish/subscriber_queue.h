@@ -29,9 +29,16 @@ class SubscriberQueue {
     ControlMessage control;  // either this
     FrameRef frame;          // or this
   };
-  // Control messages first, then the oldest frame. False when empty.
-  bool pop(Item& out);
+  // What pop() may take after the control messages, which always go first.
+  enum class Take {
+    OldestFrame,  // frames in order
+    NewestFrame,  // the newest frame; the older ones are dropped (counted)
+    ControlOnly,  // no frame
+  };
+  // False when there is nothing to take.
+  bool pop(Item& out, Take take = Take::OldestFrame);
   bool empty() const;
+  bool has_control() const;
 
   uint64_t frames_dropped() const;
   size_t frames_queued() const;

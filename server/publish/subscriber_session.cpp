@@ -47,8 +47,30 @@ void SubscriberSession::start_hello_timer(std::chrono::milliseconds timeout) {
   });
 }
 
+void SubscriberSession::on_subscriber_message(subscriber::MessageType type, std::span<const unsigned char> payload) {
+  switch (type) {
+    case subscriber::MessageType::Hello:
+      on_hello(subscriber::decode_hello(payload).wants);
+      return;
+    case subscriber::MessageType::Ack:
+      subscriber::decode_ack(payload);  // checks the length
+      on_ack();
+      return;
+    default:
+      throw subscriber::DecodeError(std::string("unexpected ") + to_string(type) + " from a subscriber");
+  }
+}
+
+void SubscriberSession::on_ack() {
+  // An Ack for a frame sent before a paced Hello took effect has nothing to free: ignored.
+  if (closed_ || !paced_ || unacked_ == 0) return;
+  --unacked_;
+  if (!writing_) pump();
+}
+
 void SubscriberSession::on_hello(uint32_t wants) {
   if (closed_) return;
+  paced_ = (wants & subscriber::kWantPaced) != 0;
   const uint32_t flags = subscriber::frame_flags_for(wants, hub_.has_mesh());
   const bool changed = !greeted_ || flags != flags_.load();
   greeted_ = true;
@@ -87,14 +109,20 @@ void SubscriberSession::pump() {
       pump_scheduled_.store(false);
       return;
     }
-    if (queue_.pop(in_flight_)) {
+    // A paced subscriber with its window full gets control messages only; its frames wait in
+    // the queue, where the newest wins, and the one sent next is the newest.
+    const bool window_full = paced_ && unacked_ >= subscriber::kPacedWindow;
+    const auto take = window_full ? SubscriberQueue::Take::ControlOnly
+                                  : (paced_ ? SubscriberQueue::Take::NewestFrame : SubscriberQueue::Take::OldestFrame);
+    if (queue_.pop(in_flight_, take)) {
       if (in_flight_.control || in_flight_.frame->has(flags_.load())) break;
       in_flight_.frame.reset();  // encoded for this subscriber's previous wants
       continue;
     }
     pump_scheduled_.store(false);
     // A push between pop() and the store above saw the flag set and did not post: look again.
-    if (queue_.empty() || pump_scheduled_.exchange(true)) return;
+    // (With the window full only a control message could be sent; an Ack calls pump() again.)
+    if ((window_full ? !queue_.has_control() : queue_.empty()) || pump_scheduled_.exchange(true)) return;
   }
   pump_scheduled_.store(false);
   writing_ = true;
@@ -102,6 +130,7 @@ void SubscriberSession::pump() {
     start_write({asio::buffer(*in_flight_.control), asio::const_buffer()});
     return;
   }
+  if (paced_) ++unacked_;
   const std::span<const unsigned char> message = in_flight_.frame->message(flags_.load());
   const size_t prefix = std::min(frame_prefix_.size(), message.size());
   std::memcpy(frame_prefix_.data(), message.data(), prefix);

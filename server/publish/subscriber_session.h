@@ -1,15 +1,18 @@
 #pragma once
 // What the TCP and WebSocket subscribers share: the Hello handshake (2 s default, then
-// positions only), the bounded queue, one write in flight, and the per-subscriber counters.
+// positions only), the bounded queue, one write in flight, pacing by Acks for subscribers that
+// ask for it, and the per-subscriber counters.
 // Everything but offer() runs on the io thread; offer() is called by the pipeline thread.
 
 #include <array>
 #include <atomic>
 #include <memory>
+#include <span>
 #include <string>
 
 #include "server/asio.h"
 #include "server/metrics/metrics.h"
+#include "protocol/subscriber_stream.h"
 #include "server/publish/subscriber_queue.h"
 
 namespace skinstream::server {
@@ -34,6 +37,9 @@ class SubscriberSession : public std::enable_shared_from_this<SubscriberSession>
   // For the transports (io thread).
   void start_hello_timer(std::chrono::milliseconds timeout);
   void on_hello(uint32_t wants);
+  // A message from the subscriber (Hello or Ack); DecodeError for anything else.
+  void on_subscriber_message(subscriber::MessageType type, std::span<const unsigned char> payload);
+  void on_ack();
   void on_protocol_error(const std::string& reason);
   void on_disconnected(const std::string& reason);
   // Writes the buffers as one protocol message, then calls write_done().
@@ -54,6 +60,8 @@ class SubscriberSession : public std::enable_shared_from_this<SubscriberSession>
   bool greeted_ = false;  // Hello received or timed out
   bool closed_ = false;
   bool writing_ = false;
+  bool paced_ = false;  // Hello asked for kWantPaced
+  int unacked_ = 0;     // Frames sent (or being sent) and not acknowledged yet
   std::atomic<bool> pump_scheduled_{false};
   std::atomic<uint32_t> flags_{0};
   std::atomic<uint64_t> sent_{0};

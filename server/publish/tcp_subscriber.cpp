@@ -29,12 +29,8 @@ void TcpSubscriber::read_next() {
                             }
                             try {
                               self->decoder_.feed(std::span(self->read_buffer_).first(n));
-                              while (auto message = self->decoder_.next()) {
-                                if (message->type != subscriber::MessageType::Hello)
-                                  throw subscriber::DecodeError(std::string("unexpected ") + to_string(message->type) +
-                                                                " from a subscriber");
-                                self->on_hello(subscriber::decode_hello(message->payload).wants);
-                              }
+                              while (auto message = self->decoder_.next())
+                                self->on_subscriber_message(message->type, message->payload);
                             } catch (const subscriber::DecodeError& e) {
                               self->on_protocol_error(e.what());
                               return;

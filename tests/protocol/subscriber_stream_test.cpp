@@ -89,8 +89,17 @@ TEST(SubscriberStream, HeaderRejectsBadMagicVersionTypeAndSize) {
 TEST(SubscriberStream, HelloMatchesGoldenBytes) {
   EXPECT_EQ(encode_hello({kWantNormals | kWantMarkers}), fixture("hello.bin"));
   EXPECT_EQ(decode_hello(payload_of(fixture("hello.bin"))).wants, kWantNormals | kWantMarkers);
-  const std::vector<unsigned char> reserved = encode_hello({0x10});
+  const std::vector<unsigned char> reserved = encode_hello({0x20});
   EXPECT_THROW(decode_hello(payload_of(reserved)), DecodeError);
+  EXPECT_EQ(decode_hello(payload_of(encode_hello({kWantPaced}))).wants, kWantPaced);
+}
+
+// ack.bin was written with Python's struct: b'SKSF' + pack('<HHI', 1, 5, 4) + pack('<I', 123456).
+TEST(SubscriberStream, AckMatchesGoldenBytes) {
+  EXPECT_EQ(encode_ack({123456}), fixture("ack.bin"));
+  const std::vector<unsigned char> golden = fixture("ack.bin");
+  EXPECT_EQ(decode_header(golden).type, MessageType::Ack);
+  EXPECT_EQ(decode_ack(payload_of(golden)).frame_number, 123456u);
 }
 
 TEST(SubscriberStream, MeshInfoMatchesGoldenBytes) {
@@ -182,7 +191,7 @@ TEST(SubscriberStream, FlagsFollowWants) {
 }
 
 TEST(SubscriberStream, EveryTruncationOfEveryMessageIsRejected) {
-  for (const char* name : {"hello.bin", "mesh_info.bin", "frame_float.bin", "frame_quantised.bin", "frame_markers_only.bin", "status.bin"}) {
+  for (const char* name : {"hello.bin", "ack.bin", "mesh_info.bin", "frame_float.bin", "frame_quantised.bin", "frame_markers_only.bin", "status.bin"}) {
     const std::vector<unsigned char> message = fixture(name);
     const MessageHeader header = decode_header(message);
     for (size_t n = kHeaderBytes; n < message.size(); ++n) {
@@ -190,6 +199,7 @@ TEST(SubscriberStream, EveryTruncationOfEveryMessageIsRejected) {
       auto decode = [&] {
         switch (header.type) {
           case MessageType::Hello: decode_hello(cut); break;
+          case MessageType::Ack: decode_ack(cut); break;
           case MessageType::MeshInfo: decode_mesh_info(cut); break;
           case MessageType::Frame: decode_frame(cut); break;
           case MessageType::Status: decode_status(cut); break;

@@ -1,6 +1,7 @@
 // The daemon in-process on real loopback sockets: a replayed take goes through the pipeline to
-// TCP and WebSocket subscribers; a stalled subscriber does not hold back the others; the filled
-// markers equal the offline fill of the same take frame by frame.
+// TCP and WebSocket subscribers; a stalled subscriber does not hold back the others; a paced
+// subscriber never has more than its window in flight; the filled markers equal the offline
+// fill of the same take frame by frame.
 #include "server/daemon.h"
 
 #include <gtest/gtest.h>
@@ -209,6 +210,68 @@ TEST(Daemon, StalledSubscriberDoesNotHoldBackTheOthers) {
   EXPECT_GT(received, 500);
   const std::string metrics = http_get(daemon.http_port(), "/metrics");
   EXPECT_NE(metrics.find("skinstream_subscriber_frames_dropped_total{"), std::string::npos);
+  daemon.stop();
+}
+
+// Reads whatever has arrived on a raw subscriber socket until `deadline`, decoding Frames.
+std::vector<subscriber::Frame> read_frames_until(tcp::socket& socket, subscriber::StreamDecoder& decoder,
+                                                 std::chrono::steady_clock::time_point deadline) {
+  std::vector<subscriber::Frame> frames;
+  std::array<unsigned char, 65536> buffer;
+  while (std::chrono::steady_clock::now() < deadline) {
+    if (socket.available() == 0) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+      continue;
+    }
+    decoder.feed(std::span(buffer).first(socket.read_some(asio::buffer(buffer))));
+    while (auto m = decoder.next())
+      if (m->type == subscriber::MessageType::Frame) frames.push_back(subscriber::decode_frame(m->payload));
+  }
+  return frames;
+}
+
+TEST(Daemon, PacedSubscriberHasAtMostTheWindowInFlightAndGetsTheNewestFrameOnAck) {
+  DaemonConfig config = test_config();
+  config.speed = 4;  // 480 frames a second
+  config.loop = true;
+  Daemon daemon(config);
+  daemon.start_serving();
+  asio::io_context io;
+  tcp::socket paced(io);
+  paced.connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), static_cast<unsigned short>(daemon.sub_port())));
+  asio::write(paced, asio::buffer(subscriber::encode_hello({subscriber::kWantMarkers | subscriber::kWantPaced})));
+  wait_until([&] { return daemon.hub().wanted_encodings() != 0; });
+  daemon.start_source();
+  subscriber::StreamDecoder decoder;
+  using std::chrono::milliseconds;
+
+  // No Ack: the window's frames come, then nothing while ~200 more are published.
+  std::vector<subscriber::Frame> first = read_frames_until(paced, decoder, std::chrono::steady_clock::now() + milliseconds(500));
+  ASSERT_EQ(first.size(), static_cast<size_t>(subscriber::kPacedWindow));
+  EXPECT_LT(first[0].info.frame_number, first[1].info.frame_number);
+
+  // One Ack frees one slot: exactly one frame, the newest (the ones in between were dropped).
+  asio::write(paced, asio::buffer(subscriber::encode_ack({first[0].info.frame_number})));
+  std::vector<subscriber::Frame> next = read_frames_until(paced, decoder, std::chrono::steady_clock::now() + milliseconds(300));
+  ASSERT_EQ(next.size(), 1u);
+  EXPECT_GT(next[0].info.subscriber_dropped, 0u);
+  EXPECT_NE(next[0].info.frame_number, first[1].info.frame_number + 1);
+
+  // Acking every frame keeps the stream going, in order (apart from the loop's restart).
+  asio::write(paced, asio::buffer(subscriber::encode_ack({first[1].info.frame_number})));
+  asio::write(paced, asio::buffer(subscriber::encode_ack({next[0].info.frame_number})));
+  long received = 0;
+  const auto end = std::chrono::steady_clock::now() + milliseconds(1000);
+  std::array<unsigned char, 65536> buffer;
+  while (std::chrono::steady_clock::now() < end) {
+    decoder.feed(std::span(buffer).first(paced.read_some(asio::buffer(buffer))));
+    while (auto m = decoder.next()) {
+      if (m->type != subscriber::MessageType::Frame) continue;
+      ++received;
+      asio::write(paced, asio::buffer(subscriber::encode_ack({subscriber::decode_frame(m->payload).info.frame_number})));
+    }
+  }
+  EXPECT_GT(received, 50);
   daemon.stop();
 }
 

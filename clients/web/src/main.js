@@ -227,7 +227,7 @@ window.skinstreamViewer = Object.freeze({
   get bannerText() { return banner.hidden ? '' : banner.textContent; },
 });
 
-worker.postMessage({ kind: 'start', url: streamUrl, wants: Wants.NORMALS | Wants.MARKERS | (quantised ? Wants.QUANTISED : 0) });
+worker.postMessage({ kind: 'start', url: streamUrl, wants: Wants.NORMALS | Wants.MARKERS | Wants.PACED | (quantised ? Wants.QUANTISED : 0) });
 setInterval(updateStatus, STATUS_INTERVAL_MS);
 updateStatus();
 requestAnimationFrame(animate);

@@ -7,9 +7,12 @@ export const PROTOCOL_VERSION = 1;
 export const HEADER_BYTES = 12;
 export const MAX_PAYLOAD_BYTES = 64 * 1024 * 1024;
 
-export const MessageType = Object.freeze({ HELLO: 1, MESH_INFO: 2, FRAME: 3, STATUS: 4 });
+export const MessageType = Object.freeze({ HELLO: 1, MESH_INFO: 2, FRAME: 3, STATUS: 4, ACK: 5 });
 
-export const Wants = Object.freeze({ NORMALS: 1, QUANTISED: 2, MARKERS: 4, NO_MESH: 8 });
+// PACED: this side sends Ack for every Frame and the daemon keeps at most PACED_WINDOW Frames
+// unacknowledged, so a slow page never has seconds of frames queued in front of it.
+export const Wants = Object.freeze({ NORMALS: 1, QUANTISED: 2, MARKERS: 4, NO_MESH: 8, PACED: 16 });
+export const PACED_WINDOW = 2;
 export const FrameFlags = Object.freeze({ NORMALS: 1, QUANTISED: 2, MARKERS: 4, NO_POSITIONS: 8 });
 
 export const MarkerStatus = Object.freeze({ MEASURED: 0, RELABELLED: 1, FILLED_PCA: 2, FILLED_RIGID: 3, HELD: 4 });
@@ -32,16 +35,25 @@ export class ProtocolError extends Error {
   }
 }
 
-export function encodeHello(wants) {
-  if ((wants & ~0xf) !== 0) throw new ProtocolError(`Hello wants 0x${wants.toString(16)} has unknown bits`);
+// The two subscriber -> daemon messages carry one u32 each.
+function encodeU32Message(type, value) {
   const buffer = new ArrayBuffer(HEADER_BYTES + 4);
   const view = new DataView(buffer);
   view.setUint32(0, MAGIC, true);
   view.setUint16(4, PROTOCOL_VERSION, true);
-  view.setUint16(6, MessageType.HELLO, true);
+  view.setUint16(6, type, true);
   view.setUint32(8, 4, true);
-  view.setUint32(12, wants, true);
+  view.setUint32(12, value >>> 0, true);
   return buffer;
+}
+
+export function encodeHello(wants) {
+  if ((wants & ~0x1f) !== 0) throw new ProtocolError(`Hello wants 0x${wants.toString(16)} has unknown bits`);
+  return encodeU32Message(MessageType.HELLO, wants);
+}
+
+export function encodeAck(frameNumber) {
+  return encodeU32Message(MessageType.ACK, frameNumber);
 }
 
 // Checks the 12-byte header of a whole message and returns its type.

@@ -1,6 +1,7 @@
 // The WebSocket to the daemon's /stream: sends Hello first, hands each binary message to the
-// listener, and reconnects with exponential backoff whenever the socket closes.
-import { encodeHello, ProtocolError } from './protocol.js';
+// listener, acknowledges each Frame when the Hello asked for pacing, and reconnects with
+// exponential backoff whenever the socket closes.
+import { encodeAck, encodeHello, MessageType, ProtocolError, Wants } from './protocol.js';
 
 export const ConnectionState = Object.freeze({ CONNECTING: 'connecting', OPEN: 'open', CLOSED: 'closed' });
 
@@ -12,6 +13,7 @@ export class StreamConnection {
   constructor(url, wants, listener) {
     this.url = url;
     this.hello = encodeHello(wants);
+    this.paced = (wants & Wants.PACED) !== 0;
     this.listener = listener;
     this.state = ConnectionState.CLOSED;
     this.retryMs = FIRST_RETRY_MS;
@@ -56,7 +58,16 @@ export class StreamConnection {
         return;
       }
       try {
+        // Read before the listener runs: it may transfer the buffer to the page (detaching it).
+        let ack = null;
+        if (this.paced && event.data.byteLength >= 16) {
+          const view = new DataView(event.data);
+          if (view.getUint16(6, true) === MessageType.FRAME) ack = encodeAck(view.getUint32(12, true));
+        }
         this.listener.onMessage(event.data);
+        // Acked on arrival: the window then bounds what waits in the sockets, and the worker
+        // keeps only the newest frame for the page.
+        if (ack) socket.send(ack);
       } catch (error) {
         if (!(error instanceof ProtocolError)) throw error;
         console.error(`skinstream: ${error.message}; closing the connection`);

@@ -129,7 +129,7 @@ const viewer = (page) => page.evaluate(() => {
     lastFrameNumber: v.lastFrameNumber, vertexCount: v.vertexCount, markerCount: v.markerCount,
     sampleIsMarkers: v.sampleIsMarkers, samplePositions: v.samplePositions, sourceRateHz: v.sourceRateHz,
     announcedRateHz: v.announcedRateHz, connectionState: v.connectionState, webgl: v.webgl,
-    webglVersion: v.webglVersion, bannerText: v.bannerText,
+    webglVersion: v.webglVersion, bannerText: v.bannerText, latencyMs: v.latencyMs,
   };
 });
 
@@ -256,6 +256,19 @@ async function main() {
     }
     after = await viewer(page);
     console.log(`status bar rate "${rateText}" (${shownHz} Hz), source ${sourceHz} Hz`);
+    // For the record (not asserted: a loaded machine stretches it), over 5 s: how many frames
+    // arrived and were drawn, and the latency from the daemon's receive to the page's draw.
+    const latencies = [];
+    const windowStart = await viewer(page);
+    for (let i = 0; i < 10; ++i) {
+      await sleep(500);
+      latencies.push((await viewer(page)).latencyMs);
+    }
+    const windowEnd = await viewer(page);
+    latencies.sort((a, b) => a - b);
+    console.log(`over 5 s: ${((windowEnd.framesReceived - windowStart.framesReceived) / 5).toFixed(1)} frames/s received, ` +
+      `${((windowEnd.framesRendered - windowStart.framesRendered) / 5).toFixed(1)} drawn, ` +
+      `${windowEnd.framesSkipped - windowStart.framesSkipped} skipped by the page; latency median ${latencies[5].toFixed(1)} ms, max ${latencies[9].toFixed(1)} ms`);
     assert.match(rateText, /Hz/);
     assert.ok(Math.abs(shownHz - sourceHz) < 0.2 * sourceHz, `status bar shows ${shownHz} Hz, the source runs at ${sourceHz} Hz`);
 

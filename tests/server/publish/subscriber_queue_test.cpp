@@ -33,6 +33,26 @@ TEST(SubscriberQueue, NewestFramesWinAndDropsAreCounted) {
   EXPECT_FALSE(queue.pop(item));
 }
 
+// What a paced subscriber's pump takes: with its window full only control messages, then the
+// newest frame, the older ones counted as dropped.
+TEST(SubscriberQueue, PacedTakesControlOnlyOrTheNewestFrame) {
+  FramePool pool;
+  SubscriberQueue queue(4);
+  for (uint32_t n = 1; n <= 3; ++n) queue.push_frame(frame(pool, n));
+  queue.push_control(status_message(7));
+  SubscriberQueue::Item item;
+  ASSERT_TRUE(queue.pop(item, SubscriberQueue::Take::ControlOnly));
+  EXPECT_TRUE(item.control);
+  EXPECT_FALSE(queue.pop(item, SubscriberQueue::Take::ControlOnly));
+  EXPECT_FALSE(queue.has_control());
+  EXPECT_EQ(queue.frames_dropped(), 0u);
+  ASSERT_TRUE(queue.pop(item, SubscriberQueue::Take::NewestFrame));
+  ASSERT_TRUE(item.frame);
+  EXPECT_EQ(item.frame->frame_number, 3u);
+  EXPECT_EQ(queue.frames_dropped(), 2u);
+  EXPECT_FALSE(queue.pop(item, SubscriberQueue::Take::NewestFrame));
+}
+
 TEST(SubscriberQueue, DroppedFramesGoBackToThePool) {
   FramePool pool;
   {
