@@ -218,6 +218,8 @@ window.skinstreamViewer = Object.freeze({
   get sourceRateHz() { return stats ? stats.sourceRateHz : 0; },
   get announcedRateHz() { return stats ? stats.announcedRateHz : 0; },
   get latencyMs() { return latencyMs; },
+  get arrivalLatencyMs() { return stats ? stats.arrivalLatencyMs : NaN; },
+  get clockSkewMs() { return Date.now() - wallClockMs(); },
   get connectionState() { return stats ? stats.connectionState : 'connecting'; },
   get reconnects() { return stats ? stats.reconnects : 0; },
   get sourceState() { return stats && stats.status ? stats.status.stateName : 'unknown'; },

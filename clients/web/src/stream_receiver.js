@@ -64,6 +64,8 @@ export class StreamReceiver {
     ++this.framesReceived;
     this.lastReceivedFrameNumber = h.frameNumber;
     this.lastFrameArrivalMs = nowMs;
+    // Daemon publish -> arrival here: the network and the browser's own queues, before the page.
+    this.arrivalLatencyMs = nowMs - h.publishTimeNs / 1e6;
     this.rate.add(h.frameNumber, nowMs);
     if (this.pending !== null) ++this.framesSkipped;
     this.pending = buffer;

@@ -38,6 +38,7 @@ function postStats() {
     framesReceived: receiver.framesReceived,
     framesSkipped: receiver.framesSkipped,
     lastReceivedFrameNumber: receiver.lastReceivedFrameNumber,
+    arrivalLatencyMs: receiver.arrivalLatencyMs,
     frameNumbersWentBack: receiver.frameNumbersWentBack,
     sourceRateHz: receiver.rate.rateHz(),
     announcedRateHz: receiver.announcedRateHz(),

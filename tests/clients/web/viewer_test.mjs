@@ -130,6 +130,7 @@ const viewer = (page) => page.evaluate(() => {
     sampleIsMarkers: v.sampleIsMarkers, samplePositions: v.samplePositions, sourceRateHz: v.sourceRateHz,
     announcedRateHz: v.announcedRateHz, connectionState: v.connectionState, webgl: v.webgl,
     webglVersion: v.webglVersion, bannerText: v.bannerText, latencyMs: v.latencyMs,
+    arrivalLatencyMs: v.arrivalLatencyMs, clockSkewMs: v.clockSkewMs,
   };
 });
 
@@ -259,16 +260,22 @@ async function main() {
     // For the record (not asserted: a loaded machine stretches it), over 5 s: how many frames
     // arrived and were drawn, and the latency from the daemon's receive to the page's draw.
     const latencies = [];
+    const arrivals = [];
     const windowStart = await viewer(page);
     for (let i = 0; i < 10; ++i) {
       await sleep(500);
-      latencies.push((await viewer(page)).latencyMs);
+      const sample = await viewer(page);
+      latencies.push(sample.latencyMs);
+      arrivals.push(sample.arrivalLatencyMs);
     }
     const windowEnd = await viewer(page);
     latencies.sort((a, b) => a - b);
+    arrivals.sort((a, b) => a - b);
     console.log(`over 5 s: ${((windowEnd.framesReceived - windowStart.framesReceived) / 5).toFixed(1)} frames/s received, ` +
       `${((windowEnd.framesRendered - windowStart.framesRendered) / 5).toFixed(1)} drawn, ` +
-      `${windowEnd.framesSkipped - windowStart.framesSkipped} skipped by the page; latency median ${latencies[5].toFixed(1)} ms, max ${latencies[9].toFixed(1)} ms`);
+      `${windowEnd.framesSkipped - windowStart.framesSkipped} skipped by the page; daemon receive -> page draw median ` +
+      `${latencies[5].toFixed(1)} ms (max ${latencies[9].toFixed(1)}), daemon publish -> worker arrival median ` +
+      `${arrivals[5].toFixed(1)} ms (max ${arrivals[9].toFixed(1)}); page clock - system clock ${windowEnd.clockSkewMs.toFixed(1)} ms`);
     assert.match(rateText, /Hz/);
     assert.ok(Math.abs(shownHz - sourceHz) < 0.2 * sourceHz, `status bar shows ${shownHz} Hz, the source runs at ${sourceHz} Hz`);
 
