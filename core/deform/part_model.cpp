@@ -82,7 +82,24 @@ PartModel build_part_model(const std::vector<Vec3>& reference_member_positions) 
       ++model.quadratic_rank;
     }
   }
-  const Eigen::MatrixXd scaled_pinv = svd.matrixV() * inverse_singular.asDiagonal() * svd.matrixU().transpose();
+  Eigen::MatrixXd scaled_pinv = svd.matrixV() * inverse_singular.asDiagonal() * svd.matrixU().transpose();
+  if (count < 9) {
+    // Eq. 6 needs Q0 Q0^T invertible, which fewer members than the 9 modes can never give: the
+    // minimum-norm fit then puts arbitrary curvature between them (measured: up to 500 mm
+    // swings inside small parts). Fit the linear modes alone instead.
+    const Eigen::MatrixXd linear = scaled.topRows(3);
+    const Eigen::JacobiSVD<Eigen::MatrixXd> linear_svd(linear, Eigen::ComputeThinU | Eigen::ComputeThinV);
+    const Eigen::VectorXd& values = linear_svd.singularValues();
+    Eigen::VectorXd inverse_values = Eigen::VectorXd::Zero(values.size());
+    model.quadratic_rank = 0;
+    for (Eigen::Index k = 0; k < values.size(); ++k)
+      if (values(k) > values(0) * kRelativeRankTolerance && values(k) > 0) {
+        inverse_values(k) = 1.0 / values(k);
+        ++model.quadratic_rank;
+      }
+    scaled_pinv.setZero();
+    scaled_pinv.leftCols(3) = linear_svd.matrixV() * inverse_values.asDiagonal() * linear_svd.matrixU().transpose();
+  }
   model.pseudo_inverse = scaled_pinv * row_scale.cwiseInverse().asDiagonal();  // undo the scaling
   model.reference_projection = model.local_reference * model.pseudo_inverse;
 
