@@ -23,7 +23,7 @@ void take(const nlohmann::json& json, const char* key, T& out, const std::string
 
 void apply_json(const nlohmann::json& json, DaemonConfig& c, const std::string& origin) {
   if (!json.is_object()) throw ConfigError(origin + ": the configuration must be a JSON object");
-  static const char* const kKeys[] = {"subject", "replay", "loop", "speed", "vicon", "vicon_pull", "bind_address",
+  static const char* const kKeys[] = {"subject", "replay", "loop", "speed", "vicon", "vicon_pull", "vicon_multicast", "bind_address",
                                       "http_port", "sub_port", "web_root", "lookahead", "deform_threads",
                                       "continuity_seconds", "use_pca", "ports_file", "log_level", "hello_timeout_ms",
                                       "subscriber_queue_frames", "status_interval_ms", "default_rate_hz"};
@@ -38,6 +38,7 @@ void apply_json(const nlohmann::json& json, DaemonConfig& c, const std::string& 
   take(json, "speed", c.speed, origin);
   take(json, "vicon", c.vicon, origin);
   take(json, "vicon_pull", c.vicon_pull, origin);
+  take(json, "vicon_multicast", c.vicon_multicast, origin);
   take(json, "bind_address", c.bind_address, origin);
   take(json, "http_port", c.http_port, origin);
   take(json, "sub_port", c.sub_port, origin);
@@ -77,6 +78,7 @@ nlohmann::json to_json(const DaemonConfig& c) {
           {"speed", c.speed},
           {"vicon", c.vicon},
           {"vicon_pull", c.vicon_pull},
+          {"vicon_multicast", c.vicon_multicast},
           {"bind_address", c.bind_address},
           {"http_port", c.http_port},
           {"sub_port", c.sub_port},
@@ -95,7 +97,8 @@ nlohmann::json to_json(const DaemonConfig& c) {
 
 void validate(const DaemonConfig& c) {
   auto fail = [](const std::string& what) { throw ConfigError("configuration: " + what); };
-  if (!c.replay.empty() && !c.vicon.empty()) fail("give either a replay file or a Vicon server, not both");
+  if (!c.replay.empty() + !c.vicon.empty() + !c.vicon_multicast.empty() > 1)
+    fail("give one source: a replay file, a Vicon server or a Vicon multicast address");
   if (!(c.speed > 0 && c.speed <= 100)) fail("speed must be in (0, 100]");
   if (c.http_port < 0 || c.http_port > 65535) fail("http_port must be 0-65535");
   if (c.sub_port < 0 || c.sub_port > 65535) fail("sub_port must be 0-65535");
@@ -110,13 +113,16 @@ void validate(const DaemonConfig& c) {
   bool level_ok = false;
   for (const char* l : kLevels) level_ok = level_ok || c.log_level == l;
   if (!level_ok) fail("log_level must be one of trace, debug, info, warn, error, critical, off");
-  if (!c.vicon.empty()) {
-    const size_t colon = c.vicon.rfind(':');
-    const std::string port = colon == std::string::npos ? std::string() : c.vicon.substr(colon + 1);
+  auto host_and_port = [](const std::string& text) {
+    const size_t colon = text.rfind(':');
+    const std::string port = colon == std::string::npos ? std::string() : text.substr(colon + 1);
     const bool digits = !port.empty() && port.size() <= 5 && port.find_first_not_of("0123456789") == std::string::npos;
-    if (colon == 0 || !digits || std::stoi(port) < 1 || std::stoi(port) > 65535)
-      fail("vicon must be HOST:PORT with a port of 1-65535 (Vicon's default is 801), not \"" + c.vicon + "\"");
-  }
+    return colon != 0 && digits && std::stoi(port) >= 1 && std::stoi(port) <= 65535;
+  };
+  if (!c.vicon.empty() && !host_and_port(c.vicon))
+    fail("vicon must be HOST:PORT with a port of 1-65535 (Vicon's default is 801), not \"" + c.vicon + "\"");
+  if (!c.vicon_multicast.empty() && !host_and_port(c.vicon_multicast))
+    fail("vicon_multicast must be GROUP:PORT with a port of 1-65535 (Vicon's default is 44801), not \"" + c.vicon_multicast + "\"");
 }
 
 std::optional<CommandLine> parse_command_line(int argc, const char* const* argv, int& out_exit_code) {
@@ -131,6 +137,8 @@ std::optional<CommandLine> parse_command_line(int argc, const char* const* argv,
   auto* speed = app.add_option("--speed", flags.speed, "replay: multiple of the capture rate");
   auto* vicon = app.add_option("--vicon", flags.vicon, "Vicon DataStream server HOST:PORT as the source");
   auto* vicon_pull = app.add_flag("--vicon-pull", flags.vicon_pull, "Vicon: ask for each frame (ClientPull) instead of the server pushing them");
+  auto* vicon_multicast = app.add_option("--vicon-multicast", flags.vicon_multicast,
+                                         "receive Vicon DataStream UDP datagrams sent to GROUP:PORT as the source");
   auto* bind = app.add_option("--bind", flags.bind_address, "address to listen on");
   auto* http_port = app.add_option("--http-port", flags.http_port, "HTTP/WebSocket port (0 = ephemeral)");
   auto* sub_port = app.add_option("--sub-port", flags.sub_port, "TCP subscriber port (0 = ephemeral)");
@@ -150,10 +158,14 @@ std::optional<CommandLine> parse_command_line(int argc, const char* const* argv,
   if (!config_path.empty()) c = load_config_file(config_path);
   auto given = [](const CLI::Option* o) { return o->count() > 0; };
   if (given(subject)) c.subject = flags.subject;
-  if (given(replay)) c.replay = flags.replay, c.vicon.clear();
+  // A source given on the command line replaces the file's (several on the command line: validate() refuses).
+  if (given(replay) || given(vicon) || given(vicon_multicast)) {
+    c.replay = given(replay) ? flags.replay : std::string();
+    c.vicon = given(vicon) ? flags.vicon : std::string();
+    c.vicon_multicast = given(vicon_multicast) ? flags.vicon_multicast : std::string();
+  }
   if (given(loop)) c.loop = flags.loop;
   if (given(speed)) c.speed = flags.speed;
-  if (given(vicon)) c.vicon = flags.vicon, c.replay = given(replay) ? flags.replay : std::string();
   if (given(vicon_pull)) c.vicon_pull = flags.vicon_pull;
   if (given(bind)) c.bind_address = flags.bind_address;
   if (given(http_port)) c.http_port = flags.http_port;

@@ -18,6 +18,7 @@ struct DaemonConfig {
   double speed = 1.0;             // replay: multiple of the capture rate
   std::string vicon;              // HOST:PORT of a Vicon DataStream server; empty = none
   bool vicon_pull = false;        // Vicon: ask for each frame instead of server push
+  std::string vicon_multicast;    // GROUP:PORT (or this host's address:PORT) of Vicon UDP datagrams; empty = none
   std::string bind_address = "0.0.0.0";
   int http_port = 8480;           // 0 = ephemeral
   int sub_port = 8481;            // 0 = ephemeral

@@ -10,6 +10,7 @@
 #include "protocol/file_error.h"
 #include "server/http/http_server.h"
 #include "server/ingest/file_replay_source.h"
+#include "server/ingest/vicon_multicast_source.h"
 #include "server/ingest/vicon_source.h"
 #include "server/listener.h"
 #include "server/publish/subscriber_hub.h"
@@ -96,13 +97,20 @@ Daemon::Daemon(const DaemonConfig& config)
 
   if (!config.replay.empty()) {
     source_ = std::make_unique<FileReplaySource>(io_, model, config.replay, static_cast<FrameSink&>(*this), ReplayOptions{config.loop, config.speed});
+  } else if (!config.vicon_multicast.empty()) {
+    const size_t colon = config.vicon_multicast.rfind(':');  // validate() checked the form
+    ViconMulticastSourceOptions options;
+    options.group = config.vicon_multicast.substr(0, colon);
+    options.port = static_cast<uint16_t>(std::stoi(config.vicon_multicast.substr(colon + 1)));
+    spdlog::info("source: Vicon DataStream multicast {}:{} (receive only)", options.group, options.port);
+    source_ = std::make_unique<ViconMulticastSource>(io_, std::move(options), model.marker_names, static_cast<FrameSink&>(*this));
   } else if (!config.vicon.empty()) {
     ViconSourceOptions options = vicon_options_of(config);
     spdlog::info("source: Vicon DataStream {}:{} ({})", options.host, options.port,
                  options.mode == ViconSourceOptions::Mode::ClientPull ? "client pull" : "server push");
     source_ = std::make_unique<ViconSource>(io_, std::move(options), model.marker_names, static_cast<FrameSink&>(*this));
   } else {
-    spdlog::warn("no source configured (--replay FILE or --vicon HOST:PORT): serving subscribers without frames");
+    spdlog::warn("no source configured (--replay FILE, --vicon HOST:PORT or --vicon-multicast GROUP:PORT): serving subscribers without frames");
   }
 
   sub_listener_ = std::make_unique<Listener>(io_, config.bind_address, config.sub_port, "subscriber port", [this](tcp::socket socket) {

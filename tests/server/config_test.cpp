@@ -68,12 +68,18 @@ TEST(Config, FlagsOverrideTheFile) {
   ASSERT_TRUE(vicon);
   EXPECT_EQ(vicon->config.vicon, "localhost:801");
   EXPECT_TRUE(vicon->config.replay.empty());
+  const auto multicast = parse({"--config", path, "--vicon-multicast", "239.255.42.1:44801"});
+  ASSERT_TRUE(multicast);
+  EXPECT_EQ(multicast->config.vicon_multicast, "239.255.42.1:44801");
+  EXPECT_TRUE(multicast->config.replay.empty());
 }
 
 TEST(Config, OutOfRangeValuesAndConflictsAreErrors) {
   EXPECT_NE(error_of([] { parse({"--deform-threads", "0"}); }).find("deform_threads"), std::string::npos);
   EXPECT_NE(error_of([] { parse({"--http-port", "70000"}); }).find("http_port"), std::string::npos);
-  EXPECT_NE(error_of([] { parse({"--replay", "a.c3d", "--vicon", "h:1"}); }).find("not both"), std::string::npos);
+  EXPECT_NE(error_of([] { parse({"--replay", "a.c3d", "--vicon", "h:1"}); }).find("one source"), std::string::npos);
+  EXPECT_NE(error_of([] { parse({"--vicon", "h:1", "--vicon-multicast", "239.1.1.1:44801"}); }).find("one source"), std::string::npos);
+  EXPECT_NE(error_of([] { parse({"--vicon-multicast", "239.1.1.1"}); }).find("GROUP:PORT"), std::string::npos);
   EXPECT_NE(error_of([] { parse({"--log-level", "loud"}); }).find("log_level"), std::string::npos);
   EXPECT_NE(error_of([] { parse({"--vicon", "nohost"}); }).find("HOST:PORT"), std::string::npos);
 }
