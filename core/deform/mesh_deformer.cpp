@@ -25,9 +25,9 @@ struct SolvedPart {
 };
 
 // The cubic B-spline of rbf_kernel.h without branches (selects, not std::max). Everything the
-// AVX2 clone of deform_vertices calls is always_inline builtins: GCC does not inline
-// default-target functions such as std::max or std::sqrt there, and a call in the loop stops it
-// vectorising (the loop ran scalar until this was found in the disassembly).
+// AVX2 clones of rbf_residuals and deform_vertices call is always_inline or a builtin: GCC does
+// not inline default-target functions such as std::max or std::sqrt there, and a call in the
+// loop stops it vectorising (the loop ran scalar until this was found in the disassembly).
 inline __attribute__((always_inline)) float bspline(float r) {
   const float far = r < 2.0f ? 2.0f - r : 0.0f;
   const float near = r < 1.0f ? 1.0f - r : 0.0f;
