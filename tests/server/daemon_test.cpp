@@ -213,12 +213,13 @@ TEST(Daemon, StalledSubscriberDoesNotHoldBackTheOthers) {
   daemon.stop();
 }
 
-// Reads whatever has arrived on a raw subscriber socket until `deadline`, decoding Frames.
+// Reads a raw subscriber socket, decoding Frames, until `deadline` or until `enough` frames
+// have come (0: no such limit).
 std::vector<subscriber::Frame> read_frames_until(tcp::socket& socket, subscriber::StreamDecoder& decoder,
-                                                 std::chrono::steady_clock::time_point deadline) {
+                                                 std::chrono::steady_clock::time_point deadline, size_t enough = 0) {
   std::vector<subscriber::Frame> frames;
   std::array<unsigned char, 65536> buffer;
-  while (std::chrono::steady_clock::now() < deadline) {
+  while (std::chrono::steady_clock::now() < deadline && (enough == 0 || frames.size() < enough)) {
     if (socket.available() == 0) {
       std::this_thread::sleep_for(std::chrono::milliseconds(2));
       continue;
@@ -245,14 +246,22 @@ TEST(Daemon, PacedSubscriberHasAtMostTheWindowInFlightAndGetsTheNewestFrameOnAck
   subscriber::StreamDecoder decoder;
   using std::chrono::milliseconds;
 
-  // No Ack: the window's frames come, then nothing while ~200 more are published.
-  std::vector<subscriber::Frame> first = read_frames_until(paced, decoder, std::chrono::steady_clock::now() + milliseconds(500));
+  // Frames now and in the next 300 ms (another ~140 are published meanwhile).
+  auto frames_then_quiet = [&](size_t expected) {
+    std::vector<subscriber::Frame> got =
+        read_frames_until(paced, decoder, std::chrono::steady_clock::now() + std::chrono::seconds(10), expected);
+    const std::vector<subscriber::Frame> more = read_frames_until(paced, decoder, std::chrono::steady_clock::now() + milliseconds(300));
+    got.insert(got.end(), more.begin(), more.end());
+    return got;
+  };
+  // No Ack: the window's frames come, then nothing.
+  std::vector<subscriber::Frame> first = frames_then_quiet(subscriber::kPacedWindow);
   ASSERT_EQ(first.size(), static_cast<size_t>(subscriber::kPacedWindow));
   EXPECT_LT(first[0].info.frame_number, first[1].info.frame_number);
 
   // One Ack frees one slot: exactly one frame, the newest (the ones in between were dropped).
   asio::write(paced, asio::buffer(subscriber::encode_ack({first[0].info.frame_number})));
-  std::vector<subscriber::Frame> next = read_frames_until(paced, decoder, std::chrono::steady_clock::now() + milliseconds(300));
+  std::vector<subscriber::Frame> next = frames_then_quiet(1);
   ASSERT_EQ(next.size(), 1u);
   EXPECT_GT(next[0].info.subscriber_dropped, 0u);
   EXPECT_NE(next[0].info.frame_number, first[1].info.frame_number + 1);
