@@ -113,16 +113,20 @@ void validate(const DaemonConfig& c) {
   bool level_ok = false;
   for (const char* l : kLevels) level_ok = level_ok || c.log_level == l;
   if (!level_ok) fail("log_level must be one of trace, debug, info, warn, error, critical, off");
-  auto host_and_port = [](const std::string& text) {
-    const size_t colon = text.rfind(':');
-    const std::string port = colon == std::string::npos ? std::string() : text.substr(colon + 1);
-    const bool digits = !port.empty() && port.size() <= 5 && port.find_first_not_of("0123456789") == std::string::npos;
-    return colon != 0 && digits && std::stoi(port) >= 1 && std::stoi(port) <= 65535;
-  };
-  if (!c.vicon.empty() && !host_and_port(c.vicon))
+  if (!c.vicon.empty() && !parse_host_port(c.vicon))
     fail("vicon must be HOST:PORT with a port of 1-65535 (Vicon's default is 801), not \"" + c.vicon + "\"");
-  if (!c.vicon_multicast.empty() && !host_and_port(c.vicon_multicast))
+  if (!c.vicon_multicast.empty() && !parse_host_port(c.vicon_multicast))
     fail("vicon_multicast must be GROUP:PORT with a port of 1-65535 (Vicon's default is 44801), not \"" + c.vicon_multicast + "\"");
+}
+
+std::optional<HostPort> parse_host_port(const std::string& text) {
+  const size_t colon = text.rfind(':');
+  if (colon == std::string::npos || colon == 0) return std::nullopt;
+  const std::string port = text.substr(colon + 1);
+  if (port.empty() || port.size() > 5 || port.find_first_not_of("0123456789") != std::string::npos) return std::nullopt;
+  const int number = std::stoi(port);
+  if (number < 1 || number > 65535) return std::nullopt;
+  return HostPort{text.substr(0, colon), static_cast<uint16_t>(number)};
 }
 
 std::optional<CommandLine> parse_command_line(int argc, const char* const* argv, int& out_exit_code) {

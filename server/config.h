@@ -2,6 +2,7 @@
 // skinstreamd's configuration: a JSON file (config/skinstreamd.reference.json documents every
 // key), then command-line flags on top. Everything the daemon is told comes through here.
 
+#include <cstdint>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -48,6 +49,14 @@ DaemonConfig load_config_file(const std::string& path);  // throws ConfigError
 nlohmann::json to_json(const DaemonConfig& config);
 // Range and consistency checks; throws ConfigError.
 void validate(const DaemonConfig& config);
+
+// "HOST:PORT" (split at the last colon; a port of 1-65535 in digits): the form of the vicon and
+// vicon_multicast keys. nullopt for anything else.
+struct HostPort {
+  std::string host;
+  uint16_t port = 0;
+};
+std::optional<HostPort> parse_host_port(const std::string& text);
 
 struct CommandLine {
   DaemonConfig config;

@@ -46,20 +46,18 @@ subscriber::MeshInfo mesh_info_of(const SubjectFile& subject) {
   return info;
 }
 
-// "HOST:PORT" (validate() has checked the colon) -> the ViconSource's options.
+// A "HOST:PORT" key, for a config that may not have been through validate().
+HostPort host_port_of(const std::string& flag, const std::string& text) {
+  const std::optional<HostPort> parsed = parse_host_port(text);
+  if (!parsed) throw ConfigError(flag + " " + text + ": expected HOST:PORT with a port of 1-65535");
+  return *parsed;
+}
+
 ViconSourceOptions vicon_options_of(const DaemonConfig& config) {
-  const size_t colon = config.vicon.rfind(':');
+  const HostPort address = host_port_of("--vicon", config.vicon);
   ViconSourceOptions options;
-  options.host = config.vicon.substr(0, colon);
-  int port = 0;
-  try {
-    port = std::stoi(config.vicon.substr(colon + 1));
-  } catch (const std::exception&) {
-    port = 0;
-  }
-  if (options.host.empty() || port <= 0 || port > 65535)
-    throw ConfigError("--vicon " + config.vicon + ": expected HOST:PORT with a port of 1-65535");
-  options.port = static_cast<uint16_t>(port);
+  options.host = address.host;
+  options.port = address.port;
   options.mode = config.vicon_pull ? ViconSourceOptions::Mode::ClientPull : ViconSourceOptions::Mode::ServerPush;
   return options;
 }
@@ -98,10 +96,10 @@ Daemon::Daemon(const DaemonConfig& config)
   if (!config.replay.empty()) {
     source_ = std::make_unique<FileReplaySource>(io_, model, config.replay, static_cast<FrameSink&>(*this), ReplayOptions{config.loop, config.speed});
   } else if (!config.vicon_multicast.empty()) {
-    const size_t colon = config.vicon_multicast.rfind(':');  // validate() checked the form
+    const HostPort address = host_port_of("--vicon-multicast", config.vicon_multicast);
     ViconMulticastSourceOptions options;
-    options.group = config.vicon_multicast.substr(0, colon);
-    options.port = static_cast<uint16_t>(std::stoi(config.vicon_multicast.substr(colon + 1)));
+    options.group = address.host;
+    options.port = address.port;
     spdlog::info("source: Vicon DataStream multicast {}:{} (receive only)", options.group, options.port);
     source_ = std::make_unique<ViconMulticastSource>(io_, std::move(options), model.marker_names, static_cast<FrameSink&>(*this));
   } else if (!config.vicon.empty()) {
