@@ -1,6 +1,7 @@
 #include "core/deform/mesh_deformer.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <stdexcept>
@@ -24,54 +25,68 @@ struct SolvedPart {
   int centre_count = 0;
 };
 
-// The cubic B-spline of rbf_kernel.h without branches (selects, not std::max). Everything the
-// AVX2 clones of rbf_residuals and deform_vertices call is always_inline or a builtin: GCC does
-// not inline default-target functions such as std::max or std::sqrt there, and a call in the
-// loop stops it vectorising (the loop ran scalar until this was found in the disassembly).
-inline __attribute__((always_inline)) float bspline(float r) {
-  const float far = r < 2.0f ? 2.0f - r : 0.0f;
-  const float near = r < 1.0f ? 1.0f - r : 0.0f;
-  return (far * far * far - 4.0f * near * near * near) * (1.0f / 6.0f);
-}
-
 // A few influences of one part close together in the reference pose.
-struct RbfCluster {
+struct InfluenceCluster {
   int part = 0;
-  int first = 0;  // into cluster_influences
-  int count = 0;
-  int64_t rest_cost = 0;  // work at the rest pose: gather test plus the kernel terms kept
+  int count = 0;          // lanes in use; the others copy lane 0 with beta 0
+  int64_t rest_cost = 0;  // work at the rest pose: the field, the gather test, the kernel terms kept
 };
 constexpr int kClusterSize = 32;
 // Centres gathered per cluster live on the stack; parts with more members than this are
-// evaluated against all their centres instead (never the case for ~350 markers in 17 parts).
+// gathered in several passes (never the case for ~350 markers in 17 parts).
 constexpr int kMaxGatheredCentres = 1024;
 
-// The quadratic field of eq. 8: A_t q^0 for one influence.
-inline __attribute__((always_inline)) void apply_quadratic(const float (&a)[3][9], const float* q, float* out) {
-  for (int r = 0; r < 3; ++r) {
-    float sum = 0.0f;
-    for (int c = 0; c < 9; ++c) sum += a[r][c] * q[c];
-    out[r] = sum;
-  }
+// A cluster's constant data, structure of arrays over its lanes (one influence per lane).
+struct alignas(64) ClusterLanes {
+  float q[9][kClusterSize];        // q^0 of the point clamped to the part's box, part's local frame
+  float outside[3][kClusterSize];  // offset beyond the box (carried rigidly)
+  float beta[kClusterSize];        // the vertex's weight for the part (eq. 9)
+};
+// A cluster's result this frame: beta * eq. 8 per lane, world frame, x then y then z.
+struct alignas(64) ClusterResult {
+  float xyz[3][kClusterSize];
+};
+static_assert(sizeof(ClusterResult) == 3 * kClusterSize * sizeof(float), "results are indexed as one float array");
+
+// Lanes of influences evaluated together: 16 floats are one AVX-512 register, two AVX2 ones.
+// Everything the vector clones of deform_clusters call is always_inline or a builtin: GCC does
+// not inline default-target functions such as std::max or std::sqrt into them, and a call in a
+// loop stops it vectorising (the loop ran scalar until this was found in the disassembly).
+constexpr int kLanes = 16;
+typedef float Lanes __attribute__((vector_size(kLanes * sizeof(float))));
+
+inline __attribute__((always_inline)) Lanes load_lanes(const float* from) {
+  Lanes lanes;
+  __builtin_memcpy(&lanes, from, sizeof(Lanes));
+  return lanes;
 }
 
-// sum_i w_i phi(|x - c_i| / sigma) over n centres (structure of arrays).
-inline __attribute__((always_inline)) void sum_rbf(const float* __restrict cx, const float* __restrict cy,
-                                                   const float* __restrict cz, const float* __restrict wx,
-                                                   const float* __restrict wy, const float* __restrict wz, int n,
-                                                   const float* x, float inverse_sigma, float* out) {
-  float ox = 0.0f, oy = 0.0f, oz = 0.0f;
-  const float x0 = x[0], x1 = x[1], x2 = x[2];
+inline __attribute__((always_inline)) Lanes lane_sqrt(Lanes x) {
+  Lanes r;
+  for (int l = 0; l < kLanes; ++l) r[l] = __builtin_sqrtf(x[l]);  // one vsqrtps per register
+  return r;
+}
+
+// Adds 6 * sum_i w_i phi(|x - c_i|) for kLanes points x at once over n centres, all in units of
+// sigma (the caller folded 1/sigma into x and c and 1/6 into w). Vectorised over points, not
+// centres: the centres are broadcast and the sums stay in registers, with no horizontal adds.
+inline __attribute__((always_inline)) void sum_rbf_lanes(const float* __restrict cx, const float* __restrict cy,
+                                                         const float* __restrict cz, const float* __restrict wx,
+                                                         const float* __restrict wy, const float* __restrict wz,
+                                                         int n, Lanes x, Lanes y, Lanes z, Lanes& sx, Lanes& sy,
+                                                         Lanes& sz) {
+  const Lanes zero = {};
   for (int i = 0; i < n; ++i) {
-    const float dx = x0 - cx[i], dy = x1 - cy[i], dz = x2 - cz[i];
-    const float phi = bspline(__builtin_sqrtf(dx * dx + dy * dy + dz * dz) * inverse_sigma);
-    ox += phi * wx[i];
-    oy += phi * wy[i];
-    oz += phi * wz[i];
+    const Lanes dx = x - cx[i], dy = y - cy[i], dz = z - cz[i];
+    const Lanes r = lane_sqrt(dx * dx + dy * dy + dz * dz);
+    Lanes far = 2.0f - r, near = 1.0f - r;
+    far = far > zero ? far : zero;
+    near = near > zero ? near : zero;
+    const Lanes phi = far * far * far - 4.0f * (near * near * near);
+    sx += phi * wx[i];
+    sy += phi * wy[i];
+    sz += phi * wz[i];
   }
-  out[0] = ox;
-  out[1] = oy;
-  out[2] = oz;
 }
 
 // Interleaves the bits of three 10-bit integers: nearby points get nearby codes.
@@ -93,46 +108,40 @@ struct MeshDeformer::State {
   DeformationMode mode = DeformationMode::QuadraticRbf;
   int marker_count = 0;
   int vertex_count = 0;
-  std::vector<std::array<int, 3>> faces;
 
   std::vector<PartDeformer> parts;
   std::vector<int> member_offsets;  // CSR over parts into member_markers
   std::vector<int> member_markers;
   std::vector<Vec3> member_scratch;
 
-  // Per vertex influence (parallel to the model's vertex_influences): part, beta and the
-  // vertex's quadratic vector q^0 in that part's local reference frame (constant, so
-  // precomputed: eq. 8 then needs only A_t q^0 per frame).
-  std::vector<int> influence_offsets;
-  std::vector<int> influence_part;
-  std::vector<float> influence_weight;
-  std::vector<float> influence_quadratic;  // 9 per influence, of the point clamped to the part's box
-  std::vector<float> influence_outside;    // 3 per influence: offset beyond the box (carried rigidly)
-
   std::vector<SolvedPart> solved;
   std::vector<float> centre_x, centre_y, centre_z, weight_x, weight_y, weight_z;
 
-  // The RBF term of eq. 8 is evaluated per cluster of nearby influences of one part (sorted
-  // along a Morton curve of their reference positions): per frame the cluster's deformed
-  // bounding sphere selects the centres whose kernel can be non-zero for any of its members
-  // (the B-spline vanishes beyond 2 sigma), exactly, without bounds on how the field stretches.
-  std::vector<RbfCluster> clusters;
-  std::vector<int> cluster_influences;  // influence indices, cluster by cluster
-  std::vector<float> rbf_offset;        // 3 per influence: this frame's RBF term, local frame
+  // Eq. 8 is evaluated per cluster of up to kClusterSize influences (vertex, part) of one part
+  // that lie close together in the reference pose (sorted along a Morton curve): the quadratic
+  // field in vector lanes, and for the RBF term the cluster's deformed bounding box selects the
+  // centres whose kernel can be non-zero for any of its members (the B-spline vanishes beyond
+  // 2 sigma), exactly, without bounds on how the field stretches.
+  std::vector<InfluenceCluster> clusters;
+  std::vector<ClusterLanes> cluster_lanes;    // parallel to clusters
+  std::vector<ClusterResult> cluster_result;  // parallel to clusters
   std::vector<int64_t> cumulative_cluster_cost;
+  // Eq. 9: per vertex (CSR by the model's vertex_influence_offsets) where its influences'
+  // results are: cluster * 3 * kClusterSize + lane, as a float index into cluster_result.
+  std::vector<int> influence_offsets;
+  std::vector<int> influence_slots;
 
-  // Normals: area-weighted face normals gathered per vertex through a vertex -> face CSR, so
-  // vertex ranges can run on different threads without write conflicts.
-  std::vector<float> face_normal;  // 3 per face
-  std::vector<int> vertex_face_offsets;
-  std::vector<int> vertex_faces;
+  // Normals: per vertex the other two corners (b, c) of each face around it, in the face's
+  // order, so its area-weighted normal is the sum of (b - v) x (c - v) read from the positions
+  // alone: vertex ranges run on different threads without a face pass or write conflicts.
+  std::vector<int> ring_offsets;
+  std::vector<std::array<int, 2>> ring;
 
   std::vector<int64_t> cumulative_cost;  // per vertex, for balanced_vertex_split
 
   void store_solved(int p);
-  void build_rbf_clusters(const std::vector<Vec3>& influence_local);
-  void deform_vertex(int v, float* out) const;
-  void rbf_cluster(int c);
+  void build_clusters(const DeformationModel& model);
+  void deform_cluster(int c);
 };
 
 MeshDeformer::MeshDeformer(const DeformationModel& model, const SubjectModel& subject, DeformationMode mode)
@@ -143,7 +152,6 @@ MeshDeformer::MeshDeformer(const DeformationModel& model, const SubjectModel& su
   s.mode = mode;
   s.marker_count = subject.marker_count();
   s.vertex_count = model.vertex_count();
-  s.faces = model.faces;
 
   // Parts: the local part reference frames and the offline factors of eqs. 6-7, from the member
   // markers' reference positions (the reference pose is every part's rest state).
@@ -170,87 +178,82 @@ MeshDeformer::MeshDeformer(const DeformationModel& model, const SubjectModel& su
     array->assign(centres, 0.0f);
 
   s.influence_offsets = model.vertex_influence_offsets;
-  const size_t influences = model.vertex_influences.size();
-  std::vector<Vec3> influence_local(influences);
-  s.influence_part.resize(influences);
-  s.influence_weight.resize(influences);
-  s.influence_quadratic.resize(influences * 9);
-  s.influence_outside.resize(influences * 3);
-  for (int v = 0; v < s.vertex_count; ++v) {
-    for (int k = model.vertex_influence_offsets[v]; k < model.vertex_influence_offsets[v + 1]; ++k) {
-      const PartInfluence& inf = model.vertex_influences[k];
-      s.influence_part[k] = inf.part;
-      s.influence_weight[k] = static_cast<float>(inf.weight);
-      const PartModel& part = s.parts[inf.part].model();
-      const Vec3 local = part.local_from_world(model.reference_vertices[v]);
-      const Vec3 inside = part.clamp_to_bounds(local);
-      influence_local[k] = inside;
-      const QuadraticVector q = quadratic_basis(inside);
-      for (int c = 0; c < 9; ++c) s.influence_quadratic[k * 9 + c] = static_cast<float>(q[c]);
-      for (int c = 0; c < 3; ++c) s.influence_outside[k * 3 + c] = static_cast<float>(local[c] - inside[c]);
-    }
-  }
+  s.build_clusters(model);
 
-  s.face_normal.assign(s.faces.size() * 3, 0.0f);
-  s.vertex_face_offsets.assign(static_cast<size_t>(s.vertex_count) + 1, 0);
-  for (const auto& f : s.faces)
-    for (int c : f) ++s.vertex_face_offsets[c + 1];
-  for (int v = 0; v < s.vertex_count; ++v) s.vertex_face_offsets[v + 1] += s.vertex_face_offsets[v];
-  s.vertex_faces.resize(s.faces.size() * 3);
-  std::vector<int> fill(s.vertex_face_offsets.begin(), s.vertex_face_offsets.end() - 1);
-  for (size_t f = 0; f < s.faces.size(); ++f)
-    for (int c : s.faces[f]) s.vertex_faces[fill[c]++] = static_cast<int>(f);
+  s.ring_offsets.assign(static_cast<size_t>(s.vertex_count) + 1, 0);
+  for (const auto& f : model.faces)
+    for (int c : f) ++s.ring_offsets[c + 1];
+  for (int v = 0; v < s.vertex_count; ++v) s.ring_offsets[v + 1] += s.ring_offsets[v];
+  s.ring.resize(model.faces.size() * 3);
+  std::vector<int> fill(s.ring_offsets.begin(), s.ring_offsets.end() - 1);
+  for (const auto& f : model.faces)
+    for (int corner = 0; corner < 3; ++corner) s.ring[fill[f[corner]]++] = {f[(corner + 1) % 3], f[(corner + 2) % 3]};
 
   for (int p = 0; p < part_count; ++p) s.store_solved(p);  // rest pose until the first solve
 
-  // Work per vertex: the quadratic and rotation of each influence.
+  // Work per vertex: one gather per influence.
   s.cumulative_cost.assign(static_cast<size_t>(s.vertex_count) + 1, 0);
   for (int v = 0; v < s.vertex_count; ++v)
-    s.cumulative_cost[v + 1] = s.cumulative_cost[v] + (s.influence_offsets[v + 1] - s.influence_offsets[v]);
-
-  s.rbf_offset.assign(influences * 3, 0.0f);
-  if (mode == DeformationMode::RigidRbf || mode == DeformationMode::QuadraticRbf) s.build_rbf_clusters(influence_local);
+    s.cumulative_cost[v + 1] = s.cumulative_cost[v] + 1 + (s.influence_offsets[v + 1] - s.influence_offsets[v]);
   s.cumulative_cluster_cost.assign(s.clusters.size() + 1, 0);
   for (size_t c = 0; c < s.clusters.size(); ++c)
     s.cumulative_cluster_cost[c + 1] = s.cumulative_cluster_cost[c] + s.clusters[c].rest_cost;
+  for (int c = 0; c < static_cast<int>(s.clusters.size()); ++c) s.deform_cluster(c);  // rest pose
 }
 
-void MeshDeformer::State::build_rbf_clusters(const std::vector<Vec3>& influence_local) {
+void MeshDeformer::State::build_clusters(const DeformationModel& model) {
+  const bool with_rbf = mode == DeformationMode::RigidRbf || mode == DeformationMode::QuadraticRbf;
   std::vector<std::vector<int>> by_part(parts.size());
-  for (size_t k = 0; k < influence_part.size(); ++k) by_part[influence_part[k]].push_back(static_cast<int>(k));
+  for (size_t k = 0; k < model.vertex_influences.size(); ++k) by_part[model.vertex_influences[k].part].push_back(static_cast<int>(k));
+  std::vector<int> vertex_of(model.vertex_influences.size());
+  for (int v = 0; v < vertex_count; ++v)
+    for (int k = model.vertex_influence_offsets[v]; k < model.vertex_influence_offsets[v + 1]; ++k) vertex_of[k] = v;
+  influence_slots.assign(model.vertex_influences.size(), 0);
   for (size_t p = 0; p < parts.size(); ++p) {
-    std::vector<int>& members = by_part[p];
-    if (members.empty()) continue;
-    const PartModel& model = parts[p].model();
-    const Vec3 extent = (model.local_max - model.local_min).cwiseMax(Vec3::Constant(1e-6));
-    std::vector<std::pair<uint32_t, int>> keyed;
-    keyed.reserve(members.size());
-    for (int k : members) {
-      const Vec3 unit = (influence_local[k] - model.local_min).cwiseQuotient(extent);
+    const PartModel& part = parts[p].model();
+    std::vector<Vec3> local(by_part[p].size()), inside(by_part[p].size());
+    std::vector<std::pair<uint32_t, int>> keyed;  // Morton code of the clamped point, index into by_part
+    const Vec3 extent = (part.local_max - part.local_min).cwiseMax(Vec3::Constant(1e-6));
+    for (size_t i = 0; i < by_part[p].size(); ++i) {
+      local[i] = part.local_from_world(model.reference_vertices[vertex_of[by_part[p][i]]]);
+      inside[i] = part.clamp_to_bounds(local[i]);
+      const Vec3 unit = (inside[i] - part.local_min).cwiseQuotient(extent);
       auto cell = [&](int a) { return static_cast<uint32_t>(std::clamp(unit[a], 0.0, 1.0) * 1023.0); };
-      keyed.emplace_back(morton3(cell(0), cell(1), cell(2)), k);
+      keyed.emplace_back(morton3(cell(0), cell(1), cell(2)), static_cast<int>(i));
     }
     std::sort(keyed.begin(), keyed.end());
-    for (size_t i = 0; i < keyed.size(); i += kClusterSize) {
-      RbfCluster cluster;
+    for (size_t first = 0; first < keyed.size(); first += kClusterSize) {
+      InfluenceCluster cluster;
       cluster.part = static_cast<int>(p);
-      cluster.first = static_cast<int>(cluster_influences.size());
-      cluster.count = static_cast<int>(std::min<size_t>(kClusterSize, keyed.size() - i));
+      cluster.count = static_cast<int>(std::min<size_t>(kClusterSize, keyed.size() - first));
+      ClusterLanes lanes{};
       Vec3 low = Vec3::Constant(1e30), high = Vec3::Constant(-1e30);
-      for (int j = 0; j < cluster.count; ++j) {
-        cluster_influences.push_back(keyed[i + j].second);
-        low = low.cwiseMin(influence_local[keyed[i + j].second]);
-        high = high.cwiseMax(influence_local[keyed[i + j].second]);
+      for (int lane = 0; lane < kClusterSize; ++lane) {
+        const int i = keyed[first + (lane < cluster.count ? lane : 0)].second;
+        const int k = by_part[p][i];
+        const QuadraticVector q = quadratic_basis(inside[i]);
+        for (int c = 0; c < 9; ++c) lanes.q[c][lane] = static_cast<float>(q[c]);
+        for (int c = 0; c < 3; ++c) lanes.outside[c][lane] = static_cast<float>(local[i][c] - inside[i][c]);
+        if (lane >= cluster.count) continue;
+        lanes.beta[lane] = static_cast<float>(model.vertex_influences[k].weight);
+        influence_slots[k] = static_cast<int>(clusters.size()) * 3 * kClusterSize + lane;
+        low = low.cwiseMin(inside[i]);
+        high = high.cwiseMax(inside[i]);
       }
-      // What rbf_cluster does at the rest pose (A = I): the split by this cost is balanced
-      // where the culling removes more terms in big parts than in small ones.
-      const double reach = 2.0 * model.rbf_dilation + 0.5 * (high - low).norm();
-      int kept = 0;
-      for (const Vec3& centre : model.local_reference_points) kept += (centre - 0.5 * (low + high)).norm() < reach;
-      cluster.rest_cost = model.member_count() + static_cast<int64_t>(cluster.count) * (16 + (kept + 7) / 8 * 8);
+      // What deform_cluster does at the rest pose (A = I), so that a split by this cost is
+      // balanced where the culling removes more terms in big parts than in small ones.
+      cluster.rest_cost = 64 * kClusterSize;
+      if (with_rbf) {
+        const double reach = 2.0 * part.rbf_dilation + 0.5 * (high - low).norm();
+        int kept = 0;
+        for (const Vec3& centre : part.local_reference_points) kept += (centre - 0.5 * (low + high)).norm() < reach;
+        cluster.rest_cost += part.member_count() + static_cast<int64_t>(kept) * kClusterSize;
+      }
       clusters.push_back(cluster);
+      cluster_lanes.push_back(lanes);
     }
   }
+  cluster_result.assign(clusters.size(), ClusterResult{});
 }
 
 MeshDeformer::~MeshDeformer() = default;
@@ -295,103 +298,89 @@ bool MeshDeformer::solve_parts(std::span<const Vec3> markers) {
   return true;
 }
 
-// Eq. 8 in every influencing part (the RBF term from rbf_cluster), blended by eq. 9.
-inline __attribute__((always_inline)) void MeshDeformer::State::deform_vertex(int v, float* out) const {
-  float result[3] = {0.0f, 0.0f, 0.0f};
-  for (int k = influence_offsets[v]; k < influence_offsets[v + 1]; ++k) {
-    const SolvedPart& part = solved[influence_part[k]];
-    float local[3];
-    apply_quadratic(part.quadratic, &influence_quadratic[static_cast<size_t>(k) * 9], local);
-    if (part.rbf) {
-      const float* rbf = &rbf_offset[static_cast<size_t>(k) * 3];
-      local[0] += rbf[0];
-      local[1] += rbf[1];
-      local[2] += rbf[2];
-    }
-    const float* outside = &influence_outside[static_cast<size_t>(k) * 3];
-    const float lx = local[0] + outside[0] - part.translation[0], ly = local[1] + outside[1] - part.translation[1],
-                lz = local[2] + outside[2] - part.translation[2];
-    const float beta = influence_weight[k];
-    for (int r = 0; r < 3; ++r) {
-      const float* row = part.inverse_rotation[r];
-      result[r] += beta * (row[0] * lx + row[1] * ly + row[2] * lz);
-    }
-  }
-  out[0] = result[0];
-  out[1] = result[1];
-  out[2] = result[2];
-}
-
-// The RBF term of eq. 8 for one cluster's influences. Centres farther than 2 sigma from every
-// deformed influence of the cluster add exactly zero, so only the others are gathered (padded
-// with zero weights to whole vectors) and summed.
-inline __attribute__((always_inline)) void MeshDeformer::State::rbf_cluster(int c) {
-  const RbfCluster& cluster = clusters[c];
+// Eq. 8 for one cluster's influences, times their beta: the quadratic field A_t q^0, the RBF
+// term, then back to the world frame. Centres farther than 2 sigma from every deformed
+// influence of the cluster add exactly zero to the RBF term, so only the others are gathered.
+inline __attribute__((always_inline)) void MeshDeformer::State::deform_cluster(int c) {
+  static_assert(kClusterSize % kLanes == 0);
+  constexpr int kBlocks = kClusterSize / kLanes;
+  const InfluenceCluster& cluster = clusters[c];
   const SolvedPart& part = solved[cluster.part];
-  if (!part.rbf) return;  // deform_vertex does not read the offsets then
-  float deformed[kClusterSize][3];
-  float low[3] = {1e30f, 1e30f, 1e30f}, high[3] = {-1e30f, -1e30f, -1e30f};
-  for (int j = 0; j < cluster.count; ++j) {
-    const int k = cluster_influences[cluster.first + j];
-    apply_quadratic(part.quadratic, &influence_quadratic[static_cast<size_t>(k) * 9], deformed[j]);
-    for (int a = 0; a < 3; ++a) {
-      low[a] = deformed[j][a] < low[a] ? deformed[j][a] : low[a];
-      high[a] = deformed[j][a] > high[a] ? deformed[j][a] : high[a];
+  const ClusterLanes& in = cluster_lanes[c];
+  Lanes local[kBlocks][3];
+  for (int b = 0; b < kBlocks; ++b)
+    for (int r = 0; r < 3; ++r) {
+      Lanes sum = part.quadratic[r][0] * load_lanes(in.q[0] + b * kLanes);
+      for (int k = 1; k < 9; ++k) sum += part.quadratic[r][k] * load_lanes(in.q[k] + b * kLanes);
+      local[b][r] = sum;
     }
-  }
-  const float* cx = &centre_x[part.first_centre];
-  const float* cy = &centre_y[part.first_centre];
-  const float* cz = &centre_z[part.first_centre];
-  const float* wx = &weight_x[part.first_centre];
-  const float* wy = &weight_y[part.first_centre];
-  const float* wz = &weight_z[part.first_centre];
-  int n = part.centre_count;
-  alignas(32) float gx[kMaxGatheredCentres], gy[kMaxGatheredCentres], gz[kMaxGatheredCentres];
-  alignas(32) float gwx[kMaxGatheredCentres], gwy[kMaxGatheredCentres], gwz[kMaxGatheredCentres];
-  if (n <= kMaxGatheredCentres - 8) {
+  if (part.rbf) {
+    // The deformed influences in units of sigma, and their bounding box (the unused lanes
+    // repeat lane 0, so every lane may take part).
+    const float inverse_sigma = part.inverse_sigma;
+    Lanes scaled[kBlocks][3];
+    float low[3], high[3];
+    for (int a = 0; a < 3; ++a) {
+      for (int b = 0; b < kBlocks; ++b) scaled[b][a] = local[b][a] * inverse_sigma;
+      low[a] = high[a] = scaled[0][a][0];
+      for (int b = 0; b < kBlocks; ++b)
+        for (int l = 0; l < kLanes; ++l) {
+          low[a] = scaled[b][a][l] < low[a] ? scaled[b][a][l] : low[a];
+          high[a] = scaled[b][a][l] > high[a] ? scaled[b][a][l] : high[a];
+        }
+    }
     const float mid[3] = {0.5f * (low[0] + high[0]), 0.5f * (low[1] + high[1]), 0.5f * (low[2] + high[2])};
     const float hx = 0.5f * (high[0] - low[0]), hy = 0.5f * (high[1] - low[1]), hz = 0.5f * (high[2] - low[2]);
-    // Support 2 sigma plus the box's half diagonal, and a hair for rounding.
-    const float reach = (2.0f / part.inverse_sigma + __builtin_sqrtf(hx * hx + hy * hy + hz * hz)) * 1.0001f + 1e-3f;
-    int m = 0;
-    for (int i = 0; i < n; ++i) {
-      const float dx = cx[i] - mid[0], dy = cy[i] - mid[1], dz = cz[i] - mid[2];
-      if (dx * dx + dy * dy + dz * dz >= reach * reach) continue;
-      gx[m] = cx[i];
-      gy[m] = cy[i];
-      gz[m] = cz[i];
-      gwx[m] = wx[i];
-      gwy[m] = wy[i];
-      gwz[m] = wz[i];
-      ++m;
+    // Support 2 (sigma units) plus the box's half diagonal, and a hair for rounding.
+    const float reach = (2.0f + __builtin_sqrtf(hx * hx + hy * hy + hz * hz)) * 1.0001f + 1e-3f;
+    alignas(64) float gx[kMaxGatheredCentres], gy[kMaxGatheredCentres], gz[kMaxGatheredCentres];
+    alignas(64) float gwx[kMaxGatheredCentres], gwy[kMaxGatheredCentres], gwz[kMaxGatheredCentres];
+    const int end = part.first_centre + part.centre_count;
+    for (int i = part.first_centre; i < end;) {  // one pass unless a part has more centres than the stack holds
+      int m = 0;
+      for (; i < end && m < kMaxGatheredCentres; ++i) {
+        const float x = centre_x[i] * inverse_sigma, y = centre_y[i] * inverse_sigma, z = centre_z[i] * inverse_sigma;
+        const float dx = x - mid[0], dy = y - mid[1], dz = z - mid[2];
+        if (dx * dx + dy * dy + dz * dz >= reach * reach) continue;
+        gx[m] = x, gy[m] = y, gz[m] = z;
+        gwx[m] = weight_x[i] * (1.0f / 6.0f), gwy[m] = weight_y[i] * (1.0f / 6.0f), gwz[m] = weight_z[i] * (1.0f / 6.0f);
+        ++m;
+      }
+      for (int b = 0; b < kBlocks; ++b)
+        sum_rbf_lanes(gx, gy, gz, gwx, gwy, gwz, m, scaled[b][0], scaled[b][1], scaled[b][2], local[b][0], local[b][1],
+                      local[b][2]);
     }
-    for (; m % 8 != 0; ++m) {  // whole vectors: zero weights add nothing
-      gx[m] = mid[0];
-      gy[m] = mid[1];
-      gz[m] = mid[2];
-      gwx[m] = gwy[m] = gwz[m] = 0.0f;
-    }
-    cx = gx, cy = gy, cz = gz, wx = gwx, wy = gwy, wz = gwz, n = m;
   }
-  for (int j = 0; j < cluster.count; ++j) {
-    const int k = cluster_influences[cluster.first + j];
-    sum_rbf(cx, cy, cz, wx, wy, wz, n, deformed[j], part.inverse_sigma, &rbf_offset[static_cast<size_t>(k) * 3]);
+  ClusterResult& out = cluster_result[c];
+  for (int b = 0; b < kBlocks; ++b) {
+    Lanes shifted[3];
+    for (int a = 0; a < 3; ++a) shifted[a] = local[b][a] + load_lanes(in.outside[a] + b * kLanes) - part.translation[a];
+    const Lanes beta = load_lanes(in.beta + b * kLanes);
+    for (int r = 0; r < 3; ++r) {
+      const float* row = part.inverse_rotation[r];
+      const Lanes world = row[0] * shifted[0] + row[1] * shifted[1] + row[2] * shifted[2];
+      const Lanes weighted = beta * world;
+      __builtin_memcpy(out.xyz[r] + b * kLanes, &weighted, sizeof(Lanes));
+    }
   }
 }
 
-__attribute__((target_clones("arch=x86-64-v3", "default")))
-void MeshDeformer::rbf_residuals(int begin, int end) {
+// Compiled three times (AVX-512, AVX2 + FMA, baseline); the loader picks what the CPU runs.
+// The clones are named by ISA level: "arch=haswell" dispatches on the CPU model, so AMD
+// processors with AVX2 ran the baseline (measured 1.9x slower on this EPYC).
+__attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
+void MeshDeformer::deform_clusters(int begin, int end) {
   State& s = *state_;
-  end = std::min(end, rbf_cluster_count());
-  for (int c = std::max(begin, 0); c < end; ++c) s.rbf_cluster(c);
+  end = std::min(end, cluster_count());
+  for (int c = std::max(begin, 0); c < end; ++c) s.deform_cluster(c);
 }
 
-int MeshDeformer::rbf_cluster_count() const { return static_cast<int>(state_->clusters.size()); }
+int MeshDeformer::cluster_count() const { return static_cast<int>(state_->clusters.size()); }
 
 int MeshDeformer::balanced_cluster_split(int index, int parts) const {
   const State& s = *state_;
   if (parts <= 0 || index <= 0) return 0;
-  if (index >= parts) return rbf_cluster_count();
+  if (index >= parts) return cluster_count();
   const int64_t target = s.cumulative_cluster_cost.back() * index / parts;
   return static_cast<int>(std::lower_bound(s.cumulative_cluster_cost.begin(), s.cumulative_cluster_cost.end(), target) -
                           s.cumulative_cluster_cost.begin());
@@ -406,46 +395,40 @@ int MeshDeformer::balanced_vertex_split(int index, int parts) const {
                           s.cumulative_cost.begin());
 }
 
-// Compiled twice (AVX2 + FMA and the baseline); the loader picks the one the CPU runs. The
-// clone is named by ISA level: "arch=haswell" dispatches on the CPU model, so AMD processors
-// with AVX2 ran the baseline (measured 1.9x slower on this EPYC).
-__attribute__((target_clones("arch=x86-64-v3", "default")))
-void MeshDeformer::deform_vertices(int begin, int end, std::span<float> positions) const {
+void MeshDeformer::blend_vertices(int begin, int end, std::span<float> positions) const {
   const State& s = *state_;
   end = std::min(end, s.vertex_count);
   if (positions.size() < static_cast<size_t>(s.vertex_count) * 3) return;
-  for (int v = std::max(begin, 0); v < end; ++v) s.deform_vertex(v, &positions[static_cast<size_t>(v) * 3]);
-}
-
-void MeshDeformer::face_normals(int begin, int end, std::span<const float> positions) {
-  State& s = *state_;
-  end = std::min(end, face_count());
-  if (positions.size() < static_cast<size_t>(s.vertex_count) * 3) return;
-  for (int f = std::max(begin, 0); f < end; ++f) {
-    const auto& face = s.faces[f];
-    const float* a = &positions[static_cast<size_t>(face[0]) * 3];
-    const float* b = &positions[static_cast<size_t>(face[1]) * 3];
-    const float* c = &positions[static_cast<size_t>(face[2]) * 3];
-    const float e1[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
-    const float e2[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
-    float* n = &s.face_normal[static_cast<size_t>(f) * 3];
-    n[0] = e1[1] * e2[2] - e1[2] * e2[1];  // twice the area, so the sum is area-weighted
-    n[1] = e1[2] * e2[0] - e1[0] * e2[2];
-    n[2] = e1[0] * e2[1] - e1[1] * e2[0];
+  const float* results = s.cluster_result.empty() ? nullptr : s.cluster_result.front().xyz[0];
+  for (int v = std::max(begin, 0); v < end; ++v) {
+    float sum[3] = {0.0f, 0.0f, 0.0f};
+    for (int k = s.influence_offsets[v]; k < s.influence_offsets[v + 1]; ++k) {
+      const float* result = results + s.influence_slots[k];
+      sum[0] += result[0];
+      sum[1] += result[kClusterSize];
+      sum[2] += result[2 * kClusterSize];
+    }
+    float* out = &positions[static_cast<size_t>(v) * 3];
+    out[0] = sum[0], out[1] = sum[1], out[2] = sum[2];
   }
 }
 
-void MeshDeformer::vertex_normals(int begin, int end, std::span<float> normals) const {
+void MeshDeformer::vertex_normals(int begin, int end, std::span<const float> positions, std::span<float> normals) const {
   const State& s = *state_;
   end = std::min(end, s.vertex_count);
-  if (normals.size() < static_cast<size_t>(s.vertex_count) * 3) return;
+  const size_t needed = static_cast<size_t>(s.vertex_count) * 3;
+  if (positions.size() < needed || normals.size() < needed) return;
   for (int v = std::max(begin, 0); v < end; ++v) {
+    const float* p = &positions[static_cast<size_t>(v) * 3];
     float n[3] = {0.0f, 0.0f, 0.0f};
-    for (int k = s.vertex_face_offsets[v]; k < s.vertex_face_offsets[v + 1]; ++k) {
-      const float* fn = &s.face_normal[static_cast<size_t>(s.vertex_faces[k]) * 3];
-      n[0] += fn[0];
-      n[1] += fn[1];
-      n[2] += fn[2];
+    for (int k = s.ring_offsets[v]; k < s.ring_offsets[v + 1]; ++k) {
+      const float* b = &positions[static_cast<size_t>(s.ring[k][0]) * 3];
+      const float* c = &positions[static_cast<size_t>(s.ring[k][1]) * 3];
+      const float e1[3] = {b[0] - p[0], b[1] - p[1], b[2] - p[2]};
+      const float e2[3] = {c[0] - p[0], c[1] - p[1], c[2] - p[2]};
+      n[0] += e1[1] * e2[2] - e1[2] * e2[1];  // twice the face's area, so the sum is area-weighted
+      n[1] += e1[2] * e2[0] - e1[0] * e2[2];
+      n[2] += e1[0] * e2[1] - e1[1] * e2[0];
     }
     const float length = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
     const float scale = length > 0.0f ? 1.0f / length : 0.0f;
@@ -458,27 +441,23 @@ void MeshDeformer::vertex_normals(int begin, int end, std::span<float> normals) 
 
 bool MeshDeformer::deform(std::span<const Vec3> markers, std::span<float> positions, std::span<float> normals) {
   if (!solve_parts(markers)) return false;
-  rbf_residuals(0, rbf_cluster_count());
-  deform_vertices(0, vertex_count(), positions);
-  if (!normals.empty()) {
-    face_normals(0, face_count(), positions);
-    vertex_normals(0, vertex_count(), normals);
-  }
+  deform_clusters(0, cluster_count());
+  blend_vertices(0, vertex_count(), positions);
+  if (!normals.empty()) vertex_normals(0, vertex_count(), positions, normals);
   return true;
 }
 
 int MeshDeformer::vertex_count() const { return state_->vertex_count; }
-int MeshDeformer::face_count() const { return static_cast<int>(state_->faces.size()); }
 DeformationMode MeshDeformer::mode() const { return state_->mode; }
 
 size_t MeshDeformer::memory_bytes() const {
   const State& s = *state_;
   auto bytes = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
-  size_t total = sizeof(State) + bytes(s.faces) + bytes(s.member_offsets) + bytes(s.member_markers) +
-                 bytes(s.member_scratch) + bytes(s.influence_offsets) + bytes(s.influence_part) +
-                 bytes(s.influence_weight) + bytes(s.influence_quadratic) + bytes(s.influence_outside) + bytes(s.solved) + bytes(s.centre_x) * 6 +
-                 bytes(s.face_normal) + bytes(s.vertex_face_offsets) + bytes(s.vertex_faces) + bytes(s.clusters) +
-                 bytes(s.cluster_influences) + bytes(s.rbf_offset) + bytes(s.cumulative_cluster_cost) + bytes(s.cumulative_cost);
+  size_t total = sizeof(State) + bytes(s.member_offsets) + bytes(s.member_markers) +
+                 bytes(s.member_scratch) + bytes(s.influence_offsets) + bytes(s.influence_slots) +
+                 bytes(s.solved) + bytes(s.centre_x) * 6 +
+                 bytes(s.ring_offsets) + bytes(s.ring) + bytes(s.clusters) +
+                 bytes(s.cluster_lanes) + bytes(s.cluster_result) + bytes(s.cumulative_cluster_cost) + bytes(s.cumulative_cost);
   for (const PartDeformer& part : s.parts) {
     const int y = part.model().member_count();
     // Members' reference data (points, Q0, pseudo-inverse) and the per-frame kernel and LU.

@@ -4,9 +4,9 @@
 // eq. 8 in every part that influences it and blends them by eq. 9, and computes vertex normals.
 //
 // Split in stages so a caller with threads can share the work out by ranges (core/ has no
-// threads itself): solve_parts() once, then rbf_residuals() over disjoint cluster ranges, then
-// deform_vertices() over vertex ranges, then face_normals() over face ranges, then
-// vertex_normals() over vertex ranges; each stage reads what the one before wrote.
+// threads itself): solve_parts() once, then deform_clusters() over disjoint cluster ranges, then
+// blend_vertices() over vertex ranges, then vertex_normals() over vertex ranges; each stage
+// reads what the one before wrote.
 // Buffers are sized at construction; no stage allocates.
 
 #include <memory>
@@ -34,29 +34,29 @@ class MeshDeformer {
   // previous fit, when the count is wrong or a marker is not finite.
   bool solve_parts(std::span<const Vec3> markers);
 
-  // The RBF term of eq. 8 for the influences of clusters [begin, end) (a no-op in the modes
-  // without RBF). Influences are grouped in clusters of nearby vertices of one part so that
-  // only the centres within the kernel's support are summed.
-  void rbf_residuals(int begin, int end);
-  int rbf_cluster_count() const;
-  // Vertices [begin, end) into `positions` (3 floats per vertex, the whole mesh's buffer).
-  void deform_vertices(int begin, int end, std::span<float> positions) const;
-  // Face normals of faces [begin, end) from the deformed positions (into an internal buffer).
-  void face_normals(int begin, int end, std::span<const float> positions);
-  // Unit vertex normals [begin, end) (3 floats per vertex) from the face normals.
-  void vertex_normals(int begin, int end, std::span<float> normals) const;
+  // Eq. 8 for the influences (vertex, part) of clusters [begin, end), each weighted by its
+  // beta. Influences are grouped in clusters of nearby vertices of one part, evaluated in
+  // vector lanes, so that only the RBF centres within the kernel's support are summed.
+  void deform_clusters(int begin, int end);
+  int cluster_count() const;
+  // Eq. 9 for vertices [begin, end) into `positions` (3 floats per vertex, the whole mesh's
+  // buffer): the sum of the vertex's weighted results from deform_clusters().
+  void blend_vertices(int begin, int end, std::span<float> positions) const;
+  // Unit area-weighted vertex normals [begin, end) (3 floats per vertex) from the whole
+  // mesh's deformed positions.
+  void vertex_normals(int begin, int end, std::span<const float> positions, std::span<float> normals) const;
 
   // All stages on the calling thread. `normals` may be empty (not wanted).
   bool deform(std::span<const Vec3> markers, std::span<float> positions, std::span<float> normals);
 
-  // Where to cut the vertices into `parts` ranges of equal work (vertices in big parts with the
-  // RBF residual cost more than others): the start of range `index` (index == parts: the end).
+  // Where to cut the vertices into `parts` ranges of equal work (vertices with more
+  // influences cost more): the start of range `index` (index == parts: the end).
   int balanced_vertex_split(int index, int parts) const;
-  // The same for the clusters of rbf_residuals().
+  // The same for the clusters of deform_clusters() (clusters in big parts with the RBF
+  // residual cost more than others).
   int balanced_cluster_split(int index, int parts) const;
 
   int vertex_count() const;
-  int face_count() const;
   DeformationMode mode() const;
   // Heap bytes held by the runtime state (precomputed per-vertex data, parts, normals scratch).
   size_t memory_bytes() const;

@@ -41,23 +41,20 @@ void DeformWorkers::work(int index) {
 }
 
 // Every participant runs every stage on its own range; the barriers keep the stages in order
-// because face normals read vertices of other ranges and vertex normals read other faces.
+// because vertices read other ranges' clusters and normals read other ranges' vertices.
 void DeformWorkers::stage_range(int index) {
   const Range clusters = {deformer_.balanced_cluster_split(index, threads_), deformer_.balanced_cluster_split(index + 1, threads_)};
   const Range vertices = {deformer_.balanced_vertex_split(index, threads_), deformer_.balanced_vertex_split(index + 1, threads_)};
   const Range vertex_normals = share(deformer_.vertex_count(), index, threads_);
-  const Range faces = share(deformer_.face_count(), index, threads_);
   const bool single = workers_.empty();
   const auto start = std::chrono::steady_clock::now();
-  deformer_.rbf_residuals(clusters.begin, clusters.end);
-  if (!single) barrier_.arrive_and_wait();  // vertices read the offsets of other ranges' clusters
-  deformer_.deform_vertices(vertices.begin, vertices.end, positions_);
+  deformer_.deform_clusters(clusters.begin, clusters.end);
+  if (!single) barrier_.arrive_and_wait();  // vertices read other ranges' clusters
+  deformer_.blend_vertices(vertices.begin, vertices.end, positions_);
   if (!normals_.empty()) {
     if (!single) barrier_.arrive_and_wait();
     if (index == 0) deform_ns_ = std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - start).count();
-    deformer_.face_normals(faces.begin, faces.end, positions_);
-    if (!single) barrier_.arrive_and_wait();
-    deformer_.vertex_normals(vertex_normals.begin, vertex_normals.end, normals_);
+    deformer_.vertex_normals(vertex_normals.begin, vertex_normals.end, positions_, normals_);
   }
   if (!single) barrier_.arrive_and_wait();  // frame done
   if (index == 0) {

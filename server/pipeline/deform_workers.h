@@ -1,8 +1,8 @@
 #pragma once
 // Shares the mesh deformation of one frame out over threads: the calling (pipeline) thread and
-// `threads - 1` persistent workers, each taking its own cluster, vertex and face ranges, with a
-// barrier between the stages of MeshDeformer (RBF clusters -> vertices -> face normals -> vertex
-// normals). No thread is created per frame.
+// `threads - 1` persistent workers, each taking its own cluster and vertex ranges, with a
+// barrier between the stages of MeshDeformer (clusters -> vertices -> vertex normals). No
+// thread is created per frame.
 
 #include <atomic>
 #include <barrier>

@@ -2,12 +2,16 @@
 // Shared fixtures for the deform tests: random rigid motions, point sets and non-rigid fields.
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "core/absolute_orientation.h"
 #include "core/capture.h"
+#include "core/deform/deformation_model.h"
+#include "core/subject_model.h"
 
 namespace skinstream::deform_test {
 
@@ -43,5 +47,45 @@ inline std::vector<Vec3> move_rigidly(const std::vector<Vec3>& points, const Rig
   for (size_t i = 0; i < points.size(); ++i) out[i] = motion.apply(points[i]);
   return out;
 }
+
+// A wavy 300 x 300 mm sheet: a 31 x 31 vertex grid in triangles that share their vertices
+// (valence up to 6, and a boundary), 100 markers on every third grid point, two parts that
+// overlap in the middle third, where the vertices are blended between them.
+struct WavySheet {
+  SubjectModel subject;
+  DeformationModel model;
+
+  WavySheet() {
+    constexpr int kSide = 31;
+    auto at = [](int i, int j) { return Vec3(10.0 * i, 10.0 * j, 15.0 * std::sin(i / 5.0) * std::cos(j / 7.0)); };
+    model.part_names = {"left", "right"};
+    for (int i = 0; i < kSide; i += 3)
+      for (int j = 0; j < kSide; j += 3) {
+        subject.marker_names.push_back("m" + std::to_string(subject.marker_names.size()));
+        subject.reference_positions.push_back(at(i, j));
+      }
+    for (int part = 0; part < 2; ++part) {
+      for (int m = 0; m < static_cast<int>(subject.reference_positions.size()); ++m) {
+        const double x = subject.reference_positions[m].x();
+        if (part == 0 ? x <= 200.0 : x >= 100.0) model.part_members.push_back({m, 1.0});
+      }
+      model.part_member_offsets.push_back(static_cast<int>(model.part_members.size()));
+    }
+    for (int i = 0; i < kSide; ++i)
+      for (int j = 0; j < kSide; ++j) {
+        model.reference_vertices.push_back(at(i, j));
+        const double x = 10.0 * i, right = std::clamp((x - 100.0) / 100.0, 0.0, 1.0);
+        if (right < 1.0) model.vertex_influences.push_back({0, 1.0 - right});
+        if (right > 0.0) model.vertex_influences.push_back({1, right});
+        model.vertex_influence_offsets.push_back(static_cast<int>(model.vertex_influences.size()));
+      }
+    for (int i = 0; i + 1 < kSide; ++i)
+      for (int j = 0; j + 1 < kSide; ++j) {
+        const int a = i * kSide + j, b = a + kSide, c = b + 1, d = a + 1;
+        model.faces.push_back({a, b, c});
+        model.faces.push_back({a, c, d});
+      }
+  }
+};
 
 }  // namespace skinstream::deform_test

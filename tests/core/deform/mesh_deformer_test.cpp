@@ -81,7 +81,8 @@ TEST(MeshDeformer, RejectsWrongMarkerCountAndMissingMarkersKeepingThePreviousFra
   markers[5] = missing_point();
   EXPECT_FALSE(deformer.solve_parts(markers));
   // Still the rest pose.
-  deformer.deform_vertices(0, 200, positions);
+  deformer.deform_clusters(0, deformer.cluster_count());
+  deformer.blend_vertices(0, 200, positions);
   for (int v = 0; v < 200; ++v) EXPECT_LT((vertex(positions, v) - scene.model.reference_vertices[v]).norm(), 1e-3);
 }
 
@@ -163,7 +164,7 @@ TEST(MeshDeformer, SupportCullingKeepsEveryNonZeroKernelTerm) {
   for (const Vec3& p : subject.reference_positions)
     now.push_back(motion.apply(p + Vec3(0.0, 2e-5 * p.x() * p.x() + 3.0 * std::sin(p.x() / 60.0), 4.0 * std::cos(p.x() / 45.0))));
   MeshDeformer deformer(model, subject);
-  ASSERT_GT(deformer.rbf_cluster_count(), 10);
+  ASSERT_GT(deformer.cluster_count(), 10);
   const std::vector<float> positions = deform_all(deformer, now);
   PartDeformer reference(part_model);
   ASSERT_TRUE(reference.solve(now));
@@ -237,6 +238,26 @@ TEST(MeshDeformer, NormalsAreUnitAndFollowTheWinding) {
   }
 }
 
+// Against a double-precision sum of (b - a) x (c - a) over the faces around each vertex,
+// computed from the deformed positions the deformer wrote, on a sheet whose vertices are shared
+// by up to six faces and whose border vertices have open fans.
+TEST(MeshDeformer, NormalsAreTheAreaWeightedSumOfTheFacesAroundEachVertex) {
+  deform_test::WavySheet sheet;
+  std::mt19937_64 rng(17);
+  const std::vector<Vec3> now = deform_non_rigidly(sheet.subject.reference_positions, random_motion(rng));
+  MeshDeformer deformer(sheet.model, sheet.subject);
+  std::vector<float> normals(sheet.model.reference_vertices.size() * 3);
+  const std::vector<float> positions = deform_all(deformer, now, &normals);
+  std::vector<Vec3> expected(sheet.model.reference_vertices.size(), Vec3::Zero());
+  for (const auto& f : sheet.model.faces) {
+    const Vec3 a = vertex(positions, f[0]), b = vertex(positions, f[1]), c = vertex(positions, f[2]);
+    for (int corner : f) expected[corner] += (b - a).cross(c - a);
+  }
+  double worst = 0.0;
+  for (size_t v = 0; v < expected.size(); ++v) worst = std::max(worst, (vertex(normals, static_cast<int>(v)) - expected[v].normalized()).norm());
+  EXPECT_LT(worst, 1e-5);
+}
+
 TEST(MeshDeformer, VertexAndNormalRangesComposeToTheWholeFrame) {
   TwoPartScene scene;
   std::mt19937_64 rng(9);
@@ -245,16 +266,14 @@ TEST(MeshDeformer, VertexAndNormalRangesComposeToTheWholeFrame) {
   std::vector<float> normals_whole(600), normals_split(600), positions_split(600);
   const std::vector<float> positions_whole = deform_all(whole, now, &normals_whole);
   ASSERT_TRUE(split.solve_parts(now));
-  const int clusters = split.rbf_cluster_count();
+  const int clusters = split.cluster_count();
   ASSERT_GT(clusters, 1);
-  split.rbf_residuals(clusters / 2, clusters);
-  split.rbf_residuals(0, clusters / 2);
-  split.deform_vertices(100, 200, positions_split);
-  split.deform_vertices(0, 100, positions_split);
-  split.face_normals(30, split.face_count(), positions_split);
-  split.face_normals(0, 30, positions_split);
-  split.vertex_normals(0, 77, normals_split);
-  split.vertex_normals(77, 200, normals_split);
+  split.deform_clusters(clusters / 2, clusters);
+  split.deform_clusters(0, clusters / 2);
+  split.blend_vertices(100, 200, positions_split);
+  split.blend_vertices(0, 100, positions_split);
+  split.vertex_normals(77, 200, positions_split, normals_split);
+  split.vertex_normals(0, 77, positions_split, normals_split);
   EXPECT_EQ(positions_whole, positions_split);
   EXPECT_EQ(normals_whole, normals_split);
 }
