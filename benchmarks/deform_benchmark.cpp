@@ -91,7 +91,7 @@ void BM_DeformOneThread(benchmark::State& state) {
 }
 
 // The daemon's split (server/pipeline/deform_workers): the calling thread and persistent
-// workers, one range of each stage apiece, barriers between stages. Argument: threads.
+// workers taking small tasks of each stage from shared counters. Argument: threads.
 void BM_DeformThreads(benchmark::State& state) {
   const Scenario& s = scenario();
   MeshDeformer deformer(s.model, s.subject);
@@ -102,8 +102,7 @@ void BM_DeformThreads(benchmark::State& state) {
   size_t frame = 0;
   for (auto _ : state) {
     const auto start = std::chrono::steady_clock::now();
-    deformer.solve_parts(s.frames[frame]);
-    workers.run(positions, normals);
+    workers.run(s.frames[frame], positions, normals);
     micros.push_back(std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count());
     benchmark::DoNotOptimize(positions.data());
     frame = (frame + 1) % s.frames.size();

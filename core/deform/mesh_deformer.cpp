@@ -131,16 +131,20 @@ struct MeshDeformer::State {
   std::vector<int> influence_offsets;
   std::vector<int> influence_slots;
 
-  // Normals: per vertex the other two corners (b, c) of each face around it, in the face's
-  // order, so its area-weighted normal is the sum of (b - v) x (c - v) read from the positions
-  // alone: vertex ranges run on different threads without a face pass or write conflicts.
-  std::vector<int> ring_offsets;
-  std::vector<std::array<int, 2>> ring;
+  // Normals: per vertex its neighbours in fan order, n_0, n_1, ..., where each consecutive
+  // pair (n_i, n_i+1) closes a face (v, n_i, n_i+1) of the mesh (a closed fan repeats n_0 at
+  // the end). The area-weighted normal is then sum (n_i - v) x (n_i+1 - v), one neighbour read
+  // per face, from the positions alone: vertex ranges run on different threads without a face
+  // pass. Where the faces around v do not form one fan (border, non-manifold), the pieces are
+  // separated by v itself, whose offset from v is zero and so adds nothing.
+  std::vector<int> fan_offsets;
+  std::vector<int> fans;
 
   std::vector<int64_t> cumulative_cost;  // per vertex, for balanced_vertex_split
 
   void store_solved(int p);
   void build_clusters(const DeformationModel& model);
+  void build_fans(const std::vector<std::array<int, 3>>& faces);
   void deform_cluster(int c);
 };
 
@@ -159,7 +163,6 @@ MeshDeformer::MeshDeformer(const DeformationModel& model, const SubjectModel& su
   s.member_offsets = model.part_member_offsets;
   s.parts.reserve(static_cast<size_t>(part_count));
   s.solved.resize(static_cast<size_t>(part_count));
-  size_t largest = 0;
   for (int p = 0; p < part_count; ++p) {
     std::vector<Vec3> reference;
     for (int k = model.part_member_offsets[p]; k < model.part_member_offsets[p + 1]; ++k) {
@@ -167,12 +170,11 @@ MeshDeformer::MeshDeformer(const DeformationModel& model, const SubjectModel& su
       s.member_markers.push_back(marker);
       reference.push_back(subject.reference_positions[marker]);
     }
-    largest = std::max(largest, reference.size());
     s.solved[p].first_centre = s.member_offsets[p];
     s.solved[p].centre_count = static_cast<int>(reference.size());
     s.parts.emplace_back(build_part_model(reference), mode);
   }
-  s.member_scratch.resize(largest);
+  s.member_scratch.resize(s.member_markers.size());
   const size_t centres = s.member_markers.size();
   for (auto* array : {&s.centre_x, &s.centre_y, &s.centre_z, &s.weight_x, &s.weight_y, &s.weight_z})
     array->assign(centres, 0.0f);
@@ -180,14 +182,7 @@ MeshDeformer::MeshDeformer(const DeformationModel& model, const SubjectModel& su
   s.influence_offsets = model.vertex_influence_offsets;
   s.build_clusters(model);
 
-  s.ring_offsets.assign(static_cast<size_t>(s.vertex_count) + 1, 0);
-  for (const auto& f : model.faces)
-    for (int c : f) ++s.ring_offsets[c + 1];
-  for (int v = 0; v < s.vertex_count; ++v) s.ring_offsets[v + 1] += s.ring_offsets[v];
-  s.ring.resize(model.faces.size() * 3);
-  std::vector<int> fill(s.ring_offsets.begin(), s.ring_offsets.end() - 1);
-  for (const auto& f : model.faces)
-    for (int corner = 0; corner < 3; ++corner) s.ring[fill[f[corner]]++] = {f[(corner + 1) % 3], f[(corner + 2) % 3]};
+  s.build_fans(model.faces);
 
   for (int p = 0; p < part_count; ++p) s.store_solved(p);  // rest pose until the first solve
 
@@ -256,6 +251,50 @@ void MeshDeformer::State::build_clusters(const DeformationModel& model) {
   cluster_result.assign(clusters.size(), ClusterResult{});
 }
 
+void MeshDeformer::State::build_fans(const std::vector<std::array<int, 3>>& faces) {
+  // Per vertex the (b, c) corner pairs of its faces, in each face's winding.
+  std::vector<int> pair_offsets(static_cast<size_t>(vertex_count) + 1, 0);
+  for (const auto& f : faces)
+    for (int c : f) ++pair_offsets[c + 1];
+  for (int v = 0; v < vertex_count; ++v) pair_offsets[v + 1] += pair_offsets[v];
+  std::vector<std::array<int, 2>> pairs(faces.size() * 3);
+  std::vector<int> fill(pair_offsets.begin(), pair_offsets.end() - 1);
+  for (const auto& f : faces)
+    for (int corner = 0; corner < 3; ++corner) pairs[fill[f[corner]]++] = {f[(corner + 1) % 3], f[(corner + 2) % 3]};
+
+  fan_offsets.assign(static_cast<size_t>(vertex_count) + 1, 0);
+  fans.clear();
+  std::vector<char> used;
+  for (int v = 0; v < vertex_count; ++v) {
+    const int first = pair_offsets[v], count = pair_offsets[v + 1] - first;
+    used.assign(static_cast<size_t>(count), 0);
+    for (int left = count; left > 0;) {
+      // Start where no other unused pair ends (a border), else anywhere (a closed fan).
+      int start = -1;
+      for (int i = 0; i < count && start < 0; ++i) {
+        if (used[i]) continue;
+        bool continues_another = false;
+        for (int j = 0; j < count; ++j) continues_another |= !used[j] && j != i && pairs[first + j][1] == pairs[first + i][0];
+        if (!continues_another) start = i;
+      }
+      for (int i = 0; i < count && start < 0; ++i)
+        if (!used[i]) start = i;
+      if (fans.size() > static_cast<size_t>(fan_offsets[v])) fans.push_back(v);  // separates pieces
+      fans.push_back(pairs[first + start][0]);
+      for (int i = start; i >= 0;) {
+        used[i] = 1;
+        --left;
+        fans.push_back(pairs[first + i][1]);
+        const int reached = pairs[first + i][1];
+        i = -1;
+        for (int j = 0; j < count && i < 0; ++j)
+          if (!used[j] && pairs[first + j][0] == reached) i = j;
+      }
+    }
+    fan_offsets[v + 1] = static_cast<int>(fans.size());
+  }
+}
+
 MeshDeformer::~MeshDeformer() = default;
 
 void MeshDeformer::State::store_solved(int p) {
@@ -285,18 +324,30 @@ void MeshDeformer::State::store_solved(int p) {
   }
 }
 
-bool MeshDeformer::solve_parts(std::span<const Vec3> markers) {
-  State& s = *state_;
-  if (static_cast<int>(markers.size()) != s.marker_count) return false;
+bool MeshDeformer::accepts(std::span<const Vec3> markers) const {
+  if (static_cast<int>(markers.size()) != state_->marker_count) return false;
   for (const Vec3& m : markers)
     if (!is_present(m)) return false;
-  for (size_t p = 0; p < s.parts.size(); ++p) {
-    const int begin = s.member_offsets[p], count = s.member_offsets[p + 1] - begin;
-    for (int i = 0; i < count; ++i) s.member_scratch[i] = markers[s.member_markers[begin + i]];
-    if (s.parts[p].solve(std::span<const Vec3>(s.member_scratch.data(), count))) s.store_solved(static_cast<int>(p));
-  }
   return true;
 }
+
+void MeshDeformer::solve_part(int p, std::span<const Vec3> markers) {
+  State& s = *state_;
+  const int begin = s.member_offsets[p], count = s.member_offsets[p + 1] - begin;
+  Vec3* members = s.member_scratch.data() + begin;  // each part its own slice: parts may run in parallel
+  for (int i = 0; i < count; ++i) members[i] = markers[s.member_markers[begin + i]];
+  if (s.parts[p].solve(std::span<const Vec3>(members, count))) s.store_solved(p);
+}
+
+bool MeshDeformer::solve_parts(std::span<const Vec3> markers) {
+  if (!accepts(markers)) return false;
+  for (int p = 0; p < part_count(); ++p) solve_part(p, markers);
+  return true;
+}
+
+int MeshDeformer::part_count() const { return static_cast<int>(state_->parts.size()); }
+int MeshDeformer::part_member_count(int p) const { return state_->parts[p].model().member_count(); }
+int MeshDeformer::cluster_part(int c) const { return state_->clusters[c].part; }
 
 // Eq. 8 for one cluster's influences, times their beta: the quadratic field A_t q^0, the RBF
 // term, then back to the world frame. Centres farther than 2 sigma from every deformed
@@ -413,6 +464,7 @@ void MeshDeformer::blend_vertices(int begin, int end, std::span<float> positions
   }
 }
 
+__attribute__((target_clones("arch=x86-64-v3", "default")))  // FMA for the cross products
 void MeshDeformer::vertex_normals(int begin, int end, std::span<const float> positions, std::span<float> normals) const {
   const State& s = *state_;
   end = std::min(end, s.vertex_count);
@@ -421,14 +473,14 @@ void MeshDeformer::vertex_normals(int begin, int end, std::span<const float> pos
   for (int v = std::max(begin, 0); v < end; ++v) {
     const float* p = &positions[static_cast<size_t>(v) * 3];
     float n[3] = {0.0f, 0.0f, 0.0f};
-    for (int k = s.ring_offsets[v]; k < s.ring_offsets[v + 1]; ++k) {
-      const float* b = &positions[static_cast<size_t>(s.ring[k][0]) * 3];
-      const float* c = &positions[static_cast<size_t>(s.ring[k][1]) * 3];
-      const float e1[3] = {b[0] - p[0], b[1] - p[1], b[2] - p[2]};
-      const float e2[3] = {c[0] - p[0], c[1] - p[1], c[2] - p[2]};
-      n[0] += e1[1] * e2[2] - e1[2] * e2[1];  // twice the face's area, so the sum is area-weighted
-      n[1] += e1[2] * e2[0] - e1[0] * e2[2];
-      n[2] += e1[0] * e2[1] - e1[1] * e2[0];
+    float previous[3] = {0.0f, 0.0f, 0.0f};
+    for (int k = s.fan_offsets[v]; k < s.fan_offsets[v + 1]; ++k) {
+      const float* q = &positions[static_cast<size_t>(s.fans[k]) * 3];
+      const float r[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]};
+      n[0] += previous[1] * r[2] - previous[2] * r[1];  // twice the face's area: area-weighted
+      n[1] += previous[2] * r[0] - previous[0] * r[2];
+      n[2] += previous[0] * r[1] - previous[1] * r[0];
+      previous[0] = r[0], previous[1] = r[1], previous[2] = r[2];
     }
     const float length = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
     const float scale = length > 0.0f ? 1.0f / length : 0.0f;
@@ -456,7 +508,7 @@ size_t MeshDeformer::memory_bytes() const {
   size_t total = sizeof(State) + bytes(s.member_offsets) + bytes(s.member_markers) +
                  bytes(s.member_scratch) + bytes(s.influence_offsets) + bytes(s.influence_slots) +
                  bytes(s.solved) + bytes(s.centre_x) * 6 +
-                 bytes(s.ring_offsets) + bytes(s.ring) + bytes(s.clusters) +
+                 bytes(s.fan_offsets) + bytes(s.fans) + bytes(s.clusters) +
                  bytes(s.cluster_lanes) + bytes(s.cluster_result) + bytes(s.cumulative_cluster_cost) + bytes(s.cumulative_cost);
   for (const PartDeformer& part : s.parts) {
     const int y = part.model().member_count();

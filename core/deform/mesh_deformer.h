@@ -33,6 +33,14 @@ class MeshDeformer {
   // Fits every part to the markers (subject order, all present). Returns false, keeping the
   // previous fit, when the count is wrong or a marker is not finite.
   bool solve_parts(std::span<const Vec3> markers);
+  // The same in pieces, for callers that share the parts out over threads: whether the
+  // markers can be used, then each part's fit (different parts may be solved concurrently;
+  // the clusters of a part need that part's fit).
+  bool accepts(std::span<const Vec3> markers) const;
+  void solve_part(int part, std::span<const Vec3> markers);
+  int part_count() const;
+  int part_member_count(int part) const;
+  int cluster_part(int cluster) const;
 
   // Eq. 8 for the influences (vertex, part) of clusters [begin, end), each weighted by its
   // beta. Influences are grouped in clusters of nearby vertices of one part, evaluated in

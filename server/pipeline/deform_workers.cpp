@@ -1,67 +1,152 @@
 #include "server/pipeline/deform_workers.h"
 
+#include <algorithm>
 #include <chrono>
+#include <numeric>
 
 namespace skinstream::server {
 namespace {
 
-struct Range {
-  int begin, end;
-};
-Range share(int count, int index, int parts) {
-  return {static_cast<int>(static_cast<long>(count) * index / parts), static_cast<int>(static_cast<long>(count) * (index + 1) / parts)};
+constexpr int kClustersPerTask = 8;  // ~3 us of work: small enough to share, large enough to count
+constexpr int kVertexTasks = 32;     // per vertex stage
+
+// Waiting for another thread's short task: spin a little, then give the core away.
+void pause(int& spins) {
+  if (++spins < 256) {
+#if defined(__x86_64__) || defined(__i386__)
+    __builtin_ia32_pause();
+#endif
+  } else {
+    std::this_thread::yield();
+  }
 }
 
 }  // namespace
 
 DeformWorkers::DeformWorkers(MeshDeformer& deformer, int threads)
-    : deformer_(deformer), threads_(std::max(1, threads)), barrier_(std::max(1, threads)) {
-  for (int i = 1; i < threads_; ++i) workers_.emplace_back([this, i] { work(i); });
+    : deformer_(deformer), threads_(std::max(1, threads)) {
+  const int parts = deformer_.part_count();
+  auto fit_cost = [&](int p) { return static_cast<int64_t>(deformer_.part_member_count(p)) * deformer_.part_member_count(p) * deformer_.part_member_count(p); };
+  part_order_.resize(static_cast<size_t>(parts));
+  std::iota(part_order_.begin(), part_order_.end(), 0);
+  std::stable_sort(part_order_.begin(), part_order_.end(), [&](int a, int b) { return fit_cost(a) > fit_cost(b); });
+  part_fitted_ = std::make_unique<std::atomic<uint32_t>[]>(static_cast<size_t>(parts));
+  for (int p = 0; p < parts; ++p) part_fitted_[p].store(0);
+
+  // The clusters of a part are contiguous; take the parts with the cheapest fit first, so that
+  // a thread reaches a part's clusters when its fit is most likely done.
+  for (auto it = part_order_.rbegin(); it != part_order_.rend(); ++it)
+    for (int c = 0; c < deformer_.cluster_count();) {
+      if (deformer_.cluster_part(c) != *it) {
+        ++c;
+        continue;
+      }
+      const int begin = c;
+      while (c < deformer_.cluster_count() && deformer_.cluster_part(c) == *it && c - begin < kClustersPerTask) ++c;
+      cluster_chunks_.push_back({*it, begin, c});
+    }
+  fits_and_clusters_.tasks = static_cast<uint32_t>(parts + cluster_chunks_.size());
+  vertex_chunk_ = std::max(1, (deformer_.vertex_count() + kVertexTasks - 1) / kVertexTasks);
+  vertices_.tasks = normals_stage_.tasks =
+      static_cast<uint32_t>((deformer_.vertex_count() + vertex_chunk_ - 1) / vertex_chunk_);
+  for (int i = 1; i < threads_; ++i) workers_.emplace_back([this] { work(); });
 }
 
 DeformWorkers::~DeformWorkers() {
   stopping_.store(true);
-  if (!workers_.empty()) barrier_.arrive_and_wait();  // releases the workers waiting for a frame
+  generation_.fetch_add(1);
+  generation_.notify_all();
   for (std::thread& t : workers_) t.join();
 }
 
-void DeformWorkers::run(std::span<float> positions, std::span<float> normals) {
+void DeformWorkers::reset(Stage& stage, uint32_t generation, bool skip) {
+  stage.done.store(skip ? stage.tasks : 0, std::memory_order_relaxed);
+  stage.next.store((static_cast<uint64_t>(generation) << 32) | (skip ? stage.tasks : 0), std::memory_order_release);
+}
+
+bool DeformWorkers::run(std::span<const Vec3> markers, std::span<float> positions, std::span<float> normals) {
+  if (!deformer_.accepts(markers)) return false;
+  const auto start = std::chrono::steady_clock::now();
+  const uint32_t generation = generation_.load(std::memory_order_relaxed) + 1;
+  markers_ = markers;
   positions_ = positions;
   normals_ = normals;
-  if (!workers_.empty()) barrier_.arrive_and_wait();  // start
-  stage_range(0);
+  reset(fits_and_clusters_, generation, false);
+  reset(vertices_, generation, false);
+  reset(normals_stage_, generation, normals.empty());
+  generation_.store(generation, std::memory_order_release);
+  if (!workers_.empty()) generation_.notify_all();
+
+  run_stage(fits_and_clusters_, generation, [&](uint32_t task) { fit_or_cluster_task(task, generation); });
+  run_stage(vertices_, generation, [&](uint32_t task) {
+    deformer_.blend_vertices(static_cast<int>(task) * vertex_chunk_, static_cast<int>(task + 1) * vertex_chunk_, positions_);
+  });
+  deform_ns_ = std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - start).count();
+  run_stage(normals_stage_, generation, [&](uint32_t task) {
+    deformer_.vertex_normals(static_cast<int>(task) * vertex_chunk_, static_cast<int>(task + 1) * vertex_chunk_, positions_, normals_);
+  });
+  normals_ns_ = normals.empty() ? 0 : std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - start).count() - deform_ns_;
+  return true;
 }
 
-void DeformWorkers::work(int index) {
+void DeformWorkers::work() {
+  uint32_t seen = 0;
   for (;;) {
-    barrier_.arrive_and_wait();  // start of a frame (or stop)
+    generation_.wait(seen, std::memory_order_acquire);
     if (stopping_.load()) return;
-    stage_range(index);
+    seen = generation_.load(std::memory_order_acquire);
+    run_frame(seen);
   }
 }
 
-// Every participant runs every stage on its own range; the barriers keep the stages in order
-// because vertices read other ranges' clusters and normals read other ranges' vertices.
-void DeformWorkers::stage_range(int index) {
-  const Range clusters = {deformer_.balanced_cluster_split(index, threads_), deformer_.balanced_cluster_split(index + 1, threads_)};
-  const Range vertices = {deformer_.balanced_vertex_split(index, threads_), deformer_.balanced_vertex_split(index + 1, threads_)};
-  const Range vertex_normals = share(deformer_.vertex_count(), index, threads_);
-  const bool single = workers_.empty();
-  const auto start = std::chrono::steady_clock::now();
-  deformer_.deform_clusters(clusters.begin, clusters.end);
-  if (!single) barrier_.arrive_and_wait();  // vertices read other ranges' clusters
-  deformer_.blend_vertices(vertices.begin, vertices.end, positions_);
-  if (!normals_.empty()) {
-    if (!single) barrier_.arrive_and_wait();
-    if (index == 0) deform_ns_ = std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - start).count();
-    deformer_.vertex_normals(vertex_normals.begin, vertex_normals.end, positions_, normals_);
+// A worker's share of one frame; it leaves as soon as it sees a later generation.
+void DeformWorkers::run_frame(uint32_t generation) {
+  if (!run_stage(fits_and_clusters_, generation, [&](uint32_t task) { fit_or_cluster_task(task, generation); })) return;
+  if (!run_stage(vertices_, generation, [&](uint32_t task) {
+        deformer_.blend_vertices(static_cast<int>(task) * vertex_chunk_, static_cast<int>(task + 1) * vertex_chunk_, positions_);
+      }))
+    return;
+  run_stage(normals_stage_, generation, [&](uint32_t task) {
+    deformer_.vertex_normals(static_cast<int>(task) * vertex_chunk_, static_cast<int>(task + 1) * vertex_chunk_, positions_, normals_);
+  });
+}
+
+// Takes tasks of this generation until none are left, then waits for the ones others took.
+// Returns false when the frame has moved on (only a late worker sees that).
+template <typename Task>
+bool DeformWorkers::run_stage(Stage& stage, uint32_t generation, Task&& task) {
+  uint64_t next = stage.next.load(std::memory_order_acquire);
+  for (;;) {
+    if (static_cast<uint32_t>(next >> 32) != generation) return false;
+    const uint32_t index = static_cast<uint32_t>(next);
+    if (index >= stage.tasks) break;
+    if (!stage.next.compare_exchange_weak(next, next + 1, std::memory_order_acquire, std::memory_order_acquire)) continue;
+    task(index);
+    stage.done.fetch_add(1, std::memory_order_release);
+    next = stage.next.load(std::memory_order_acquire);
   }
-  if (!single) barrier_.arrive_and_wait();  // frame done
-  if (index == 0) {
-    const int64_t total = std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - start).count();
-    if (normals_.empty()) deform_ns_ = total;
-    normals_ns_ = normals_.empty() ? 0 : total - deform_ns_;
+  int spins = 0;
+  while (stage.done.load(std::memory_order_acquire) < stage.tasks) {
+    if (static_cast<uint32_t>(stage.next.load(std::memory_order_acquire) >> 32) != generation) return false;
+    pause(spins);
   }
+  return true;
+}
+
+// Tasks [0, parts): fit part part_order_[task]; then cluster chunks, each after its part's fit.
+void DeformWorkers::fit_or_cluster_task(uint32_t task, uint32_t generation) {
+  const uint32_t parts = static_cast<uint32_t>(part_order_.size());
+  if (task < parts) {
+    const int part = part_order_[task];
+    deformer_.solve_part(part, markers_);
+    part_fitted_[part].store(generation, std::memory_order_release);
+    return;
+  }
+  const ClusterChunk& chunk = cluster_chunks_[task - parts];
+  int spins = 0;
+  // Every fit task was taken before any cluster task, so the part's fit is under way.
+  while (part_fitted_[chunk.part].load(std::memory_order_acquire) != generation) pause(spins);
+  deformer_.deform_clusters(chunk.begin, chunk.end);
 }
 
 }  // namespace skinstream::server

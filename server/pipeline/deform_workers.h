@@ -1,12 +1,17 @@
 #pragma once
 // Shares the mesh deformation of one frame out over threads: the calling (pipeline) thread and
-// `threads - 1` persistent workers, each taking its own cluster and vertex ranges, with a
-// barrier between the stages of MeshDeformer (clusters -> vertices -> vertex normals). No
-// thread is created per frame.
+// `threads - 1` persistent workers. Each stage of MeshDeformer is cut into small tasks that
+// whoever is running takes from a shared counter, so a worker the OS has not scheduled yet
+// holds nobody up: the calling thread then does the frame alone (on a loaded stage machine
+// that is the difference between a late frame and a merely slower one).
+//
+// Stages, in order: part fits and clusters (a cluster waits only for its own part's fit, so
+// the largest part's fit overlaps the other parts' clusters), then eq. 9 per vertex, then the
+// vertex normals. No thread is created and nothing is allocated per frame.
 
 #include <atomic>
-#include <barrier>
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <thread>
 #include <vector>
@@ -22,23 +27,49 @@ class DeformWorkers {
   DeformWorkers(const DeformWorkers&) = delete;
   DeformWorkers& operator=(const DeformWorkers&) = delete;
 
-  // Deforms into `positions` (3V floats) and, when `normals` is not empty, `normals` (3V).
-  // Call solve_parts() on the deformer first. Runs on the calling thread plus the workers.
-  void run(std::span<float> positions, std::span<float> normals);
+  // Fits the parts to `markers` and deforms into `positions` (3V floats) and, when `normals`
+  // is not empty, `normals` (3V). Returns false, changing nothing, when the deformer does not
+  // accept the markers (wrong count, a marker not finite).
+  bool run(std::span<const Vec3> markers, std::span<float> positions, std::span<float> normals);
   int threads() const { return threads_; }
-  // Wall time of the last run's stages (measured by the calling thread, barriers included).
+  // Wall time of the last run's stages, measured by the calling thread: fits to positions, and
+  // normals.
   int64_t last_deform_ns() const { return deform_ns_; }
   int64_t last_normals_ns() const { return normals_ns_; }
 
  private:
-  void work(int index);
-  void stage_range(int index);
+  // One stage's tasks: `next` holds the frame's generation in its high 32 bits and the next
+  // task in its low 32, so a worker that wakes after its frame ended can never take a task of
+  // the next one; `done` counts finished tasks.
+  struct alignas(64) Stage {  // own cache line: both threads hammer these counters
+    std::atomic<uint64_t> next{0};
+    std::atomic<uint32_t> done{0};
+    uint32_t tasks = 0;
+  };
+  struct ClusterChunk {
+    int part, begin, end;
+  };
+
+  void work();
+  void run_frame(uint32_t generation);
+  template <typename Task>
+  bool run_stage(Stage& stage, uint32_t generation, Task&& task);
+  void reset(Stage& stage, uint32_t generation, bool skip);
+  void fit_or_cluster_task(uint32_t task, uint32_t generation);
 
   MeshDeformer& deformer_;
   int threads_;
-  std::barrier<> barrier_;
+  std::vector<int> part_order_;             // largest part first: its fit is the longest task
+  std::vector<ClusterChunk> cluster_chunks_;  // the largest part's clusters last
+  int vertex_chunk_ = 0;
+  std::unique_ptr<std::atomic<uint32_t>[]> part_fitted_;  // the generation of each part's last fit
+
+  Stage fits_and_clusters_, vertices_, normals_stage_;
+  std::atomic<uint32_t> generation_{0};
   std::atomic<bool> stopping_{false};
-  std::span<float> positions_, normals_;  // set before the start barrier, read after it
+  // Set by run() before the generation is published, read by tasks after they take one.
+  std::span<const Vec3> markers_;
+  std::span<float> positions_, normals_;
   std::vector<std::thread> workers_;
   int64_t deform_ns_ = 0, normals_ns_ = 0;
 };

@@ -125,8 +125,7 @@ void Pipeline::publish(const Released& meta, std::span<const Vec3> positions, st
 
   if (deformer_) {
     const auto start = std::chrono::steady_clock::now();
-    if (deformer_->solve_parts(positions)) {
-      workers_->run(positions_, want_normals ? std::span<float>(normals_) : std::span<float>());
+    if (workers_->run(positions, positions_, want_normals ? std::span<float>(normals_) : std::span<float>())) {
       metrics_.deform.observe_ns(since_ns(start) - workers_->last_normals_ns());
       if (want_normals) metrics_.normals.observe_ns(workers_->last_normals_ns());
     } else {

@@ -240,9 +240,14 @@ TEST(MeshDeformer, NormalsAreUnitAndFollowTheWinding) {
 
 // Against a double-precision sum of (b - a) x (c - a) over the faces around each vertex,
 // computed from the deformed positions the deformer wrote, on a sheet whose vertices are shared
-// by up to six faces and whose border vertices have open fans.
+// by up to six faces and whose border vertices have open fans, plus faces that break the fans:
+// a fin on an interior edge (three faces on one edge), one wound the other way and a lone
+// triangle across the sheet.
 TEST(MeshDeformer, NormalsAreTheAreaWeightedSumOfTheFacesAroundEachVertex) {
   deform_test::WavySheet sheet;
+  sheet.model.faces.push_back({40, 71, 300});
+  sheet.model.faces.push_back({500, 470, 501});
+  sheet.model.faces.push_back({100, 650, 900});
   std::mt19937_64 rng(17);
   const std::vector<Vec3> now = deform_non_rigidly(sheet.subject.reference_positions, random_motion(rng));
   MeshDeformer deformer(sheet.model, sheet.subject);

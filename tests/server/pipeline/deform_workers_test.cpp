@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <random>
 
 #include "tests/core/deform/deform_test_support.h"
@@ -16,26 +17,45 @@ TEST(DeformWorkers, AnyThreadCountGivesTheSingleThreadFrameBitForBit) {
   deform_test::WavySheet sheet;
   const size_t floats = sheet.model.reference_vertices.size() * 3;
   MeshDeformer reference(sheet.model, sheet.subject);
-  for (int threads : {1, 2, 3}) {
+  for (int threads : {1, 2, 4}) {  // 4 threads on a 2-core machine: workers are often late
     MeshDeformer deformer(sheet.model, sheet.subject);
     DeformWorkers workers(deformer, threads);
     EXPECT_EQ(workers.threads(), threads);
     std::mt19937_64 rng(4);
-    for (int frame = 0; frame < 5; ++frame) {
+    for (int frame = 0; frame < 30; ++frame) {
       const std::vector<Vec3> now =
           deform_test::deform_non_rigidly(sheet.subject.reference_positions, deform_test::random_motion(rng));
       std::vector<float> positions(floats), normals(floats), expected_positions(floats), expected_normals(floats);
       ASSERT_TRUE(reference.deform(now, expected_positions, expected_normals));
-      ASSERT_TRUE(deformer.solve_parts(now));
-      workers.run(positions, normals);
+      ASSERT_TRUE(workers.run(now, positions, normals));
       EXPECT_EQ(positions, expected_positions) << threads << " threads, frame " << frame;
       EXPECT_EQ(normals, expected_normals) << threads << " threads, frame " << frame;
       // Without normals the positions are the same.
       std::vector<float> positions_only(floats);
-      workers.run(positions_only, {});
+      ASSERT_TRUE(workers.run(now, positions_only, {}));
       EXPECT_EQ(positions_only, expected_positions);
     }
   }
+}
+
+TEST(DeformWorkers, RejectsUnusableMarkersAndKeepsThePreviousFit) {
+  deform_test::WavySheet sheet;
+  const size_t floats = sheet.model.reference_vertices.size() * 3;
+  MeshDeformer deformer(sheet.model, sheet.subject);
+  DeformWorkers workers(deformer, 2);
+  std::mt19937_64 rng(6);
+  const std::vector<Vec3> now =
+      deform_test::deform_non_rigidly(sheet.subject.reference_positions, deform_test::random_motion(rng));
+  std::vector<float> fitted(floats), again(floats);
+  ASSERT_TRUE(workers.run(now, fitted, {}));
+  std::vector<Vec3> short_by_one(now.begin(), now.end() - 1), with_nan = now;
+  with_nan[7].x() = std::nan("");
+  EXPECT_FALSE(workers.run(short_by_one, again, {}));
+  EXPECT_FALSE(workers.run(with_nan, again, {}));
+  // The deformer still holds the last good fit: its stages reproduce that frame.
+  deformer.deform_clusters(0, deformer.cluster_count());
+  deformer.blend_vertices(0, deformer.vertex_count(), again);
+  EXPECT_EQ(again, fitted);
 }
 
 }  // namespace
