@@ -470,7 +470,8 @@ void MeshDeformer::vertex_normals(int begin, int end, std::span<const float> pos
   end = std::min(end, s.vertex_count);
   const size_t needed = static_cast<size_t>(s.vertex_count) * 3;
   if (positions.size() < needed || normals.size() < needed) return;
-  for (int v = std::max(begin, 0); v < end; ++v) {
+  begin = std::max(begin, 0);
+  for (int v = begin; v < end; ++v) {
     const float* p = &positions[static_cast<size_t>(v) * 3];
     float n[3] = {0.0f, 0.0f, 0.0f};
     float previous[3] = {0.0f, 0.0f, 0.0f};
@@ -482,12 +483,16 @@ void MeshDeformer::vertex_normals(int begin, int end, std::span<const float> pos
       n[2] += previous[0] * r[1] - previous[1] * r[0];
       previous[0] = r[0], previous[1] = r[1], previous[2] = r[2];
     }
-    const float length = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-    const float scale = length > 0.0f ? 1.0f / length : 0.0f;
     float* out = &normals[static_cast<size_t>(v) * 3];
-    out[0] = n[0] * scale;
-    out[1] = n[1] * scale;
-    out[2] = n[2] * scale;
+    out[0] = n[0], out[1] = n[1], out[2] = n[2];
+  }
+  // Normalised in a second pass that vectorises: per vertex, a scalar square root and division
+  // behind the sums stalled the loop above (a quarter of its time in perf).
+  float* n = normals.data();
+  for (size_t i = static_cast<size_t>(begin) * 3; i < static_cast<size_t>(std::max(begin, end)) * 3; i += 3) {
+    const float squared = n[i] * n[i] + n[i + 1] * n[i + 1] + n[i + 2] * n[i + 2];
+    const float scale = squared > 0.0f ? 1.0f / __builtin_sqrtf(squared) : 0.0f;
+    n[i] *= scale, n[i + 1] *= scale, n[i + 2] *= scale;
   }
 }
 
