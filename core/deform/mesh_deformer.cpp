@@ -115,6 +115,7 @@ struct MeshDeformer::State {
   std::vector<Vec3> member_scratch;
 
   std::vector<SolvedPart> solved;
+  // Per part its RBF centres in units of sigma and weights over 6 (see store_solved).
   std::vector<float> centre_x, centre_y, centre_z, weight_x, weight_y, weight_z;
 
   // Eq. 8 is evaluated per cluster of up to kClusterSize influences (vertex, part) of one part
@@ -315,12 +316,13 @@ void MeshDeformer::State::store_solved(int p) {
   const Eigen::MatrixX3d& weights = part.rbf_weights();
   for (int i = 0; i < out.centre_count; ++i) {
     const int k = out.first_centre + i;
-    centre_x[k] = static_cast<float>(centres(0, i));
-    centre_y[k] = static_cast<float>(centres(1, i));
-    centre_z[k] = static_cast<float>(centres(2, i));
-    weight_x[k] = static_cast<float>(weights(i, 0));
-    weight_y[k] = static_cast<float>(weights(i, 1));
-    weight_z[k] = static_cast<float>(weights(i, 2));
+    // In the units deform_cluster sums in: centres in sigma, weights over 6 (the B-spline's).
+    centre_x[k] = static_cast<float>(centres(0, i) * out.inverse_sigma);
+    centre_y[k] = static_cast<float>(centres(1, i) * out.inverse_sigma);
+    centre_z[k] = static_cast<float>(centres(2, i) * out.inverse_sigma);
+    weight_x[k] = static_cast<float>(weights(i, 0) / 6.0);
+    weight_y[k] = static_cast<float>(weights(i, 1) / 6.0);
+    weight_z[k] = static_cast<float>(weights(i, 2) / 6.0);
   }
 }
 
@@ -390,11 +392,10 @@ inline __attribute__((always_inline)) void MeshDeformer::State::deform_cluster(i
     for (int i = part.first_centre; i < end;) {  // one pass unless a part has more centres than the stack holds
       int m = 0;
       for (; i < end && m < kMaxGatheredCentres; ++i) {
-        const float x = centre_x[i] * inverse_sigma, y = centre_y[i] * inverse_sigma, z = centre_z[i] * inverse_sigma;
-        const float dx = x - mid[0], dy = y - mid[1], dz = z - mid[2];
+        const float dx = centre_x[i] - mid[0], dy = centre_y[i] - mid[1], dz = centre_z[i] - mid[2];
         if (dx * dx + dy * dy + dz * dz >= reach * reach) continue;
-        gx[m] = x, gy[m] = y, gz[m] = z;
-        gwx[m] = weight_x[i] * (1.0f / 6.0f), gwy[m] = weight_y[i] * (1.0f / 6.0f), gwz[m] = weight_z[i] * (1.0f / 6.0f);
+        gx[m] = centre_x[i], gy[m] = centre_y[i], gz[m] = centre_z[i];
+        gwx[m] = weight_x[i], gwy[m] = weight_y[i], gwz[m] = weight_z[i];
         ++m;
       }
       for (int b = 0; b < kBlocks; ++b)
