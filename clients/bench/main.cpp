@@ -266,6 +266,9 @@ int main(int argc, char** argv) {
       rss_samples.push_back(resident_kb(pid));
     }
     for (std::thread& t : threads) t.join();
+    // The growth over the run, at a glance: a leak climbs minute after minute, a warm-up does not.
+    std::vector<long> every_minute;
+    for (size_t i = 0; i < rss_samples.size(); i += 60) every_minute.push_back(rss_samples[i]);
     const nlohmann::json health = server::fetch_health(http_port);
     const uint64_t sent = replay.stats().frame_packets_sent.load() - sent_before;
     const uint64_t replay_dropped = replay.stats().frames_dropped.load() - replay_dropped_before;
@@ -312,6 +315,7 @@ int main(int argc, char** argv) {
                     {"rss_kb_after_1s", rss_samples.empty() ? 0 : rss_samples.front()},
                     {"rss_kb_at_end", rss_samples.empty() ? 0 : rss_samples.back()},
                     {"rss_kb_max_sampled", rss_samples.empty() ? 0 : *std::max_element(rss_samples.begin(), rss_samples.end())},
+                    {"rss_kb_every_60s", every_minute},
                     {"exit_status", WIFEXITED(status) ? WEXITSTATUS(status) : -1}}}};
     if (json) {
       std::printf("%s\n", report.dump(2).c_str());

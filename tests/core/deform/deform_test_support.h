@@ -48,15 +48,17 @@ inline std::vector<Vec3> move_rigidly(const std::vector<Vec3>& points, const Rig
   return out;
 }
 
-// A wavy 300 x 300 mm sheet: a 31 x 31 vertex grid in triangles that share their vertices
-// (valence up to 6, and a boundary), 100 markers on every third grid point, two parts that
-// overlap in the middle third, where the vertices are blended between them.
+// A wavy sheet, 10 mm between grid points: a side x side vertex grid in triangles that share
+// their vertices (valence up to 6, and a boundary), markers on every third grid point (100 for
+// the default side of 31), two parts that overlap in the middle third of the sheet's x extent,
+// where the vertices are blended between them.
 struct WavySheet {
   SubjectModel subject;
   DeformationModel model;
 
-  WavySheet() {
-    constexpr int kSide = 31;
+  explicit WavySheet(int side = 31) {
+    const int kSide = side;
+    const double third = 10.0 * (kSide - 1) / 3.0;
     auto at = [](int i, int j) { return Vec3(10.0 * i, 10.0 * j, 15.0 * std::sin(i / 5.0) * std::cos(j / 7.0)); };
     model.part_names = {"left", "right"};
     for (int i = 0; i < kSide; i += 3)
@@ -67,14 +69,14 @@ struct WavySheet {
     for (int part = 0; part < 2; ++part) {
       for (int m = 0; m < static_cast<int>(subject.reference_positions.size()); ++m) {
         const double x = subject.reference_positions[m].x();
-        if (part == 0 ? x <= 200.0 : x >= 100.0) model.part_members.push_back({m, 1.0});
+        if (part == 0 ? x <= 2.0 * third : x >= third) model.part_members.push_back({m, 1.0});
       }
       model.part_member_offsets.push_back(static_cast<int>(model.part_members.size()));
     }
     for (int i = 0; i < kSide; ++i)
       for (int j = 0; j < kSide; ++j) {
         model.reference_vertices.push_back(at(i, j));
-        const double x = 10.0 * i, right = std::clamp((x - 100.0) / 100.0, 0.0, 1.0);
+        const double x = 10.0 * i, right = std::clamp((x - third) / third, 0.0, 1.0);
         if (right < 1.0) model.vertex_influences.push_back({0, 1.0 - right});
         if (right > 0.0) model.vertex_influences.push_back({1, right});
         model.vertex_influence_offsets.push_back(static_cast<int>(model.vertex_influences.size()));

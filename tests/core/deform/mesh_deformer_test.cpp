@@ -295,5 +295,21 @@ TEST(MeshDeformer, PerFrameWorkAllocatesNothing) {
   EXPECT_EQ(count.count(), 0u);
 }
 
+// Parts far larger than the small scene's (a trunk carries ~150 markers): dense solvers switch
+// to blocked algorithms at such sizes, which must not allocate either.
+TEST(MeshDeformer, PerFrameWorkAllocatesNothingWithLargeParts) {
+  deform_test::WavySheet sheet(61);  // parts of ~300 markers
+  ASSERT_GT(sheet.model.part_member_offsets[1], 140);
+  std::mt19937_64 rng(14);
+  std::vector<std::vector<Vec3>> frames;
+  for (int f = 0; f < 10; ++f) frames.push_back(deform_non_rigidly(sheet.subject.reference_positions, random_motion(rng)));
+  MeshDeformer deformer(sheet.model, sheet.subject);
+  std::vector<float> positions(sheet.model.reference_vertices.size() * 3), normals(positions.size());
+  ASSERT_TRUE(deformer.deform(frames[0], positions, normals));
+  test::CountAllocations count;
+  for (const auto& markers : frames) ASSERT_TRUE(deformer.deform(markers, positions, normals));
+  EXPECT_EQ(count.count(), 0u);
+}
+
 }  // namespace
 }  // namespace skinstream
