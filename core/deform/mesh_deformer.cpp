@@ -13,8 +13,8 @@ namespace skinstream {
 
 namespace {
 
-// What eq. 8 needs of one part at the solved frame, in float, so the per-vertex work is a few
-// small products and one loop over the part's RBF centres that the compiler can vectorise.
+// What eq. 8 needs of one part at the solved frame, in float: the cluster stage broadcasts
+// these scalars over its vector lanes.
 struct SolvedPart {
   float quadratic[3][9] = {};         // A_t
   float inverse_rotation[3][3] = {};  // (R_t)^-1 = R_t^T
