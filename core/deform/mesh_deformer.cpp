@@ -28,8 +28,7 @@ struct SolvedPart {
 // A few influences of one part close together in the reference pose.
 struct InfluenceCluster {
   int part = 0;
-  int count = 0;          // lanes in use; the others copy lane 0 with beta 0
-  int64_t rest_cost = 0;  // work at the rest pose: the field, the gather test, the kernel terms kept
+  int count = 0;  // lanes in use; the others copy lane 0 with beta 0
 };
 constexpr int kClusterSize = 32;
 // Centres gathered per cluster live on the stack; parts with more members than this are
@@ -126,7 +125,6 @@ struct MeshDeformer::State {
   std::vector<InfluenceCluster> clusters;
   std::vector<ClusterLanes> cluster_lanes;    // parallel to clusters
   std::vector<ClusterResult> cluster_result;  // parallel to clusters
-  std::vector<int64_t> cumulative_cluster_cost;
   // Eq. 9: per vertex (CSR by the model's vertex_influence_offsets) where its influences'
   // results are: cluster * 3 * kClusterSize + lane, as a float index into cluster_result.
   std::vector<int> influence_offsets;
@@ -141,7 +139,6 @@ struct MeshDeformer::State {
   std::vector<int> fan_offsets;
   std::vector<int> fans;
 
-  std::vector<int64_t> cumulative_cost;  // per vertex, for balanced_vertex_split
 
   void store_solved(int p);
   void build_clusters(const DeformationModel& model);
@@ -187,18 +184,10 @@ MeshDeformer::MeshDeformer(const DeformationModel& model, const SubjectModel& su
 
   for (int p = 0; p < part_count; ++p) s.store_solved(p);  // rest pose until the first solve
 
-  // Work per vertex: one gather per influence.
-  s.cumulative_cost.assign(static_cast<size_t>(s.vertex_count) + 1, 0);
-  for (int v = 0; v < s.vertex_count; ++v)
-    s.cumulative_cost[v + 1] = s.cumulative_cost[v] + 1 + (s.influence_offsets[v + 1] - s.influence_offsets[v]);
-  s.cumulative_cluster_cost.assign(s.clusters.size() + 1, 0);
-  for (size_t c = 0; c < s.clusters.size(); ++c)
-    s.cumulative_cluster_cost[c + 1] = s.cumulative_cluster_cost[c] + s.clusters[c].rest_cost;
   for (int c = 0; c < static_cast<int>(s.clusters.size()); ++c) s.deform_cluster(c);  // rest pose
 }
 
 void MeshDeformer::State::build_clusters(const DeformationModel& model) {
-  const bool with_rbf = mode == DeformationMode::RigidRbf || mode == DeformationMode::QuadraticRbf;
   std::vector<std::vector<int>> by_part(parts.size());
   for (size_t k = 0; k < model.vertex_influences.size(); ++k) by_part[model.vertex_influences[k].part].push_back(static_cast<int>(k));
   std::vector<int> vertex_of(model.vertex_influences.size());
@@ -223,7 +212,6 @@ void MeshDeformer::State::build_clusters(const DeformationModel& model) {
       cluster.part = static_cast<int>(p);
       cluster.count = static_cast<int>(std::min<size_t>(kClusterSize, keyed.size() - first));
       ClusterLanes lanes{};
-      Vec3 low = Vec3::Constant(1e30), high = Vec3::Constant(-1e30);
       for (int lane = 0; lane < kClusterSize; ++lane) {
         const int i = keyed[first + (lane < cluster.count ? lane : 0)].second;
         const int k = by_part[p][i];
@@ -233,17 +221,6 @@ void MeshDeformer::State::build_clusters(const DeformationModel& model) {
         if (lane >= cluster.count) continue;
         lanes.beta[lane] = static_cast<float>(model.vertex_influences[k].weight);
         influence_slots[k] = static_cast<int>(clusters.size()) * 3 * kClusterSize + lane;
-        low = low.cwiseMin(inside[i]);
-        high = high.cwiseMax(inside[i]);
-      }
-      // What deform_cluster does at the rest pose (A = I), so that a split by this cost is
-      // balanced where the culling removes more terms in big parts than in small ones.
-      cluster.rest_cost = 64 * kClusterSize;
-      if (with_rbf) {
-        const double reach = 2.0 * part.rbf_dilation + 0.5 * (high - low).norm();
-        int kept = 0;
-        for (const Vec3& centre : part.local_reference_points) kept += (centre - 0.5 * (low + high)).norm() < reach;
-        cluster.rest_cost += part.member_count() + static_cast<int64_t>(kept) * kClusterSize;
       }
       clusters.push_back(cluster);
       cluster_lanes.push_back(lanes);
@@ -429,24 +406,6 @@ void MeshDeformer::deform_clusters(int begin, int end) {
 
 int MeshDeformer::cluster_count() const { return static_cast<int>(state_->clusters.size()); }
 
-int MeshDeformer::balanced_cluster_split(int index, int parts) const {
-  const State& s = *state_;
-  if (parts <= 0 || index <= 0) return 0;
-  if (index >= parts) return cluster_count();
-  const int64_t target = s.cumulative_cluster_cost.back() * index / parts;
-  return static_cast<int>(std::lower_bound(s.cumulative_cluster_cost.begin(), s.cumulative_cluster_cost.end(), target) -
-                          s.cumulative_cluster_cost.begin());
-}
-
-int MeshDeformer::balanced_vertex_split(int index, int parts) const {
-  const State& s = *state_;
-  if (parts <= 0 || index <= 0) return 0;
-  if (index >= parts) return s.vertex_count;
-  const int64_t target = s.cumulative_cost.back() * index / parts;
-  return static_cast<int>(std::lower_bound(s.cumulative_cost.begin(), s.cumulative_cost.end(), target) -
-                          s.cumulative_cost.begin());
-}
-
 void MeshDeformer::blend_vertices(int begin, int end, std::span<float> positions) const {
   const State& s = *state_;
   end = std::min(end, s.vertex_count);
@@ -528,7 +487,7 @@ size_t MeshDeformer::memory_bytes() const {
                  bytes(s.member_scratch) + bytes(s.influence_offsets) + bytes(s.influence_slots) +
                  bytes(s.solved) + bytes(s.centre_x) * 6 +
                  bytes(s.fan_offsets) + bytes(s.fans) + bytes(s.clusters) +
-                 bytes(s.cluster_lanes) + bytes(s.cluster_result) + bytes(s.cumulative_cluster_cost) + bytes(s.cumulative_cost);
+                 bytes(s.cluster_lanes) + bytes(s.cluster_result);
   for (const PartDeformer& part : s.parts) {
     const int y = part.model().member_count();
     // Members' reference data (points, Q0, pseudo-inverse) and the per-frame kernel and LU.

@@ -57,13 +57,6 @@ class MeshDeformer {
   // All stages on the calling thread. `normals` may be empty (not wanted).
   bool deform(std::span<const Vec3> markers, std::span<float> positions, std::span<float> normals);
 
-  // Where to cut the vertices into `parts` ranges of equal work (vertices with more
-  // influences cost more): the start of range `index` (index == parts: the end).
-  int balanced_vertex_split(int index, int parts) const;
-  // The same for the clusters of deform_clusters() (clusters in big parts with the RBF
-  // residual cost more than others).
-  int balanced_cluster_split(int index, int parts) const;
-
   int vertex_count() const;
   DeformationMode mode() const;
   // Heap bytes held by the runtime state (precomputed per-vertex data, parts, normals scratch).

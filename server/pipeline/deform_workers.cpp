@@ -77,14 +77,7 @@ bool DeformWorkers::run(std::span<const Vec3> markers, std::span<float> position
   generation_.store(generation, std::memory_order_release);
   if (!workers_.empty()) generation_.notify_all();
 
-  run_stage(fits_and_clusters_, generation, [&](uint32_t task) { fit_or_cluster_task(task, generation); });
-  run_stage(vertices_, generation, [&](uint32_t task) {
-    deformer_.blend_vertices(static_cast<int>(task) * vertex_chunk_, static_cast<int>(task + 1) * vertex_chunk_, positions_);
-  });
-  deform_ns_ = std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - start).count();
-  run_stage(normals_stage_, generation, [&](uint32_t task) {
-    deformer_.vertex_normals(static_cast<int>(task) * vertex_chunk_, static_cast<int>(task + 1) * vertex_chunk_, positions_, normals_);
-  });
+  run_frame(generation, &start);
   normals_ns_ = normals.empty() ? 0 : std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - start).count() - deform_ns_;
   return true;
 }
@@ -95,17 +88,19 @@ void DeformWorkers::work() {
     generation_.wait(seen, std::memory_order_acquire);
     if (stopping_.load()) return;
     seen = generation_.load(std::memory_order_acquire);
-    run_frame(seen);
+    run_frame(seen, nullptr);
   }
 }
 
-// A worker's share of one frame; it leaves as soon as it sees a later generation.
-void DeformWorkers::run_frame(uint32_t generation) {
+// One participant's share of a frame: the calling thread's (which times the stages from
+// `start`) or a worker's, which leaves as soon as it sees a later generation.
+void DeformWorkers::run_frame(uint32_t generation, const std::chrono::steady_clock::time_point* start) {
   if (!run_stage(fits_and_clusters_, generation, [&](uint32_t task) { fit_or_cluster_task(task, generation); })) return;
   if (!run_stage(vertices_, generation, [&](uint32_t task) {
         deformer_.blend_vertices(static_cast<int>(task) * vertex_chunk_, static_cast<int>(task + 1) * vertex_chunk_, positions_);
       }))
     return;
+  if (start) deform_ns_ = std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - *start).count();
   run_stage(normals_stage_, generation, [&](uint32_t task) {
     deformer_.vertex_normals(static_cast<int>(task) * vertex_chunk_, static_cast<int>(task + 1) * vertex_chunk_, positions_, normals_);
   });

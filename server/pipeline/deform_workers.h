@@ -10,6 +10,7 @@
 // vertex normals. No thread is created and nothing is allocated per frame.
 
 #include <atomic>
+#include <chrono>
 #include <cstdint>
 #include <memory>
 #include <span>
@@ -51,7 +52,7 @@ class DeformWorkers {
   };
 
   void work();
-  void run_frame(uint32_t generation);
+  void run_frame(uint32_t generation, const std::chrono::steady_clock::time_point* start);
   template <typename Task>
   bool run_stage(Stage& stage, uint32_t generation, Task&& task);
   void reset(Stage& stage, uint32_t generation, bool skip);
