@@ -300,6 +300,9 @@ std::string Daemon::health_json() const {
         {"processed", metrics_.frames_processed.load()},
         {"published", metrics_.frames_published.load()},
         {"dropped", metrics_.frames_dropped.load()}}},
+      // Encoded frame buffers created so far: grows only while the pool meets a new high-water
+      // mark of frames in use (bounded by the subscribers' queues), so RSS steps with it.
+      {"frame_buffers_allocated", metrics_.frame_buffers_allocated.load()},
       {"subscribers", hub_->subscriber_count()},
       {"subject", {{"markers", subject_.model.marker_count()}, {"vertices", pipeline_->vertex_count()}}}};
   return health.dump();

@@ -260,10 +260,12 @@ int main(int argc, char** argv) {
       });
     // RSS once a second: the first sample after warm-up against the last.
     std::vector<long> rss_samples;
+    uint64_t buffers_after_1s = 0;  // the daemon's encoded frame buffers: RSS steps when they grow
     const auto first_sample = std::chrono::steady_clock::now() + std::chrono::seconds(1);
     for (auto next = first_sample; next < deadline; next += std::chrono::seconds(1)) {
       std::this_thread::sleep_until(next);
       rss_samples.push_back(resident_kb(pid));
+      if (rss_samples.size() == 1) buffers_after_1s = server::fetch_health(http_port).value("frame_buffers_allocated", 0);
     }
     for (std::thread& t : threads) t.join();
     // The growth over the run, at a glance: a leak climbs minute after minute, a warm-up does not.
@@ -316,6 +318,8 @@ int main(int argc, char** argv) {
                     {"rss_kb_at_end", rss_samples.empty() ? 0 : rss_samples.back()},
                     {"rss_kb_max_sampled", rss_samples.empty() ? 0 : *std::max_element(rss_samples.begin(), rss_samples.end())},
                     {"rss_kb_every_60s", every_minute},
+                    {"frame_buffers_after_1s", buffers_after_1s},
+                    {"frame_buffers_at_end", health.value("frame_buffers_allocated", 0)},
                     {"exit_status", WIFEXITED(status) ? WEXITSTATUS(status) : -1}}}};
     if (json) {
       std::printf("%s\n", report.dump(2).c_str());

@@ -337,6 +337,9 @@ TEST(Daemon, ServesHealthMetricsWebSocketAndSubscribersWithoutHello) {
   EXPECT_EQ(status, 200);
   EXPECT_GT(health["frames"]["received"].get<long>(), 0);
   EXPECT_GE(health["subscribers"].get<int>(), 2);
+  // Frames went out, so encoded buffers exist (the counter only grows, and frames keep coming).
+  EXPECT_GE(health["frame_buffers_allocated"].get<long>(), 1);
+  EXPECT_LE(health["frame_buffers_allocated"].get<uint64_t>(), daemon.metrics().frame_buffers_allocated.load());
   const std::string metrics = http_get(daemon.http_port(), "/metrics", &status);
   EXPECT_EQ(status, 200);
   for (const char* name : {"skinstream_frames_received_total ", "skinstream_frames_published_total ", "skinstream_frames_dropped_total ",
