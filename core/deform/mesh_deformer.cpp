@@ -179,12 +179,11 @@ MeshDeformer::MeshDeformer(const DeformationModel& model, const SubjectModel& su
 
   s.influence_offsets = model.vertex_influence_offsets;
   s.build_clusters(model);
-
   s.build_fans(model.faces);
 
-  for (int p = 0; p < part_count; ++p) s.store_solved(p);  // rest pose until the first solve
-
-  for (int c = 0; c < static_cast<int>(s.clusters.size()); ++c) s.deform_cluster(c);  // rest pose
+  // The rest pose until the first fit.
+  for (int p = 0; p < part_count; ++p) s.store_solved(p);
+  for (int c = 0; c < static_cast<int>(s.clusters.size()); ++c) s.deform_cluster(c);
 }
 
 void MeshDeformer::State::build_clusters(const DeformationModel& model) {
