@@ -84,9 +84,11 @@ void encode(const DeformationModel* d, ByteWriter& w) {
     w.put<double>(inf.weight);
   }
   w.put<double>(d->registration_rms_mm);
+  w.put<uint32_t>(static_cast<uint32_t>(d->part_rbf_ridge.size()));  // version 3
+  for (double ridge : d->part_rbf_ridge) w.put<double>(ridge);
 }
 
-std::optional<DeformationModel> decode_deformation(ByteReader& r) {
+std::optional<DeformationModel> decode_deformation(ByteReader& r, uint32_t version) {
   if (r.get<uint8_t>() == 0) return std::nullopt;
   DeformationModel d;
   d.reference_vertices.resize(r.get_count(24));
@@ -109,6 +111,10 @@ std::optional<DeformationModel> decode_deformation(ByteReader& r) {
     inf.weight = r.get<double>();
   }
   d.registration_rms_mm = r.get<double>();
+  if (version >= 3) {
+    d.part_rbf_ridge.resize(r.get_count(8));
+    for (double& ridge : d.part_rbf_ridge) ridge = r.get<double>();
+  }
   return d;
 }
 
@@ -191,8 +197,8 @@ SubjectFile read_subject_file(const std::string& path) {
     throw FileError(path, "not a skinstream subject file (bad magic)");
   ByteReader header(bytes.data() + 8, 12);
   const uint32_t version = header.get<uint32_t>();
-  if (version != 1 && version != kSubjectFileVersion)
-    throw FileError(path, "subject file version " + std::to_string(version) + ", this build reads version " +
+  if (version < 1 || version > kSubjectFileVersion)
+    throw FileError(path, "subject file version " + std::to_string(version) + ", this build reads versions 1 to " +
                               std::to_string(kSubjectFileVersion) + "; rebuild it with skinstream build-subject");
   const uint64_t size = header.get<uint64_t>();
   if (size != bytes.size() - 24)
@@ -206,7 +212,7 @@ SubjectFile read_subject_file(const std::string& path) {
   try {
     ByteReader r(payload, size);
     file.model = decode(r);
-    if (version >= 2) file.deformation = decode_deformation(r);
+    if (version >= 2) file.deformation = decode_deformation(r, version);
     if (r.remaining() != 0) throw std::out_of_range(std::to_string(r.remaining()) + " unexpected bytes after the model");
   } catch (const std::out_of_range& e) {
     throw FileError(path, std::string("corrupt subject payload: ") + e.what());

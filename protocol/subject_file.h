@@ -7,7 +7,8 @@
 //   payload     little-endian: markers, reference pose, triangles, one-rings, local frames,
 //               anchors, PCA models, fill parameters (see subject_file.cpp, in that order);
 //               version 2 adds a flag byte and, when set, the deformation model of section 5
-//               (registered mesh, parts with marker weights, vertex weights)
+//               (registered mesh, parts with marker weights, vertex weights); version 3
+//               appends to it each part's ridge of eq. 7 (a count, then doubles)
 //   last 4      u32 CRC-32 of the payload
 //
 // Another version, a bad magic, a size or CRC mismatch or an inconsistent model is rejected
@@ -21,7 +22,7 @@
 
 namespace skinstream {
 
-inline constexpr uint32_t kSubjectFileVersion = 2;  // reads 1 (no deformation model) and 2
+inline constexpr uint32_t kSubjectFileVersion = 3;  // reads 1 (no deformation model), 2 (no ridges) and 3
 
 struct SubjectFile {
   SubjectModel model;

@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "clients/skinstream/commands.h"
+#include "clients/skinstream/json_output.h"
 #include "core/capture_filler.h"
 #include "core/offline/deformation_builder.h"
 #include "core/offline/subject_builder.h"
@@ -127,7 +128,8 @@ void add_build_subject(CLI::App& app) {
                      {"mean_shift_groups", d.mean_shift_groups},
                      {"max_part_rigid_rms_mm", d.max_part_rigid_rms_mm},
                      {"boundary_markers", d.boundary_markers},
-                     {"mean_parts_per_vertex", d.mean_influences_per_vertex}};
+                     {"mean_parts_per_vertex", d.mean_influences_per_vertex},
+                     {"part_rbf_ridges", to_json(d.part_ridges)}};
     }
     std::printf("%s\n", out.dump(2).c_str());
   });

@@ -3,11 +3,20 @@
 #include <nlohmann/json.hpp>
 
 #include "core/evaluation/error_stats.h"
+#include "core/offline/rbf_ridge_selection.h"
 
 namespace skinstream::cli {
 
 inline nlohmann::json to_json(const ErrorStats& s) {
   return {{"count", s.count}, {"mean", s.mean}, {"median", s.median}, {"p95", s.p95}, {"max", s.max}};
+}
+
+// Per part the ridge of eq. 7 and the leave-one-out miss that chose it.
+inline nlohmann::json to_json(const std::vector<RidgeChoice>& parts) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const RidgeChoice& c : parts)
+    out.push_back({{"ridge", c.ridge}, {"loo_rms_mm", c.loo_rms_mm}, {"loo_rms_exact_mm", c.loo_rms_exact_mm}});
+  return out;
 }
 
 }  // namespace skinstream::cli

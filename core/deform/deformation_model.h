@@ -26,6 +26,9 @@ struct DeformationModel {
   std::vector<std::string> part_names;
   std::vector<int> part_member_offsets{0};     // CSR over parts
   std::vector<PartMember> part_members;
+  // Per part the ridge of eq. 7 (PartModel::rbf_ridge), chosen by leave-one-out error over the
+  // training take; empty (a subject file before version 3): 0 for every part.
+  std::vector<double> part_rbf_ridge;
 
   std::vector<int> vertex_influence_offsets{0};  // CSR over vertices
   std::vector<PartInfluence> vertex_influences;  // beta_{j,p}, each vertex sums to 1

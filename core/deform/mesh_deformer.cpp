@@ -182,7 +182,9 @@ MeshDeformer::MeshDeformer(const DeformationModel& model, const SubjectModel& su
     }
     s.solved[p].first_centre = s.member_offsets[p];
     s.solved[p].centre_count = static_cast<int>(reference.size());
-    s.parts.emplace_back(build_part_model(reference), mode);
+    PartModel part = build_part_model(reference);
+    if (!model.part_rbf_ridge.empty()) part.rbf_ridge = model.part_rbf_ridge[p];
+    s.parts.emplace_back(std::move(part), mode);
   }
   s.member_scratch.resize(s.member_markers.size());
   s.centres.assign(s.member_markers.size(), RbfCentre{});

@@ -68,16 +68,19 @@ void PartDeformer::solve_residual() {
       kernel_(j, i) = value;
     }
   }
+  double added = model_.rbf_ridge;  // chosen offline, the same every frame
+  kernel_.diagonal().array() += added;
   kernel_lu_.compute(kernel_);
   weights_.noalias() = kernel_lu_.solve(residuals_);
   // The cubic B-spline is not positive definite as a radial function in 3D: with many members
   // and a wide dilation the kernel matrix can be nearly singular, and the exact weights then
   // reach thousands of times the residual and swing the surface between the members by metres.
-  // Then a ridge (smoothing interpolation) is added, the smallest of a few that tames them.
+  // A frame the part's own ridge does not tame (a pose far from the training take) gets a
+  // larger one, the smallest of a few that does.
   const double limit = kMaxWeightGain * std::max(residuals_.cwiseAbs().maxCoeff(), 1e-6);
-  double added = 0.0;
   for (double ridge : {1e-3, 1e-2, 1e-1, 1.0}) {
     if (weights_.allFinite() && weights_.cwiseAbs().maxCoeff() <= limit) break;
+    if (ridge <= added) continue;
     kernel_.diagonal().array() += ridge - added;
     added = ridge;
     kernel_lu_.compute(kernel_);

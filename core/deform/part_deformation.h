@@ -40,7 +40,8 @@ class PartDeformer {
   const Eigen::MatrixX3d& rbf_weights() const { return weights_; }               // w_i, Y x 3
   // False when this frame's kernel matrix was singular; the residual is then not applied.
   bool rbf_applied() const { return rbf_applied_; }
-  // The ridge added to this frame's kernel diagonal (0: exact interpolation at the members).
+  // The ridge added to this frame's kernel diagonal (0: exact interpolation at the members): the
+  // model's rbf_ridge, or more on a frame whose weights it does not keep in bounds.
   double rbf_ridge() const { return ridge_; }
   // Weights beyond this multiple of the largest residual mean a near-singular kernel.
   static constexpr double kMaxWeightGain = 200.0;

@@ -34,6 +34,10 @@ struct PartModel {
   // sigma of eq. 7: twice the largest nearest-member distance. 0 when the residual cannot be
   // interpolated (fewer than 2 distinct members); the RBF term is then skipped.
   double rbf_dilation = 0.0;
+  // Added to the diagonal of eq. 7's kernel matrix (kernel units, phi(0) = 2/3): 0 interpolates
+  // the members exactly, as the paper writes it; the subject builder chooses it per part by
+  // leave-one-out error over the training take (core/offline/rbf_ridge_selection.h).
+  double rbf_ridge = 0.0;
 
   // The members' bounding box in the local part frame. The quadratic field (and the RBF
   // residual) are evaluated at the nearest point of this box and the rest of the offset is

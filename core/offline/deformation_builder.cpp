@@ -61,6 +61,20 @@ DeformationModel build_deformation_model(const SubjectModel& subject, std::span<
   report.mean_influences_per_vertex =
       static_cast<double>(model.vertex_influences.size()) / static_cast<double>(model.vertex_count());
 
+  // Eq. 7's ridge per part, from the members' leave-one-out misses over the training take.
+  for (int p = 0; p < model.part_count(); ++p) {
+    std::vector<Vec3> reference;
+    std::vector<int> members;
+    for (int k = model.part_member_offsets[p]; k < model.part_member_offsets[p + 1]; ++k) {
+      members.push_back(model.part_members[k].marker);
+      reference.push_back(subject.reference_positions[members.back()]);
+    }
+    const RidgeChoice choice =
+        choose_rbf_ridge(build_part_model(reference), members, training, frame_count, subject.marker_count());
+    model.part_rbf_ridge.push_back(choice.ridge);
+    report.part_ridges.push_back(choice);
+  }
+
   const std::string problem = model.validate(subject.marker_count());
   if (!problem.empty()) throw std::invalid_argument("built an inconsistent " + problem);
   if (out_report) *out_report = report;

@@ -11,6 +11,7 @@
 #include "core/offline/marker_part_weights.h"
 #include "core/offline/mesh_registration.h"
 #include "core/offline/part_segmentation.h"
+#include "core/offline/rbf_ridge_selection.h"
 #include "core/subject_model.h"
 
 namespace skinstream {
@@ -36,6 +37,7 @@ struct DeformationBuildReport {
   int boundary_markers = 0;
   int markers_added_for_min_members = 0;
   double mean_influences_per_vertex = 0.0;
+  std::vector<RidgeChoice> part_ridges;  // eq. 7's ridge per part, by leave-one-out error
 };
 
 // subject: the marker model (reference pose and marker surface); training: frame_count x

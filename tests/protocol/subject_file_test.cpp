@@ -120,6 +120,7 @@ DeformationModel limb_deformation(const SubjectModel& model) {
     d.vertex_influence_offsets.push_back(v + 1);
   }
   d.registration_rms_mm = 0.25;
+  d.part_rbf_ridge = {0.0316};
   return d;
 }
 
@@ -135,6 +136,7 @@ TEST_F(SubjectFile, DeformationModelRoundTripsExactly) {
   EXPECT_EQ(back.deformation->part_member_offsets, d.part_member_offsets);
   EXPECT_EQ(back.deformation->vertex_influence_offsets, d.vertex_influence_offsets);
   EXPECT_EQ(back.deformation->registration_rms_mm, 0.25);
+  EXPECT_EQ(back.deformation->part_rbf_ridge, d.part_rbf_ridge);
   EXPECT_EQ(back.model.marker_names, model_.marker_names);
   // Without a mesh: no deformation model, and read_subject still gives the markers.
   EXPECT_FALSE(read_subject_file(path_).deformation.has_value());
@@ -149,6 +151,16 @@ TEST_F(SubjectFile, RefusesToWriteADeformationModelOfAnotherSubject) {
     FAIL() << "wrote a mismatched deformation model";
   } catch (const FileError& e) {
     EXPECT_NE(std::string(e.what()).find("part member marker"), std::string::npos) << e.what();
+  }
+  for (const std::vector<double>& ridges : {std::vector<double>{0.1, 0.2}, std::vector<double>{-0.1}}) {
+    DeformationModel bad_ridges = limb_deformation(model_);
+    bad_ridges.part_rbf_ridge = ridges;  // two for one part; a negative one
+    try {
+      write_subject(model_, &bad_ridges, test::scratch_path("ridges.subject"));
+      FAIL() << "wrote unusable ridges";
+    } catch (const FileError& e) {
+      EXPECT_NE(std::string(e.what()).find("ridge"), std::string::npos) << e.what();
+    }
   }
 }
 

@@ -136,6 +136,28 @@ TEST(PartDeformer, NearSingularKernelGetsARidgeAndBoundedWeights) {
   EXPECT_LE(part.rbf_weights().cwiseAbs().maxCoeff(), PartDeformer::kMaxWeightGain * residual);
 }
 
+// The model's ridge: eq. 7 with lambda on the kernel diagonal, so at each member the fit falls
+// short of the marker by exactly lambda times its weight (Phi w = r - lambda w).
+TEST(PartDeformer, ModelRidgeSmoothsTheResidualByExactlyItsShare) {
+  std::mt19937_64 rng(16);
+  const std::vector<Vec3> members = random_points(rng, 30, Vec3(120, 60, 40));
+  const std::vector<Vec3> now = deform_non_rigidly(members, random_motion(rng));
+  PartModel model = build_part_model(members);
+  model.rbf_ridge = 0.05;
+  PartDeformer part(model, DeformationMode::QuadraticRbf);
+  ASSERT_TRUE(part.solve(now));
+  ASSERT_TRUE(part.rbf_applied());
+  EXPECT_EQ(part.rbf_ridge(), 0.05);
+  double smallest_gap = 1e9;
+  for (int i = 0; i < model.member_count(); ++i) {
+    const Vec3 fitted = part.to_local().apply(part.deform(model.local_reference_points[i]));
+    const Vec3 expected = part.local_positions().col(i) - 0.05 * part.rbf_weights().row(i).transpose();
+    EXPECT_LT((fitted - expected).norm(), 1e-6) << i;
+    smallest_gap = std::min(smallest_gap, (fitted - part.local_positions().col(i)).norm());
+  }
+  EXPECT_GT(smallest_gap, 0.0);  // no longer an interpolant
+}
+
 TEST(PartDeformer, DegenerateMemberSetsGiveNoNaN) {
   std::mt19937_64 rng(15);
   std::vector<Vec3> collinear;
