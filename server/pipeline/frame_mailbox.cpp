@@ -1,19 +1,32 @@
 #include "server/pipeline/frame_mailbox.h"
 
-#include <utility>
+#include <stdexcept>
 
 namespace skinstream::server {
 
-FrameMailbox::FrameMailbox(int marker_count)
-    : slots_{MarkerFrame(marker_count), MarkerFrame(marker_count), MarkerFrame(marker_count)} {}
+FrameMailbox::FrameMailbox(int marker_count, int backlog)
+    : backlog_(backlog >= 1 ? backlog : throw std::invalid_argument("frame mailbox: backlog below 1")),
+      slots_(static_cast<size_t>(backlog) + 2, MarkerFrame(marker_count)),
+      generations_(slots_.size(), 0),
+      waiting_(static_cast<size_t>(backlog), 0) {
+  free_.reserve(slots_.size());
+  for (int slot = static_cast<int>(slots_.size()) - 1; slot >= 2; --slot) free_.push_back(slot);
+}
 
 void FrameMailbox::post(uint64_t generation) {
   {
     std::lock_guard lock(mutex_);
     generations_[write_] = generation;
-    std::swap(write_, ready_);
-    if (has_ready_) ++dropped_;  // the frame now in write_ was never taken
-    has_ready_ = true;
+    if (waiting_count_ == backlog_) {  // full: the oldest waiting frame is never taken
+      free_.push_back(waiting_[waiting_head_]);
+      waiting_head_ = (waiting_head_ + 1) % backlog_;
+      --waiting_count_;
+      ++dropped_;
+    }
+    waiting_[(waiting_head_ + waiting_count_) % backlog_] = write_;
+    ++waiting_count_;
+    write_ = free_.back();  // one is free: backlog + 2 slots, at most backlog waiting
+    free_.pop_back();
     ++posted_;
   }
   ready_cv_.notify_one();
@@ -21,9 +34,12 @@ void FrameMailbox::post(uint64_t generation) {
 
 const MarkerFrame* FrameMailbox::take(std::chrono::milliseconds timeout, uint64_t& out_generation) {
   std::unique_lock lock(mutex_);
-  if (!ready_cv_.wait_for(lock, timeout, [&] { return has_ready_ || closed_; }) || !has_ready_) return nullptr;
-  std::swap(read_, ready_);
-  has_ready_ = false;
+  if (!ready_cv_.wait_for(lock, timeout, [&] { return waiting_count_ > 0 || closed_; }) || waiting_count_ == 0)
+    return nullptr;
+  free_.push_back(read_);  // the frame taken last time is done with
+  read_ = waiting_[waiting_head_];
+  waiting_head_ = (waiting_head_ + 1) % backlog_;
+  --waiting_count_;
   out_generation = generations_[read_];
   return &slots_[read_];
 }
@@ -44,6 +60,11 @@ uint64_t FrameMailbox::dropped() const {
 uint64_t FrameMailbox::posted() const {
   std::lock_guard lock(mutex_);
   return posted_;
+}
+
+int FrameMailbox::waiting() const {
+  std::lock_guard lock(mutex_);
+  return waiting_count_;
 }
 
 }  // namespace skinstream::server

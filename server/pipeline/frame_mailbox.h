@@ -1,14 +1,17 @@
 #pragma once
-// Hands marker frames from the io thread to the pipeline thread: newest frame wins. Three
-// preallocated slots (being written, ready, being read), so the writer never waits for the
-// reader and nothing is allocated per frame. A ready frame overwritten before the pipeline took
-// it is counted as dropped.
+// Hands marker frames from the io thread to the pipeline thread, oldest first, with a short
+// bounded backlog. Frames that arrive together (the io thread was descheduled, the network
+// held them) are all processed, so the gap filler sees every frame; when the pipeline falls
+// behind by more than the backlog, the oldest waiting frame gives way (counted as dropped),
+// so the newest frame always gets in and the added latency stays bounded. backlog + 2
+// preallocated slots (being written, being read, the waiting ones): the writer never waits for
+// the reader and nothing is allocated per frame. A backlog of 1 is "newest frame wins".
 
-#include <array>
 #include <chrono>
 #include <condition_variable>
 #include <cstdint>
 #include <mutex>
+#include <vector>
 
 #include "server/ingest/marker_frame.h"
 
@@ -16,28 +19,37 @@ namespace skinstream::server {
 
 class FrameMailbox {
  public:
-  explicit FrameMailbox(int marker_count);
+  // 3 frames: 25 ms at 120 Hz, several times a frame's processing time, so a stall of the
+  // pipeline or a burst from the io thread of that length is caught up without a loss.
+  static constexpr int kDefaultBacklog = 3;
+
+  // Throws std::invalid_argument for a backlog below 1.
+  explicit FrameMailbox(int marker_count, int backlog = kDefaultBacklog);
 
   // Producer side (one thread): fill writable() completely, then post() it. `generation` changes
   // when the source restarts (reconnect, replay loop): the pipeline then forgets the past.
   MarkerFrame& writable() { return slots_[write_]; }
   void post(uint64_t generation);
 
-  // Consumer side (one thread): the newest frame, or nullptr after `timeout` or close(). The
-  // frame stays valid until the next take().
+  // Consumer side (one thread): the oldest waiting frame, or nullptr after `timeout` or close().
+  // The frame stays valid until the next take().
   const MarkerFrame* take(std::chrono::milliseconds timeout, uint64_t& out_generation);
   void close();
 
   uint64_t dropped() const;
   uint64_t posted() const;
+  int waiting() const;  // posted and not yet taken
 
  private:
+  const int backlog_;
   mutable std::mutex mutex_;
   std::condition_variable ready_cv_;
-  std::array<MarkerFrame, 3> slots_;
-  std::array<uint64_t, 3> generations_{};
-  int write_ = 0, ready_ = 1, read_ = 2;
-  bool has_ready_ = false;
+  std::vector<MarkerFrame> slots_;
+  std::vector<uint64_t> generations_;  // per slot
+  std::vector<int> waiting_;           // ring of slot indices, oldest at waiting_head_
+  int waiting_head_ = 0, waiting_count_ = 0;
+  std::vector<int> free_;  // slots nobody holds; capacity reserved for all of them
+  int write_ = 0, read_ = 1;
   bool closed_ = false;
   uint64_t dropped_ = 0;
   uint64_t posted_ = 0;

@@ -1,6 +1,6 @@
 #pragma once
-// The pipeline thread: takes the newest marker frame from the mailbox, fills it (GapFiller, then
-// the optional lookahead blend of GapEndBlender, as core/capture_filler.cpp does), deforms the
+// The pipeline thread: takes the marker frames from the mailbox in order, fills each (GapFiller,
+// then the optional lookahead blend of GapEndBlender, as core/capture_filler.cpp does), deforms the
 // mesh (MeshDeformer over DeformWorkers), encodes the Frame message in every encoding someone
 // subscribed to into a pooled buffer, and hands it to the publishers. Allocates nothing per
 // frame in steady state; never waits for a subscriber.
