@@ -1,6 +1,7 @@
 #include "core/offline/rbf_ridge_selection.h"
 
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>

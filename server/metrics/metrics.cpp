@@ -70,7 +70,7 @@ std::string Metrics::render_prometheus(const std::vector<SubscriberMetrics>& sub
   counter(out, "frames_received_total", "Marker frames received from the source.", frames_received);
   counter(out, "frames_processed_total", "Frames through the gap filler.", frames_processed);
   counter(out, "frames_published_total", "Frames handed to the publishers.", frames_published);
-  counter(out, "frames_dropped_total", "Frames overwritten by a newer one before the pipeline took them.", frames_dropped);
+  counter(out, "frames_dropped_total", "Frames that waited in the mailbox beyond its backlog and gave way to newer ones.", frames_dropped);
   counter(out, "markers_filled_total", "Marker samples filled (PCA, rigid or held).", markers_filled);
   counter(out, "markers_relabelled_total", "Marker samples taken from unlabelled points.", markers_relabelled);
   counter(out, "markers_held_total", "Marker samples held relative to their anchors.", markers_held);

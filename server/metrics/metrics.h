@@ -41,7 +41,7 @@ class Metrics {
   std::atomic<uint64_t> frames_received{0};
   std::atomic<uint64_t> frames_processed{0};
   std::atomic<uint64_t> frames_published{0};
-  std::atomic<uint64_t> frames_dropped{0};  // overwritten in the mailbox before the pipeline took them
+  std::atomic<uint64_t> frames_dropped{0};  // gave way in the mailbox, beyond its backlog
   std::atomic<uint64_t> markers_filled{0};
   std::atomic<uint64_t> markers_relabelled{0};
   std::atomic<uint64_t> markers_held{0};
