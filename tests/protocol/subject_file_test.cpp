@@ -2,10 +2,12 @@
 
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <fstream>
 #include <iterator>
 
 #include "core/offline/subject_builder.h"
+#include "protocol/byte_buffer.h"
 #include "protocol/file_error.h"
 #include "support/synthetic_limb.h"
 #include "support/test_data.h"
@@ -141,6 +143,31 @@ TEST_F(SubjectFile, DeformationModelRoundTripsExactly) {
   // Without a mesh: no deformation model, and read_subject still gives the markers.
   EXPECT_FALSE(read_subject_file(path_).deformation.has_value());
   EXPECT_EQ(read_subject(path).marker_names, model_.marker_names);
+}
+
+// A version 2 file (before the per-part ridges): the same layout without the ridge count at
+// the end of the deformation section. It still reads, with no ridges (0 for every part).
+TEST_F(SubjectFile, VersionTwoFileReadsWithoutRidges) {
+  DeformationModel d = limb_deformation(model_);
+  d.part_rbf_ridge.clear();
+  const std::string path = test::scratch_path("limb_v2.subject");
+  write_subject(model_, &d, path);
+  std::vector<char> bytes = slurp(path);
+  bytes.erase(bytes.end() - 8, bytes.end() - 4);  // the ridge count (0), just before the CRC
+  const uint32_t version = 2;
+  std::memcpy(bytes.data() + 8, &version, 4);
+  uint64_t size = 0;
+  std::memcpy(&size, bytes.data() + 12, 8);
+  size -= 4;
+  std::memcpy(bytes.data() + 12, &size, 8);
+  const uint32_t crc = crc32(reinterpret_cast<const unsigned char*>(bytes.data()) + 20, size);
+  std::memcpy(bytes.data() + bytes.size() - 4, &crc, 4);
+  spit(path, bytes);
+  const auto back = read_subject_file(path);
+  ASSERT_TRUE(back.deformation.has_value());
+  EXPECT_TRUE(back.deformation->part_rbf_ridge.empty());
+  EXPECT_EQ(back.deformation->registration_rms_mm, 0.25);
+  EXPECT_EQ(back.deformation->validate(model_.marker_count()), "");
 }
 
 TEST_F(SubjectFile, RefusesToWriteADeformationModelOfAnotherSubject) {
