@@ -19,7 +19,10 @@
 namespace skinstream {
 
 // The candidates: 0 (exact interpolation, the paper as written) and a logarithmic grid from
-// 1e-5 to 1, four per decade, in kernel units (phi(0) = 2/3).
+// 1e-5 to 1, four per decade, in kernel units (phi(0) = 2/3). The top is not a neutral bound:
+// small parts pick it, and with a grid up to 100 they pick 100 (no residual in effect) and the
+// synthetic takes all got worse. Leaving a marker out of a small part opens a gap wider than
+// any vertex sees, so leave-one-out over-smooths there (README, skin deformation).
 std::vector<double> rbf_ridge_candidates();
 
 // Sum over members of |e_i|^2 (mm^2), Rippa's formula, for each ridge; one frame's centres
