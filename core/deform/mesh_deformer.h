@@ -59,7 +59,7 @@ class MeshDeformer {
 
   int vertex_count() const;
   DeformationMode mode() const;
-  // Heap bytes held by the runtime state (precomputed per-vertex data, parts, normals scratch).
+  // Heap bytes held by the runtime state (precomputed per-vertex data and fans, parts).
   size_t memory_bytes() const;
 
  private:

@@ -57,17 +57,8 @@ bool PartDeformer::solve(std::span<const Vec3> member_positions_now) {
 // Eq. 7: weights w with sum_i w_i phi(|p~_i - p~_j| / sigma) = r_j. The centres move every
 // frame, so the kernel is rebuilt and LU-refactored in the preallocated storage.
 void PartDeformer::solve_residual() {
-  const int count = model_.member_count();
-  const double inverse_sigma = 1.0 / model_.rbf_dilation;
   residuals_ = (local_now_ - centres_).transpose();
-  for (int j = 0; j < count; ++j) {
-    kernel_(j, j) = cubic_bspline_kernel(0.0);
-    for (int i = j + 1; i < count; ++i) {
-      const double value = cubic_bspline_kernel((centres_.col(i) - centres_.col(j)).norm() * inverse_sigma);
-      kernel_(i, j) = value;
-      kernel_(j, i) = value;
-    }
-  }
+  fill_rbf_kernel(centres_, model_.rbf_dilation, kernel_);
   double added = model_.rbf_ridge;  // chosen offline, the same every frame
   kernel_.diagonal().array() += added;
   kernel_lu_.compute(kernel_);

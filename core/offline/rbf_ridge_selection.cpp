@@ -21,8 +21,7 @@ std::vector<double> leave_one_out_squared_errors(const Eigen::Matrix3Xd& centres
                                                  double dilation, std::span<const double> ridges) {
   const int count = static_cast<int>(centres.cols());
   Eigen::MatrixXd kernel(count, count);
-  for (int j = 0; j < count; ++j)
-    for (int i = 0; i < count; ++i) kernel(i, j) = cubic_bspline_kernel((centres.col(i) - centres.col(j)).norm() / dilation);
+  fill_rbf_kernel(centres, dilation, kernel);
   const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(kernel);
   const Eigen::MatrixXd& v = eigen.eigenvectors();
   const Eigen::VectorXd& mu = eigen.eigenvalues();
