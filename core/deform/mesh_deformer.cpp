@@ -85,11 +85,13 @@ inline __attribute__((always_inline)) void sum_rbf_lanes(const RbfCentre* __rest
   for (int i = 0; i < n; ++i) {
     const RbfCentre& c = centres[listed[i]];
     const Lanes dx = x - c.x, dy = y - c.y, dz = z - c.z;
-    const Lanes r = lane_sqrt(dx * dx + dy * dy + dz * dz);
-    Lanes far = 2.0f - r, near = 1.0f - r;
-    far = far > zero ? far : zero;
-    near = near > zero ? near : zero;
-    const Lanes phi = far * far * far - 4.0f * (near * near * near);
+    const Lanes squared = dx * dx + dy * dy + dz * dz;
+    const Lanes r = lane_sqrt(squared);
+    // 6 phi: (2 - r)^3 on [1, 2), 4 - 6 r^2 + 3 r^3 below 1 (two fused multiply-adds), 0 beyond.
+    const Lanes far = 2.0f - r;
+    const Lanes outer = r < 2.0f ? far * far * far : zero;
+    const Lanes inner = (3.0f * r - 6.0f) * squared + 4.0f;
+    const Lanes phi = r < 1.0f ? inner : outer;
     sx += phi * c.wx;
     sy += phi * c.wy;
     sz += phi * c.wz;
