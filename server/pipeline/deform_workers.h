@@ -39,11 +39,11 @@ class DeformWorkers {
   int64_t last_normals_ns() const { return normals_ns_; }
 
  private:
-  // One stage's tasks: `next` holds the frame's generation in its high 32 bits and the next
-  // task in its low 32, so a worker that wakes after its frame ended can never take a task of
-  // the next one; `done` counts finished tasks.
+  // One stage's tasks: `left` holds the frame's generation in its high 32 bits and the tasks
+  // not yet taken, [front, back), in its low 32 (16 bits each), so a worker that wakes after its
+  // frame ended can never take a task of the next one; `done` counts finished tasks.
   struct alignas(64) Stage {  // own cache line: both threads hammer these counters
-    std::atomic<uint64_t> next{0};
+    std::atomic<uint64_t> left{0};
     std::atomic<uint32_t> done{0};
     uint32_t tasks = 0;
   };
@@ -53,8 +53,10 @@ class DeformWorkers {
 
   void work();
   void run_frame(uint32_t generation, const std::chrono::steady_clock::time_point* start);
+  // Which end of a stage's tasks a participant takes from.
+  enum class End { Front, Back };
   template <typename Task>
-  bool run_stage(Stage& stage, uint32_t generation, Task&& task);
+  bool run_stage(Stage& stage, uint32_t generation, End end, Task&& task);
   void reset(Stage& stage, uint32_t generation, bool skip);
   void fit_or_cluster_task(uint32_t task, uint32_t generation);
 
