@@ -20,7 +20,8 @@ SubscriberSession::SubscriberSession(asio::io_context& io, SubscriberHub& hub, s
       transport_(std::move(transport)),
       remote_(std::move(remote)),
       queue_(hub.options().queue_frames),
-      hello_timer_(io) {}
+      hello_timer_(io),
+      pump_slot_(std::make_shared<HandlerSlot>()) {}
 
 void SubscriberSession::offer(const FrameRef& frame) {
   if (!frame->has(flags_.load())) return;  // encoding not ready in this frame (wants just changed)
@@ -100,31 +101,28 @@ void SubscriberSession::on_disconnected(const std::string& reason) {
 
 void SubscriberSession::kick() {
   if (pump_scheduled_.exchange(true)) return;
-  asio::post(io_, [self = shared_from_this()] { self->pump(); });
+  // Only the posted pump clears pump_scheduled_, as it starts (asio has given its memory back by
+  // then): one posted pump at a time, so its memory can be the session's slot.
+  asio::post(io_, in_slot(pump_slot_, [self = shared_from_this()] {
+               self->pump_scheduled_.store(false);
+               self->pump();
+             }));
 }
 
+// Io thread: from the posted kick, after a write, after an Ack. Anything pushed after the queue
+// was found empty here comes with a kick that posts a pump (its flag is clear by now).
 void SubscriberSession::pump() {
+  if (writing_ || closed_) return;
   for (;;) {
-    if (writing_ || closed_) {
-      pump_scheduled_.store(false);
-      return;
-    }
     // A paced subscriber with its window full gets control messages only; its frames wait in
     // the queue, where the newest wins, and the one sent next is the newest.
     const bool window_full = paced_ && unacked_ >= subscriber::kPacedWindow;
     const auto take = window_full ? SubscriberQueue::Take::ControlOnly
                                   : (paced_ ? SubscriberQueue::Take::NewestFrame : SubscriberQueue::Take::OldestFrame);
-    if (queue_.pop(in_flight_, take)) {
-      if (in_flight_.control || in_flight_.frame->has(flags_.load())) break;
-      in_flight_.frame.reset();  // encoded for this subscriber's previous wants
-      continue;
-    }
-    pump_scheduled_.store(false);
-    // A push between pop() and the store above saw the flag set and did not post: look again.
-    // (With the window full only a control message could be sent; an Ack calls pump() again.)
-    if ((window_full ? !queue_.has_control() : queue_.empty()) || pump_scheduled_.exchange(true)) return;
+    if (!queue_.pop(in_flight_, take)) return;
+    if (in_flight_.control || in_flight_.frame->has(flags_.load())) break;
+    in_flight_.frame.reset();  // encoded for this subscriber's previous wants
   }
-  pump_scheduled_.store(false);
   writing_ = true;
   if (in_flight_.control) {
     start_write({asio::buffer(*in_flight_.control), asio::const_buffer()});

@@ -13,6 +13,7 @@
 #include "server/asio.h"
 #include "server/metrics/metrics.h"
 #include "protocol/subscriber_stream.h"
+#include "server/publish/handler_slot.h"
 #include "server/publish/subscriber_queue.h"
 
 namespace skinstream::server {
@@ -63,6 +64,7 @@ class SubscriberSession : public std::enable_shared_from_this<SubscriberSession>
   bool paced_ = false;  // Hello asked for kWantPaced
   int unacked_ = 0;     // Frames sent (or being sent) and not acknowledged yet
   std::atomic<bool> pump_scheduled_{false};
+  std::shared_ptr<HandlerSlot> pump_slot_;  // the posted pump's memory: the pipeline thread posts it
   std::atomic<uint32_t> flags_{0};
   std::atomic<uint64_t> sent_{0};
   SubscriberQueue::Item in_flight_;
