@@ -24,22 +24,38 @@ void FrameRef::reset() {
   frame_ = nullptr;
 }
 
+FramePool::FramePool(int initial_frames) {
+  std::lock_guard lock(mutex_);
+  for (int i = 0; i < initial_frames; ++i) create_locked();
+  free_ = all_;
+  free_count_ = all_.size();
+}
+
 FramePool::~FramePool() {
   for (EncodedFrame* f : all_) delete f;
+}
+
+// With no frame free (free_count_ == 0): a new one, and the ring grown to hold every frame, so
+// release() never allocates.
+EncodedFrame* FramePool::create_locked() {
+  EncodedFrame* frame = new EncodedFrame();
+  frame->pool_ = this;
+  all_.push_back(frame);
+  free_.assign(all_.size(), nullptr);
+  free_head_ = 0;
+  return frame;
 }
 
 FrameRef FramePool::acquire() {
   EncodedFrame* frame = nullptr;
   {
     std::lock_guard lock(mutex_);
-    if (!free_.empty()) {
-      frame = free_.back();
-      free_.pop_back();
+    if (free_count_ > 0) {
+      frame = free_[free_head_];
+      free_head_ = (free_head_ + 1) % free_.size();
+      --free_count_;
     } else {
-      frame = new EncodedFrame();
-      frame->pool_ = this;
-      all_.push_back(frame);
-      free_.reserve(all_.size());  // release() never allocates
+      frame = create_locked();
     }
   }
   frame->encoded_mask = 0;
@@ -53,7 +69,7 @@ size_t FramePool::allocated() const {
 
 void FramePool::release(EncodedFrame* frame) {
   std::lock_guard lock(mutex_);
-  free_.push_back(frame);
+  free_[(free_head_ + free_count_++) % free_.size()] = frame;
 }
 
 }  // namespace skinstream::server

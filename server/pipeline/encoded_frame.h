@@ -2,7 +2,10 @@
 // A published frame: the Frame message in every encoding a subscriber asked for, immutable once
 // published and shared by all subscribers through a reference count. The buffers come from a
 // pool and go back to it when the last subscriber has written them, so steady state allocates
-// nothing (the pool only grows while the number of frames held at once grows).
+// nothing (the pool only grows while the number of frames held at once grows beyond what it
+// was made with). Free frames are reused oldest first, so every pooled frame has its buffers
+// sized for an encoding within a few frames of a subscriber asking for it, not minutes later
+// when a late subscriber first holds more frames than usual.
 
 #include <array>
 #include <atomic>
@@ -56,7 +59,7 @@ class FrameRef {
 
 class FramePool {
  public:
-  FramePool() = default;
+  explicit FramePool(int initial_frames = 0);
   FramePool(const FramePool&) = delete;
   FramePool& operator=(const FramePool&) = delete;
   ~FramePool();  // every FrameRef must be gone by then
@@ -69,9 +72,12 @@ class FramePool {
   friend class FrameRef;
   void release(EncodedFrame* frame);
 
+  EncodedFrame* create_locked();
+
   mutable std::mutex mutex_;
   std::vector<EncodedFrame*> all_;
-  std::vector<EncodedFrame*> free_;
+  std::vector<EncodedFrame*> free_;  // a ring of all_.size() slots: free_count_ from free_head_
+  size_t free_head_ = 0, free_count_ = 0;
 };
 
 }  // namespace skinstream::server

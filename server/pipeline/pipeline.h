@@ -72,7 +72,11 @@ class Pipeline {
   FrameMailbox& mailbox_;
   FrameConsumer& consumer_;
   Metrics& metrics_;
-  FramePool pool_;
+  // Frames alive at once: the one being encoded, two queued and one being written per
+  // subscriber, more when subscribers are at different frames. Made up front, so the buffers are
+  // all sized within the first frames (EncodedFrame sizes them per encoding on first use).
+  static constexpr int kPooledFrames = 8;
+  FramePool pool_{kPooledFrames};
 
   std::optional<GapFiller> filler_;
   double filler_rate_hz_ = 0.0;

@@ -1,0 +1,153 @@
+// The pipeline thread with a real subscriber on loopback: a real take (CMU 85_12, with gaps cut
+// into it) is filled, a mesh deformed over two threads, the frame encoded and handed to a TCP
+// subscriber. In steady state the pipeline thread allocates nothing per frame, from taking the
+// frame to handing it to every subscriber.
+#include "server/pipeline/pipeline.h"
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <optional>
+#include <thread>
+
+#include "core/offline/subject_builder.h"
+#include "protocol/capture_file.h"
+#include "server/client/subscriber_client.h"
+#include "server/publish/subscriber_hub.h"
+#include "server/publish/tcp_subscriber.h"
+#include "support/allocation_counter.h"
+#include "support/test_data.h"
+
+namespace skinstream::server {
+namespace {
+
+// One part made of every marker, over a mesh of the markers' own reference positions and a
+// copy of them 20 mm out (faces between consecutive markers): small, but every stage of the
+// deformation runs.
+DeformationModel one_part_over(const SubjectModel& subject) {
+  DeformationModel model;
+  model.part_names = {"all"};
+  for (int m = 0; m < subject.marker_count(); ++m) model.part_members.push_back({m, 1.0});
+  model.part_member_offsets.push_back(subject.marker_count());
+  for (const Vec3& p : subject.reference_positions) model.reference_vertices.push_back(p);
+  for (const Vec3& p : subject.reference_positions) model.reference_vertices.push_back(p + Vec3(0, 0, 20));
+  const int n = subject.marker_count();
+  for (int v = 0; v < 2 * n; ++v) {
+    model.vertex_influences.push_back({0, 1.0});
+    model.vertex_influence_offsets.push_back(static_cast<int>(model.vertex_influences.size()));
+  }
+  for (int m = 0; m + 1 < n; ++m) {
+    model.faces.push_back({m, m + 1, n + m});
+    model.faces.push_back({m + 1, n + m + 1, n + m});
+  }
+  return model;
+}
+
+// Passes frames on to the hub and counts the pipeline thread's heap allocations from the
+// publish of frame `first` to that of frame `last`: everything the thread did for the frames
+// in between.
+class CountingConsumer : public FrameConsumer {
+ public:
+  CountingConsumer(SubscriberHub& hub, int first, int last) : hub_(hub), first_(first), last_(last) {}
+  uint32_t wanted_encodings() const override { return hub_.wanted_encodings(); }
+  void publish(const FrameRef& frame) override {
+    hub_.publish(frame);
+    const int n = ++published_;
+    if (n == first_) counter_.emplace();
+    if (n == last_) {
+      allocations_ = counter_->count();
+      counter_.reset();
+      measured_.store(true);
+    }
+  }
+  bool measured() const { return measured_.load(); }
+  size_t allocations() const { return allocations_; }
+
+ private:
+  SubscriberHub& hub_;
+  const int first_, last_;
+  int published_ = 0;
+  std::optional<test::CountAllocations> counter_;
+  size_t allocations_ = 0;
+  std::atomic<bool> measured_{false};
+};
+
+TEST(Pipeline, AllocatesNothingPerFrameFromMailboxToSubscriber) {
+  const SubjectModel subject = build_subject(read_capture(test::source_path("replay_data/cmu/85_02.c3d")), {});
+  const Capture take = read_capture(test::source_path("replay_data/cmu/85_12.c3d"));
+  ASSERT_EQ(take.point_count(), subject.marker_count());
+  const DeformationModel deformation = one_part_over(subject);
+  ASSERT_EQ(deformation.validate(subject.marker_count()), "");
+
+  asio::io_context io;
+  auto guard = asio::make_work_guard(io);
+  std::thread io_thread([&] { io.run(); });
+  Metrics metrics;
+  subscriber::MeshInfo info;
+  info.vertex_count = static_cast<uint32_t>(deformation.vertex_count());
+  info.marker_count = static_cast<uint32_t>(subject.marker_count());
+  info.part_count = 1;
+  info.marker_names = subject.marker_names;
+  for (const auto& f : deformation.faces)
+    info.faces.push_back({static_cast<uint32_t>(f[0]), static_cast<uint32_t>(f[1]), static_cast<uint32_t>(f[2])});
+  info.dominant_part.assign(info.vertex_count, 0);
+  SubscriberHub hub(metrics, HubOptions{}, info, true);
+
+  tcp::acceptor acceptor(io, tcp::endpoint(asio::ip::make_address("127.0.0.1"), 0));
+  acceptor.async_accept([&](const boost::system::error_code& ec, tcp::socket socket) {
+    ASSERT_FALSE(ec) << ec.message();
+    auto session = std::make_shared<TcpSubscriber>(io, hub, std::move(socket), "test");
+    hub.add(session);
+    session->start();
+  });
+  // The subscriber wants everything a renderer can ask for (positions, normals, markers).
+  std::atomic<int> frames_received{0};
+  std::thread subscriber_thread([&, port = acceptor.local_endpoint().port()] {
+    sub::SubscriberClient client("127.0.0.1", std::to_string(port), subscriber::kWantNormals | subscriber::kWantMarkers);
+    client.run([&](subscriber::MessageType type, std::span<const unsigned char>, int64_t) {
+      if (type == subscriber::MessageType::Frame) ++frames_received;
+      return true;
+    });
+  });
+  const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+  while (hub.wanted_encodings() == 0 && std::chrono::steady_clock::now() < give_up)
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  ASSERT_NE(hub.wanted_encodings(), 0u) << "the subscriber never said Hello";
+
+  constexpr int kFrames = 200, kFirst = 40, kLast = 180;
+  FrameMailbox mailbox(subject.marker_count());
+  CountingConsumer consumer(hub, kFirst, kLast);
+  PipelineOptions options;
+  options.deform_threads = 2;
+  Pipeline pipeline(subject, &deformation, options, mailbox, consumer, metrics);
+  pipeline.start();
+  for (int f = 0; f < kFrames; ++f) {
+    MarkerFrame& frame = mailbox.writable();
+    frame.clear();
+    frame.frame_number = static_cast<uint32_t>(f);
+    frame.source_rate_hz = take.rate_hz;
+    frame.source_time_ns = static_cast<int64_t>(f * 1e9 / take.rate_hz);
+    frame.receive_time_ns = sub::wall_clock_ns();
+    // Gaps of 15 frames rolling over the markers (the take itself is cleaned): they are filled.
+    for (int m = 0; m < subject.marker_count(); ++m)
+      frame.labelled[m] = f >= 20 && (m + f / 15) % 13 == 0 ? missing_point() : take.at(f, m);
+    mailbox.post(1);
+    // Lockstep with the subscriber: every frame is processed and received (when fed as fast as
+    // the pipeline runs, a subscriber on a busy machine falls behind its queue of 2).
+    while (frames_received.load() < f + 1 && std::chrono::steady_clock::now() < give_up) std::this_thread::yield();
+  }
+  ASSERT_TRUE(consumer.measured()) << "published " << pipeline.frames_published();
+  EXPECT_EQ(consumer.allocations(), 0u) << "heap allocations on the pipeline thread over " << kLast - kFirst << " frames";
+  EXPECT_EQ(mailbox.dropped(), 0u);
+
+  EXPECT_EQ(frames_received.load(), kFrames);
+  pipeline.stop();
+  hub.close_all();
+  guard.reset();
+  io.stop();
+  io_thread.join();
+  subscriber_thread.join();
+}
+
+}  // namespace
+}  // namespace skinstream::server
