@@ -7,7 +7,7 @@
 namespace skinstream::server {
 namespace {
 
-constexpr int kClustersPerTask = 8;  // ~3 us of work: small enough to share, large enough to count
+constexpr int kClustersPerTask = 8;  // ~6 us of work: small enough to share, large enough to count
 constexpr int kVertexTasks = 32;     // per vertex stage
 constexpr int kMaxTasks = 0xffff;    // per stage: tasks are counted in 16 bits
 
