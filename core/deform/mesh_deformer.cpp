@@ -310,6 +310,8 @@ void MeshDeformer::State::build_clusters(const DeformationModel& model) {
     }
   }
   cluster_result.assign(clusters.size(), ClusterResult{});
+  clusters.shrink_to_fit();  // grown by push_back: up to half of it slack
+  cluster_lanes.shrink_to_fit();
 }
 
 void MeshDeformer::State::build_fans(const std::vector<std::array<int, 3>>& faces) {
@@ -373,6 +375,7 @@ void MeshDeformer::State::build_fans(const std::vector<std::array<int, 3>>& face
       }
     fan_block_offsets[b + 1] = fan_block_offsets[b] + rows + 1;
   }
+  fan_rows.shrink_to_fit();
 }
 
 MeshDeformer::~MeshDeformer() = default;
