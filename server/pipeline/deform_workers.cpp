@@ -37,7 +37,8 @@ DeformWorkers::DeformWorkers(MeshDeformer& deformer, int threads)
   // The clusters of a part are contiguous; take the parts with the cheapest fit first, so that
   // a thread reaches a part's clusters when its fit is most likely done.
   // A stage counts its tasks in 16 bits: a mesh far beyond ~100k vertices gets larger chunks.
-  const int clusters_per_task = std::max(kClustersPerTask, deformer_.cluster_count() / (kMaxTasks - parts - 1) + 1);
+  // (Each part may add one short chunk: room is left for those and for the fits.)
+  const int clusters_per_task = std::max(kClustersPerTask, deformer_.cluster_count() / (kMaxTasks - 2 * parts - 1) + 1);
   for (auto it = part_order_.rbegin(); it != part_order_.rend(); ++it)
     for (int c = 0; c < deformer_.cluster_count();) {
       if (deformer_.cluster_part(c) != *it) {
