@@ -11,6 +11,11 @@ constexpr int kClustersPerTask = 8;  // ~6 us of work: small enough to share, la
 constexpr int kVertexTasks = 32;     // per vertex stage
 constexpr int kMaxTasks = 0xffff;    // per stage: tasks are counted in 16 bits
 
+// A stage's Stage::left: the generation, then the first and one past the last task not taken.
+uint64_t pack_left(uint32_t generation, uint32_t front, uint32_t back) {
+  return (static_cast<uint64_t>(generation) << 32) | (front << 16) | back;
+}
+
 // Waiting for another thread's short task: spin a little, then give the core away.
 void pause(int& spins) {
   if (++spins < 256) {
@@ -62,12 +67,6 @@ DeformWorkers::~DeformWorkers() {
   generation_.notify_all();
   for (std::thread& t : workers_) t.join();
 }
-
-namespace {
-uint64_t pack_left(uint32_t generation, uint32_t front, uint32_t back) {
-  return (static_cast<uint64_t>(generation) << 32) | (front << 16) | back;
-}
-}  // namespace
 
 void DeformWorkers::reset(Stage& stage, uint32_t generation, bool skip) {
   stage.done.store(skip ? stage.tasks : 0, std::memory_order_relaxed);

@@ -27,22 +27,20 @@ void FrameRef::reset() {
 FramePool::FramePool(int initial_frames) {
   std::lock_guard lock(mutex_);
   for (int i = 0; i < initial_frames; ++i) create_locked();
-  free_ = all_;
-  free_count_ = all_.size();
+  for (EncodedFrame* frame : all_) free_.push(frame);
 }
 
 FramePool::~FramePool() {
   for (EncodedFrame* f : all_) delete f;
 }
 
-// With no frame free (free_count_ == 0): a new one, and the ring grown to hold every frame, so
-// release() never allocates.
+// With no frame free: a new one, and the ring grown to hold every frame, so release() never
+// allocates.
 EncodedFrame* FramePool::create_locked() {
   EncodedFrame* frame = new EncodedFrame();
   frame->pool_ = this;
   all_.push_back(frame);
-  free_.assign(all_.size(), nullptr);
-  free_head_ = 0;
+  free_.reset(all_.size());
   return frame;
 }
 
@@ -50,13 +48,7 @@ FrameRef FramePool::acquire() {
   EncodedFrame* frame = nullptr;
   {
     std::lock_guard lock(mutex_);
-    if (free_count_ > 0) {
-      frame = free_[free_head_];
-      free_head_ = (free_head_ + 1) % free_.size();
-      --free_count_;
-    } else {
-      frame = create_locked();
-    }
+    frame = free_.empty() ? create_locked() : free_.pop();
   }
   frame->encoded_mask = 0;
   return FrameRef(frame);
@@ -69,7 +61,7 @@ size_t FramePool::allocated() const {
 
 void FramePool::release(EncodedFrame* frame) {
   std::lock_guard lock(mutex_);
-  free_[(free_head_ + free_count_++) % free_.size()] = frame;
+  free_.push(frame);
 }
 
 }  // namespace skinstream::server

@@ -14,6 +14,8 @@
 #include <span>
 #include <vector>
 
+#include "server/pipeline/bounded_ring.h"
+
 namespace skinstream::server {
 
 class FramePool;
@@ -76,8 +78,7 @@ class FramePool {
 
   mutable std::mutex mutex_;
   std::vector<EncodedFrame*> all_;
-  std::vector<EncodedFrame*> free_;  // a ring of all_.size() slots: free_count_ from free_head_
-  size_t free_head_ = 0, free_count_ = 0;
+  BoundedRing<EncodedFrame*> free_;  // room for all_: release() never allocates
 };
 
 }  // namespace skinstream::server

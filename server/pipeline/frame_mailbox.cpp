@@ -8,7 +8,7 @@ FrameMailbox::FrameMailbox(int marker_count, int backlog)
     : backlog_(backlog >= 1 ? backlog : throw std::invalid_argument("frame mailbox: backlog below 1")),
       slots_(static_cast<size_t>(backlog) + 2, MarkerFrame(marker_count)),
       generations_(slots_.size(), 0),
-      waiting_(static_cast<size_t>(backlog), 0) {
+      waiting_(static_cast<size_t>(backlog)) {
   free_.reserve(slots_.size());
   for (int slot = static_cast<int>(slots_.size()) - 1; slot >= 2; --slot) free_.push_back(slot);
 }
@@ -17,14 +17,11 @@ void FrameMailbox::post(uint64_t generation) {
   {
     std::lock_guard lock(mutex_);
     generations_[write_] = generation;
-    if (waiting_count_ == backlog_) {  // full: the oldest waiting frame is never taken
-      free_.push_back(waiting_[waiting_head_]);
-      waiting_head_ = (waiting_head_ + 1) % backlog_;
-      --waiting_count_;
+    if (waiting_.full()) {  // the oldest waiting frame is never taken
+      free_.push_back(waiting_.pop());
       ++dropped_;
     }
-    waiting_[(waiting_head_ + waiting_count_) % backlog_] = write_;
-    ++waiting_count_;
+    waiting_.push(write_);
     write_ = free_.back();  // one is free: backlog + 2 slots, at most backlog waiting
     free_.pop_back();
     ++posted_;
@@ -34,12 +31,10 @@ void FrameMailbox::post(uint64_t generation) {
 
 const MarkerFrame* FrameMailbox::take(std::chrono::milliseconds timeout, uint64_t& out_generation) {
   std::unique_lock lock(mutex_);
-  if (!ready_cv_.wait_for(lock, timeout, [&] { return waiting_count_ > 0 || closed_; }) || waiting_count_ == 0)
+  if (!ready_cv_.wait_for(lock, timeout, [&] { return !waiting_.empty() || closed_; }) || waiting_.empty())
     return nullptr;
   free_.push_back(read_);  // the frame taken last time is done with
-  read_ = waiting_[waiting_head_];
-  waiting_head_ = (waiting_head_ + 1) % backlog_;
-  --waiting_count_;
+  read_ = waiting_.pop();
   out_generation = generations_[read_];
   return &slots_[read_];
 }
@@ -64,7 +59,7 @@ uint64_t FrameMailbox::posted() const {
 
 int FrameMailbox::waiting() const {
   std::lock_guard lock(mutex_);
-  return waiting_count_;
+  return static_cast<int>(waiting_.size());
 }
 
 }  // namespace skinstream::server

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "server/ingest/marker_frame.h"
+#include "server/pipeline/bounded_ring.h"
 
 namespace skinstream::server {
 
@@ -46,8 +47,7 @@ class FrameMailbox {
   std::condition_variable ready_cv_;
   std::vector<MarkerFrame> slots_;
   std::vector<uint64_t> generations_;  // per slot
-  std::vector<int> waiting_;           // ring of slot indices, oldest at waiting_head_
-  int waiting_head_ = 0, waiting_count_ = 0;
+  BoundedRing<int> waiting_;           // slot indices, oldest first
   std::vector<int> free_;  // slots nobody holds; capacity reserved for all of them
   int write_ = 0, read_ = 1;
   bool closed_ = false;
