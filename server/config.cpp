@@ -1,5 +1,7 @@
 #include "server/config.h"
 
+#include "server/pipeline/deform_cpus.h"
+
 #include <CLI/CLI.hpp>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -25,6 +27,7 @@ void apply_json(const nlohmann::json& json, DaemonConfig& c, const std::string& 
   if (!json.is_object()) throw ConfigError(origin + ": the configuration must be a JSON object");
   static const char* const kKeys[] = {"subject", "replay", "loop", "speed", "vicon", "vicon_pull", "vicon_multicast", "bind_address",
                                       "http_port", "sub_port", "web_root", "lookahead", "deform_threads",
+                                      "deform_cpus", "deform_spin_lead_us",
                                       "continuity_seconds", "use_pca", "ports_file", "log_level", "hello_timeout_ms",
                                       "subscriber_queue_frames", "status_interval_ms", "default_rate_hz"};
   for (const auto& [key, value] : json.items()) {
@@ -45,6 +48,8 @@ void apply_json(const nlohmann::json& json, DaemonConfig& c, const std::string& 
   take(json, "web_root", c.web_root, origin);
   take(json, "lookahead", c.lookahead, origin);
   take(json, "deform_threads", c.deform_threads, origin);
+  take(json, "deform_cpus", c.deform_cpus, origin);
+  take(json, "deform_spin_lead_us", c.deform_spin_lead_us, origin);
   take(json, "continuity_seconds", c.continuity_seconds, origin);
   take(json, "use_pca", c.use_pca, origin);
   take(json, "ports_file", c.ports_file, origin);
@@ -85,6 +90,8 @@ nlohmann::json to_json(const DaemonConfig& c) {
           {"web_root", c.web_root},
           {"lookahead", c.lookahead},
           {"deform_threads", c.deform_threads},
+          {"deform_cpus", c.deform_cpus},
+          {"deform_spin_lead_us", c.deform_spin_lead_us},
           {"continuity_seconds", c.continuity_seconds},
           {"use_pca", c.use_pca},
           {"ports_file", c.ports_file},
@@ -104,6 +111,8 @@ void validate(const DaemonConfig& c) {
   if (c.sub_port < 0 || c.sub_port > 65535) fail("sub_port must be 0-65535");
   if (c.lookahead < 0 || c.lookahead > 240) fail("lookahead must be 0-240 frames");
   if (c.deform_threads < 1 || c.deform_threads > 64) fail("deform_threads must be 1-64");
+  if (const std::string problem = deform_cpus_problem(c.deform_cpus); !problem.empty()) fail(problem);
+  if (c.deform_spin_lead_us < 0 || c.deform_spin_lead_us > 1'000'000) fail("deform_spin_lead_us must be 0-1000000");
   if (c.continuity_seconds < 0) fail("continuity_seconds must be >= 0");
   if (c.hello_timeout_ms < 0) fail("hello_timeout_ms must be >= 0");
   if (c.subscriber_queue_frames < 1 || c.subscriber_queue_frames > 64) fail("subscriber_queue_frames must be 1-64");
@@ -149,6 +158,9 @@ std::optional<CommandLine> parse_command_line(int argc, const char* const* argv,
   auto* web_root = app.add_option("--web-root", flags.web_root, "folder of static files served at /");
   auto* lookahead = app.add_option("--lookahead", flags.lookahead, "gap-end blend lookahead in frames (adds latency)");
   auto* threads = app.add_option("--deform-threads", flags.deform_threads, "threads deforming the mesh (pipeline thread included)");
+  auto* cpus = app.add_option("--deform-cpus", flags.deform_cpus, "CPUs of the deform threads: auto, off, or a list such as 2,3");
+  auto* spin_lead = app.add_option("--deform-spin-lead-us", flags.deform_spin_lead_us,
+                                   "deform workers spin this long before a frame is due (0 = sleep until woken)");
   auto* ports_file = app.add_option("--ports-file", flags.ports_file, "write {\"http\":N,\"sub\":N} here once listening");
   auto* log_level = app.add_option("--log-level", flags.log_level, "trace, debug, info, warn, error, critical, off");
   app.add_flag("--print-config", result.print_config, "print the effective configuration as JSON and exit");
@@ -177,6 +189,8 @@ std::optional<CommandLine> parse_command_line(int argc, const char* const* argv,
   if (given(web_root)) c.web_root = flags.web_root;
   if (given(lookahead)) c.lookahead = flags.lookahead;
   if (given(threads)) c.deform_threads = flags.deform_threads;
+  if (given(cpus)) c.deform_cpus = flags.deform_cpus;
+  if (given(spin_lead)) c.deform_spin_lead_us = flags.deform_spin_lead_us;
   if (given(ports_file)) c.ports_file = flags.ports_file;
   if (given(log_level)) c.log_level = flags.log_level;
   validate(c);

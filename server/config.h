@@ -26,6 +26,8 @@ struct DaemonConfig {
   std::string web_root;           // static files served at /; empty = none
   int lookahead = 0;              // gap-end blend lookahead, frames
   int deform_threads = 2;         // the pipeline thread plus deform_threads - 1 workers
+  std::string deform_cpus = "auto";  // "auto", "off" or "2,3": server/pipeline/deform_cpus.h
+  int deform_spin_lead_us = 1000;  // workers spin this long before a frame is due; 0 = sleep until woken
   double continuity_seconds = 1.0;
   bool use_pca = true;
   std::string ports_file;         // written as {"http":N,"sub":N} once listening

@@ -1,5 +1,6 @@
 #include "server/daemon.h"
 
+#include <spdlog/fmt/ranges.h>
 #include <spdlog/spdlog.h>
 
 #include <cmath>
@@ -13,6 +14,7 @@
 #include "server/ingest/vicon_multicast_source.h"
 #include "server/ingest/vicon_source.h"
 #include "server/listener.h"
+#include "server/pipeline/deform_cpus.h"
 #include "server/publish/subscriber_hub.h"
 #include "server/publish/tcp_subscriber.h"
 
@@ -83,6 +85,18 @@ Daemon::Daemon(const DaemonConfig& config)
   PipelineOptions pipeline_options;
   pipeline_options.lookahead = config.lookahead;
   pipeline_options.deform_threads = config.deform_threads;
+  pipeline_options.deform_spin_lead = std::chrono::microseconds(config.deform_spin_lead_us);
+  try {
+    deform_cpus_ = pipeline_options.deform_cpus = choose_deform_cpus(config.deform_cpus, config.deform_threads, allowed_cpus());
+  } catch (const std::invalid_argument& e) {
+    throw ConfigError(std::string("configuration: ") + e.what());
+  }
+  if (pipeline_options.deform_cpus.empty())
+    spdlog::info("deform threads: {}, not pinned (deform_cpus \"{}\"), spin lead {} us", config.deform_threads,
+                 config.deform_cpus, config.deform_spin_lead_us);
+  else
+    spdlog::info("deform threads: {} on CPUs {}, spin lead {} us", config.deform_threads,
+                 fmt::join(pipeline_options.deform_cpus, ","), config.deform_spin_lead_us);
   pipeline_options.default_rate_hz = config.default_rate_hz;
   pipeline_options.filler.continuity_seconds = config.continuity_seconds;
   pipeline_options.filler.use_pca = config.use_pca;
@@ -304,6 +318,7 @@ std::string Daemon::health_json() const {
       // mark of frames in use (bounded by the subscribers' queues), so RSS steps with it.
       {"frame_buffers_allocated", metrics_.frame_buffers_allocated.load()},
       {"subscribers", hub_->subscriber_count()},
+      {"deform", {{"threads", config_.deform_threads}, {"cpus", deform_cpus_}, {"spin_lead_us", config_.deform_spin_lead_us}}},
       {"subject", {{"markers", subject_.model.marker_count()}, {"vertices", pipeline_->vertex_count()}}}};
   return health.dump();
 }

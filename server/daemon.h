@@ -10,6 +10,7 @@
 #include <optional>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "protocol/subject_file.h"
 #include "server/asio.h"
@@ -60,6 +61,7 @@ class Daemon : private FrameSink {
   void write_ports_file() const;
 
   DaemonConfig config_;
+  std::vector<int> deform_cpus_;  // one per deform thread, or none (not pinned)
   SubjectFile subject_;
   Metrics metrics_;
   RateLimitedLog bad_input_log_;

@@ -160,13 +160,17 @@ int main(int argc, char** argv) {
   CLI::App app{"skinstream-bench: end-to-end latency and cost of the real skinstreamd fed by a Vicon DataStream replay"};
   double seconds = 10;
   int subscriber_count = 1, deform_threads = 2;
-  std::string recording = "replay_data/cmu/85_12.c3d", subject, vicon_subject_name;
+  std::string recording = "replay_data/cmu/85_12.c3d", subject, vicon_subject_name, deform_cpus;
+  int deform_spin_lead_us = -1;  // -1: the daemon's default
   bool json = false, normals = false;
   app.add_option("--seconds", seconds, "how long to measure")->check(CLI::Range(0.5, 3600.0))->capture_default_str();
   app.add_option("--subscribers", subscriber_count, "subscribers connected in-process, one thread each")->check(CLI::Range(1, 256))->capture_default_str();
   app.add_option("--recording", recording, "capture the Vicon replay server streams, looped")->capture_default_str();
   app.add_option("--subject", subject, "subject file for the recording's performer")->required();
   app.add_option("--deform-threads", deform_threads, "skinstreamd --deform-threads")->check(CLI::Range(1, 64))->capture_default_str();
+  app.add_option("--deform-cpus", deform_cpus, "skinstreamd --deform-cpus (default: the daemon's, auto)");
+  app.add_option("--deform-spin-lead-us", deform_spin_lead_us, "skinstreamd --deform-spin-lead-us (default: the daemon's)")
+      ->check(CLI::Range(0, 1'000'000));
   app.add_option("--vicon-subject-name", vicon_subject_name, "subject name the replay announces (default: the recording's file name)");
   app.add_flag("--normals", normals, "subscribers ask for normals too");
   app.add_flag("--json", json, "print the report as JSON");
@@ -209,10 +213,12 @@ int main(int argc, char** argv) {
       ~ReplayThreadStop() { stop(); }
     } replay_thread_stop{stop_replay};
 
-    pid = launch({daemon_path.string(), "--subject", subject, "--vicon", "127.0.0.1:" + std::to_string(replay.port()),
-                  "--deform-threads", std::to_string(deform_threads), "--http-port", "0", "--sub-port", "0", "--bind", "127.0.0.1",
-                  "--ports-file", ports_path, "--log-level", "warn"},
-                 log_path);
+    std::vector<std::string> daemon_args = {daemon_path.string(), "--subject", subject, "--vicon", "127.0.0.1:" + std::to_string(replay.port()),
+                                            "--deform-threads", std::to_string(deform_threads), "--http-port", "0", "--sub-port", "0",
+                                            "--bind", "127.0.0.1", "--ports-file", ports_path, "--log-level", "warn"};
+    if (!deform_cpus.empty()) daemon_args.insert(daemon_args.end(), {"--deform-cpus", deform_cpus});
+    if (deform_spin_lead_us >= 0) daemon_args.insert(daemon_args.end(), {"--deform-spin-lead-us", std::to_string(deform_spin_lead_us)});
+    pid = launch(daemon_args, log_path);
     const nlohmann::json ports = wait_for_ports(ports_path, pid, log_path);
     const int sub_port = ports.at("sub"), http_port = ports.at("http");
     wait_for_streaming(http_port, pid, log_path);
@@ -298,6 +304,7 @@ int main(int argc, char** argv) {
         {"seconds", seconds},
         {"subscribers", subscriber_count},
         {"deform_threads", deform_threads},
+        {"deform", health["deform"]},  // as the daemon applied it: threads, CPUs pinned to, spin lead
         {"recording", recording},
         {"vertices", health["subject"]["vertices"]},
         {"markers", health["subject"]["markers"]},

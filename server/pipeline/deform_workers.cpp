@@ -4,12 +4,20 @@
 #include <chrono>
 #include <numeric>
 
+#include <pthread.h>
+#include <sched.h>
+
 namespace skinstream::server {
 namespace {
 
 constexpr int kClustersPerTask = 8;  // ~6 us of work: small enough to share, large enough to count
 constexpr int kVertexTasks = 32;     // per vertex stage
 constexpr int kMaxTasks = 0xffff;    // per stage: tasks are counted in 16 bits
+// A woken worker spins this long for its frame before it sleeps again: longer than the fill
+// that get_ready() overlaps, short enough not to hold a core when frames stop.
+constexpr std::chrono::microseconds kReadySpin{2000};
+// Intervals between runs longer than this are pauses of the source, not its frame rate.
+constexpr int64_t kLongestFrameIntervalNs = 100'000'000;
 
 // A stage's Stage::left: the generation, then the first and one past the last task not taken.
 uint64_t pack_left(uint32_t generation, uint32_t front, uint32_t back) {
@@ -27,10 +35,22 @@ void pause(int& spins) {
   }
 }
 
+bool pin_thread(pthread_t thread, int cpu) {
+  if (cpu < 0 || cpu >= CPU_SETSIZE) return false;
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  CPU_SET(cpu, &set);
+  return pthread_setaffinity_np(thread, sizeof(set), &set) == 0;
+}
+
 }  // namespace
 
-DeformWorkers::DeformWorkers(MeshDeformer& deformer, int threads)
-    : deformer_(deformer), threads_(std::max(1, threads)) {
+bool pin_this_thread(int cpu) { return pin_thread(pthread_self(), cpu); }
+
+DeformWorkers::DeformWorkers(MeshDeformer& deformer, const DeformWorkerOptions& options)
+    : deformer_(deformer),
+      threads_(std::max(1, options.threads)),
+      spin_lead_(std::max(options.spin_lead, std::chrono::microseconds(0))) {
   const int parts = deformer_.part_count();
   auto fit_cost = [&](int p) { return static_cast<int64_t>(deformer_.part_member_count(p)) * deformer_.part_member_count(p) * deformer_.part_member_count(p); };
   part_order_.resize(static_cast<size_t>(parts));
@@ -58,13 +78,18 @@ DeformWorkers::DeformWorkers(MeshDeformer& deformer, int threads)
   vertex_chunk_ = std::max(1, (deformer_.vertex_count() + kVertexTasks - 1) / kVertexTasks);
   vertices_.tasks = normals_stage_.tasks =
       static_cast<uint32_t>((deformer_.vertex_count() + vertex_chunk_ - 1) / vertex_chunk_);
-  for (int i = 1; i < threads_; ++i) workers_.emplace_back([this] { work(); });
+  for (int i = 1; i < threads_; ++i) {
+    workers_.emplace_back([this] { work(); });
+    if (static_cast<int>(options.cpus.size()) == threads_ && !pin_thread(workers_.back().native_handle(), options.cpus[i]))
+      ++unpinned_workers_;
+  }
 }
 
 DeformWorkers::~DeformWorkers() {
   stopping_.store(true);
   generation_.fetch_add(1);
-  generation_.notify_all();
+  wake_.fetch_add(1);
+  wake_.notify_all();
   for (std::thread& t : workers_) t.join();
 }
 
@@ -76,6 +101,7 @@ void DeformWorkers::reset(Stage& stage, uint32_t generation, bool skip) {
 bool DeformWorkers::run(std::span<const Vec3> markers, std::span<float> positions, std::span<float> normals) {
   if (!deformer_.accepts(markers)) return false;
   const auto start = std::chrono::steady_clock::now();
+  expect_next_run(start);
   const uint32_t generation = generation_.load(std::memory_order_relaxed) + 1;
   markers_ = markers;
   positions_ = positions;
@@ -84,20 +110,66 @@ bool DeformWorkers::run(std::span<const Vec3> markers, std::span<float> position
   reset(vertices_, generation, false);
   reset(normals_stage_, generation, normals.empty());
   generation_.store(generation, std::memory_order_release);
-  if (!workers_.empty()) generation_.notify_all();
+  get_ready();
 
   run_frame(generation, &start);
   normals_ns_ = normals.empty() ? 0 : std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - start).count() - deform_ns_;
   return true;
 }
 
+void DeformWorkers::get_ready() {
+  if (workers_.empty()) return;
+  wake_.fetch_add(1, std::memory_order_release);
+  wake_.notify_all();  // no system call unless a worker sleeps
+}
+
+// The interval between runs, smoothed over about 8 runs so that one late frame moves the
+// estimate by an eighth of its lateness.
+void DeformWorkers::expect_next_run(std::chrono::steady_clock::time_point start) {
+  const int64_t now = std::chrono::duration_cast<std::chrono::nanoseconds>(start.time_since_epoch()).count();
+  const int64_t interval = now - last_run_ns_;
+  last_run_ns_ = now;
+  if (interval <= 0 || interval > kLongestFrameIntervalNs) {
+    run_interval_ns_ = 0;  // a pause: no estimate until two runs come close together again
+  } else {
+    run_interval_ns_ = run_interval_ns_ == 0 ? interval : run_interval_ns_ + (interval - run_interval_ns_) / 8;
+  }
+  next_run_due_ns_.store(run_interval_ns_ == 0 ? 0 : now + run_interval_ns_, std::memory_order_relaxed);
+}
+
+// Sleeps until woken, then spins for a new generation and runs it. After a frame it
+// anticipates the next (see the header) or sleeps again; a spin that finds no frame within
+// kReadySpin of when one was due sleeps too. `wake_` is read before the generation each time
+// round: a run() published after that read bumps `wake_` past it, so no sleep misses its frame.
 void DeformWorkers::work() {
-  uint32_t seen = 0;
+  using Clock = std::chrono::steady_clock;
+  uint32_t seen_wake = 0, seen_generation = 0;
   for (;;) {
-    generation_.wait(seen, std::memory_order_acquire);
-    if (stopping_.load()) return;
-    seen = generation_.load(std::memory_order_acquire);
-    run_frame(seen, nullptr);
+    wake_.wait(seen_wake, std::memory_order_acquire);
+    auto give_up = Clock::now() + kReadySpin;
+    for (int spins = 0;; pause(spins)) {
+      const uint32_t wake = wake_.load(std::memory_order_acquire);
+      const uint32_t generation = generation_.load(std::memory_order_acquire);
+      if (stopping_.load()) return;
+      if (generation != seen_generation) {
+        seen_generation = generation;
+        run_frame(generation, nullptr);
+        const int64_t due_ns = next_run_due_ns_.load(std::memory_order_relaxed);
+        if (spin_lead_.count() > 0 && due_ns > 0) {
+          const Clock::time_point due{std::chrono::nanoseconds(due_ns)};
+          std::this_thread::sleep_until(due - spin_lead_);  // returns at once when that has passed
+          give_up = std::max(due, Clock::now()) + kReadySpin;
+        } else {
+          give_up = Clock::now();  // one more look at `wake_`, then sleep
+        }
+        spins = 0;
+        continue;
+      } else if (spins % 64 != 63 || Clock::now() < give_up) {
+        continue;
+      }
+      seen_wake = wake;
+      break;
+    }
   }
 }
 

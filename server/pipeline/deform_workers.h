@@ -8,6 +8,14 @@
 // Stages, in order: part fits and clusters (a cluster waits only for its own part's fit, so
 // the largest part's fit overlaps the other parts' clusters), then eq. 9 per vertex, then the
 // vertex normals. No thread is created and nothing is allocated per frame.
+//
+// Waking a sleeping worker costs the OS's wake-up latency inside the frame: on a virtual
+// machine whose idle core has halted, 0.1 ms typically and more than a whole frame's work
+// for one frame in five (measured with skinstream-bench). Frames come at a steady rate, so a
+// worker can anticipate: after a frame it sleeps until `spin_lead` before the next one is due
+// (from the interval between runs) and spins from then on. The lead is a trade of CPU for
+// latency: 0 sleeps until woken (get_ready() and run() wake it), a lead longer than the frame
+// interval never sleeps while frames keep coming.
 
 #include <atomic>
 #include <chrono>
@@ -21,9 +29,22 @@
 
 namespace skinstream::server {
 
+struct DeformWorkerOptions {
+  int threads = 1;  // the calling thread included
+  // How long before the next frame is due a worker starts to spin for it (see above).
+  std::chrono::microseconds spin_lead{0};
+  // Empty, or one CPU per thread: index 0 is the calling thread's (its owner pins it, with
+  // pin_this_thread), the others the workers', pinned as they are made.
+  std::vector<int> cpus;
+};
+
+// Pins the calling thread to `cpu`; false when the OS refuses.
+bool pin_this_thread(int cpu);
+
 class DeformWorkers {
  public:
-  DeformWorkers(MeshDeformer& deformer, int threads);
+  DeformWorkers(MeshDeformer& deformer, const DeformWorkerOptions& options);
+  DeformWorkers(MeshDeformer& deformer, int threads) : DeformWorkers(deformer, DeformWorkerOptions{threads, {}, {}}) {}
   ~DeformWorkers();
   DeformWorkers(const DeformWorkers&) = delete;
   DeformWorkers& operator=(const DeformWorkers&) = delete;
@@ -32,7 +53,12 @@ class DeformWorkers {
   // is not empty, `normals` (3V). Returns false, changing nothing, when the deformer does not
   // accept the markers (wrong count, a marker not finite).
   bool run(std::span<const Vec3> markers, std::span<float> positions, std::span<float> normals);
+  // Says a run() is coming soon (the caller is about to fill the frame): a sleeping worker
+  // wakes now, and its wake-up overlaps the caller's work instead of the deformation.
+  void get_ready();
   int threads() const { return threads_; }
+  // The workers the OS refused to pin to their CPU (0 when none were to be pinned).
+  int unpinned_workers() const { return unpinned_workers_; }
   // Wall time of the last run's stages, measured by the calling thread: fits to positions, and
   // normals.
   int64_t last_deform_ns() const { return deform_ns_; }
@@ -58,10 +84,12 @@ class DeformWorkers {
   template <typename Task>
   bool run_stage(Stage& stage, uint32_t generation, End end, Task&& task);
   void reset(Stage& stage, uint32_t generation, bool skip);
+  void expect_next_run(std::chrono::steady_clock::time_point start);
   void fit_or_cluster_task(uint32_t task, uint32_t generation);
 
   MeshDeformer& deformer_;
   int threads_;
+  int unpinned_workers_ = 0;
   std::vector<int> part_order_;             // largest part first: its fit is the longest task
   std::vector<ClusterChunk> cluster_chunks_;  // the largest part's clusters last
   int vertex_chunk_ = 0;
@@ -69,6 +97,12 @@ class DeformWorkers {
 
   Stage fits_and_clusters_, vertices_, normals_stage_;
   std::atomic<uint32_t> generation_{0};
+  std::atomic<uint32_t> wake_{0};  // what sleeping workers wait on: bumped by get_ready(), run(), stop
+  // When the next run() is expected (steady clock, ns; 0: no estimate yet), from the interval
+  // between runs, smoothed.
+  std::atomic<int64_t> next_run_due_ns_{0};
+  int64_t last_run_ns_ = 0, run_interval_ns_ = 0;  // the calling thread's
+  std::chrono::nanoseconds spin_lead_;
   std::atomic<bool> stopping_{false};
   // Set by run() before the generation is published, read by tasks after they take one.
   std::span<const Vec3> markers_;

@@ -45,7 +45,11 @@ Pipeline::Pipeline(const SubjectModel& model, const DeformationModel* deformatio
     deformer_ = std::make_unique<MeshDeformer>(*deformation, model);
     positions_.resize(3 * static_cast<size_t>(deformer_->vertex_count()));
     normals_.resize(positions_.size());
-    workers_ = std::make_unique<DeformWorkers>(*deformer_, options.deform_threads);
+    workers_ = std::make_unique<DeformWorkers>(
+        *deformer_, DeformWorkerOptions{options.deform_threads, options.deform_spin_lead, options.deform_cpus});
+    if (workers_->unpinned_workers() > 0)
+      spdlog::warn("pipeline: {} deform worker(s) could not be pinned to their CPU; they run where the OS puts them",
+                   workers_->unpinned_workers());
   }
 }
 
@@ -63,6 +67,8 @@ void Pipeline::stop() {
 }
 
 void Pipeline::run() {
+  if (!options_.deform_cpus.empty() && deformer_ && !pin_this_thread(options_.deform_cpus.front()))
+    spdlog::warn("pipeline: could not pin the pipeline thread to CPU {}; it runs where the OS puts it", options_.deform_cpus.front());
   while (running_.load()) {
     uint64_t generation = 0;
     const MarkerFrame* frame = mailbox_.take(std::chrono::milliseconds(100), generation);
@@ -94,6 +100,8 @@ void Pipeline::process(const MarkerFrame& frame, uint64_t generation) {
     spdlog::info("pipeline: source rate {} Hz", frame.source_rate_hz);
   }
 
+  // The deform worker's wake-up (tens to hundreds of microseconds on a busy host) overlaps the fill.
+  if (workers_) workers_->get_ready();
   const auto fill_start = std::chrono::steady_clock::now();
   const size_t free_count = static_cast<size_t>(std::clamp(frame.unlabelled_count, 0, MarkerFrame::kMaxUnlabelled));
   const FrameInput input{frame.labelled, std::span(frame.unlabelled).first(free_count),

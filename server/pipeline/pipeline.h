@@ -36,6 +36,8 @@ class FrameConsumer {
 struct PipelineOptions {
   int lookahead = 0;
   int deform_threads = 2;
+  std::chrono::microseconds deform_spin_lead{0};  // DeformWorkerOptions
+  std::vector<int> deform_cpus;                   // DeformWorkerOptions; index 0 the pipeline thread's
   double default_rate_hz = 120.0;
   GapFillerOptions filler;
 };

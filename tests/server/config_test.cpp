@@ -74,8 +74,23 @@ TEST(Config, FlagsOverrideTheFile) {
   EXPECT_TRUE(multicast->config.replay.empty());
 }
 
+TEST(Config, DeformCpusAndSpinLeadComeFromFileAndFlags) {
+  const std::string path = write_file("deform.json", R"({"deform_cpus": "off", "deform_spin_lead_us": 0})");
+  const auto from_file = parse({"--config", path});
+  ASSERT_TRUE(from_file);
+  EXPECT_EQ(from_file->config.deform_cpus, "off");
+  EXPECT_EQ(from_file->config.deform_spin_lead_us, 0);
+  const auto flags = parse({"--config", path, "--deform-cpus", "2,3", "--deform-spin-lead-us", "1500"});
+  ASSERT_TRUE(flags);
+  EXPECT_EQ(flags->config.deform_cpus, "2,3");
+  EXPECT_EQ(flags->config.deform_spin_lead_us, 1500);
+}
+
 TEST(Config, OutOfRangeValuesAndConflictsAreErrors) {
   EXPECT_NE(error_of([] { parse({"--deform-threads", "0"}); }).find("deform_threads"), std::string::npos);
+  EXPECT_NE(error_of([] { parse({"--deform-cpus", "1;2"}); }).find("deform_cpus must be"), std::string::npos);
+  EXPECT_NE(error_of([] { parse({"--deform-cpus", "1,1"}); }).find("names a CPU twice"), std::string::npos);
+  EXPECT_NE(error_of([] { parse({"--deform-spin-lead-us", "-5"}); }).find("deform_spin_lead_us"), std::string::npos);
   EXPECT_NE(error_of([] { parse({"--http-port", "70000"}); }).find("http_port"), std::string::npos);
   EXPECT_NE(error_of([] { parse({"--replay", "a.c3d", "--vicon", "h:1"}); }).find("one source"), std::string::npos);
   EXPECT_NE(error_of([] { parse({"--vicon", "h:1", "--vicon-multicast", "239.1.1.1:44801"}); }).find("one source"), std::string::npos);

@@ -2,9 +2,15 @@
 
 #include <gtest/gtest.h>
 
+#include <pthread.h>
+#include <sched.h>
+
+#include <chrono>
 #include <cmath>
 #include <random>
+#include <thread>
 
+#include "server/pipeline/deform_cpus.h"
 #include "tests/core/deform/deform_test_support.h"
 
 namespace skinstream::server {
@@ -36,6 +42,47 @@ TEST(DeformWorkers, AnyThreadCountGivesTheSingleThreadFrameBitForBit) {
       EXPECT_EQ(positions_only, expected_positions);
     }
   }
+}
+
+// Frames at an uneven pace, workers pinned (when the machine has the CPUs) and anticipating
+// each frame: they sleep until the spin lead before it is due, or come late when a frame is
+// early; either way every frame is the single-thread frame, and stopping does not hang.
+TEST(DeformWorkers, PinnedAnticipatingWorkersGiveTheSameFramesAtAnyPace) {
+  deform_test::WavySheet sheet;
+  const size_t floats = sheet.model.reference_vertices.size() * 3;
+  MeshDeformer reference(sheet.model, sheet.subject);
+  MeshDeformer deformer(sheet.model, sheet.subject);
+  DeformWorkerOptions options;
+  options.threads = 2;
+  options.spin_lead = std::chrono::microseconds(1000);
+  options.cpus = choose_deform_cpus("auto", 2, allowed_cpus());
+  if (!options.cpus.empty()) {
+    EXPECT_TRUE(pin_this_thread(options.cpus[0]));
+  }
+  {
+    DeformWorkers workers(deformer, options);
+    EXPECT_EQ(workers.unpinned_workers(), 0);
+    std::mt19937_64 rng(5);
+    const int gaps_us[] = {4000, 4000, 4000, 0, 9000, 300, 4000, 20000, 4000, 1000};
+    for (int frame = 0; frame < 40; ++frame) {
+      std::this_thread::sleep_for(std::chrono::microseconds(gaps_us[frame % 10]));
+      const std::vector<Vec3> now =
+          deform_test::deform_non_rigidly(sheet.subject.reference_positions, deform_test::random_motion(rng));
+      std::vector<float> positions(floats), normals(floats), expected_positions(floats), expected_normals(floats);
+      ASSERT_TRUE(reference.deform(now, expected_positions, expected_normals));
+      if (frame % 3 == 0) workers.get_ready();
+      ASSERT_TRUE(workers.run(now, positions, normals));
+      EXPECT_EQ(positions, expected_positions) << "frame " << frame;
+      EXPECT_EQ(normals, expected_normals) << "frame " << frame;
+    }
+  }  // joins a worker that may be asleep until the next frame it expected
+  const std::vector<int> everywhere = allowed_cpus();
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  for (int cpu : everywhere) {
+    CPU_SET(cpu, &set);
+  }
+  pthread_setaffinity_np(pthread_self(), sizeof(set), &set);  // the test thread as it was
 }
 
 TEST(DeformWorkers, RejectsUnusableMarkersAndKeepsThePreviousFit) {

@@ -1,0 +1,32 @@
+#pragma once
+// Which CPUs the deform threads (the pipeline thread, then each worker) run on.
+//
+// Left to itself, the scheduler of a small virtual machine kept the pipeline thread and its
+// worker on one core for about one frame in five (it packs threads so that other cores can
+// idle), and those frames were deformed by one thread: skinstream-bench showed deformation
+// p90 1.2 ms unpinned against 0.75 ms pinned, on the same code. A pinned thread cannot move
+// away from a busy CPU either, so this is a setting: `auto` (the default) pins when there are
+// CPUs enough, `off` never does, or a list names them.
+
+#include <string>
+#include <vector>
+
+namespace skinstream::server {
+
+// Checks the form of a deform_cpus setting: "auto", "off", or CPU numbers separated by
+// commas. Returns the problem, or an empty string.
+std::string deform_cpus_problem(const std::string& spec);
+
+// The CPU for each of `threads` deform threads (index 0: the pipeline thread), or none.
+// `allowed`: the CPUs this process may run on, ascending.
+//  - "auto": the last `threads` allowed CPUs (CPU 0 tends to take the most interrupts), or
+//    none when fewer are allowed than there are threads;
+//  - "off": none;
+//  - a list: exactly `threads` distinct CPUs, each of them allowed.
+// Throws std::invalid_argument, saying what is wrong, for a list that does not fit.
+std::vector<int> choose_deform_cpus(const std::string& spec, int threads, const std::vector<int>& allowed);
+
+// The CPUs the calling process may run on (its affinity mask), ascending.
+std::vector<int> allowed_cpus();
+
+}  // namespace skinstream::server
