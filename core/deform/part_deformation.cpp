@@ -54,6 +54,19 @@ bool PartDeformer::solve(std::span<const Vec3> member_positions_now) {
   return true;
 }
 
+// weights = kernel^-1 residuals from the LU factors, one column at a time: Eigen's solve() with
+// a 3-column right-hand side takes a blocking workspace from the heap on every call once a part
+// has more than about 100 members (175 kB for the 148-marker trunk); a single column is solved
+// in place.
+void PartDeformer::solve_weights() {
+  weights_ = kernel_lu_.permutationP() * residuals_;
+  const Eigen::MatrixXd& lu = kernel_lu_.matrixLU();
+  for (int c = 0; c < 3; ++c) {
+    lu.triangularView<Eigen::UnitLower>().solveInPlace(weights_.col(c));
+    lu.triangularView<Eigen::Upper>().solveInPlace(weights_.col(c));
+  }
+}
+
 // Eq. 7: weights w with sum_i w_i phi(|p~_i - p~_j| / sigma) = r_j. The centres move every
 // frame, so the kernel is rebuilt and LU-refactored in the preallocated storage.
 void PartDeformer::solve_residual() {
@@ -62,7 +75,7 @@ void PartDeformer::solve_residual() {
   double added = model_.rbf_ridge;  // chosen offline, the same every frame
   kernel_.diagonal().array() += added;
   kernel_lu_.compute(kernel_);
-  weights_.noalias() = kernel_lu_.solve(residuals_);
+  solve_weights();
   // The cubic B-spline is not positive definite as a radial function in 3D: with many members
   // and a wide dilation the kernel matrix can be nearly singular, and the exact weights then
   // reach thousands of times the residual and swing the surface between the members by metres.
@@ -75,7 +88,7 @@ void PartDeformer::solve_residual() {
     kernel_.diagonal().array() += ridge - added;
     added = ridge;
     kernel_lu_.compute(kernel_);
-    weights_.noalias() = kernel_lu_.solve(residuals_);
+    solve_weights();
   }
   ridge_ = added;
   // Coincident centres make the kernel singular; then skip the residual rather than emit NaN.

@@ -50,6 +50,7 @@ class PartDeformer {
   bool uses_quadratic() const;
   bool uses_rbf() const;
   void solve_residual();
+  void solve_weights();
 
   PartModel model_;
   DeformationMode mode_;

@@ -8,9 +8,31 @@ thread_local bool counting = false;
 thread_local size_t allocations = 0;
 }  // namespace
 
+// The test executables link with --wrap=malloc,calloc,realloc (tests/CMakeLists.txt): calls
+// to them from our objects and the static libraries come here. Eigen allocates with malloc,
+// which operator new alone would not see. (Calls from shared libraries are not wrapped;
+// libstdc++'s own operator new is replaced below.)
+extern "C" {
+void* __real_malloc(std::size_t size);
+void* __real_calloc(std::size_t count, std::size_t size);
+void* __real_realloc(void* p, std::size_t size);
+void* __wrap_malloc(std::size_t size) {
+  if (counting) ++allocations;
+  return __real_malloc(size);
+}
+void* __wrap_calloc(std::size_t count, std::size_t size) {
+  if (counting) ++allocations;
+  return __real_calloc(count, size);
+}
+void* __wrap_realloc(void* p, std::size_t size) {
+  if (counting) ++allocations;
+  return __real_realloc(p, size);
+}
+}
+
 void* operator new(std::size_t size) {
   if (counting) ++allocations;
-  if (void* p = std::malloc(size ? size : 1)) return p;
+  if (void* p = __real_malloc(size ? size : 1)) return p;
   throw std::bad_alloc();
 }
 void* operator new[](std::size_t size) { return operator new(size); }
