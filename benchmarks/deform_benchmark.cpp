@@ -7,15 +7,20 @@
 //   build/bin/deform_benchmark --benchmark_format=json
 #include <benchmark/benchmark.h>
 
+#include <pthread.h>
+#include <sched.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cstring>
+#include <thread>
 
 #include "core/deform/mesh_deformer.h"
 #include "core/offline/deformation_builder.h"
 #include "core/offline/subject_builder.h"
 #include "core/synth/synth_capture.h"
 #include "protocol/makehuman.h"
+#include "server/pipeline/deform_cpus.h"  // allowed_cpus
 #include "server/pipeline/deform_workers.h"
 
 namespace skinstream {
@@ -110,6 +115,54 @@ void BM_DeformThreads(benchmark::State& state) {
   report(state, micros, deformer);
 }
 
+// Two threads fed at 120 Hz as the daemon is, not back to back: between frames the worker
+// sleeps, and each frame pays for waking it unless it anticipated the frame. Argument 0: the
+// worker woken by run() (deform_spin_lead_us 0); 1: a 1000 us spin lead (the daemon's
+// default); 2: the lead and both threads pinned to the last two CPUs (deform_cpus "0,1" on a
+// 2-core machine, where "auto" does not pin). The wait between frames is not timed.
+void BM_DeformTwoThreadsAt120Hz(benchmark::State& state) {
+  const Scenario& s = scenario();
+  MeshDeformer deformer(s.model, s.subject);
+  std::vector<float> positions(static_cast<size_t>(deformer.vertex_count()) * 3), normals(positions.size());
+  server::DeformWorkerOptions options;
+  options.threads = 2;
+  const std::vector<int> allowed = server::allowed_cpus();
+  if (state.range(0) >= 1) options.spin_lead = std::chrono::microseconds(1000);
+  if (state.range(0) == 2 && allowed.size() >= 2) {
+    options.cpus = {allowed[allowed.size() - 2], allowed.back()};
+    server::pin_this_thread(options.cpus[0]);
+  }
+  std::vector<double> micros;
+  micros.reserve(1 << 14);
+  {
+    server::DeformWorkers workers(deformer, options);
+    const auto period = std::chrono::nanoseconds(1'000'000'000 / 120);
+    auto due = std::chrono::steady_clock::now();
+    size_t frame = 0;
+    for (auto _ : state) {
+      state.PauseTiming();
+      due += period;
+      std::this_thread::sleep_until(due);
+      state.ResumeTiming();
+      const auto start = std::chrono::steady_clock::now();
+      workers.run(s.frames[frame], positions, normals);
+      micros.push_back(std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count());
+      benchmark::DoNotOptimize(positions.data());
+      frame = (frame + 1) % s.frames.size();
+    }
+  }
+  state.counters["pinned"] = options.cpus.empty() ? 0 : 1;
+  if (!options.cpus.empty()) {  // the benchmarks after this one run unpinned
+    cpu_set_t set;
+    CPU_ZERO(&set);
+    for (int cpu : allowed) {
+      CPU_SET(cpu, &set);
+    }
+    pthread_setaffinity_np(pthread_self(), sizeof(set), &set);
+  }
+  report(state, micros, deformer);
+}
+
 void BM_SolvePartsOnly(benchmark::State& state) {
   const Scenario& s = scenario();
   MeshDeformer deformer(s.model, s.subject);
@@ -135,6 +188,7 @@ void BM_CopyOutputBuffer(benchmark::State& state) {
 
 BENCHMARK(BM_DeformOneThread)->Arg(3)->Arg(1)->Arg(0)->Unit(benchmark::kMicrosecond)->MinTime(3.0)->UseRealTime();
 BENCHMARK(BM_DeformThreads)->Arg(1)->Arg(2)->Unit(benchmark::kMicrosecond)->MinTime(3.0)->UseRealTime();
+BENCHMARK(BM_DeformTwoThreadsAt120Hz)->Arg(0)->Arg(1)->Arg(2)->Unit(benchmark::kMicrosecond)->Iterations(2400)->UseRealTime();  // 20 s each
 BENCHMARK(BM_SolvePartsOnly)->Unit(benchmark::kMicrosecond)->MinTime(1.0);
 BENCHMARK(BM_CopyOutputBuffer)->Unit(benchmark::kMicrosecond)->MinTime(1.0);
 

@@ -52,6 +52,24 @@ class SendTimes {
   void record(uint32_t frame_number, int64_t send_ns) {
     std::lock_guard lock(mutex_);
     slots_[frame_number % kSlots] = {frame_number, send_ns};
+    // The replay's own regularity: after a stall of this (shared) machine it sends the frames
+    // it owes back to back, and a burst longer than the daemon's mailbox backlog (3 frames) is
+    // dropped there, newest frame winning, as it should be for live preview.
+    if (counting_ && last_send_ns_ > 0) {
+      const int64_t gap = send_ns - last_send_ns_;
+      max_gap_ns_ = std::max(max_gap_ns_, gap);
+      if (gap > 3 * period_ns_) ++gaps_over_3_periods_;
+    }
+    last_send_ns_ = send_ns;
+  }
+  void start_counting(int64_t period_ns) {
+    std::lock_guard lock(mutex_);
+    period_ns_ = period_ns;
+    counting_ = true;
+  }
+  nlohmann::json regularity() const {
+    std::lock_guard lock(mutex_);
+    return {{"max_gap_ms", static_cast<double>(max_gap_ns_) / 1e6}, {"gaps_over_3_frame_periods", gaps_over_3_periods_}};
   }
   // 0 when the frame number was never sent (or is too old).
   int64_t find(uint32_t frame_number) const {
@@ -68,6 +86,9 @@ class SendTimes {
   };
   mutable std::mutex mutex_;
   std::array<Slot, kSlots> slots_{};
+  bool counting_ = false;
+  int64_t period_ns_ = 0, last_send_ns_ = 0, max_gap_ns_ = 0;
+  uint64_t gaps_over_3_periods_ = 0;
 };
 
 fs::path own_folder() { return fs::read_symlink("/proc/self/exe").parent_path(); }
@@ -223,6 +244,7 @@ int main(int argc, char** argv) {
     const int sub_port = ports.at("sub"), http_port = ports.at("http");
     wait_for_streaming(http_port, pid, log_path);
     const nlohmann::json health_before = server::fetch_health(http_port);
+    send_times.start_counting(static_cast<int64_t>(1e9 / capture.rate_hz));
     const uint64_t sent_before = replay.stats().frame_packets_sent.load();
     const uint64_t replay_dropped_before = replay.stats().frames_dropped.load();
     const double cpu_before = process_usage(pid).first;  // startup (loading the subject) is not counted
@@ -310,6 +332,7 @@ int main(int argc, char** argv) {
         {"markers", health["subject"]["markers"]},
         {"end_to_end", end_to_end.summary()},
         {"daemon_processing", processing.summary()},
+        {"replay_sends", send_times.regularity()},  // gaps between the replay's consecutive sends
         {"frames", {{"sent_by_replay", sent},
                     {"dropped_by_replay", replay_dropped},
                     {"received_by_daemon", delta("received")},

@@ -8,7 +8,7 @@
 namespace skinstream::server {
 namespace {
 
-// Parses "3,1,2" into numbers; nullopt-like empty result with `ok` false for anything else.
+// Parses "3,1,2" into numbers; `ok` false for anything else.
 std::vector<int> parse_list(const std::string& spec, bool& ok) {
   std::vector<int> cpus;
   ok = !spec.empty();
@@ -40,7 +40,7 @@ std::vector<int> choose_deform_cpus(const std::string& spec, int threads, const 
   if (const std::string problem = deform_cpus_problem(spec); !problem.empty()) throw std::invalid_argument(problem);
   if (spec == "off") return {};
   if (spec == "auto") {
-    if (threads < 1 || static_cast<int>(allowed.size()) < threads) return {};
+    if (threads < 1 || static_cast<int>(allowed.size()) <= threads) return {};
     return {allowed.end() - threads, allowed.end()};
   }
   bool ok = false;

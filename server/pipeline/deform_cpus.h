@@ -4,9 +4,11 @@
 // Left to itself, the scheduler of a small virtual machine kept the pipeline thread and its
 // worker on one core for about one frame in five (it packs threads so that other cores can
 // idle), and those frames were deformed by one thread: skinstream-bench showed deformation
-// p90 1.2 ms unpinned against 0.75 ms pinned, on the same code. A pinned thread cannot move
-// away from a busy CPU either, so this is a setting: `auto` (the default) pins when there are
-// CPUs enough, `off` never does, or a list names them.
+// p90 1.2 ms unpinned against 0.75 ms pinned, on the same code. But a pinned thread cannot
+// move away from a busy CPU: with every CPU of a 2-core machine pinned, the io thread's bursts
+// after a stall had nowhere else to run and the 10-minute benchmark dropped 9 frames (none
+// unpinned). So `auto` (the default) pins only when a CPU is left over for the rest of the
+// process, `off` never does, and a list names the CPUs.
 
 #include <string>
 #include <vector>
@@ -20,7 +22,7 @@ std::string deform_cpus_problem(const std::string& spec);
 // The CPU for each of `threads` deform threads (index 0: the pipeline thread), or none.
 // `allowed`: the CPUs this process may run on, ascending.
 //  - "auto": the last `threads` allowed CPUs (CPU 0 tends to take the most interrupts), or
-//    none when fewer are allowed than there are threads;
+//    none unless more are allowed than there are threads;
 //  - "off": none;
 //  - a list: exactly `threads` distinct CPUs, each of them allowed.
 // Throws std::invalid_argument, saying what is wrong, for a list that does not fit.
