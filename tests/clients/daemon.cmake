@@ -28,6 +28,13 @@ if(TARGET skinstreamd AND TARGET skinstream-sub AND TARGET skinstream-replay)
   add_test(NAME daemon.vicon_without_port COMMAND skinstreamd --vicon 127.0.0.1 --print-config)
   add_test(NAME sub.without_address COMMAND skinstream-sub)
   add_test(NAME sub.bad_address COMMAND skinstream-sub nohost)
+  add_test(NAME daemon.deform_cpus_twice COMMAND skinstreamd --deform-cpus 1,1 --print-config)
   set_tests_properties(daemon.unknown_flag daemon.without_subject daemon.vicon_without_port sub.without_address sub.bad_address
-    PROPERTIES WILL_FAIL TRUE LABELS clients)
+    daemon.deform_cpus_twice PROPERTIES WILL_FAIL TRUE LABELS clients)
+  # A CPU the process may not use is refused at start with the reason (a daemon that started
+  # anyway would run until the timeout and fail this).
+  add_test(NAME daemon.deform_cpu_not_allowed COMMAND skinstreamd --subject ${CMAKE_BINARY_DIR}/demo/subject.sksubj
+    --deform-cpus 0,4095 --http-port 0 --sub-port 0)
+  set_tests_properties(daemon.deform_cpu_not_allowed PROPERTIES
+    PASS_REGULAR_EXPRESSION "CPU 4095 is not one this process may run on" TIMEOUT 60 LABELS clients FIXTURES_REQUIRED demo_subject)
 endif()
