@@ -7,9 +7,6 @@
 //   build/bin/deform_benchmark --benchmark_format=json
 #include <benchmark/benchmark.h>
 
-#include <pthread.h>
-#include <sched.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cstring>
@@ -20,7 +17,7 @@
 #include "core/offline/subject_builder.h"
 #include "core/synth/synth_capture.h"
 #include "protocol/makehuman.h"
-#include "server/pipeline/deform_cpus.h"  // allowed_cpus
+#include "server/pipeline/deform_cpus.h"
 #include "server/pipeline/deform_workers.h"
 
 namespace skinstream {
@@ -152,14 +149,7 @@ void BM_DeformTwoThreadsAt120Hz(benchmark::State& state) {
     }
   }
   state.counters["pinned"] = options.cpus.empty() ? 0 : 1;
-  if (!options.cpus.empty()) {  // the benchmarks after this one run unpinned
-    cpu_set_t set;
-    CPU_ZERO(&set);
-    for (int cpu : allowed) {
-      CPU_SET(cpu, &set);
-    }
-    pthread_setaffinity_np(pthread_self(), sizeof(set), &set);
-  }
+  if (!options.cpus.empty()) server::set_this_thread_cpus(allowed);  // the benchmarks after this one run unpinned
   report(state, micros, deformer);
 }
 

@@ -1,5 +1,6 @@
 #include "server/pipeline/deform_cpus.h"
 
+#include <pthread.h>
 #include <sched.h>
 
 #include <algorithm>
@@ -21,6 +22,16 @@ std::vector<int> parse_list(const std::string& spec, bool& ok) {
     at = comma + 1;
   }
   return cpus;
+}
+
+bool set_cpus(pthread_t thread, const std::vector<int>& cpus) {
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  for (int cpu : cpus) {
+    if (cpu < 0 || cpu >= CPU_SETSIZE) return false;
+    CPU_SET(cpu, &set);
+  }
+  return !cpus.empty() && pthread_setaffinity_np(thread, sizeof(set), &set) == 0;
 }
 
 }  // namespace
@@ -63,5 +74,8 @@ std::vector<int> allowed_cpus() {
     if (CPU_ISSET(cpu, &set)) cpus.push_back(cpu);
   return cpus;
 }
+
+bool set_thread_cpus(std::thread& thread, const std::vector<int>& cpus) { return set_cpus(thread.native_handle(), cpus); }
+bool set_this_thread_cpus(const std::vector<int>& cpus) { return set_cpus(pthread_self(), cpus); }
 
 }  // namespace skinstream::server

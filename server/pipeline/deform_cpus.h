@@ -11,6 +11,7 @@
 // process, `off` never does, and a list names the CPUs.
 
 #include <string>
+#include <thread>
 #include <vector>
 
 namespace skinstream::server {
@@ -30,5 +31,11 @@ std::vector<int> choose_deform_cpus(const std::string& spec, int threads, const 
 
 // The CPUs the calling process may run on (its affinity mask), ascending.
 std::vector<int> allowed_cpus();
+
+// Lets a thread run on `cpus` only (one CPU pins it); false when the OS refuses or a number
+// is out of range.
+bool set_thread_cpus(std::thread& thread, const std::vector<int>& cpus);
+bool set_this_thread_cpus(const std::vector<int>& cpus);
+inline bool pin_this_thread(int cpu) { return set_this_thread_cpus({cpu}); }
 
 }  // namespace skinstream::server

@@ -4,8 +4,7 @@
 #include <chrono>
 #include <numeric>
 
-#include <pthread.h>
-#include <sched.h>
+#include "server/pipeline/deform_cpus.h"
 
 namespace skinstream::server {
 namespace {
@@ -35,17 +34,7 @@ void pause(int& spins) {
   }
 }
 
-bool pin_thread(pthread_t thread, int cpu) {
-  if (cpu < 0 || cpu >= CPU_SETSIZE) return false;
-  cpu_set_t set;
-  CPU_ZERO(&set);
-  CPU_SET(cpu, &set);
-  return pthread_setaffinity_np(thread, sizeof(set), &set) == 0;
-}
-
 }  // namespace
-
-bool pin_this_thread(int cpu) { return pin_thread(pthread_self(), cpu); }
 
 DeformWorkers::DeformWorkers(MeshDeformer& deformer, const DeformWorkerOptions& options)
     : deformer_(deformer),
@@ -80,7 +69,7 @@ DeformWorkers::DeformWorkers(MeshDeformer& deformer, const DeformWorkerOptions& 
       static_cast<uint32_t>((deformer_.vertex_count() + vertex_chunk_ - 1) / vertex_chunk_);
   for (int i = 1; i < threads_; ++i) {
     workers_.emplace_back([this] { work(); });
-    if (static_cast<int>(options.cpus.size()) == threads_ && !pin_thread(workers_.back().native_handle(), options.cpus[i]))
+    if (static_cast<int>(options.cpus.size()) == threads_ && !set_thread_cpus(workers_.back(), {options.cpus[i]}))
       ++unpinned_workers_;
   }
 }

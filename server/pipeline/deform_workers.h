@@ -34,12 +34,9 @@ struct DeformWorkerOptions {
   // How long before the next frame is due a worker starts to spin for it (see above).
   std::chrono::microseconds spin_lead{0};
   // Empty, or one CPU per thread: index 0 is the calling thread's (its owner pins it, with
-  // pin_this_thread), the others the workers', pinned as they are made.
+  // pin_this_thread from deform_cpus.h), the others the workers', pinned as they are made.
   std::vector<int> cpus;
 };
-
-// Pins the calling thread to `cpu`; false when the OS refuses.
-bool pin_this_thread(int cpu);
 
 class DeformWorkers {
  public:

@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "protocol/subscriber_stream.h"
+#include "server/pipeline/deform_cpus.h"
 
 namespace skinstream::server {
 namespace {

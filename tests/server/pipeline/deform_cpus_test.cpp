@@ -2,6 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <sched.h>
+
+#include <algorithm>
 #include <stdexcept>
 
 namespace skinstream::server {
@@ -41,10 +44,15 @@ TEST(DeformCpus, MalformedSettingsSayWhatIsAccepted) {
   EXPECT_EQ(deform_cpus_problem("0,1"), "");
 }
 
-TEST(DeformCpus, TheProcessMayRunOnSomeCpu) {
+TEST(DeformCpus, TheProcessMayRunOnSomeCpuAndAThreadCanBePinnedThere) {
   const std::vector<int> allowed = allowed_cpus();
   ASSERT_FALSE(allowed.empty());
   EXPECT_TRUE(std::is_sorted(allowed.begin(), allowed.end()));
+  EXPECT_TRUE(pin_this_thread(allowed.back()));
+  EXPECT_EQ(sched_getcpu(), allowed.back());  // moved there before the call returned
+  EXPECT_FALSE(pin_this_thread(-1));
+  EXPECT_FALSE(set_this_thread_cpus({}));
+  EXPECT_TRUE(set_this_thread_cpus(allowed));  // the test thread as it was
 }
 
 }  // namespace

@@ -2,9 +2,6 @@
 
 #include <gtest/gtest.h>
 
-#include <pthread.h>
-#include <sched.h>
-
 #include <chrono>
 #include <cmath>
 #include <random>
@@ -77,12 +74,7 @@ TEST(DeformWorkers, PinnedAnticipatingWorkersGiveTheSameFramesAtAnyPace) {
       EXPECT_EQ(normals, expected_normals) << "frame " << frame;
     }
   }  // joins a worker that may be asleep until the next frame it expected
-  cpu_set_t set;
-  CPU_ZERO(&set);
-  for (int cpu : allowed) {
-    CPU_SET(cpu, &set);
-  }
-  pthread_setaffinity_np(pthread_self(), sizeof(set), &set);  // the test thread as it was
+  set_this_thread_cpus(allowed);  // the test thread as it was
 }
 
 TEST(DeformWorkers, RejectsUnusableMarkersAndKeepsThePreviousFit) {
