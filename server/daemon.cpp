@@ -253,7 +253,15 @@ void Daemon::on_frame(const MarkerFrame& in) {
     std::lock_guard lock(state_mutex_);
     generation = generation_;
   }
-  mailbox_.post(generation);
+  if (const std::optional<FrameMailbox::Drop> drop = mailbox_.post(generation)) {
+    // Says which side fell behind: a frame that waited long behind a pipeline that took nothing,
+    // or frames that arrived together (the source, the network or this io thread held them).
+    using Ms = std::chrono::duration<double, std::milli>;
+    drop_log_.warn("frame_gave_way", fmt::format("frame {} waited {:.1f} ms and gave way to newer ones; the pipeline last took "
+                                                 "a frame {:.1f} ms ago ({} dropped in all)",
+                                                 drop->frame_number, Ms(drop->waited).count(), Ms(drop->since_last_take).count(),
+                                                 mailbox_.dropped()));
+  }
 }
 
 void Daemon::on_source_state(SourceState state, std::string_view detail) {

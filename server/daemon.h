@@ -65,6 +65,7 @@ class Daemon : private FrameSink {
   SubjectFile subject_;
   Metrics metrics_;
   RateLimitedLog bad_input_log_;
+  RateLimitedLog drop_log_;  // frames that gave way in the mailbox, with the reason
   FrameMailbox mailbox_;
   std::unique_ptr<SubscriberHub> hub_;
   std::unique_ptr<Pipeline> pipeline_;

@@ -312,6 +312,14 @@ int main(int argc, char** argv) {
     for (const std::string& e : errors)
       if (!e.empty()) throw std::runtime_error("subscriber: " + e);
 
+    // What the daemon warned about during the run (dropped frames say why there), first lines only.
+    std::vector<std::string> daemon_warnings;
+    {
+      std::ifstream log(log_path);
+      for (std::string text; std::getline(log, text) && daemon_warnings.size() < 20;)
+        if (text.find("[warning]") != std::string::npos || text.find("[error]") != std::string::npos) daemon_warnings.push_back(text);
+    }
+
     long total_received = 0, total_dropped = 0, total_unmatched = 0, total_out_of_order = 0;
     for (int s = 0; s < subscriber_count; ++s) {
       total_received += received[s];
@@ -350,7 +358,8 @@ int main(int argc, char** argv) {
                     {"rss_kb_every_60s", every_minute},
                     {"frame_buffers_after_1s", buffers_after_1s},
                     {"frame_buffers_at_end", health.value("frame_buffers_allocated", 0)},
-                    {"exit_status", WIFEXITED(status) ? WEXITSTATUS(status) : -1}}}};
+                    {"exit_status", WIFEXITED(status) ? WEXITSTATUS(status) : -1},
+                    {"warnings", daemon_warnings}}}};
     if (json) {
       std::printf("%s\n", report.dump(2).c_str());
     } else {
@@ -365,6 +374,7 @@ int main(int argc, char** argv) {
       std::printf("daemon: %.2f s CPU (%.0f%% of one core), peak RSS %ld kB, RSS %ld kB after 1 s and %ld kB at the end\n",
                   cpu_seconds, 100 * cpu_seconds / seconds, peak_rss_kb, rss_samples.empty() ? 0L : rss_samples.front(),
                   rss_samples.empty() ? 0L : rss_samples.back());
+      for (const std::string& text : daemon_warnings) std::printf("daemon: %s\n", text.c_str());
     }
     fs::remove_all(work);
     return 0;

@@ -11,6 +11,7 @@
 #include <condition_variable>
 #include <cstdint>
 #include <mutex>
+#include <optional>
 #include <vector>
 
 #include "server/ingest/marker_frame.h"
@@ -27,10 +28,20 @@ class FrameMailbox {
   // Throws std::invalid_argument for a backlog below 1.
   explicit FrameMailbox(int marker_count, int backlog = kDefaultBacklog);
 
+  // What a frame that gave way tells about why: one that waited long while the pipeline took
+  // nothing says the pipeline stalled; one that waited a fraction of a frame period says frames
+  // arrived in a burst (the io thread or the network held them).
+  struct Drop {
+    uint32_t frame_number = 0;
+    std::chrono::nanoseconds waited{0};           // posted -> gave way
+    std::chrono::nanoseconds since_last_take{0};  // the pipeline's last take (or the start) -> now
+  };
+
   // Producer side (one thread): fill writable() completely, then post() it. `generation` changes
   // when the source restarts (reconnect, replay loop): the pipeline then forgets the past.
+  // Returns the frame that gave way to this one, if any.
   MarkerFrame& writable() { return slots_[write_]; }
-  void post(uint64_t generation);
+  std::optional<Drop> post(uint64_t generation);
 
   // Consumer side (one thread): the oldest waiting frame, or nullptr after `timeout` or close().
   // The frame stays valid until the next take().
@@ -47,6 +58,8 @@ class FrameMailbox {
   std::condition_variable ready_cv_;
   std::vector<MarkerFrame> slots_;
   std::vector<uint64_t> generations_;  // per slot
+  std::vector<std::chrono::steady_clock::time_point> posted_at_;  // per slot
+  std::chrono::steady_clock::time_point last_take_;  // the start until the first take
   BoundedRing<int> waiting_;           // slot indices, oldest first
   std::vector<int> free_;  // slots nobody holds; capacity reserved for all of them
   int write_ = 0, read_ = 1;

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <stdexcept>
+#include <thread>
 #include <vector>
 
 #include "support/allocation_counter.h"
@@ -65,6 +66,30 @@ TEST(FrameMailbox, BeyondTheBacklogTheOldestWaitingFramesGiveWay) {
     ASSERT_EQ(take_all(mailbox), expected);
   }
   EXPECT_EQ(mailbox.dropped(), 4u);
+}
+
+TEST(FrameMailbox, AFrameThatGivesWaySaysHowLongItWaitedAndWhenThePipelineLastTook) {
+  FrameMailbox mailbox(3, 2);
+  auto post = [&](uint32_t number) {
+    mailbox.writable().frame_number = number;
+    return mailbox.post(1);
+  };
+  EXPECT_FALSE(post(1));
+  std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  EXPECT_FALSE(post(2));
+  const auto stalled = post(3);  // nothing taken since the start: a stalled pipeline
+  ASSERT_TRUE(stalled);
+  EXPECT_EQ(stalled->frame_number, 1u);
+  EXPECT_GE(stalled->waited, std::chrono::milliseconds(20));
+  EXPECT_GE(stalled->since_last_take, stalled->waited);
+  uint64_t generation = 0;
+  ASSERT_NE(mailbox.take(std::chrono::milliseconds(0), generation), nullptr);  // frame 2
+  EXPECT_FALSE(post(4));
+  const auto burst = post(5);  // frame 3 was waiting before the take: the take is more recent
+  ASSERT_TRUE(burst);
+  EXPECT_EQ(burst->frame_number, 3u);
+  EXPECT_LE(burst->since_last_take, burst->waited);
+  EXPECT_EQ(mailbox.dropped(), 2u);
 }
 
 TEST(FrameMailbox, BacklogOfOneIsNewestFrameWins) {
