@@ -26,7 +26,7 @@ void take(const nlohmann::json& json, const char* key, T& out, const std::string
 void apply_json(const nlohmann::json& json, DaemonConfig& c, const std::string& origin) {
   if (!json.is_object()) throw ConfigError(origin + ": the configuration must be a JSON object");
   static const char* const kKeys[] = {"subject", "replay", "loop", "speed", "vicon", "vicon_pull", "vicon_multicast", "bind_address",
-                                      "http_port", "sub_port", "web_root", "lookahead", "deform_threads",
+                                      "http_port", "sub_port", "web_root", "lookahead", "max_frame_wait_ms", "deform_threads",
                                       "deform_cpus", "deform_spin_lead_us",
                                       "continuity_seconds", "use_pca", "ports_file", "log_level", "hello_timeout_ms",
                                       "subscriber_queue_frames", "status_interval_ms", "default_rate_hz"};
@@ -47,6 +47,7 @@ void apply_json(const nlohmann::json& json, DaemonConfig& c, const std::string& 
   take(json, "sub_port", c.sub_port, origin);
   take(json, "web_root", c.web_root, origin);
   take(json, "lookahead", c.lookahead, origin);
+  take(json, "max_frame_wait_ms", c.max_frame_wait_ms, origin);
   take(json, "deform_threads", c.deform_threads, origin);
   take(json, "deform_cpus", c.deform_cpus, origin);
   take(json, "deform_spin_lead_us", c.deform_spin_lead_us, origin);
@@ -89,6 +90,7 @@ nlohmann::json to_json(const DaemonConfig& c) {
           {"sub_port", c.sub_port},
           {"web_root", c.web_root},
           {"lookahead", c.lookahead},
+          {"max_frame_wait_ms", c.max_frame_wait_ms},
           {"deform_threads", c.deform_threads},
           {"deform_cpus", c.deform_cpus},
           {"deform_spin_lead_us", c.deform_spin_lead_us},
@@ -110,6 +112,7 @@ void validate(const DaemonConfig& c) {
   if (c.http_port < 0 || c.http_port > 65535) fail("http_port must be 0-65535");
   if (c.sub_port < 0 || c.sub_port > 65535) fail("sub_port must be 0-65535");
   if (c.lookahead < 0 || c.lookahead > 240) fail("lookahead must be 0-240 frames");
+  if (c.max_frame_wait_ms < 0 || c.max_frame_wait_ms > 1000) fail("max_frame_wait_ms must be 0-1000");
   if (c.deform_threads < 1 || c.deform_threads > 64) fail("deform_threads must be 1-64");
   if (const std::string problem = deform_cpus_problem(c.deform_cpus); !problem.empty()) fail(problem);
   if (c.deform_spin_lead_us < 0 || c.deform_spin_lead_us > 1'000'000) fail("deform_spin_lead_us must be 0-1000000");
@@ -157,6 +160,8 @@ std::optional<CommandLine> parse_command_line(int argc, const char* const* argv,
   auto* sub_port = app.add_option("--sub-port", flags.sub_port, "TCP subscriber port (0 = ephemeral)");
   auto* web_root = app.add_option("--web-root", flags.web_root, "folder of static files served at /");
   auto* lookahead = app.add_option("--lookahead", flags.lookahead, "gap-end blend lookahead in frames (adds latency)");
+  auto* max_wait = app.add_option("--max-frame-wait-ms", flags.max_frame_wait_ms,
+                                  "a frame that waited this long for the pipeline gives way to a newer one (0 = newest frame wins)");
   auto* threads = app.add_option("--deform-threads", flags.deform_threads, "threads deforming the mesh (pipeline thread included)");
   auto* cpus = app.add_option("--deform-cpus", flags.deform_cpus, "CPUs of the deform threads: auto, off, or a list such as 2,3");
   auto* spin_lead = app.add_option("--deform-spin-lead-us", flags.deform_spin_lead_us,
@@ -188,6 +193,7 @@ std::optional<CommandLine> parse_command_line(int argc, const char* const* argv,
   if (given(sub_port)) c.sub_port = flags.sub_port;
   if (given(web_root)) c.web_root = flags.web_root;
   if (given(lookahead)) c.lookahead = flags.lookahead;
+  if (given(max_wait)) c.max_frame_wait_ms = flags.max_frame_wait_ms;
   if (given(threads)) c.deform_threads = flags.deform_threads;
   if (given(cpus)) c.deform_cpus = flags.deform_cpus;
   if (given(spin_lead)) c.deform_spin_lead_us = flags.deform_spin_lead_us;

@@ -71,7 +71,7 @@ subscriber::SourceStateCode code_of(SourceState s) { return static_cast<subscrib
 Daemon::Daemon(const DaemonConfig& config)
     : config_(config),
       subject_(load_subject(config)),
-      mailbox_(subject_.model.marker_count()),
+      mailbox_(subject_.model.marker_count(), std::chrono::milliseconds(config.max_frame_wait_ms)),
       status_timer_(io_) {
   const SubjectModel& model = subject_.model;
   if (!subject_.deformation)
@@ -254,13 +254,17 @@ void Daemon::on_frame(const MarkerFrame& in) {
     generation = generation_;
   }
   if (const std::optional<FrameMailbox::Drop> drop = mailbox_.post(generation)) {
-    // Says which side fell behind: a frame that waited long behind a pipeline that took nothing,
-    // or frames that arrived together (the source, the network or this io thread held them).
+    // Says which side fell behind: the pipeline (it took nothing for a while), or the source,
+    // whose frames came in a burst longer than the mailbox holds.
     using Ms = std::chrono::duration<double, std::milli>;
-    drop_log_.warn("frame_gave_way", fmt::format("frame {} waited {:.1f} ms and gave way to newer ones; the pipeline last took "
-                                                 "a frame {:.1f} ms ago ({} dropped in all)",
-                                                 drop->frame_number, Ms(drop->waited).count(), Ms(drop->since_last_take).count(),
-                                                 mailbox_.dropped()));
+    const bool full = drop->reason == FrameMailbox::DropReason::kMailboxFull;
+    drop_log_.warn("frame_gave_way",
+                   fmt::format("frame {} gave way to newer ones after waiting {:.1f} ms: {}; the pipeline last took a frame {:.1f} ms "
+                               "before ({} dropped in all)",
+                               drop->frame_number, Ms(drop->waited).count(),
+                               full ? "more frames arrived together than the mailbox holds (a burst from the source)"
+                                    : "the pipeline is behind (longer than max_frame_wait_ms)",
+                               Ms(drop->since_last_take).count(), mailbox_.dropped()));
   }
 }
 
@@ -321,7 +325,8 @@ std::string Daemon::health_json() const {
        {{"received", metrics_.frames_received.load()},
         {"processed", metrics_.frames_processed.load()},
         {"published", metrics_.frames_published.load()},
-        {"dropped", metrics_.frames_dropped.load()}}},
+        {"dropped", metrics_.frames_dropped.load()},
+        {"dropped_mailbox_full", metrics_.frames_dropped_mailbox_full.load()}}},
       // Encoded frame buffers created so far: grows only while the pool meets a new high-water
       // mark of frames in use (bounded by the subscribers' queues), so RSS steps with it.
       {"frame_buffers_allocated", metrics_.frame_buffers_allocated.load()},

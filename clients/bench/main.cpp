@@ -53,8 +53,8 @@ class SendTimes {
     std::lock_guard lock(mutex_);
     slots_[frame_number % kSlots] = {frame_number, send_ns};
     // The replay's own regularity: after a stall of this (shared) machine it sends the frames
-    // it owes back to back, and a burst longer than the daemon's mailbox backlog (3 frames) is
-    // dropped there, newest frame winning, as it should be for live preview.
+    // it owes back to back, as a capture system's server would after a hitch; the daemon
+    // processes such a burst whole unless it is longer than its mailbox (32 frames).
     if (counting_ && last_send_ns_ > 0) {
       const int64_t gap = send_ns - last_send_ns_;
       max_gap_ns_ = std::max(max_gap_ns_, gap);
@@ -347,6 +347,7 @@ int main(int argc, char** argv) {
                     {"processed", delta("processed")},
                     {"published", delta("published")},
                     {"dropped_in_pipeline", delta("dropped")},
+                    {"dropped_in_pipeline_mailbox_full", delta("dropped_mailbox_full")},
                     {"received_by_subscribers", total_received},
                     {"dropped_for_subscribers", total_dropped},
                     {"out_of_order", total_out_of_order},

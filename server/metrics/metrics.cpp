@@ -70,7 +70,8 @@ std::string Metrics::render_prometheus(const std::vector<SubscriberMetrics>& sub
   counter(out, "frames_received_total", "Marker frames received from the source.", frames_received);
   counter(out, "frames_processed_total", "Frames through the gap filler.", frames_processed);
   counter(out, "frames_published_total", "Frames handed to the publishers.", frames_published);
-  counter(out, "frames_dropped_total", "Frames that waited in the mailbox beyond its backlog and gave way to newer ones.", frames_dropped);
+  counter(out, "frames_dropped_total", "Frames that gave way to newer ones in the mailbox (waited longer than max_frame_wait_ms, or a burst overfilled it).", frames_dropped);
+  counter(out, "frames_dropped_mailbox_full_total", "Of the dropped frames, those of bursts longer than the mailbox holds.", frames_dropped_mailbox_full);
   counter(out, "markers_filled_total", "Marker samples filled (PCA, rigid or held).", markers_filled);
   counter(out, "markers_relabelled_total", "Marker samples taken from unlabelled points.", markers_relabelled);
   counter(out, "markers_held_total", "Marker samples held relative to their anchors.", markers_held);

@@ -41,7 +41,8 @@ class Metrics {
   std::atomic<uint64_t> frames_received{0};
   std::atomic<uint64_t> frames_processed{0};
   std::atomic<uint64_t> frames_published{0};
-  std::atomic<uint64_t> frames_dropped{0};  // gave way in the mailbox, beyond its backlog
+  std::atomic<uint64_t> frames_dropped{0};  // gave way in the mailbox: waited too long, or a burst overfilled it
+  std::atomic<uint64_t> frames_dropped_mailbox_full{0};  // of those, the burst's
   std::atomic<uint64_t> markers_filled{0};
   std::atomic<uint64_t> markers_relabelled{0};
   std::atomic<uint64_t> markers_held{0};

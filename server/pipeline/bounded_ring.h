@@ -26,6 +26,7 @@ class BoundedRing {
     return item;
   }
 
+  const T& front() const { return items_[head_]; }  // the oldest; the ring must not be empty
   size_t size() const { return count_; }
   bool empty() const { return count_ == 0; }
   bool full() const { return count_ == items_.size(); }

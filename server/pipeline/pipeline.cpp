@@ -176,6 +176,7 @@ void Pipeline::publish(const Released& meta, std::span<const Vec3> positions, st
   }
   metrics_.encode.observe_ns(since_ns(encode_start));
   metrics_.frames_dropped.store(mailbox_.dropped(), std::memory_order_relaxed);
+  metrics_.frames_dropped_mailbox_full.store(mailbox_.dropped_mailbox_full(), std::memory_order_relaxed);
   consumer_.publish(ref);
   published_.fetch_add(1, std::memory_order_relaxed);
   metrics_.frames_published.fetch_add(1, std::memory_order_relaxed);

@@ -56,8 +56,9 @@ TEST(Config, UnknownKeysAndWrongTypesAreErrors) {
 TEST(Config, FlagsOverrideTheFile) {
   const std::string path = write_file("base.json", R"({"subject": "a.sks", "http_port": 9000, "sub_port": 9001, "lookahead": 4,
                                                        "replay": "take.c3d", "loop": true})");
-  const auto parsed = parse({"--config", path, "--http-port", "0", "--lookahead", "6"});
+  const auto parsed = parse({"--config", path, "--http-port", "0", "--lookahead", "6", "--max-frame-wait-ms", "40"});
   ASSERT_TRUE(parsed);
+  EXPECT_EQ(parsed->config.max_frame_wait_ms, 40);
   EXPECT_EQ(parsed->config.subject, "a.sks");
   EXPECT_EQ(parsed->config.http_port, 0);
   EXPECT_EQ(parsed->config.sub_port, 9001);
@@ -91,6 +92,7 @@ TEST(Config, OutOfRangeValuesAndConflictsAreErrors) {
   EXPECT_NE(error_of([] { parse({"--deform-cpus", "1;2"}); }).find("deform_cpus must be"), std::string::npos);
   EXPECT_NE(error_of([] { parse({"--deform-cpus", "1,1"}); }).find("names a CPU twice"), std::string::npos);
   EXPECT_NE(error_of([] { parse({"--deform-spin-lead-us", "-5"}); }).find("deform_spin_lead_us"), std::string::npos);
+  EXPECT_NE(error_of([] { parse({"--max-frame-wait-ms", "-1"}); }).find("max_frame_wait_ms"), std::string::npos);
   EXPECT_NE(error_of([] { parse({"--http-port", "70000"}); }).find("http_port"), std::string::npos);
   EXPECT_NE(error_of([] { parse({"--replay", "a.c3d", "--vicon", "h:1"}); }).find("one source"), std::string::npos);
   EXPECT_NE(error_of([] { parse({"--vicon", "h:1", "--vicon-multicast", "239.1.1.1:44801"}); }).find("one source"), std::string::npos);

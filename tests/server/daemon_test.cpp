@@ -336,6 +336,7 @@ TEST(Daemon, ServesHealthMetricsWebSocketAndSubscribersWithoutHello) {
   const nlohmann::json health = nlohmann::json::parse(http_get(daemon.http_port(), "/health", &status));
   EXPECT_EQ(status, 200);
   EXPECT_GT(health["frames"]["received"].get<long>(), 0);
+  EXPECT_LE(health["frames"]["dropped_mailbox_full"].get<uint64_t>(), health["frames"]["dropped"].get<uint64_t>());
   EXPECT_GE(health["subscribers"].get<int>(), 2);
   // Frames went out, so encoded buffers exist (the counter only grows, and frames keep coming).
   EXPECT_GE(health["frame_buffers_allocated"].get<long>(), 1);
@@ -343,7 +344,7 @@ TEST(Daemon, ServesHealthMetricsWebSocketAndSubscribersWithoutHello) {
   const std::string metrics = http_get(daemon.http_port(), "/metrics", &status);
   EXPECT_EQ(status, 200);
   for (const char* name : {"skinstream_frames_received_total ", "skinstream_frames_published_total ", "skinstream_frames_dropped_total ",
-                           "skinstream_markers_filled_total ", "skinstream_fill_seconds_bucket{le=\"+Inf\"}",
+                           "skinstream_frames_dropped_mailbox_full_total ", "skinstream_markers_filled_total ", "skinstream_fill_seconds_bucket{le=\"+Inf\"}",
                            "skinstream_encode_seconds_count", "skinstream_bad_subscriber_messages_total 1"})
     EXPECT_NE(metrics.find(name), std::string::npos) << name;
   http_get(daemon.http_port(), "/nothing-here", &status);

@@ -32,7 +32,7 @@ std::vector<uint32_t> take_all(FrameMailbox& mailbox) {
 }
 
 TEST(FrameMailbox, FramesArrivingTogetherAreAllTakenInOrder) {
-  FrameMailbox mailbox(3);  // the default backlog, 3
+  FrameMailbox mailbox(3, std::chrono::seconds(10), 32);
   post_frame(mailbox, 10);
   post_frame(mailbox, 11);
   post_frame(mailbox, 12, 2);
@@ -52,10 +52,38 @@ TEST(FrameMailbox, FramesArrivingTogetherAreAllTakenInOrder) {
   EXPECT_EQ(mailbox.take(std::chrono::milliseconds(0), generation), nullptr);  // taken once only
 }
 
-TEST(FrameMailbox, BeyondTheBacklogTheOldestWaitingFramesGiveWay) {
-  FrameMailbox mailbox(3, 3);
+// A source that held its frames for a while and then sends them back to back: the pipeline
+// gets every one, however many, as long as it takes them within max_wait.
+TEST(FrameMailbox, ABurstIsTakenWholeWithinTheWaitLimit) {
+  FrameMailbox mailbox(3, std::chrono::seconds(10), 32);
+  std::vector<uint32_t> expected;
+  for (uint32_t n = 1; n <= 30; ++n) {
+    post_frame(mailbox, n);
+    expected.push_back(n);
+  }
+  EXPECT_EQ(take_all(mailbox), expected);
+  EXPECT_EQ(mailbox.dropped(), 0u);
+}
+
+TEST(FrameMailbox, FramesThatWaitedTooLongGiveWayButTheNewestIsAlwaysTaken) {
+  FrameMailbox mailbox(3, std::chrono::milliseconds(10), 32);
+  post_frame(mailbox, 1);
+  post_frame(mailbox, 2);
+  std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  post_frame(mailbox, 3);
+  EXPECT_EQ(take_all(mailbox), (std::vector<uint32_t>{3}));  // 1 and 2 waited 20 ms
+  EXPECT_EQ(mailbox.dropped_waited_too_long(), 2u);
+  post_frame(mailbox, 4);
+  std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  EXPECT_EQ(take_all(mailbox), (std::vector<uint32_t>{4}));  // old, but nothing newer
+  EXPECT_EQ(mailbox.dropped(), 2u);
+  EXPECT_EQ(mailbox.dropped_mailbox_full(), 0u);
+}
+
+TEST(FrameMailbox, BeyondItsCapacityTheOldestWaitingFramesGiveWay) {
+  FrameMailbox mailbox(3, std::chrono::seconds(10), 3);
   for (uint32_t n = 1; n <= 7; ++n) post_frame(mailbox, n);
-  EXPECT_EQ(mailbox.dropped(), 4u);  // 1..4: the newest always gets in
+  EXPECT_EQ(mailbox.dropped_mailbox_full(), 4u);  // 1..4: the newest always gets in
   EXPECT_EQ(take_all(mailbox), (std::vector<uint32_t>{5, 6, 7}));
   // Taking and posting interleaved: the slots cycle without loss.
   for (uint32_t n = 8; n < 40; ++n) {
@@ -66,44 +94,50 @@ TEST(FrameMailbox, BeyondTheBacklogTheOldestWaitingFramesGiveWay) {
     ASSERT_EQ(take_all(mailbox), expected);
   }
   EXPECT_EQ(mailbox.dropped(), 4u);
+  EXPECT_EQ(mailbox.dropped_waited_too_long(), 0u);
 }
 
-TEST(FrameMailbox, AFrameThatGivesWaySaysHowLongItWaitedAndWhenThePipelineLastTook) {
-  FrameMailbox mailbox(3, 2);
-  auto post = [&](uint32_t number) {
-    mailbox.writable().frame_number = number;
-    return mailbox.post(1);
-  };
-  EXPECT_FALSE(post(1));
-  std::this_thread::sleep_for(std::chrono::milliseconds(20));
-  EXPECT_FALSE(post(2));
-  const auto stalled = post(3);  // nothing taken since the start: a stalled pipeline
-  ASSERT_TRUE(stalled);
-  EXPECT_EQ(stalled->frame_number, 1u);
-  EXPECT_GE(stalled->waited, std::chrono::milliseconds(20));
-  EXPECT_GE(stalled->since_last_take, stalled->waited);
-  uint64_t generation = 0;
-  ASSERT_NE(mailbox.take(std::chrono::milliseconds(0), generation), nullptr);  // frame 2
-  EXPECT_FALSE(post(4));
-  const auto burst = post(5);  // frame 3 was waiting before the take: the take is more recent
-  ASSERT_TRUE(burst);
-  EXPECT_EQ(burst->frame_number, 3u);
-  EXPECT_LE(burst->since_last_take, burst->waited);
-  EXPECT_EQ(mailbox.dropped(), 2u);
-}
-
-TEST(FrameMailbox, BacklogOfOneIsNewestFrameWins) {
-  FrameMailbox mailbox(3, 1);
+TEST(FrameMailbox, WaitLimitOfZeroIsNewestFrameWins) {
+  FrameMailbox mailbox(3, std::chrono::nanoseconds(0), 32);
   post_frame(mailbox, 10);
   post_frame(mailbox, 11);
   post_frame(mailbox, 12);
   EXPECT_EQ(take_all(mailbox), (std::vector<uint32_t>{12}));
   EXPECT_EQ(mailbox.dropped(), 2u);
-  EXPECT_THROW(FrameMailbox(3, 0), std::invalid_argument);
+  EXPECT_THROW(FrameMailbox(3, std::chrono::milliseconds(25), 0), std::invalid_argument);
+  EXPECT_THROW(FrameMailbox(3, std::chrono::milliseconds(-1), 32), std::invalid_argument);
+}
+
+TEST(FrameMailbox, AFrameThatGivesWayIsReportedOnceWithWhyAndHowLongItWaited) {
+  FrameMailbox mailbox(3, std::chrono::milliseconds(200), 2);
+  auto post = [&](uint32_t number) {
+    mailbox.writable().frame_number = number;
+    return mailbox.post(1);
+  };
+  EXPECT_FALSE(post(1));
+  std::this_thread::sleep_for(std::chrono::milliseconds(30));
+  EXPECT_FALSE(post(2));
+  const auto full = post(3);  // nothing taken since the start, the mailbox holds 2
+  ASSERT_TRUE(full);
+  EXPECT_EQ(full->frame_number, 1u);
+  EXPECT_EQ(full->reason, FrameMailbox::DropReason::kMailboxFull);
+  EXPECT_GE(full->waited, std::chrono::milliseconds(30));
+  EXPECT_GE(full->since_last_take, full->waited);
+  uint64_t generation = 0;
+  ASSERT_EQ(mailbox.take(std::chrono::milliseconds(0), generation)->frame_number, 2u);
+  EXPECT_FALSE(post(4));  // reported once
+  std::this_thread::sleep_for(std::chrono::milliseconds(250));
+  ASSERT_EQ(mailbox.take(std::chrono::milliseconds(0), generation)->frame_number, 4u);  // 3 waited 250 ms
+  const auto late = post(5);  // the drop at the take is reported to the producer
+  ASSERT_TRUE(late);
+  EXPECT_EQ(late->frame_number, 3u);
+  EXPECT_EQ(late->reason, FrameMailbox::DropReason::kWaitedTooLong);
+  EXPECT_GE(late->waited, std::chrono::milliseconds(250));
+  EXPECT_EQ(mailbox.dropped(), 2u);
 }
 
 TEST(FrameMailbox, FrameTakenStaysIntactWhileTheWriterGoesOn) {
-  FrameMailbox mailbox(3);
+  FrameMailbox mailbox(3, std::chrono::seconds(10), 3);
   post_frame(mailbox, 1);
   uint64_t generation = 0;
   const MarkerFrame* taken = mailbox.take(std::chrono::milliseconds(0), generation);
