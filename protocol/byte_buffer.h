@@ -61,6 +61,19 @@ class ByteReader {
       throw std::out_of_range("count " + std::to_string(n) + " exceeds the data left");
     return n;
   }
+  // `count` values at once: one bounds check and one copy (the stream's byte order is the host's,
+  // little-endian, as for get()).
+  template <typename T>
+  void get_array(T* out, size_t count) {
+    static_assert(std::is_arithmetic_v<T>);
+    if (count > (size_ - pos_) / sizeof(T)) throw std::out_of_range("truncated at byte " + std::to_string(pos_));
+    std::memcpy(out, data_ + pos_, count * sizeof(T));
+    pos_ += count * sizeof(T);
+  }
+  void skip(size_t n) {
+    need(n);
+    pos_ += n;
+  }
   size_t remaining() const { return size_ - pos_; }
   size_t position() const { return pos_; }
 

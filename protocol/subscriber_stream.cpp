@@ -61,9 +61,11 @@ auto decode_payload(const char* what, std::span<const unsigned char> payload, F&
   }
 }
 
+// Only after the frame's sizes were checked against the payload (read_frame_info), so `count`
+// never allocates more than the payload holds.
 void get_floats(ByteReader& r, std::vector<float>& out, size_t count) {
   out.resize(count);
-  for (size_t i = 0; i < count; ++i) out[i] = r.get<float>();
+  r.get_array(out.data(), count);
 }
 
 }  // namespace
@@ -288,31 +290,52 @@ MeshInfo decode_mesh_info(std::span<const unsigned char> payload) {
   });
 }
 
+namespace {
+
+// The fixed part of a Frame payload, checked against the sizes of what follows it; the reader is
+// left at the first array.
+FrameInfo read_frame_info(ByteReader& r) {
+  FrameInfo info;
+  info.frame_number = r.get<uint32_t>();
+  info.flags = r.get<uint32_t>();
+  info.source_time_ns = r.get<int64_t>();
+  info.receive_time_ns = r.get<int64_t>();
+  info.publish_time_ns = r.get<int64_t>();
+  info.vertex_count = r.get<uint32_t>();
+  info.marker_count = r.get<uint32_t>();
+  info.markers_filled = r.get<uint16_t>();
+  info.markers_relabelled = r.get<uint16_t>();
+  info.pipeline_dropped = r.get<uint32_t>();
+  info.subscriber_dropped = r.get<uint32_t>();
+  if (info.flags & ~uint32_t{0xF}) throw DecodeError("Frame: reserved flag bits set (" + std::to_string(info.flags) + ")");
+  const bool has_positions = !(info.flags & kFrameNoPositions);
+  if (!has_positions && info.vertex_count != 0) throw DecodeError("Frame: vertex count with \"no positions\"");
+  if (!has_positions && (info.flags & kFrameNormals)) throw DecodeError("Frame: normals without positions");
+  if (!(info.flags & kFrameMarkers) && info.marker_count != 0) throw DecodeError("Frame: marker count without markers");
+  // Sizes first, so a corrupt count is refused before anything is allocated for it.
+  const size_t expected = frame_message_bytes(info.flags, info.vertex_count, info.marker_count) - kHeaderBytes - kFrameInfoBytes;
+  if (expected != r.remaining())
+    throw DecodeError("Frame: counts say " + std::to_string(expected) + " bytes of data, the payload holds " +
+                      std::to_string(r.remaining()));
+  return info;
+}
+
+}  // namespace
+
+FrameInfo decode_frame_info(std::span<const unsigned char> payload) {
+  return decode_payload("Frame", payload, [](ByteReader& r) {
+    const FrameInfo info = read_frame_info(r);
+    r.skip(r.remaining());
+    return info;
+  });
+}
+
 Frame decode_frame(std::span<const unsigned char> payload) {
   return decode_payload("Frame", payload, [](ByteReader& r) {
     Frame frame;
-    FrameInfo& info = frame.info;
-    info.frame_number = r.get<uint32_t>();
-    info.flags = r.get<uint32_t>();
-    info.source_time_ns = r.get<int64_t>();
-    info.receive_time_ns = r.get<int64_t>();
-    info.publish_time_ns = r.get<int64_t>();
-    info.vertex_count = r.get<uint32_t>();
-    info.marker_count = r.get<uint32_t>();
-    info.markers_filled = r.get<uint16_t>();
-    info.markers_relabelled = r.get<uint16_t>();
-    info.pipeline_dropped = r.get<uint32_t>();
-    info.subscriber_dropped = r.get<uint32_t>();
-    if (info.flags & ~uint32_t{0xF}) throw DecodeError("Frame: reserved flag bits set (" + std::to_string(info.flags) + ")");
+    frame.info = read_frame_info(r);
+    const FrameInfo& info = frame.info;
     const bool has_positions = !(info.flags & kFrameNoPositions);
-    if (!has_positions && info.vertex_count != 0) throw DecodeError("Frame: vertex count with \"no positions\"");
-    if (!has_positions && (info.flags & kFrameNormals)) throw DecodeError("Frame: normals without positions");
-    if (!(info.flags & kFrameMarkers) && info.marker_count != 0) throw DecodeError("Frame: marker count without markers");
-    // Sizes first, so a corrupt count is refused before anything is allocated for it.
-    const size_t expected = frame_message_bytes(info.flags, info.vertex_count, info.marker_count) - kHeaderBytes - kFrameInfoBytes;
-    if (expected != r.remaining())
-      throw DecodeError("Frame: counts say " + std::to_string(expected) + " bytes of data, the payload holds " +
-                        std::to_string(r.remaining()));
     const size_t v3 = 3 * size_t{info.vertex_count};
     const bool quantised = info.flags & kFrameQuantised;
     if (has_positions && !quantised) get_floats(r, frame.positions, v3);
@@ -358,16 +381,28 @@ Status decode_status(std::span<const unsigned char> payload) {
 }
 
 void StreamDecoder::feed(std::span<const unsigned char> bytes) {
-  // Drop what was consumed before growing, so the buffer holds at most one partial message.
-  if (consumed_ > 0) {
-    buffer_.erase(buffer_.begin(), buffer_.begin() + static_cast<std::ptrdiff_t>(consumed_));
-    consumed_ = 0;
-  }
-  buffer_.insert(buffer_.end(), bytes.begin(), bytes.end());
+  const std::span<unsigned char> room = prepare(bytes.size());
+  std::copy(bytes.begin(), bytes.end(), room.begin());
+  commit(bytes.size());
 }
 
+std::span<unsigned char> StreamDecoder::prepare(size_t bytes) {
+  if (consumed_ == filled_) consumed_ = filled_ = 0;  // everything was cut: start at the front for free
+  if (buffer_.size() - filled_ < bytes) {
+    // Move what is not cut yet (at most one partial message) to the front, then grow if need be.
+    std::copy(buffer_.begin() + static_cast<std::ptrdiff_t>(consumed_), buffer_.begin() + static_cast<std::ptrdiff_t>(filled_),
+              buffer_.begin());
+    filled_ -= consumed_;
+    consumed_ = 0;
+    if (buffer_.size() - filled_ < bytes) buffer_.resize(filled_ + bytes);
+  }
+  return std::span(buffer_).subspan(filled_, bytes);
+}
+
+void StreamDecoder::commit(size_t bytes) { filled_ += std::min(bytes, buffer_.size() - filled_); }
+
 std::optional<RawMessage> StreamDecoder::next() {
-  const std::span<const unsigned char> pending(buffer_.data() + consumed_, buffer_.size() - consumed_);
+  const std::span<const unsigned char> pending(buffer_.data() + consumed_, filled_ - consumed_);
   if (pending.size() < kHeaderBytes) return std::nullopt;
   const MessageHeader header = decode_header(pending, max_payload_);
   if (pending.size() - kHeaderBytes < header.payload_bytes) return std::nullopt;

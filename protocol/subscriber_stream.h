@@ -137,11 +137,15 @@ Hello decode_hello(std::span<const unsigned char> payload);
 Ack decode_ack(std::span<const unsigned char> payload);
 MeshInfo decode_mesh_info(std::span<const unsigned char> payload);
 Frame decode_frame(std::span<const unsigned char> payload);
+// decode_frame's checks of the fixed part and of the sizes, but the arrays are not read (nor
+// their marker status values checked): only the FrameInfo, nothing copied or allocated (for a
+// reader that wants the numbers, not the mesh, such as skinstream-bench).
+FrameInfo decode_frame_info(std::span<const unsigned char> payload);
 Status decode_status(std::span<const unsigned char> payload);
 
 struct RawMessage {
   MessageType type = MessageType::Hello;
-  std::span<const unsigned char> payload;  // valid until the next feed()/next()
+  std::span<const unsigned char> payload;  // valid until the next feed() or prepare()
 };
 
 // Cuts a byte stream into messages. After a DecodeError the stream is unusable (close it).
@@ -149,13 +153,18 @@ class StreamDecoder {
  public:
   explicit StreamDecoder(uint32_t max_payload = kMaxPayloadBytes) : max_payload_(max_payload) {}
   void feed(std::span<const unsigned char> bytes);
+  // Reading straight into the decoder, without a copy: prepare() gives room for at least
+  // `bytes` more, the socket reads into it, commit() says how many it wrote.
+  std::span<unsigned char> prepare(size_t bytes);
+  void commit(size_t bytes);
   // The next complete message, or nullopt when more bytes are needed. Throws DecodeError.
   std::optional<RawMessage> next();
-  size_t buffered() const { return buffer_.size() - consumed_; }
+  size_t buffered() const { return filled_ - consumed_; }
 
  private:
   uint32_t max_payload_;
-  std::vector<unsigned char> buffer_;
+  std::vector<unsigned char> buffer_;  // storage; [consumed_, filled_) is not yet cut
+  size_t filled_ = 0;
   size_t consumed_ = 0;
 };
 

@@ -1,6 +1,5 @@
 #include "server/client/subscriber_client.h"
 
-#include <array>
 #include <stdexcept>
 
 namespace skinstream::sub {
@@ -30,13 +29,16 @@ SubscriberClient::SubscriberClient(const std::string& host, const std::string& p
 
 bool SubscriberClient::run(
     const std::function<bool(subscriber::MessageType, std::span<const unsigned char>, int64_t)>& on_message) {
-  std::array<unsigned char, 1 << 16> buffer;
+  // Straight into the decoder, up to 1 MiB a read: a 53,500-vertex frame (640 kB) in one or two
+  // reads, no copy on the way.
+  constexpr size_t kReadBytes = 1 << 20;
   for (;;) {
     boost::system::error_code ec;
-    const size_t n = socket_.read_some(server::asio::buffer(buffer), ec);
+    const std::span<unsigned char> room = decoder_.prepare(kReadBytes);
+    const size_t n = socket_.read_some(server::asio::buffer(room.data(), room.size()), ec);
     if (ec) return false;
     const int64_t now = wall_clock_ns();
-    decoder_.feed(std::span(buffer).first(n));
+    decoder_.commit(n);
     while (auto message = decoder_.next())
       if (!on_message(message->type, message->payload, now)) return true;
   }

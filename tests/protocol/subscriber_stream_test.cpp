@@ -206,11 +206,13 @@ TEST(SubscriberStream, EveryTruncationOfEveryMessageIsRejected) {
         }
       };
       EXPECT_THROW(decode(), DecodeError) << name << " cut at " << n;
+      if (header.type == MessageType::Frame) EXPECT_THROW(decode_frame_info(cut), DecodeError) << name << " cut at " << n;
     }
     // A byte too many is refused as well.
     std::vector<unsigned char> longer(message.begin() + kHeaderBytes, message.end());
     longer.push_back(0);
     if (header.type == MessageType::Frame) EXPECT_THROW(decode_frame(longer), DecodeError) << name;
+    if (header.type == MessageType::Frame) EXPECT_THROW(decode_frame_info(longer), DecodeError) << name;
     if (header.type == MessageType::Hello) EXPECT_THROW(decode_hello(longer), DecodeError) << name;
   }
 }
@@ -225,6 +227,8 @@ TEST(SubscriberStream, CorruptFrameCountsAndFlagsAreRejected) {
   EXPECT_THROW(decode_frame(corrupt(32, 1'000'000'000)), DecodeError);  // vertex count
   EXPECT_THROW(decode_frame(corrupt(36, 0xFFFFFFFF)), DecodeError);     // marker count
   EXPECT_THROW(decode_frame(corrupt(4, 0x10)), DecodeError);            // reserved flag
+  for (const auto& [offset, value] : {std::pair<size_t, uint32_t>{32, 1'000'000'000}, {36, 0xFFFFFFFF}, {4, 0x10}})
+    EXPECT_THROW(decode_frame_info(corrupt(offset, value)), DecodeError) << "offset " << offset;
   std::vector<unsigned char> bad_status(golden.begin() + kHeaderBytes, golden.end());
   bad_status[bad_status.size() - 4] = 9;  // first marker status byte
   EXPECT_THROW(decode_frame(bad_status), DecodeError);
@@ -248,6 +252,57 @@ TEST(SubscriberStream, StreamDecoderCutsMessagesAtAnyBoundary) {
     }
     EXPECT_EQ(types, (std::vector<MessageType>{MessageType::Status, MessageType::MeshInfo, MessageType::Frame, MessageType::Frame}))
         << "chunk " << chunk;
+    EXPECT_EQ(decoder.buffered(), 0u);
+  }
+}
+
+TEST(SubscriberStream, FrameInfoAloneMatchesTheWholeDecode) {
+  for (const char* name : {"frame_float.bin", "frame_quantised.bin", "frame_markers_only.bin"}) {
+    const std::vector<unsigned char> message = fixture(name);
+    const std::span<const unsigned char> payload = std::span(message).subspan(kHeaderBytes);
+    const FrameInfo whole = decode_frame(payload).info, alone = decode_frame_info(payload);
+    EXPECT_EQ(alone.frame_number, whole.frame_number) << name;
+    EXPECT_EQ(alone.flags, whole.flags) << name;
+    EXPECT_EQ(alone.source_time_ns, whole.source_time_ns) << name;
+    EXPECT_EQ(alone.receive_time_ns, whole.receive_time_ns) << name;
+    EXPECT_EQ(alone.publish_time_ns, whole.publish_time_ns) << name;
+    EXPECT_EQ(alone.vertex_count, whole.vertex_count) << name;
+    EXPECT_EQ(alone.marker_count, whole.marker_count) << name;
+    EXPECT_EQ(alone.markers_filled, whole.markers_filled) << name;
+    EXPECT_EQ(alone.markers_relabelled, whole.markers_relabelled) << name;
+    EXPECT_EQ(alone.pipeline_dropped, whole.pipeline_dropped) << name;
+    EXPECT_EQ(alone.subscriber_dropped, whole.subscriber_dropped) << name;
+  }
+}
+
+// As a socket reader uses it: room for more than arrives, a short read, the rest later.
+TEST(SubscriberStream, StreamDecoderTakesReadsStraightIntoItsBuffer) {
+  std::vector<unsigned char> stream;
+  for (int repeat = 0; repeat < 3; ++repeat)
+    for (const char* name : {"status.bin", "frame_float.bin", "mesh_info.bin", "frame_quantised.bin"}) {
+      const std::vector<unsigned char> m = fixture(name);
+      stream.insert(stream.end(), m.begin(), m.end());
+    }
+  for (size_t read_bytes : {size_t{1}, size_t{7}, size_t{100}, stream.size()}) {
+    StreamDecoder decoder;
+    int frames = 0, messages = 0;
+    for (size_t at = 0; at < stream.size();) {
+      const std::span<unsigned char> room = decoder.prepare(2 * read_bytes + 3);
+      ASSERT_GE(room.size(), 2 * read_bytes + 3);
+      const size_t n = std::min(read_bytes, stream.size() - at);
+      std::copy_n(stream.begin() + static_cast<std::ptrdiff_t>(at), n, room.begin());
+      decoder.commit(n);
+      at += n;
+      while (auto message = decoder.next()) {
+        ++messages;
+        if (message->type == MessageType::Frame) {
+          EXPECT_EQ(decode_frame(message->payload).info.frame_number, 1234u);
+          ++frames;
+        }
+      }
+    }
+    EXPECT_EQ(messages, 12) << "reads of " << read_bytes;
+    EXPECT_EQ(frames, 6) << "reads of " << read_bytes;
     EXPECT_EQ(decoder.buffered(), 0u);
   }
 }
