@@ -161,7 +161,8 @@ std::optional<CommandLine> parse_command_line(int argc, const char* const* argv,
   auto* web_root = app.add_option("--web-root", flags.web_root, "folder of static files served at /");
   auto* lookahead = app.add_option("--lookahead", flags.lookahead, "gap-end blend lookahead in frames (adds latency)");
   auto* max_wait = app.add_option("--max-frame-wait-ms", flags.max_frame_wait_ms,
-                                  "a frame that waited this long for the pipeline gives way to a newer one (0 = newest frame wins)");
+                                  "a frame that waited this long for the pipeline or a subscriber gives way to a newer one "
+                                  "(0 = newest frame wins)");
   auto* threads = app.add_option("--deform-threads", flags.deform_threads, "threads deforming the mesh (pipeline thread included)");
   auto* cpus = app.add_option("--deform-cpus", flags.deform_cpus, "CPUs of the deform threads: auto, off, or a list such as 2,3");
   auto* spin_lead = app.add_option("--deform-spin-lead-us", flags.deform_spin_lead_us,

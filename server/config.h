@@ -25,7 +25,7 @@ struct DaemonConfig {
   int sub_port = 8481;            // 0 = ephemeral
   std::string web_root;           // static files served at /; empty = none
   int lookahead = 0;              // gap-end blend lookahead, frames
-  int max_frame_wait_ms = 25;     // a frame that waited this long for the pipeline gives way to a newer one
+  int max_frame_wait_ms = 25;     // a frame that waited this long (for the pipeline, for a subscriber) gives way to a newer one
   int deform_threads = 2;         // the pipeline thread plus deform_threads - 1 workers
   std::string deform_cpus = "auto";  // "auto", "off" or "2,3": server/pipeline/deform_cpus.h
   int deform_spin_lead_us = 1000;  // workers spin this long before a frame is due; 0 = sleep until woken
@@ -34,7 +34,7 @@ struct DaemonConfig {
   std::string ports_file;         // written as {"http":N,"sub":N} once listening
   std::string log_level = "info";
   int hello_timeout_ms = 2000;    // subscribers that say nothing get positions only
-  int subscriber_queue_frames = 2;  // per subscriber, newest wins
+  int subscriber_queue_frames = 32;  // per subscriber at most; max_frame_wait_ms bounds their age
   int status_interval_ms = 1000;
   double default_rate_hz = 120.0;  // until the source says its rate
 };

@@ -79,6 +79,7 @@ Daemon::Daemon(const DaemonConfig& config)
                  config.subject);
   HubOptions hub_options;
   hub_options.queue_frames = config.subscriber_queue_frames;
+  hub_options.frame_max_wait = std::chrono::milliseconds(config.max_frame_wait_ms);
   hub_options.hello_timeout = std::chrono::milliseconds(config.hello_timeout_ms);
   hub_ = std::make_unique<SubscriberHub>(metrics_, hub_options, mesh_info_of(subject_), subject_.deformation.has_value());
 

@@ -94,7 +94,7 @@ std::string Metrics::render_prometheus(const std::vector<SubscriberMetrics>& sub
   for (const SubscriberMetrics& s : subscribers)
     out += "skinstream_subscriber_frames_sent_total{id=\"" + std::to_string(s.id) + "\",transport=\"" + s.transport +
            "\",remote=\"" + label_value(s.remote) + "\"} " + std::to_string(s.sent) + "\n";
-  out += "# HELP skinstream_subscriber_frames_dropped_total Frames dropped for each subscriber (its queue was full).\n"
+  out += "# HELP skinstream_subscriber_frames_dropped_total Frames dropped for each subscriber (waited longer than max_frame_wait_ms while a newer one was queued, or its queue was full).\n"
          "# TYPE skinstream_subscriber_frames_dropped_total counter\n";
   for (const SubscriberMetrics& s : subscribers)
     out += "skinstream_subscriber_frames_dropped_total{id=\"" + std::to_string(s.id) + "\",transport=\"" + s.transport +

@@ -9,6 +9,7 @@
 
 #include <array>
 #include <atomic>
+#include <chrono>
 #include <cstdint>
 #include <mutex>
 #include <span>
@@ -24,7 +25,8 @@ struct EncodedFrame {
   static constexpr int kEncodings = 16;  // one per combination of subscriber frame flags
 
   uint32_t frame_number = 0;
-  int64_t publish_time_ns = 0;
+  int64_t publish_time_ns = 0;                     // wall clock, as sent
+  std::chrono::steady_clock::time_point published;  // for the subscriber queues' wait limit
   uint32_t encoded_mask = 0;  // bit f: messages[f] holds the frame with flags f
   std::array<std::vector<unsigned char>, kEncodings> messages;  // sized on first use, then reused
 

@@ -161,6 +161,7 @@ void Pipeline::publish(const Released& meta, std::span<const Vec3> positions, st
   info.pipeline_dropped = static_cast<uint32_t>(mailbox_.dropped());
   out.frame_number = meta.frame_number;
   out.publish_time_ns = info.publish_time_ns;
+  out.published = std::chrono::steady_clock::now();
   for (uint32_t f = 0; f < EncodedFrame::kEncodings; ++f) {
     if (!((wanted >> f) & 1u)) continue;
     info.flags = f;

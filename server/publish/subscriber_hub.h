@@ -21,7 +21,8 @@ namespace skinstream::server {
 class SubscriberSession;
 
 struct HubOptions {
-  int queue_frames = 2;
+  int queue_frames = 32;  // per subscriber, at most
+  std::chrono::nanoseconds frame_max_wait = std::chrono::milliseconds(25);  // in a subscriber's queue
   std::chrono::milliseconds hello_timeout{2000};
 };
 

@@ -4,9 +4,26 @@
 
 namespace skinstream::server {
 
-SubscriberQueue::SubscriberQueue(int frame_capacity) : ring_(static_cast<size_t>(std::max(1, frame_capacity))) {}
+SubscriberQueue::SubscriberQueue(int frame_capacity, std::chrono::nanoseconds max_wait)
+    : max_wait_(max_wait), ring_(static_cast<size_t>(std::max(1, frame_capacity))) {}
+
+template <typename Predicate>
+void SubscriberQueue::drop_oldest_while(Predicate should) {
+  for (;;) {  // one at a time, each released outside the lock
+    FrameRef older;
+    std::lock_guard lock(mutex_);
+    if (count_ == 0 || !should(*ring_[head_])) return;
+    older = std::move(ring_[head_]);
+    head_ = (head_ + 1) % ring_.size();
+    --count_;
+    ++dropped_;
+  }
+}
 
 void SubscriberQueue::push_frame(const FrameRef& frame) {
+  // The new frame is newer than every queued one: those that waited too long give way to it.
+  const auto now = std::chrono::steady_clock::now();
+  drop_oldest_while([&](const EncodedFrame& oldest) { return now - oldest.published >= max_wait_; });
   FrameRef evicted;  // released outside the lock
   std::lock_guard lock(mutex_);
   if (count_ == ring_.size()) {
@@ -30,16 +47,11 @@ void SubscriberQueue::push_control(ControlMessage message) {
 }
 
 bool SubscriberQueue::pop(Item& out, Take take) {
-  if (take == Take::NewestFrame) {
-    for (;;) {  // the older frames go, one at a time, each released outside the lock
-      FrameRef older;
-      std::lock_guard lock(mutex_);
-      if (count_ <= 1 || !control_.empty()) break;
-      older = std::move(ring_[head_]);
-      head_ = (head_ + 1) % ring_.size();
-      --count_;
-      ++dropped_;
-    }
+  // The predicates run with mutex_ held (by drop_oldest_while).
+  if (take == Take::NewestFrame) drop_oldest_while([&](const EncodedFrame&) { return count_ > 1 && control_.empty(); });
+  if (take == Take::OldestFrame) {
+    const auto now = std::chrono::steady_clock::now();
+    drop_oldest_while([&](const EncodedFrame& oldest) { return count_ > 1 && now - oldest.published >= max_wait_; });
   }
   std::lock_guard lock(mutex_);
   if (!control_.empty()) {

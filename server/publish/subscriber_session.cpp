@@ -19,7 +19,7 @@ SubscriberSession::SubscriberSession(asio::io_context& io, SubscriberHub& hub, s
       id_(next_id.fetch_add(1)),
       transport_(std::move(transport)),
       remote_(std::move(remote)),
-      queue_(hub.options().queue_frames),
+      queue_(hub.options().queue_frames, hub.options().frame_max_wait),
       hello_timer_(io),
       pump_slot_(std::make_shared<HandlerSlot>()) {}
 

@@ -113,6 +113,7 @@ TEST(Daemon, PortInUseFailsClearly) {
 TEST(Daemon, PublishesTheOfflineFillFrameByFrameInOrder) {
   DaemonConfig config = test_config();
   config.subscriber_queue_frames = 64;  // this test wants every frame; back-pressure is tested below
+  config.max_frame_wait_ms = 1000;
   Daemon daemon(config);
   std::vector<subscriber::Frame> frames;
   subscriber::MeshInfo mesh_info;
@@ -164,6 +165,7 @@ TEST(Daemon, StalledSubscriberDoesNotHoldBackTheOthers) {
   config.speed = 4;
   config.loop = true;
   config.subscriber_queue_frames = 256;  // the healthy subscriber never needs more
+  config.max_frame_wait_ms = 1000;       // nor waits that long on a busy machine
   Daemon daemon(config);
   daemon.start_serving();
 

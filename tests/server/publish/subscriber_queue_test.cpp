@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <thread>
+
 #include "protocol/subscriber_stream.h"
 #include "support/allocation_counter.h"
 
@@ -35,6 +37,51 @@ TEST(SubscriberQueue, NewestFramesWinAndDropsAreCounted) {
 
 // What a paced subscriber's pump takes: with its window full only control messages, then the
 // newest frame, the older ones counted as dropped.
+FrameRef frame_published(FramePool& pool, uint32_t number, std::chrono::steady_clock::time_point published) {
+  FrameRef ref = frame(pool, number);
+  ref.mutable_frame()->published = published;
+  return ref;
+}
+
+TEST(SubscriberQueue, ABurstReadWithinTheWaitLimitArrivesWhole) {
+  FramePool pool;
+  SubscriberQueue queue(32, std::chrono::seconds(10));
+  const auto now = std::chrono::steady_clock::now();
+  for (uint32_t n = 1; n <= 20; ++n) queue.push_frame(frame_published(pool, n, now));
+  SubscriberQueue::Item item;
+  for (uint32_t n = 1; n <= 20; ++n) {
+    ASSERT_TRUE(queue.pop(item));
+    EXPECT_EQ(item.frame->frame_number, n);
+  }
+  EXPECT_EQ(queue.frames_dropped(), 0u);
+}
+
+TEST(SubscriberQueue, FramesOlderThanTheWaitLimitGiveWayToNewerOnes) {
+  FramePool pool;
+  SubscriberQueue queue(32, std::chrono::milliseconds(30));
+  const auto now = std::chrono::steady_clock::now();
+  // At the push: frames published a second ago give way to the new one.
+  for (uint32_t n = 1; n <= 10; ++n) queue.push_frame(frame_published(pool, n, now - std::chrono::seconds(1)));
+  EXPECT_EQ(queue.frames_queued(), 1u);  // a subscriber that never reads holds only the last
+  queue.push_frame(frame_published(pool, 11, now));
+  EXPECT_EQ(queue.frames_queued(), 1u);
+  EXPECT_EQ(queue.frames_dropped(), 10u);
+  SubscriberQueue::Item item;
+  ASSERT_TRUE(queue.pop(item));
+  EXPECT_EQ(item.frame->frame_number, 11u);
+  // At the pop: 12 was young when 13 came, and is too old when the writer gets to it.
+  queue.push_frame(frame_published(pool, 12, std::chrono::steady_clock::now() - std::chrono::milliseconds(20)));
+  queue.push_frame(frame_published(pool, 13, std::chrono::steady_clock::now()));
+  std::this_thread::sleep_for(std::chrono::milliseconds(15));
+  ASSERT_TRUE(queue.pop(item));
+  EXPECT_EQ(item.frame->frame_number, 13u);
+  EXPECT_EQ(queue.frames_dropped(), 11u);
+  // The newest is always taken, however old.
+  queue.push_frame(frame_published(pool, 14, now - std::chrono::seconds(1)));
+  ASSERT_TRUE(queue.pop(item));
+  EXPECT_EQ(item.frame->frame_number, 14u);
+}
+
 TEST(SubscriberQueue, PacedTakesControlOnlyOrTheNewestFrame) {
   FramePool pool;
   SubscriberQueue queue(4);
