@@ -51,7 +51,7 @@ std::vector<int> choose_deform_cpus(const std::string& spec, int threads, const 
   if (const std::string problem = deform_cpus_problem(spec); !problem.empty()) throw std::invalid_argument(problem);
   if (spec == "off") return {};
   if (spec == "auto") {
-    if (threads < 1 || static_cast<int>(allowed.size()) <= threads) return {};
+    if (threads < 1 || static_cast<int>(allowed.size()) < threads) return {};
     return {allowed.end() - threads, allowed.end()};
   }
   bool ok = false;

@@ -4,11 +4,11 @@
 // Left to itself, the scheduler of a small virtual machine kept the pipeline thread and its
 // worker on one core for about one frame in five (it packs threads so that other cores can
 // idle), and those frames were deformed by one thread: skinstream-bench showed deformation
-// p90 1.2 ms unpinned against 0.75 ms pinned, on the same code. But a pinned thread cannot
-// move away from a busy CPU: with every CPU of a 2-core machine pinned, the io thread's bursts
-// after a stall had nowhere else to run and the 10-minute benchmark dropped 9 frames (none
-// unpinned). So `auto` (the default) pins only when a CPU is left over for the rest of the
-// process, `off` never does, and a list names the CPUs.
+// p90 1.2 ms unpinned against 0.75 ms pinned, on the same code, and in four 10-minute runs
+// with both cores of a 2-core machine pinned the processing p99 was 1.6-2.0 ms against
+// 2.2-2.5 ms in three unpinned ones. One pinned run dropped 9 frames, which the mailbox's
+// wait limit now absorbs when they come as a burst. So `auto` (the default) pins whenever
+// there is a CPU per thread, `off` never does, and a list names the CPUs.
 
 #include <string>
 #include <thread>
@@ -23,7 +23,7 @@ std::string deform_cpus_problem(const std::string& spec);
 // The CPU for each of `threads` deform threads (index 0: the pipeline thread), or none.
 // `allowed`: the CPUs this process may run on, ascending.
 //  - "auto": the last `threads` allowed CPUs (CPU 0 tends to take the most interrupts), or
-//    none unless more are allowed than there are threads;
+//    none when fewer are allowed than there are threads;
 //  - "off": none;
 //  - a list: exactly `threads` distinct CPUs, each of them allowed.
 // Throws std::invalid_argument, saying what is wrong, for a list that does not fit.

@@ -19,11 +19,11 @@ std::string error_of(const std::string& spec, int threads, const std::vector<int
   return "";
 }
 
-TEST(DeformCpus, AutoTakesTheLastAllowedCpusWhenOneIsLeftOver) {
+TEST(DeformCpus, AutoTakesTheLastAllowedCpusWhenThereIsOnePerThread) {
   EXPECT_EQ(choose_deform_cpus("auto", 2, {0, 1, 2}), (std::vector<int>{1, 2}));
   EXPECT_EQ(choose_deform_cpus("auto", 2, {0, 1, 2, 5}), (std::vector<int>{2, 5}));
   EXPECT_EQ(choose_deform_cpus("auto", 1, {0, 1, 2, 3}), (std::vector<int>{3}));
-  EXPECT_TRUE(choose_deform_cpus("auto", 2, {0, 1}).empty());  // nothing left for the io thread
+  EXPECT_EQ(choose_deform_cpus("auto", 2, {0, 1}), (std::vector<int>{0, 1}));  // the io thread shares them
   EXPECT_TRUE(choose_deform_cpus("auto", 3, {0, 1}).empty());  // sharing a CPU would be worse than the OS's choice
   EXPECT_TRUE(choose_deform_cpus("auto", 2, {}).empty());
   EXPECT_TRUE(choose_deform_cpus("off", 2, {0, 1, 2, 3}).empty());
