@@ -21,17 +21,11 @@ void SubscriberQueue::drop_oldest_while(Predicate should) {
 }
 
 void SubscriberQueue::push_frame(const FrameRef& frame) {
-  // The new frame is newer than every queued one: those that waited too long give way to it.
+  // The new frame is newer than every queued one: those that waited too long give way to it, and
+  // the oldest when the ring is full (only this thread pushes, so the ring stays below full).
   const auto now = std::chrono::steady_clock::now();
-  drop_oldest_while([&](const EncodedFrame& oldest) { return now - oldest.published >= max_wait_; });
-  FrameRef evicted;  // released outside the lock
+  drop_oldest_while([&](const EncodedFrame& oldest) { return count_ == ring_.size() || now - oldest.published >= max_wait_; });
   std::lock_guard lock(mutex_);
-  if (count_ == ring_.size()) {
-    evicted = std::move(ring_[head_]);
-    head_ = (head_ + 1) % ring_.size();
-    --count_;
-    ++dropped_;
-  }
   ring_[(head_ + count_) % ring_.size()] = frame;
   ++count_;
 }
