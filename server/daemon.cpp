@@ -108,6 +108,8 @@ Daemon::Daemon(const DaemonConfig& config)
     throw FileError(config.subject, std::string("deformation model unusable: ") + e.what());
   }
 
+  hub_->set_encoding_preparer([pipeline = pipeline_.get()](uint32_t frame_flags) { pipeline->prepare_encoding(frame_flags); });
+
   if (!config.replay.empty()) {
     source_ = std::make_unique<FileReplaySource>(io_, model, config.replay, static_cast<FrameSink&>(*this), ReplayOptions{config.loop, config.speed});
   } else if (!config.vicon_multicast.empty()) {
@@ -331,6 +333,7 @@ std::string Daemon::health_json() const {
       // Encoded frame buffers created so far: grows only while the pool meets a new high-water
       // mark of frames in use (bounded by the subscribers' queues), so RSS steps with it.
       {"frame_buffers_allocated", metrics_.frame_buffers_allocated.load()},
+      {"frame_buffers_allocated_by_pipeline", metrics_.frame_buffers_allocated_by_pipeline.load()},
       {"subscribers", hub_->subscriber_count()},
       {"deform", {{"threads", config_.deform_threads}, {"cpus", deform_cpus_}, {"spin_lead_us", config_.deform_spin_lead_us}}},
       {"subject", {{"markers", subject_.model.marker_count()}, {"vertices", pipeline_->vertex_count()}}}};

@@ -78,6 +78,9 @@ std::string Metrics::render_prometheus(const std::vector<SubscriberMetrics>& sub
   counter(out, "bad_subscriber_messages_total", "Subscriber messages that broke the protocol.", bad_subscriber_messages);
   counter(out, "subscribers_accepted_total", "Subscriber connections accepted.", subscribers_connected);
   counter(out, "frame_buffers_allocated_total", "Encoded frame buffers created (steady state: constant).", frame_buffers_allocated);
+  counter(out, "frame_buffers_allocated_by_pipeline_total",
+          "Of those, created on the pipeline thread because none was prepared when the subscriber asked (expected: 0).",
+          frame_buffers_allocated_by_pipeline);
   out += "# HELP skinstream_bad_input_total Source input dropped, by category.\n# TYPE skinstream_bad_input_total counter\n";
   {
     std::lock_guard lock(bad_input_mutex_);

@@ -59,6 +59,42 @@ size_t FramePool::allocated() const {
   return all_.size();
 }
 
+size_t FramePool::prepare(uint32_t flags, size_t bytes) {
+  if (flags >= EncodedFrame::kEncodings || bytes == 0) return 0;
+  std::lock_guard serial(prepare_mutex_);
+  size_t missing = 0;
+  {
+    std::lock_guard lock(mutex_);
+    const size_t covered = sized_[flags] + ready_[flags].size();
+    missing = all_.size() > covered ? all_.size() - covered : 0;
+  }
+  // Made outside the lock: value-initialised, so every page is touched here and not on the
+  // pipeline thread.
+  std::vector<std::vector<unsigned char>> made;
+  made.reserve(missing);
+  for (size_t i = 0; i < missing; ++i) made.emplace_back(bytes);
+  std::lock_guard lock(mutex_);
+  for (auto& buffer : made) ready_[flags].push_back(std::move(buffer));
+  return missing;
+}
+
+bool FramePool::size_message(EncodedFrame& frame, uint32_t flags, size_t bytes) {
+  std::vector<unsigned char>& message = frame.messages[flags];
+  if (message.size() == bytes) return false;
+  std::lock_guard lock(mutex_);
+  std::vector<std::vector<unsigned char>>& ready = ready_[flags];
+  const bool had_buffer = !message.empty();
+  if (!ready.empty() && ready.back().size() == bytes) {
+    message.swap(ready.back());
+    ready.pop_back();  // the frame's old buffer, empty unless the size changed (never, for one mesh)
+    if (!had_buffer) ++sized_[flags];
+    return false;
+  }
+  message.resize(bytes);
+  if (!had_buffer) ++sized_[flags];
+  return true;
+}
+
 void FramePool::release(EncodedFrame* frame) {
   std::lock_guard lock(mutex_);
   free_.push(frame);

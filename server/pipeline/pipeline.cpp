@@ -126,6 +126,16 @@ void Pipeline::process(const MarkerFrame& frame, uint64_t generation) {
     publish(held_[static_cast<size_t>(released) % held_.size()], released_positions_, released_status_);
 }
 
+size_t Pipeline::message_bytes(uint32_t flags) const {
+  return subscriber::frame_message_bytes(flags, (flags & subscriber::kFrameNoPositions) ? 0 : vertex_count(),
+                                         (flags & subscriber::kFrameMarkers) ? static_cast<uint32_t>(model_.marker_count()) : 0);
+}
+
+void Pipeline::prepare_encoding(uint32_t flags) {
+  const size_t made = pool_.prepare(flags, message_bytes(flags));
+  metrics_.frame_buffers_allocated.fetch_add(made, std::memory_order_relaxed);
+}
+
 void Pipeline::publish(const Released& meta, std::span<const Vec3> positions, std::span<const MarkerStatus> status) {
   const uint32_t wanted = consumer_.wanted_encodings();
   bool want_normals = false;
@@ -165,14 +175,12 @@ void Pipeline::publish(const Released& meta, std::span<const Vec3> positions, st
   for (uint32_t f = 0; f < EncodedFrame::kEncodings; ++f) {
     if (!((wanted >> f) & 1u)) continue;
     info.flags = f;
-    const size_t bytes = subscriber::frame_message_bytes(f, (f & subscriber::kFrameNoPositions) ? 0 : info.vertex_count,
-                                                         (f & subscriber::kFrameMarkers) ? info.marker_count : 0);
-    std::vector<unsigned char>& message = out.messages[f];
-    if (message.size() != bytes) {
-      message.resize(bytes);  // first use of this encoding in this pooled buffer
+    const size_t bytes = message_bytes(f);
+    if (pool_.size_message(out, f, bytes)) {  // first use of this encoding in this pooled frame, nothing prepared
       metrics_.frame_buffers_allocated.fetch_add(1, std::memory_order_relaxed);
+      metrics_.frame_buffers_allocated_by_pipeline.fetch_add(1, std::memory_order_relaxed);
     }
-    subscriber::encode_frame(info, positions_, normals_, marker_floats_, marker_status_bytes_, message);
+    subscriber::encode_frame(info, positions_, normals_, marker_floats_, marker_status_bytes_, out.messages[f]);
     out.encoded_mask |= 1u << f;
   }
   metrics_.encode.observe_ns(since_ns(encode_start));

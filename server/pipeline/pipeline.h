@@ -56,8 +56,13 @@ class Pipeline {
   bool has_mesh() const { return deformer_ != nullptr; }
   uint32_t vertex_count() const { return deformer_ ? static_cast<uint32_t>(deformer_->vertex_count()) : 0; }
   uint64_t frames_published() const { return published_.load(); }
+  // Any thread, before the pipeline is told anyone wants encoding `flags` (subscriber frame
+  // flags): makes its buffers for every pooled frame, so the first frames encoded that way do
+  // not allocate (and fault in 640 kB each) on the pipeline thread.
+  void prepare_encoding(uint32_t flags);
 
  private:
+  size_t message_bytes(uint32_t flags) const;  // a Frame message with these flags
   struct Released {
     uint32_t frame_number = 0;
     int64_t source_time_ns = 0;
@@ -74,9 +79,9 @@ class Pipeline {
   FrameMailbox& mailbox_;
   FrameConsumer& consumer_;
   Metrics& metrics_;
-  // Frames alive at once: the one being encoded, two queued and one being written per
-  // subscriber, more when subscribers are at different frames. Made up front, so the buffers are
-  // all sized within the first frames (EncodedFrame sizes them per encoding on first use).
+  // Frames alive at once: the one being encoded and those queued or being written for the
+  // subscribers (one or two in steady state; more after a burst or behind a slow subscriber, and
+  // then the pool grows). Made up front; their buffers come from prepare_encoding().
   static constexpr int kPooledFrames = 8;
   FramePool pool_{kPooledFrames};
 

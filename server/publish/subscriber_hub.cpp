@@ -7,7 +7,7 @@
 namespace skinstream::server {
 
 SubscriberHub::SubscriberHub(Metrics& metrics, const HubOptions& options, subscriber::MeshInfo mesh_info, bool has_mesh)
-    : metrics_(metrics), options_(options), mesh_info_(std::move(mesh_info)), has_mesh_(has_mesh) {
+    : metrics_(metrics), options_(options), has_mesh_(has_mesh), mesh_info_(std::move(mesh_info)) {
   status_ = std::make_shared<const std::vector<unsigned char>>(subscriber::encode_status({}));
 }
 
@@ -17,7 +17,8 @@ void SubscriberHub::add(const std::shared_ptr<SubscriberSession>& session) {
   metrics_.subscribers_connected.fetch_add(1, std::memory_order_relaxed);
 }
 
-void SubscriberHub::activate(SubscriberSession& session, uint32_t) {
+void SubscriberHub::activate(SubscriberSession& session, uint32_t frame_flags) {
+  if (prepare_encoding_) prepare_encoding_(frame_flags);  // does nothing once the encoding is prepared
   std::lock_guard lock(mutex_);
   if (std::find(active_.begin(), active_.end(), &session) == active_.end()) active_.push_back(&session);
   update_wanted_locked();
@@ -51,7 +52,7 @@ void SubscriberHub::update_wanted_locked() {
 }
 
 ControlMessage SubscriberHub::mesh_info_message(uint32_t frame_flags) {
-  std::lock_guard lock(mutex_);
+  std::lock_guard lock(mesh_info_mutex_);
   ControlMessage& cached = mesh_info_messages_[frame_flags & 15u];
   if (!cached) {
     subscriber::MeshInfo info = mesh_info_;
@@ -66,7 +67,7 @@ ControlMessage SubscriberHub::mesh_info_message(uint32_t frame_flags) {
 }
 
 void SubscriberHub::set_source_rate(float rate_hz) {
-  std::lock_guard lock(mutex_);
+  std::lock_guard lock(mesh_info_mutex_);
   if (mesh_info_.source_rate_hz == rate_hz) return;
   mesh_info_.source_rate_hz = rate_hz;
   for (ControlMessage& m : mesh_info_messages_) m.reset();
@@ -79,7 +80,6 @@ ControlMessage SubscriberHub::status_message() const {
 
 void SubscriberHub::broadcast_status(const subscriber::Status& status) {
   const ControlMessage message = std::make_shared<const std::vector<unsigned char>>(subscriber::encode_status(status));
-  std::vector<SubscriberSession*> active;
   std::lock_guard lock(mutex_);
   status_ = message;
   for (SubscriberSession* s : active_) s->offer_control(message);
