@@ -82,16 +82,14 @@ bool FramePool::size_message(EncodedFrame& frame, uint32_t flags, size_t bytes) 
   std::vector<unsigned char>& message = frame.messages[flags];
   if (message.size() == bytes) return false;
   std::lock_guard lock(mutex_);
+  if (message.empty()) ++sized_[flags];  // this frame now holds the encoding, either way
   std::vector<std::vector<unsigned char>>& ready = ready_[flags];
-  const bool had_buffer = !message.empty();
   if (!ready.empty() && ready.back().size() == bytes) {
     message.swap(ready.back());
     ready.pop_back();  // the frame's old buffer, empty unless the size changed (never, for one mesh)
-    if (!had_buffer) ++sized_[flags];
     return false;
   }
   message.resize(bytes);
-  if (!had_buffer) ++sized_[flags];
   return true;
 }
 
