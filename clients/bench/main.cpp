@@ -6,6 +6,9 @@
 //
 //   end to end        = subscriber arrival - replay send time of the same frame number
 //   daemon processing = publish_time_ns - receive_time_ns (both from the frame header)
+//   ingest            = receive_time_ns - replay send time (the network in, and the daemon's io thread)
+//   delivery          = subscriber arrival - publish_time_ns (the subscriber queue and the network out)
+// so end to end = ingest + processing + delivery, frame by frame; the three say where a tail comes from.
 //
 // Every clock is the same machine's system clock, so the differences need no synchronisation.
 #include <CLI/CLI.hpp>
@@ -251,7 +254,7 @@ int main(int argc, char** argv) {
     const double own_cpu_before = process_usage(getpid()).first;
 
     std::mutex mutex;
-    Samples end_to_end, processing;
+    Samples end_to_end, processing, ingest, delivery;
     std::vector<long> received(subscriber_count, 0), unmatched(subscriber_count, 0), out_of_order(subscriber_count, 0);
     std::vector<uint32_t> dropped_first(subscriber_count, 0), dropped_last(subscriber_count, 0);
     const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
@@ -262,18 +265,25 @@ int main(int argc, char** argv) {
       threads.emplace_back([&, s] {
         try {
           sub::SubscriberClient client("127.0.0.1", std::to_string(sub_port), wants);
-          std::vector<double> local_e2e, local_processing;
+          std::vector<double> local_e2e, local_processing, local_ingest, local_delivery;
           local_e2e.reserve(static_cast<size_t>(seconds * capture.rate_hz * 1.2) + 16);
           local_processing.reserve(local_e2e.capacity());
+          local_ingest.reserve(local_e2e.capacity());
+          local_delivery.reserve(local_e2e.capacity());
           int64_t last_frame = -1;
           client.run([&](subscriber::MessageType type, std::span<const unsigned char> payload, int64_t now) {
             if (type == subscriber::MessageType::Frame) {
               // The numbers only: copying the vertices out is a renderer's work, not the daemon's.
               const subscriber::FrameInfo info = subscriber::decode_frame_info(payload);
               const int64_t sent = send_times.find(info.frame_number);
-              if (sent > 0) local_e2e.push_back((now - sent) * 1e-6);
-              else ++unmatched[s];
+              if (sent > 0) {
+                local_e2e.push_back((now - sent) * 1e-6);
+                local_ingest.push_back((info.receive_time_ns - sent) * 1e-6);
+              } else {
+                ++unmatched[s];
+              }
               local_processing.push_back((info.publish_time_ns - info.receive_time_ns) * 1e-6);
+              local_delivery.push_back((now - info.publish_time_ns) * 1e-6);
               if (static_cast<int64_t>(info.frame_number) <= last_frame) ++out_of_order[s];
               last_frame = info.frame_number;
               if (received[s]++ == 0) dropped_first[s] = info.subscriber_dropped;
@@ -284,6 +294,8 @@ int main(int argc, char** argv) {
           std::lock_guard lock(mutex);
           end_to_end.ms.insert(end_to_end.ms.end(), local_e2e.begin(), local_e2e.end());
           processing.ms.insert(processing.ms.end(), local_processing.begin(), local_processing.end());
+          ingest.ms.insert(ingest.ms.end(), local_ingest.begin(), local_ingest.end());
+          delivery.ms.insert(delivery.ms.end(), local_delivery.begin(), local_delivery.end());
         } catch (const std::exception& e) {
           errors[s] = e.what();
         }
@@ -343,6 +355,8 @@ int main(int argc, char** argv) {
         {"markers", health["subject"]["markers"]},
         {"end_to_end", end_to_end.summary()},
         {"daemon_processing", processing.summary()},
+        {"ingest", ingest.summary()},      // replay send -> daemon receive
+        {"delivery", delivery.summary()},  // daemon publish -> subscriber arrival
         {"replay_sends", send_times.regularity()},  // gaps between the replay's consecutive sends
         {"frames", {{"sent_by_replay", sent},
                     {"dropped_by_replay", replay_dropped},
@@ -362,6 +376,9 @@ int main(int argc, char** argv) {
                     {"rss_kb_every_60s", every_minute},
                     {"frame_buffers_after_1s", buffers_after_1s},
                     {"frame_buffers_at_end", health.value("frame_buffers_allocated", 0)},
+                    // Of those, made on the 120 Hz thread because no prepared one was ready: 0 when
+                    // every subscriber's encoding was prepared on its Hello.
+                    {"frame_buffers_made_by_pipeline", health.value("frame_buffers_allocated_by_pipeline", 0)},
                     {"exit_status", WIFEXITED(status) ? WEXITSTATUS(status) : -1},
                     {"warnings", daemon_warnings}}},
         // This process: the replay server and the subscribers, sharing the machine with the daemon.
@@ -376,6 +393,8 @@ int main(int argc, char** argv) {
       std::printf("%s\n", report["mode"].get<std::string>().c_str());
       line("end to end", report["end_to_end"]);
       line("daemon processing", report["daemon_processing"]);
+      line("  ingest", report["ingest"]);
+      line("  delivery", report["delivery"]);
       std::printf("frames: %s\n", report["frames"].dump().c_str());
       std::printf("daemon: %.2f s CPU (%.0f%% of one core), peak RSS %ld kB, RSS %ld kB after 1 s and %ld kB at the end\n",
                   cpu_seconds, 100 * cpu_seconds / seconds, peak_rss_kb, rss_samples.empty() ? 0L : rss_samples.front(),
