@@ -34,6 +34,7 @@ struct DaemonConfig {
   std::string ports_file;         // written as {"http":N,"sub":N} once listening
   std::string log_level = "info";
   int hello_timeout_ms = 2000;    // subscribers that say nothing get positions only
+  int publish_threads = 2;        // threads writing to TCP subscribers; 0 = the io thread (server/publish/publish_threads.h)
   int subscriber_queue_frames = 32;  // per subscriber at most; max_frame_wait_ms bounds their age
   int status_interval_ms = 1000;
   double default_rate_hz = 120.0;  // until the source says its rate

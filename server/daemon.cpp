@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <unistd.h>
 
 #include "protocol/file_error.h"
 #include "server/http/http_server.h"
@@ -72,6 +73,7 @@ Daemon::Daemon(const DaemonConfig& config)
     : config_(config),
       subject_(load_subject(config)),
       mailbox_(subject_.model.marker_count(), std::chrono::milliseconds(config.max_frame_wait_ms)),
+      publish_(config.publish_threads),
       status_timer_(io_) {
   const SubjectModel& model = subject_.model;
   if (!subject_.deformation)
@@ -132,9 +134,23 @@ Daemon::Daemon(const DaemonConfig& config)
     boost::system::error_code ec;
     const auto endpoint = socket.remote_endpoint(ec);
     const std::string remote = ec ? "?" : endpoint.address().to_string() + ":" + std::to_string(endpoint.port());
-    auto subscriber = std::make_shared<TcpSubscriber>(io_, *hub_, std::move(socket), remote);
+    // To the publish thread with the fewest subscribers: the socket moves to its io_context, and
+    // the session starts there.
+    PublishThreads::Placement placed = publish_.place(io_);
+    tcp::socket own(placed.io);
+    const tcp protocol = socket.local_endpoint(ec).protocol();
+    const auto handle = ec ? tcp::socket::native_handle_type(-1) : socket.release(ec);
+    if (!ec) {
+      own.assign(protocol, handle, ec);
+      if (ec) ::close(handle);
+    }
+    if (ec) {
+      spdlog::warn("subscriber {}: cannot hand the socket to its thread: {}; closing", remote, ec.message());
+      return;
+    }
+    auto subscriber = std::make_shared<TcpSubscriber>(placed.io, *hub_, std::move(own), remote, std::move(placed.token));
     hub_->add(subscriber);
-    subscriber->start();
+    asio::post(placed.io, [subscriber] { subscriber->start(); });
   });
   HttpRoutes routes;
   routes.health_json = [this] { return health_json(); };
@@ -167,6 +183,7 @@ void Daemon::start_source() {
 void Daemon::start_serving() {
   if (started_.exchange(true)) return;
   pipeline_->start();
+  publish_.start();
   sub_listener_->start();
   http_->start();
   schedule_status();
@@ -188,7 +205,8 @@ void Daemon::request_stop() {
     http_->stop();
     status_timer_.cancel();
     pipeline_->stop();  // no more frames published after this
-    hub_->close_all();
+    hub_->close_all();  // posted to each TCP subscriber's thread
+    publish_.stop();    // after those closes
     io_.stop();
   });
 }
@@ -196,6 +214,7 @@ void Daemon::request_stop() {
 void Daemon::wait() {
   std::lock_guard lock(stop_mutex_);
   if (io_thread_.joinable()) io_thread_.join();
+  publish_.join();
   if (!stopped_) {
     stopped_ = true;
     pipeline_->stop();
@@ -336,6 +355,7 @@ std::string Daemon::health_json() const {
       {"frame_buffers_allocated_by_pipeline", metrics_.frame_buffers_allocated_by_pipeline.load()},
       {"subscribers", hub_->subscriber_count()},
       {"deform", {{"threads", config_.deform_threads}, {"cpus", deform_cpus_}, {"spin_lead_us", config_.deform_spin_lead_us}}},
+      {"publish_threads", publish_.count()},
       {"subject", {{"markers", subject_.model.marker_count()}, {"vertices", pipeline_->vertex_count()}}}};
   return health.dump();
 }

@@ -1,7 +1,8 @@
 #pragma once
 // skinstreamd put together: the subject, the source (file replay or Vicon), the mailbox, the
 // pipeline thread, the publishers (TCP subscriber port, HTTP port with /stream, /health,
-// /metrics and static files) and the 1 Hz Status. One io thread runs every socket and timer.
+// /metrics and static files) and the 1 Hz Status. One io thread runs the source, HTTP, the
+// WebSocket subscribers and the timers; the TCP subscribers are written by the publish threads.
 // main.cpp adds only argument parsing and signals; tests run the same object in-process.
 
 #include <atomic>
@@ -20,6 +21,7 @@
 #include "server/metrics/metrics.h"
 #include "server/pipeline/frame_mailbox.h"
 #include "server/pipeline/pipeline.h"
+#include "server/publish/publish_threads.h"
 
 namespace skinstream::server {
 
@@ -72,6 +74,9 @@ class Daemon : private FrameSink {
   // After the pipeline and the hub: the io_context is destroyed first, and with it the handlers
   // still holding sessions whose queues hold frames of the pipeline's pool.
   asio::io_context io_;
+  // The TCP subscribers' threads: destroyed before io_ and after the listeners (declared
+  // between), once every session was closed on its own thread.
+  PublishThreads publish_;
   std::unique_ptr<Listener> sub_listener_;
   std::unique_ptr<HttpServer> http_;
   std::unique_ptr<FrameSource> source_;

@@ -186,6 +186,7 @@ int main(int argc, char** argv) {
   int subscriber_count = 1, deform_threads = 2;
   std::string recording = "replay_data/cmu/85_12.c3d", subject, vicon_subject_name, deform_cpus;
   int deform_spin_lead_us = -1;  // -1: the daemon's default
+  int publish_threads = -1;      // -1: the daemon's default
   bool json = false, normals = false;
   app.add_option("--seconds", seconds, "how long to measure")->check(CLI::Range(0.5, 3600.0))->capture_default_str();
   app.add_option("--subscribers", subscriber_count, "subscribers connected in-process, one thread each")->check(CLI::Range(1, 256))->capture_default_str();
@@ -195,6 +196,7 @@ int main(int argc, char** argv) {
   app.add_option("--deform-cpus", deform_cpus, "skinstreamd --deform-cpus (default: the daemon's, auto)");
   app.add_option("--deform-spin-lead-us", deform_spin_lead_us, "skinstreamd --deform-spin-lead-us (default: the daemon's)")
       ->check(CLI::Range(0, 1'000'000));
+  app.add_option("--publish-threads", publish_threads, "skinstreamd --publish-threads (default: the daemon's)")->check(CLI::Range(0, 16));
   app.add_option("--vicon-subject-name", vicon_subject_name, "subject name the replay announces (default: the recording's file name)");
   app.add_flag("--normals", normals, "subscribers ask for normals too");
   app.add_flag("--json", json, "print the report as JSON");
@@ -242,6 +244,7 @@ int main(int argc, char** argv) {
                                             "--bind", "127.0.0.1", "--ports-file", ports_path, "--log-level", "warn"};
     if (!deform_cpus.empty()) daemon_args.insert(daemon_args.end(), {"--deform-cpus", deform_cpus});
     if (deform_spin_lead_us >= 0) daemon_args.insert(daemon_args.end(), {"--deform-spin-lead-us", std::to_string(deform_spin_lead_us)});
+    if (publish_threads >= 0) daemon_args.insert(daemon_args.end(), {"--publish-threads", std::to_string(publish_threads)});
     pid = launch(daemon_args, log_path);
     const nlohmann::json ports = wait_for_ports(ports_path, pid, log_path);
     const int sub_port = ports.at("sub"), http_port = ports.at("http");
@@ -350,6 +353,7 @@ int main(int argc, char** argv) {
         {"subscribers", subscriber_count},
         {"deform_threads", deform_threads},
         {"deform", health["deform"]},  // as the daemon applied it: threads, CPUs pinned to, spin lead
+        {"publish_threads", health["publish_threads"]},
         {"recording", recording},
         {"vertices", health["subject"]["vertices"]},
         {"markers", health["subject"]["markers"]},

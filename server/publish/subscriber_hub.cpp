@@ -42,7 +42,7 @@ void SubscriberHub::close_all() {
     std::lock_guard lock(mutex_);
     sessions = sessions_;
   }
-  for (const auto& s : sessions) s->close();
+  for (const auto& s : sessions) s->close_from_any_thread();
 }
 
 void SubscriberHub::update_wanted_locked() {

@@ -34,6 +34,11 @@ void SubscriberSession::offer_control(ControlMessage message) {
   kick();
 }
 
+void SubscriberSession::close_from_any_thread() {
+  if (io_.get_executor().running_in_this_thread()) close();
+  else asio::post(io_, [self = shared_from_this()] { self->close(); });
+}
+
 SubscriberMetrics SubscriberSession::stats() const {
   return {id_, transport_, remote_, sent_.load(), queue_.frames_dropped()};
 }

@@ -2,7 +2,8 @@
 // What the TCP and WebSocket subscribers share: the Hello handshake (2 s default, then
 // positions only), the bounded queue, one write in flight, pacing by Acks for subscribers that
 // ask for it, and the per-subscriber counters.
-// Everything but offer() runs on the io thread; offer() is called by the pipeline thread.
+// Everything but offer() runs on the session's io thread (the daemon's, or one of the publish
+// threads for a TCP subscriber); offer() is called by the pipeline thread.
 
 #include <array>
 #include <atomic>
@@ -32,7 +33,10 @@ class SubscriberSession : public std::enable_shared_from_this<SubscriberSession>
   uint32_t frame_flags() const { return flags_.load(); }
   SubscriberMetrics stats() const;
   uint64_t id() const { return id_; }
-  virtual void close() = 0;  // io thread; idempotent
+  virtual void close() = 0;  // the session's io thread; idempotent
+  // Any thread: close() now when called on the session's io thread, else posted there (after
+  // whatever is already posted to it).
+  void close_from_any_thread();
 
  protected:
   // For the transports (io thread).

@@ -4,8 +4,9 @@
 
 namespace skinstream::server {
 
-TcpSubscriber::TcpSubscriber(asio::io_context& io, SubscriberHub& hub, tcp::socket socket, std::string remote)
-    : SubscriberSession(io, hub, "tcp", std::move(remote)), socket_(std::move(socket)) {}
+TcpSubscriber::TcpSubscriber(asio::io_context& io, SubscriberHub& hub, tcp::socket socket, std::string remote,
+                             std::shared_ptr<const void> placement)
+    : SubscriberSession(io, hub, "tcp", std::move(remote)), socket_(std::move(socket)), placement_(std::move(placement)) {}
 
 void TcpSubscriber::start() {
   start_hello_timer(hub_.options().hello_timeout);

@@ -11,7 +11,10 @@ namespace skinstream::server {
 
 class TcpSubscriber : public SubscriberSession {
  public:
-  TcpSubscriber(asio::io_context& io, SubscriberHub& hub, tcp::socket socket, std::string remote);
+  // `socket` must belong to `io`, the context all of this subscriber's handlers run on;
+  // `placement` is kept for the subscriber's life (PublishThreads counts subscribers by it).
+  TcpSubscriber(asio::io_context& io, SubscriberHub& hub, tcp::socket socket, std::string remote,
+                std::shared_ptr<const void> placement = nullptr);
   void start();
   void close() override;
 
@@ -20,6 +23,7 @@ class TcpSubscriber : public SubscriberSession {
   void start_write(const std::array<asio::const_buffer, 2>& buffers) override;
 
   tcp::socket socket_;
+  std::shared_ptr<const void> placement_;
   std::array<unsigned char, 1024> read_buffer_{};
   subscriber::StreamDecoder decoder_{1024};  // subscribers only ever send a 4-byte Hello
 };

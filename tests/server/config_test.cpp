@@ -87,6 +87,19 @@ TEST(Config, DeformCpusAndSpinLeadComeFromFileAndFlags) {
   EXPECT_EQ(flags->config.deform_spin_lead_us, 1500);
 }
 
+TEST(Config, PublishThreadsComeFromFileAndFlags) {
+  EXPECT_EQ(DaemonConfig{}.publish_threads, 2);
+  const std::string path = write_file("publish.json", R"({"publish_threads": 0})");
+  const auto from_file = parse({"--config", path});
+  ASSERT_TRUE(from_file);
+  EXPECT_EQ(from_file->config.publish_threads, 0);
+  const auto flags = parse({"--config", path, "--publish-threads", "3"});
+  ASSERT_TRUE(flags);
+  EXPECT_EQ(flags->config.publish_threads, 3);
+  EXPECT_NE(error_of([] { parse({"--publish-threads", "-1"}); }).find("publish_threads"), std::string::npos);
+  EXPECT_NE(error_of([] { parse({"--publish-threads", "17"}); }).find("publish_threads"), std::string::npos);
+}
+
 TEST(Config, OutOfRangeValuesAndConflictsAreErrors) {
   EXPECT_NE(error_of([] { parse({"--deform-threads", "0"}); }).find("deform_threads"), std::string::npos);
   EXPECT_NE(error_of([] { parse({"--deform-cpus", "1;2"}); }).find("deform_cpus must be"), std::string::npos);

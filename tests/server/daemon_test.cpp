@@ -215,6 +215,61 @@ TEST(Daemon, StalledSubscriberDoesNotHoldBackTheOthers) {
   daemon.stop();
 }
 
+// TCP subscribers on the publish threads (three threads, four subscribers) and on the io thread
+// (publish_threads 0) each get every frame in order; stopping the daemon with a subscriber
+// still connected and not reading closes it on its own thread and returns.
+class DaemonPublishThreads : public ::testing::TestWithParam<int> {};
+
+TEST_P(DaemonPublishThreads, EverySubscriberGetsEveryFrameInOrderAndStopClosesTheRest) {
+  DaemonConfig config = test_config();
+  config.publish_threads = GetParam();
+  config.subscriber_queue_frames = 64;
+  config.max_frame_wait_ms = 1000;
+  Daemon daemon(config);
+  daemon.start_serving();
+  EXPECT_EQ(nlohmann::json::parse(daemon.health_json())["publish_threads"].get<int>(), GetParam());
+
+  asio::io_context io;  // the subscriber that never reads: still connected at stop()
+  tcp::socket idle(io);
+  idle.connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), static_cast<unsigned short>(daemon.sub_port())));
+  asio::write(idle, asio::buffer(subscriber::encode_hello({subscriber::kWantMarkers})));
+
+  constexpr int kSubscribers = 4;
+  constexpr size_t kFrames = 120;
+  std::vector<std::vector<uint32_t>> numbers(kSubscribers);
+  std::vector<uint32_t> dropped(kSubscribers, 0);
+  std::vector<std::thread> readers;
+  for (int s = 0; s < kSubscribers; ++s)
+    readers.emplace_back([&, s] {
+      sub::SubscriberClient client("127.0.0.1", std::to_string(daemon.sub_port()), subscriber::kWantMarkers);
+      client.run([&](subscriber::MessageType type, std::span<const unsigned char> payload, int64_t) {
+        if (type != subscriber::MessageType::Frame) return true;
+        const subscriber::FrameInfo info = subscriber::decode_frame_info(payload);
+        numbers[s].push_back(info.frame_number);
+        dropped[s] = info.pipeline_dropped + info.subscriber_dropped;
+        return numbers[s].size() < kFrames;
+      });
+    });
+  wait_until([&] { return daemon.hub().subscriber_count() == kSubscribers + 1 && daemon.hub().wanted_encodings() != 0; });
+  daemon.start_source();
+  for (std::thread& t : readers) t.join();
+  daemon.stop();
+
+  for (int s = 0; s < kSubscribers; ++s) {
+    ASSERT_EQ(numbers[s].size(), kFrames) << "subscriber " << s;
+    if (dropped[s] != 0) GTEST_SKIP() << "a frame was dropped: the machine is too busy for a frame-by-frame check";
+    for (size_t i = 1; i < kFrames; ++i)
+      ASSERT_EQ(numbers[s][i], numbers[s][i - 1] + 1) << "subscriber " << s << " frame " << i;
+  }
+  // The idle subscriber's connection was closed by the daemon: it reads what was sent, then EOF.
+  boost::system::error_code ec;
+  std::array<unsigned char, 65536> buffer;
+  while (!ec) idle.read_some(asio::buffer(buffer), ec);
+  EXPECT_TRUE(ec == asio::error::eof || ec == asio::error::connection_reset) << ec.message();
+}
+
+INSTANTIATE_TEST_SUITE_P(Threads, DaemonPublishThreads, ::testing::Values(0, 3));
+
 // Reads a raw subscriber socket, decoding Frames, until `deadline` or until `enough` frames
 // have come (0: no such limit).
 std::vector<subscriber::Frame> read_frames_until(tcp::socket& socket, subscriber::StreamDecoder& decoder,
