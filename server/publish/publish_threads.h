@@ -4,11 +4,13 @@
 // still runs on one thread and needs no strand. New subscribers go to the thread with the fewest
 // (ties: the first).
 //
-// Why: a 53,500-vertex frame is 640 kB per subscriber, and one io thread writing every
-// subscriber in turn made delivery (publish -> arrival) grow by about 0.19 ms per subscriber on
-// loopback (p50 0.49 ms for one, 1.05 ms for four; README). Between frames both cores are free
-// (the pipeline waits for the next frame), so two writers halve the wait of the last one, and
-// the source's io thread no longer waits behind the writes.
+// Why: a 53,500-vertex frame is 640 kB per subscriber, and one io thread wrote every
+// subscriber in turn, between reading the source and serving HTTP. Delivery (publish ->
+// arrival) on loopback grew from 0.49 ms at the median for one subscriber to 1.05 ms for four.
+// With two publish threads, in five alternating pairs of 20-30 s runs with 4 subscribers
+// (skinstream-bench --publish-threads 0 | 2): delivery p50 1.30 -> 1.14 ms, end-to-end p99
+// 4.66 -> 4.28 ms and p99.9 38 -> 11 ms (medians of the five runs of each); the source's frames no longer
+// wait behind the writes at start-up, when every subscriber is sent a 1.3 MB MeshInfo.
 //
 // With count 0 there are no threads and every subscriber stays on the caller's io_context.
 
