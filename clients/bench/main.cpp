@@ -187,7 +187,7 @@ int main(int argc, char** argv) {
   std::string recording = "replay_data/cmu/85_12.c3d", subject, vicon_subject_name, deform_cpus;
   int deform_spin_lead_us = -1;  // -1: the daemon's default
   int publish_threads = -1;      // -1: the daemon's default
-  bool json = false, normals = false;
+  bool json = false, normals = false, quantised = false;
   app.add_option("--seconds", seconds, "how long to measure")->check(CLI::Range(0.5, 3600.0))->capture_default_str();
   app.add_option("--subscribers", subscriber_count, "subscribers connected in-process, one thread each")->check(CLI::Range(1, 256))->capture_default_str();
   app.add_option("--recording", recording, "capture the Vicon replay server streams, looped")->capture_default_str();
@@ -199,6 +199,7 @@ int main(int argc, char** argv) {
   app.add_option("--publish-threads", publish_threads, "skinstreamd --publish-threads (default: the daemon's)")->check(CLI::Range(0, 16));
   app.add_option("--vicon-subject-name", vicon_subject_name, "subject name the replay announces (default: the recording's file name)");
   app.add_flag("--normals", normals, "subscribers ask for normals too");
+  app.add_flag("--quantised", quantised, "subscribers ask for the quantised encoding (half the bytes)");
   app.add_flag("--json", json, "print the report as JSON");
   CLI11_PARSE(app, argc, argv);
 
@@ -261,7 +262,7 @@ int main(int argc, char** argv) {
     std::vector<long> received(subscriber_count, 0), unmatched(subscriber_count, 0), out_of_order(subscriber_count, 0);
     std::vector<uint32_t> dropped_first(subscriber_count, 0), dropped_last(subscriber_count, 0);
     const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
-    const uint32_t wants = normals ? subscriber::kWantNormals : 0u;
+    const uint32_t wants = (normals ? subscriber::kWantNormals : 0u) | (quantised ? subscriber::kWantQuantised : 0u);
     std::vector<std::thread> threads;
     std::vector<std::string> errors(subscriber_count);
     for (int s = 0; s < subscriber_count; ++s)
@@ -351,6 +352,7 @@ int main(int argc, char** argv) {
         {"mode", "Vicon DataStream replay (in-process, loopback) -> skinstreamd --vicon -> subscribers"},
         {"seconds", seconds},
         {"subscribers", subscriber_count},
+        {"subscribers_want", {{"normals", normals}, {"quantised", quantised}}},
         {"deform_threads", deform_threads},
         {"deform", health["deform"]},  // as the daemon applied it: threads, CPUs pinned to, spin lead
         {"publish_threads", health["publish_threads"]},
