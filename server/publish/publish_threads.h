@@ -7,10 +7,12 @@
 // Why: a 53,500-vertex frame is 640 kB per subscriber, and one io thread wrote every
 // subscriber in turn, between reading the source and serving HTTP. Delivery (publish ->
 // arrival) on loopback grew from 0.49 ms at the median for one subscriber to 1.05 ms for four.
-// With two publish threads, in five alternating pairs of 20-30 s runs with 4 subscribers
-// (skinstream-bench --publish-threads 0 | 2): delivery p50 1.30 -> 1.14 ms, end-to-end p99
-// 4.66 -> 4.28 ms and p99.9 38 -> 11 ms (medians of the five runs of each); the source's frames no longer
-// wait behind the writes at start-up, when every subscriber is sent a 1.3 MB MeshInfo.
+// With two publish threads (skinstream-bench --publish-threads 2 against 0, alternating, 4
+// subscribers): the medians are lower in every pair (delivery p50 1.11-1.21 ms against
+// 1.21-1.41 over 120 s and 10 minutes), the p99s show no consistent difference on this 2-core
+// machine, and in 20-30 s runs, where start-up weighs more, end-to-end p99.9 fell from 22-43 ms
+// to 7-16 ms: the source's frames no longer wait while every subscriber is sent its 1.3 MB
+// MeshInfo. Figures in the README.
 //
 // With count 0 there are no threads and every subscriber stays on the caller's io_context.
 
