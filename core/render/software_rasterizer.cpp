@@ -6,6 +6,7 @@
 #include <limits>
 #include <numbers>
 #include <stdexcept>
+#include <tuple>
 
 namespace skinstream::render {
 
@@ -41,6 +42,12 @@ struct ScreenVertex {
 };
 
 double edge(double ax, double ay, double bx, double by, double px, double py) {
+  // Two triangles sharing an edge see it in opposite directions. Evaluated as written, a*b - c*d
+  // is not exactly antisymmetric once the compiler fuses one product into an FMA, and a pixel
+  // centre on the edge then falls between both triangles (a hole along the diagonal of a quad).
+  // Evaluating every edge from its lower endpoint and negating keeps the two results exact
+  // negatives of each other, whatever the rounding.
+  if (std::tie(bx, by) < std::tie(ax, ay)) return -edge(bx, by, ax, ay, px, py);
   return (bx - ax) * (py - ay) - (by - ay) * (px - ax);
 }
 
