@@ -6,7 +6,11 @@ WORKDIR /src/skinstream
 COPY scripts/install-deps.sh scripts/install-deps.sh
 RUN bash scripts/install-deps.sh && rm -rf /var/lib/apt/lists/*
 COPY . .
+# The CPU level the image needs (AVX2 + FMA by default): --build-arg SKINSTREAM_CPU_LEVEL=x86-64
+# for an image that runs on any x86-64 host.
+ARG SKINSTREAM_CPU_LEVEL=x86-64-v3
 RUN cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DSKINSTREAM_BUILD_TESTS=OFF -DSKINSTREAM_BUILD_BENCHMARKS=OFF \
+    -DSKINSTREAM_CPU_LEVEL="${SKINSTREAM_CPU_LEVEL}" \
  && cmake --build build -j "$(nproc)" \
  && bash clients/web/build.sh build/web \
  && bash scripts/make-demo.sh build/bin/skinstream build/demo
