@@ -74,8 +74,8 @@ class ViconServer {
   void stop();   // closes the listener and every client; safe to call twice
   uint16_t port() const;
 
-  // Called right after each frame has been handed to every client and multicast destination,
-  // with the system clock (ns since epoch) at that moment.
+  // Called for each frame just before it is handed to the clients and multicast destinations,
+  // with the system clock (ns since epoch) at that moment: the frame's send time.
   void set_frame_hook(FrameHook hook);
   // Called once when the last frame has been produced (never with loop).
   void set_on_finished(std::function<void()> on_finished);

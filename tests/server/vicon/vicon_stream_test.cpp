@@ -54,6 +54,7 @@ class IoThread {
 struct ReceivedFrame {
   uint32_t number = 0;
   int64_t source_time_ns = 0;
+  int64_t receive_time_ns = 0;
   double rate = 0.0;
   std::vector<Vec3> labelled;
   std::vector<std::pair<int, Vec3>> unlabelled;  // id, position
@@ -66,6 +67,7 @@ class RecordingSink : public FrameSink {
     ReceivedFrame r;
     r.number = frame.frame_number;
     r.source_time_ns = frame.source_time_ns;
+    r.receive_time_ns = frame.receive_time_ns;
     r.rate = frame.source_rate_hz;
     r.labelled = frame.labelled;
     for (int i = 0; i < frame.unlabelled_count; ++i)
@@ -215,6 +217,13 @@ TEST(ViconStream, PushDeliversEveryFrameInOrderWithExactPositions) {
   ASSERT_EQ(hooked.size(), static_cast<size_t>(capture.frame_count));
   EXPECT_EQ(hooked.front().first, static_cast<uint32_t>(capture.first_frame));
   for (size_t i = 1; i < hooked.size(); ++i) EXPECT_GE(hooked[i].second, hooked[i - 1].second);
+  // The hook's time is the send time: taken before the client could have the frame.
+  sink.with_lock([&] {
+    for (size_t i = 0; i < hooked.size(); ++i) {
+      ASSERT_EQ(hooked[i].first, sink.frames_[i].number);
+      EXPECT_LE(hooked[i].second, sink.frames_[i].receive_time_ns) << "frame " << hooked[i].first;
+    }
+  });
 }
 
 TEST(ViconStream, PullDeliversOneFramePerRequestInOrder) {
