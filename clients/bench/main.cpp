@@ -1,6 +1,7 @@
 // skinstream-bench: end-to-end latency and cost of the real skinstreamd, fed over the network as
 // in production. In this process: the Vicon DataStream server engine (server/vicon/vicon_server.h)
-// loops the recording on an ephemeral loopback port and notes when each frame number left it,
+// loops the recording on an ephemeral loopback port and notes when each frame number is sent
+// (the clock read just before the write, so ingest includes it),
 // and N subscribers (one thread each, the blocking client of server/client/) note when each frame
 // arrived. The daemon is the real skinstreamd, a child process started with --vicon.
 //
