@@ -135,20 +135,25 @@ Daemon::Daemon(const DaemonConfig& config)
     const auto endpoint = socket.remote_endpoint(ec);
     const std::string remote = ec ? "?" : endpoint.address().to_string() + ":" + std::to_string(endpoint.port());
     // To the publish thread with the fewest subscribers: the socket moves to its io_context, and
-    // the session starts there.
+    // the session starts there. (Accepting straight onto that context would leave the waiting
+    // accept, and a socket of a publish context, in io_'s queue, which outlives the publish
+    // threads: see the members' order in daemon.h.) Without publish threads it stays on io_.
     PublishThreads::Placement placed = publish_.place(io_);
-    tcp::socket own(placed.io);
-    const tcp protocol = socket.local_endpoint(ec).protocol();
-    const auto handle = ec ? tcp::socket::native_handle_type(-1) : socket.release(ec);
-    if (!ec) {
-      own.assign(protocol, handle, ec);
-      if (ec) ::close(handle);
+    if (&placed.io != &io_) {
+      tcp::socket own(placed.io);
+      const tcp protocol = socket.local_endpoint(ec).protocol();
+      const auto handle = ec ? tcp::socket::native_handle_type(-1) : socket.release(ec);
+      if (!ec) {
+        own.assign(protocol, handle, ec);
+        if (ec) ::close(handle);
+      }
+      if (ec) {
+        spdlog::warn("subscriber {}: cannot hand the socket to its thread: {}; closing", remote, ec.message());
+        return;
+      }
+      socket = std::move(own);
     }
-    if (ec) {
-      spdlog::warn("subscriber {}: cannot hand the socket to its thread: {}; closing", remote, ec.message());
-      return;
-    }
-    auto subscriber = std::make_shared<TcpSubscriber>(placed.io, *hub_, std::move(own), remote, std::move(placed.token));
+    auto subscriber = std::make_shared<TcpSubscriber>(placed.io, *hub_, std::move(socket), remote, std::move(placed.token));
     hub_->add(subscriber);
     asio::post(placed.io, [subscriber] { subscriber->start(); });
   });
