@@ -48,6 +48,25 @@ struct Samples {
   }
 };
 
+// What one subscriber thread saw: its own, so the threads share nothing while they run; merged
+// after they are joined.
+struct SubscriberTally {
+  Samples end_to_end, processing, ingest, delivery;  // see the report's keys
+  long received = 0, unmatched = 0, out_of_order = 0;
+  uint32_t dropped_first = 0, dropped_last = 0;  // the daemon's drop counter for it, first and last frame
+
+  void reserve(size_t frames) {
+    for (Samples* s : {&end_to_end, &processing, &ingest, &delivery}) s->ms.reserve(frames);
+  }
+  void merge_samples(const SubscriberTally& other) {
+    auto append = [](Samples& to, const Samples& from) { to.ms.insert(to.ms.end(), from.ms.begin(), from.ms.end()); };
+    append(end_to_end, other.end_to_end);
+    append(processing, other.processing);
+    append(ingest, other.ingest);
+    append(delivery, other.delivery);
+  }
+};
+
 // Send times by frame number, written by the replay server's io thread and read by the
 // subscriber threads. A ring of the last kSlots frames (34 s at 120 Hz): a frame still in flight
 // after that long is reported as unmatched rather than given a wrong send time.
@@ -258,23 +277,17 @@ int main(int argc, char** argv) {
     const double cpu_before = process_usage(pid).first;  // startup (loading the subject) is not counted
     const double own_cpu_before = process_usage(getpid()).first;
 
-    std::mutex mutex;
-    Samples end_to_end, processing, ingest, delivery;
-    std::vector<long> received(subscriber_count, 0), unmatched(subscriber_count, 0), out_of_order(subscriber_count, 0);
-    std::vector<uint32_t> dropped_first(subscriber_count, 0), dropped_last(subscriber_count, 0);
+    std::vector<SubscriberTally> tallies(subscriber_count);
     const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
     const uint32_t wants = (normals ? subscriber::kWantNormals : 0u) | (quantised ? subscriber::kWantQuantised : 0u);
     std::vector<std::thread> threads;
     std::vector<std::string> errors(subscriber_count);
     for (int s = 0; s < subscriber_count; ++s)
       threads.emplace_back([&, s] {
+        SubscriberTally& tally = tallies[s];
         try {
           sub::SubscriberClient client("127.0.0.1", std::to_string(sub_port), wants);
-          std::vector<double> local_e2e, local_processing, local_ingest, local_delivery;
-          local_e2e.reserve(static_cast<size_t>(seconds * capture.rate_hz * 1.2) + 16);
-          local_processing.reserve(local_e2e.capacity());
-          local_ingest.reserve(local_e2e.capacity());
-          local_delivery.reserve(local_e2e.capacity());
+          tally.reserve(static_cast<size_t>(seconds * capture.rate_hz * 1.2) + 16);
           int64_t last_frame = -1;
           client.run([&](subscriber::MessageType type, std::span<const unsigned char> payload, int64_t now) {
             if (type == subscriber::MessageType::Frame) {
@@ -282,25 +295,20 @@ int main(int argc, char** argv) {
               const subscriber::FrameInfo info = subscriber::decode_frame_info(payload);
               const int64_t sent = send_times.find(info.frame_number);
               if (sent > 0) {
-                local_e2e.push_back((now - sent) * 1e-6);
-                local_ingest.push_back((info.receive_time_ns - sent) * 1e-6);
+                tally.end_to_end.ms.push_back((now - sent) * 1e-6);
+                tally.ingest.ms.push_back((info.receive_time_ns - sent) * 1e-6);
               } else {
-                ++unmatched[s];
+                ++tally.unmatched;
               }
-              local_processing.push_back((info.publish_time_ns - info.receive_time_ns) * 1e-6);
-              local_delivery.push_back((now - info.publish_time_ns) * 1e-6);
-              if (static_cast<int64_t>(info.frame_number) <= last_frame) ++out_of_order[s];
+              tally.processing.ms.push_back((info.publish_time_ns - info.receive_time_ns) * 1e-6);
+              tally.delivery.ms.push_back((now - info.publish_time_ns) * 1e-6);
+              if (static_cast<int64_t>(info.frame_number) <= last_frame) ++tally.out_of_order;
               last_frame = info.frame_number;
-              if (received[s]++ == 0) dropped_first[s] = info.subscriber_dropped;
-              dropped_last[s] = info.subscriber_dropped;
+              if (tally.received++ == 0) tally.dropped_first = info.subscriber_dropped;
+              tally.dropped_last = info.subscriber_dropped;
             }
             return std::chrono::steady_clock::now() < deadline;
           });
-          std::lock_guard lock(mutex);
-          end_to_end.ms.insert(end_to_end.ms.end(), local_e2e.begin(), local_e2e.end());
-          processing.ms.insert(processing.ms.end(), local_processing.begin(), local_processing.end());
-          ingest.ms.insert(ingest.ms.end(), local_ingest.begin(), local_ingest.end());
-          delivery.ms.insert(delivery.ms.end(), local_delivery.begin(), local_delivery.end());
         } catch (const std::exception& e) {
           errors[s] = e.what();
         }
@@ -340,12 +348,14 @@ int main(int argc, char** argv) {
         if (text.find("[warning]") != std::string::npos || text.find("[error]") != std::string::npos) daemon_warnings.push_back(text);
     }
 
-    long total_received = 0, total_dropped = 0, total_unmatched = 0, total_out_of_order = 0;
-    for (int s = 0; s < subscriber_count; ++s) {
-      total_received += received[s];
-      total_dropped += dropped_last[s] - dropped_first[s];
-      total_unmatched += unmatched[s];
-      total_out_of_order += out_of_order[s];
+    SubscriberTally all;
+    long total_dropped = 0;
+    for (const SubscriberTally& tally : tallies) {
+      all.merge_samples(tally);
+      all.received += tally.received;
+      all.unmatched += tally.unmatched;
+      all.out_of_order += tally.out_of_order;
+      total_dropped += tally.dropped_last - tally.dropped_first;
     }
     auto delta = [&](const char* key) { return health["frames"][key].get<uint64_t>() - health_before["frames"][key].get<uint64_t>(); };
     // CPU: the measured window only; peak RSS: the daemon's whole life.
@@ -360,10 +370,10 @@ int main(int argc, char** argv) {
         {"recording", recording},
         {"vertices", health["subject"]["vertices"]},
         {"markers", health["subject"]["markers"]},
-        {"end_to_end", end_to_end.summary()},
-        {"daemon_processing", processing.summary()},
-        {"ingest", ingest.summary()},      // replay send -> daemon receive
-        {"delivery", delivery.summary()},  // daemon publish -> subscriber arrival
+        {"end_to_end", all.end_to_end.summary()},
+        {"daemon_processing", all.processing.summary()},
+        {"ingest", all.ingest.summary()},      // replay send -> daemon receive
+        {"delivery", all.delivery.summary()},  // daemon publish -> subscriber arrival
         {"replay_sends", send_times.regularity()},  // gaps between the replay's consecutive sends
         {"frames", {{"sent_by_replay", sent},
                     {"dropped_by_replay", replay_dropped},
@@ -372,10 +382,10 @@ int main(int argc, char** argv) {
                     {"published", delta("published")},
                     {"dropped_in_pipeline", delta("dropped")},
                     {"dropped_in_pipeline_mailbox_full", delta("dropped_mailbox_full")},
-                    {"received_by_subscribers", total_received},
+                    {"received_by_subscribers", all.received},
                     {"dropped_for_subscribers", total_dropped},
-                    {"out_of_order", total_out_of_order},
-                    {"without_send_time", total_unmatched}}},
+                    {"out_of_order", all.out_of_order},
+                    {"without_send_time", all.unmatched}}},
         {"daemon", {{"cpu_seconds", cpu_seconds}, {"cpu_share_of_one_core", cpu_seconds / seconds}, {"peak_rss_kb", peak_rss_kb},
                     {"rss_kb_after_1s", rss_samples.empty() ? 0 : rss_samples.front()},
                     {"rss_kb_at_end", rss_samples.empty() ? 0 : rss_samples.back()},
