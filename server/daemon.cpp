@@ -18,6 +18,7 @@
 #include "server/pipeline/deform_cpus.h"
 #include "server/publish/subscriber_hub.h"
 #include "server/publish/tcp_subscriber.h"
+#include "server/thread_name.h"
 
 namespace skinstream::server {
 namespace {
@@ -196,6 +197,7 @@ void Daemon::start_serving() {
   spdlog::info("skinstreamd: subject {} ({} markers, {} vertices), HTTP port {}, subscriber port {}", config_.subject,
                subject_.model.marker_count(), pipeline_->vertex_count(), http_port(), sub_port());
   io_thread_ = std::thread([this] {
+    name_this_thread("io");
     auto guard = asio::make_work_guard(io_);
     io_.run();
   });

@@ -3,8 +3,10 @@
 #include <algorithm>
 #include <chrono>
 #include <numeric>
+#include <string>
 
 #include "server/pipeline/deform_cpus.h"
+#include "server/thread_name.h"
 
 namespace skinstream::server {
 namespace {
@@ -68,7 +70,10 @@ DeformWorkers::DeformWorkers(MeshDeformer& deformer, const DeformWorkerOptions& 
   vertices_.tasks = normals_stage_.tasks =
       static_cast<uint32_t>((deformer_.vertex_count() + vertex_chunk_ - 1) / vertex_chunk_);
   for (int i = 1; i < threads_; ++i) {
-    workers_.emplace_back([this] { work(); });
+    workers_.emplace_back([this, i] {
+      name_this_thread("deform-" + std::to_string(i));
+      work();
+    });
     if (static_cast<int>(options.cpus.size()) == threads_ && !set_thread_cpus(workers_.back(), {options.cpus[i]}))
       ++unpinned_workers_;
   }

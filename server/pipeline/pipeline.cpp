@@ -7,6 +7,7 @@
 
 #include "protocol/subscriber_stream.h"
 #include "server/pipeline/deform_cpus.h"
+#include "server/thread_name.h"
 
 namespace skinstream::server {
 namespace {
@@ -58,7 +59,10 @@ Pipeline::~Pipeline() { stop(); }
 
 void Pipeline::start() {
   if (running_.exchange(true)) return;
-  thread_ = std::thread([this] { run(); });
+  thread_ = std::thread([this] {
+    name_this_thread("pipeline");
+    run();
+  });
 }
 
 void Pipeline::stop() {

@@ -2,6 +2,10 @@
 
 #include <spdlog/spdlog.h>
 
+#include <string>
+
+#include "server/thread_name.h"
+
 namespace skinstream::server {
 
 PublishThreads::PublishThreads(int count) {
@@ -14,9 +18,10 @@ PublishThreads::~PublishThreads() {
 }
 
 void PublishThreads::start() {
-  for (auto& c : contexts_)
-    if (!c->thread.joinable())
-      c->thread = std::thread([&io = c->io] {
+  for (size_t i = 0; i < contexts_.size(); ++i)
+    if (Context* c = contexts_[i].get(); !c->thread.joinable())
+      c->thread = std::thread([&io = c->io, i] {
+        name_this_thread("publish-" + std::to_string(i));
         try {
           io.run();
         } catch (const std::exception& e) {  // a handler that throws is a bug; say so rather than terminate

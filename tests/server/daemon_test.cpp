@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include <nlohmann/json.hpp>
+#include <set>
 #include <thread>
 
 #include "core/capture_filler.h"
@@ -18,6 +19,7 @@
 #include "server/client/subscriber_client.h"
 #include "server/publish/subscriber_hub.h"
 #include "support/test_data.h"
+#include "support/thread_names.h"
 
 namespace skinstream::server {
 namespace {
@@ -269,6 +271,23 @@ TEST_P(DaemonPublishThreads, EverySubscriberGetsEveryFrameInOrderAndStopClosesTh
 }
 
 INSTANTIATE_TEST_SUITE_P(Threads, DaemonPublishThreads, ::testing::Values(0, 3));
+
+// `top -H` on a stage machine tells the daemon's threads apart: each names itself (this
+// subject has no mesh, so there is no deform worker; deform_workers_test checks those).
+TEST(Daemon, NamesItsThreads) {
+  DaemonConfig config = test_config();
+  config.publish_threads = 2;
+  Daemon daemon(config);
+  daemon.start_serving();
+  std::multiset<std::string> names;
+  // Each thread names itself once it runs.
+  wait_until([&] {
+    names = test::process_thread_names();
+    return names.count("io") == 1 && names.count("pipeline") == 1 && names.count("publish-1") == 1;
+  });
+  daemon.stop();
+  for (const char* expected : {"io", "pipeline", "publish-0", "publish-1"}) EXPECT_EQ(names.count(expected), 1u) << expected;
+}
 
 // Reads a raw subscriber socket, decoding Frames, until `deadline` or until `enough` frames
 // have come (0: no such limit).

@@ -5,9 +5,12 @@
 #include <chrono>
 #include <cmath>
 #include <random>
+#include <set>
+#include <string>
 #include <thread>
 
 #include "server/pipeline/deform_cpus.h"
+#include "support/thread_names.h"
 #include "tests/core/deform/deform_test_support.h"
 
 namespace skinstream::server {
@@ -75,6 +78,22 @@ TEST(DeformWorkers, PinnedAnticipatingWorkersGiveTheSameFramesAtAnyPace) {
     }
   }  // joins a worker that may be asleep until the next frame it expected
   set_this_thread_cpus(allowed);  // the test thread as it was
+}
+
+// Each worker names itself deform-N (N from 1; the calling thread is 0), as `top -H` shows.
+TEST(DeformWorkers, WorkersNameThemselves) {
+  deform_test::WavySheet sheet;
+  MeshDeformer deformer(sheet.model, sheet.subject);
+  DeformWorkers workers(deformer, 3);
+  // Each worker names itself once it runs.
+  std::multiset<std::string> names = test::process_thread_names();
+  const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+  while ((names.count("deform-1") == 0 || names.count("deform-2") == 0) && std::chrono::steady_clock::now() < give_up) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    names = test::process_thread_names();
+  }
+  EXPECT_EQ(names.count("deform-1"), 1u);
+  EXPECT_EQ(names.count("deform-2"), 1u);
 }
 
 TEST(DeformWorkers, RejectsUnusableMarkersAndKeepsThePreviousFit) {
