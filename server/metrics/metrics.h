@@ -13,11 +13,14 @@
 
 namespace skinstream::server {
 
-// Fixed buckets (seconds) so observing never allocates.
+// Fixed buckets (seconds) so observing never allocates. Fine between 0.1 and 10 ms, where a
+// 120 Hz frame's stages and their targets (1 ms deformation, 2 ms processing, 8.3 ms between
+// frames) lie: with a bucket from 1 to 2.5 ms a p99 of 1.9 ms could not be told from 2.4.
 class LatencyHistogram {
  public:
-  static constexpr std::array<double, 14> kBounds = {10e-6, 25e-6, 50e-6, 100e-6, 250e-6, 500e-6, 1e-3,
-                                                     2.5e-3, 5e-3, 10e-3, 25e-3, 50e-3, 100e-3, 1.0};
+  static constexpr std::array<double, 22> kBounds = {10e-6,  25e-6,  50e-6, 100e-6, 200e-6, 300e-6, 500e-6, 750e-6,
+                                                     1e-3,   1.25e-3, 1.5e-3, 2e-3,  2.5e-3, 3e-3,  4e-3,  5e-3,
+                                                     7.5e-3, 10e-3,  25e-3, 50e-3, 100e-3, 1.0};
   void observe_ns(int64_t ns);
   void render(std::string& out, std::string_view name, std::string_view help) const;
   uint64_t count() const { return count_.load(std::memory_order_relaxed); }

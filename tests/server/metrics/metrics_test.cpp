@@ -1,0 +1,74 @@
+// /metrics as Prometheus reads it: cumulative histogram buckets with an upper bound that
+// includes its value, +Inf, sum and count; counters by category; label values escaped.
+#include "server/metrics/metrics.h"
+
+#include <gtest/gtest.h>
+
+#include <sstream>
+#include <string>
+
+namespace skinstream::server {
+namespace {
+
+// The value of the first line starting with `prefix`, or -1 when there is none.
+double value_of(const std::string& text, const std::string& prefix) {
+  std::istringstream lines(text);
+  for (std::string line; std::getline(lines, line);)
+    if (line.rfind(prefix, 0) == 0) return std::stod(line.substr(prefix.size()));
+  return -1;
+}
+
+TEST(LatencyHistogram, BucketsAreCumulativeAndIncludeTheirBound) {
+  LatencyHistogram h;
+  h.observe_ns(900'000);     // 0.9 ms: in le=0.001, not in le=0.00075
+  h.observe_ns(1'000'000);   // exactly 1 ms: in le=0.001
+  h.observe_ns(1'900'000);   // 1.9 ms: in le=0.002, not in le=0.0015
+  h.observe_ns(2'000'000'000);  // 2 s: beyond every bound, only in +Inf
+  std::string out;
+  h.render(out, "stage_seconds", "A stage.");
+  EXPECT_NE(out.find("# TYPE skinstream_stage_seconds histogram\n"), std::string::npos) << out;
+  EXPECT_EQ(value_of(out, "skinstream_stage_seconds_bucket{le=\"0.00075\"} "), 0);
+  EXPECT_EQ(value_of(out, "skinstream_stage_seconds_bucket{le=\"0.001\"} "), 2);
+  EXPECT_EQ(value_of(out, "skinstream_stage_seconds_bucket{le=\"0.0015\"} "), 2);
+  EXPECT_EQ(value_of(out, "skinstream_stage_seconds_bucket{le=\"0.002\"} "), 3);
+  EXPECT_EQ(value_of(out, "skinstream_stage_seconds_bucket{le=\"1\"} "), 3);
+  EXPECT_EQ(value_of(out, "skinstream_stage_seconds_bucket{le=\"+Inf\"} "), 4);
+  EXPECT_EQ(value_of(out, "skinstream_stage_seconds_count "), 4);
+  EXPECT_NEAR(value_of(out, "skinstream_stage_seconds_sum "), 2.0038, 1e-9);
+  EXPECT_EQ(h.count(), 4u);
+}
+
+TEST(LatencyHistogram, BoundsAscendAndEveryOneIsRendered) {
+  for (size_t b = 1; b < LatencyHistogram::kBounds.size(); ++b)
+    EXPECT_LT(LatencyHistogram::kBounds[b - 1], LatencyHistogram::kBounds[b]) << b;
+  LatencyHistogram h;
+  std::string out;
+  h.render(out, "empty_seconds", "Nothing yet.");
+  size_t buckets = 0;
+  for (size_t at = out.find("_bucket{"); at != std::string::npos; at = out.find("_bucket{", at + 1)) ++buckets;
+  EXPECT_EQ(buckets, LatencyHistogram::kBounds.size() + 1);  // and +Inf
+}
+
+TEST(Metrics, BadInputIsCountedByCategoryAndLabelValuesAreEscaped) {
+  Metrics m;
+  m.count_bad_input("nan");
+  m.count_bad_input("nan");
+  m.count_bad_input("wrong_marker_count");
+  m.frames_received = 7;
+  EXPECT_EQ(m.bad_input("nan"), 2u);
+  EXPECT_EQ(m.bad_input("unseen"), 0u);
+  SubscriberMetrics s;
+  s.id = 3;
+  s.transport = "tcp";
+  s.remote = "a\"b\\c\nd";
+  s.sent = 11;
+  const std::string out = m.render_prometheus({s});
+  EXPECT_EQ(value_of(out, "skinstream_frames_received_total "), 7);
+  EXPECT_EQ(value_of(out, "skinstream_bad_input_total{category=\"nan\"} "), 2);
+  EXPECT_EQ(value_of(out, "skinstream_bad_input_total{category=\"wrong_marker_count\"} "), 1);
+  EXPECT_EQ(value_of(out, "skinstream_subscriber_frames_sent_total{id=\"3\",transport=\"tcp\",remote=\"a\\\"b\\\\c\\nd\"} "), 11);
+  EXPECT_EQ(value_of(out, "skinstream_subscribers "), 1);
+}
+
+}  // namespace
+}  // namespace skinstream::server
