@@ -225,6 +225,11 @@ void patch_subscriber_dropped(std::span<unsigned char> frame_message, uint32_t d
   std::memcpy(frame_message.data() + kSubscriberDroppedOffset, &dropped, 4);
 }
 
+void patch_publish_time(std::span<unsigned char> frame_message, int64_t publish_time_ns) {
+  if (frame_message.size() < kPublishTimeOffset + 8) throw std::invalid_argument("patch_publish_time: not a frame message");
+  std::memcpy(frame_message.data() + kPublishTimeOffset, &publish_time_ns, 8);
+}
+
 MessageHeader decode_header(std::span<const unsigned char> bytes, uint32_t max_payload) {
   if (bytes.size() < kHeaderBytes)
     throw DecodeError("message header truncated: " + std::to_string(bytes.size()) + " of 12 bytes");

@@ -97,6 +97,9 @@ inline constexpr size_t kFrameInfoBytes = 52;
 // Where a Frame message (header included) keeps frames_dropped for this subscriber, so one shared
 // encoded frame can be sent to every subscriber with only this field changed.
 inline constexpr size_t kSubscriberDroppedOffset = kHeaderBytes + 48;
+// Where it keeps publish_time_ns: the daemon stamps it after encoding, just before it hands the
+// frame to the publishers, so that publish - receive covers all of its processing.
+inline constexpr size_t kPublishTimeOffset = kHeaderBytes + 24;
 
 // A decoded frame; quantised data is expanded to floats (origin/step kept for checks).
 struct Frame {
@@ -130,6 +133,7 @@ size_t frame_message_bytes(uint32_t flags, uint32_t vertex_count, uint32_t marke
 void encode_frame(const FrameInfo& info, std::span<const float> positions, std::span<const float> normals,
                   std::span<const float> markers, std::span<const uint8_t> marker_status, std::span<unsigned char> out);
 void patch_subscriber_dropped(std::span<unsigned char> frame_message, uint32_t dropped);
+void patch_publish_time(std::span<unsigned char> frame_message, int64_t publish_time_ns);
 
 // ---- decoding (each throws DecodeError naming what is wrong) ----
 MessageHeader decode_header(std::span<const unsigned char> bytes, uint32_t max_payload = kMaxPayloadBytes);

@@ -167,15 +167,13 @@ void Pipeline::publish(const Released& meta, std::span<const Vec3> positions, st
   info.frame_number = meta.frame_number;
   info.source_time_ns = meta.source_time_ns;
   info.receive_time_ns = meta.receive_time_ns;
-  info.publish_time_ns = wall_clock_ns();
+  info.publish_time_ns = 0;  // stamped below, once every encoding is written
   info.vertex_count = vertex_count();
   info.marker_count = static_cast<uint32_t>(status.size());
   info.markers_filled = meta.filled;
   info.markers_relabelled = meta.relabelled;
   info.pipeline_dropped = static_cast<uint32_t>(mailbox_.dropped());
   out.frame_number = meta.frame_number;
-  out.publish_time_ns = info.publish_time_ns;
-  out.published = std::chrono::steady_clock::now();
   for (uint32_t f = 0; f < EncodedFrame::kEncodings; ++f) {
     if (!((wanted >> f) & 1u)) continue;
     info.flags = f;
@@ -188,6 +186,12 @@ void Pipeline::publish(const Released& meta, std::span<const Vec3> positions, st
     out.encoded_mask |= 1u << f;
   }
   metrics_.encode.observe_ns(since_ns(encode_start));
+  // The publish time is taken last, so that publish - receive (in every frame's header) is the
+  // daemon's whole processing, encoding included; delivery starts here.
+  out.publish_time_ns = wall_clock_ns();
+  out.published = std::chrono::steady_clock::now();
+  for (uint32_t f = 0; f < EncodedFrame::kEncodings; ++f)
+    if ((out.encoded_mask >> f) & 1u) subscriber::patch_publish_time(out.messages[f], out.publish_time_ns);
   metrics_.frames_dropped.store(mailbox_.dropped(), std::memory_order_relaxed);
   metrics_.frames_dropped_mailbox_full.store(mailbox_.dropped_mailbox_full(), std::memory_order_relaxed);
   consumer_.publish(ref);

@@ -183,6 +183,21 @@ TEST(SubscriberStream, PatchingSubscriberDropsChangesOnlyThatField) {
   EXPECT_EQ(message, fixture("frame_float.bin"));
 }
 
+TEST(SubscriberStream, PatchingThePublishTimeChangesOnlyThatField) {
+  const std::vector<unsigned char> original = fixture("frame_quantised.bin");
+  const FrameInfo before = decode_frame(payload_of(original)).info;
+  std::vector<unsigned char> message = original;
+  patch_publish_time(message, 1'800'000'000'123'456'789);
+  const Frame patched = decode_frame(payload_of(message));
+  EXPECT_EQ(patched.info.publish_time_ns, 1'800'000'000'123'456'789);
+  EXPECT_EQ(patched.info.receive_time_ns, before.receive_time_ns);
+  EXPECT_EQ(patched.info.vertex_count, before.vertex_count);
+  patch_publish_time(message, before.publish_time_ns);
+  EXPECT_EQ(message, original);
+  std::vector<unsigned char> too_short(kPublishTimeOffset + 7);
+  EXPECT_THROW(patch_publish_time(too_short, 1), std::invalid_argument);
+}
+
 TEST(SubscriberStream, FlagsFollowWants) {
   EXPECT_EQ(frame_flags_for(0, true), 0u);
   EXPECT_EQ(frame_flags_for(kWantNormals | kWantQuantised, true), kFrameNormals | kFrameQuantised);
