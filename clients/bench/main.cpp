@@ -6,9 +6,11 @@
 // arrived. The daemon is the real skinstreamd, a child process started with --vicon.
 //
 //   end to end        = subscriber arrival - replay send time of the same frame number
-//   daemon processing = publish_time_ns - receive_time_ns (both from the frame header)
+//   daemon processing = publish_time_ns - receive_time_ns (both from the frame header; the
+//                       publish time is taken after encoding, as the frame goes to the publishers)
 //   ingest            = receive_time_ns - replay send time (the network in, and the daemon's io thread)
-//   delivery          = subscriber arrival - publish_time_ns (the subscriber queue and the network out)
+//   delivery          = subscriber arrival - publish_time_ns (the hand-off, the subscriber queue
+//                       and the network out)
 // so end to end = ingest + processing + delivery, frame by frame; the three say where a tail comes from.
 //
 // Every clock is the same machine's system clock, so the differences need no synchronisation.
