@@ -60,12 +60,17 @@ struct SubscriberTally {
   void reserve(size_t frames) {
     for (Samples* s : {&end_to_end, &processing, &ingest, &delivery}) s->ms.reserve(frames);
   }
-  void merge_samples(const SubscriberTally& other) {
+  uint32_t dropped() const { return dropped_last - dropped_first; }
+  // Adds another subscriber's samples and counts (not its drop counter: see dropped()).
+  void add(const SubscriberTally& other) {
     auto append = [](Samples& to, const Samples& from) { to.ms.insert(to.ms.end(), from.ms.begin(), from.ms.end()); };
     append(end_to_end, other.end_to_end);
     append(processing, other.processing);
     append(ingest, other.ingest);
     append(delivery, other.delivery);
+    received += other.received;
+    unmatched += other.unmatched;
+    out_of_order += other.out_of_order;
   }
 };
 
@@ -353,11 +358,8 @@ int main(int argc, char** argv) {
     SubscriberTally all;
     long total_dropped = 0;
     for (const SubscriberTally& tally : tallies) {
-      all.merge_samples(tally);
-      all.received += tally.received;
-      all.unmatched += tally.unmatched;
-      all.out_of_order += tally.out_of_order;
-      total_dropped += tally.dropped_last - tally.dropped_first;
+      all.add(tally);
+      total_dropped += tally.dropped();
     }
     auto delta = [&](const char* key) { return health["frames"][key].get<uint64_t>() - health_before["frames"][key].get<uint64_t>(); };
     // CPU: the measured window only; peak RSS: the daemon's whole life.
