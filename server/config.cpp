@@ -1,6 +1,7 @@
 #include "server/config.h"
 
 #include "server/pipeline/deform_cpus.h"
+#include "server/tcp_congestion.h"
 
 #include <CLI/CLI.hpp>
 #include <fstream>
@@ -29,7 +30,7 @@ void apply_json(const nlohmann::json& json, DaemonConfig& c, const std::string& 
                                       "http_port", "sub_port", "web_root", "lookahead", "max_frame_wait_ms", "deform_threads",
                                       "deform_cpus", "deform_spin_lead_us",
                                       "continuity_seconds", "use_pca", "ports_file", "log_level", "hello_timeout_ms",
-                                      "subscriber_queue_frames", "publish_threads", "status_interval_ms", "default_rate_hz"};
+                                      "subscriber_queue_frames", "subscriber_tcp_congestion", "publish_threads", "status_interval_ms", "default_rate_hz"};
   for (const auto& [key, value] : json.items()) {
     bool known = false;
     for (const char* k : kKeys) known = known || key == k;
@@ -57,6 +58,7 @@ void apply_json(const nlohmann::json& json, DaemonConfig& c, const std::string& 
   take(json, "log_level", c.log_level, origin);
   take(json, "hello_timeout_ms", c.hello_timeout_ms, origin);
   take(json, "subscriber_queue_frames", c.subscriber_queue_frames, origin);
+  take(json, "subscriber_tcp_congestion", c.subscriber_tcp_congestion, origin);
   take(json, "publish_threads", c.publish_threads, origin);
   take(json, "status_interval_ms", c.status_interval_ms, origin);
   take(json, "default_rate_hz", c.default_rate_hz, origin);
@@ -101,6 +103,7 @@ nlohmann::json to_json(const DaemonConfig& c) {
           {"log_level", c.log_level},
           {"hello_timeout_ms", c.hello_timeout_ms},
           {"subscriber_queue_frames", c.subscriber_queue_frames},
+          {"subscriber_tcp_congestion", c.subscriber_tcp_congestion},
           {"publish_threads", c.publish_threads},
           {"status_interval_ms", c.status_interval_ms},
           {"default_rate_hz", c.default_rate_hz}};
@@ -122,6 +125,9 @@ void validate(const DaemonConfig& c) {
   if (c.hello_timeout_ms < 0) fail("hello_timeout_ms must be >= 0");
   if (c.subscriber_queue_frames < 1 || c.subscriber_queue_frames > 64) fail("subscriber_queue_frames must be 1-64");
   if (c.publish_threads < 0 || c.publish_threads > 16) fail("publish_threads must be 0-16");
+  if (!c.subscriber_tcp_congestion.empty() && !is_tcp_congestion_name(c.subscriber_tcp_congestion))
+    fail("subscriber_tcp_congestion must be empty (the system's) or a Linux congestion control name such as reno, not \"" +
+         c.subscriber_tcp_congestion + "\"");
   if (c.status_interval_ms < 10) fail("status_interval_ms must be >= 10");
   if (!(c.default_rate_hz > 0)) fail("default_rate_hz must be > 0");
   static const char* const kLevels[] = {"trace", "debug", "info", "warn", "error", "critical", "off"};
@@ -172,6 +178,8 @@ std::optional<CommandLine> parse_command_line(int argc, const char* const* argv,
                                    "deform workers spin this long before a frame is due (0 = sleep until woken)");
   auto* publish_threads = app.add_option("--publish-threads", flags.publish_threads,
                                          "threads writing to TCP subscribers (0 = the io thread)");
+  auto* tcp_congestion = app.add_option("--subscriber-tcp-congestion", flags.subscriber_tcp_congestion,
+                                        "TCP congestion control of subscriber connections, e.g. reno (\"\" = the system's)");
   auto* ports_file = app.add_option("--ports-file", flags.ports_file, "write {\"http\":N,\"sub\":N} here once listening");
   auto* log_level = app.add_option("--log-level", flags.log_level, "trace, debug, info, warn, error, critical, off");
   app.add_flag("--print-config", result.print_config, "print the effective configuration as JSON and exit");
@@ -204,6 +212,7 @@ std::optional<CommandLine> parse_command_line(int argc, const char* const* argv,
   if (given(cpus)) c.deform_cpus = flags.deform_cpus;
   if (given(spin_lead)) c.deform_spin_lead_us = flags.deform_spin_lead_us;
   if (given(publish_threads)) c.publish_threads = flags.publish_threads;
+  if (given(tcp_congestion)) c.subscriber_tcp_congestion = flags.subscriber_tcp_congestion;
   if (given(ports_file)) c.ports_file = flags.ports_file;
   if (given(log_level)) c.log_level = flags.log_level;
   validate(c);

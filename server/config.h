@@ -35,6 +35,7 @@ struct DaemonConfig {
   std::string log_level = "info";
   int hello_timeout_ms = 2000;    // subscribers that say nothing get positions only
   int publish_threads = 2;        // threads writing to TCP subscribers; 0 = the io thread (server/publish/publish_threads.h)
+  std::string subscriber_tcp_congestion = "reno";  // on subscriber and HTTP connections; empty = the system's (server/tcp_congestion.h)
   int subscriber_queue_frames = 32;  // per subscriber at most; max_frame_wait_ms bounds their age
   int status_interval_ms = 1000;
   double default_rate_hz = 120.0;  // until the source says its rate

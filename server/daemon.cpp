@@ -157,14 +157,15 @@ Daemon::Daemon(const DaemonConfig& config)
     auto subscriber = std::make_shared<TcpSubscriber>(placed.io, *hub_, std::move(socket), remote, std::move(placed.token));
     hub_->add(subscriber);
     asio::post(placed.io, [subscriber] { subscriber->start(); });
-  });
+  }, config.subscriber_tcp_congestion);
   HttpRoutes routes;
   routes.health_json = [this] { return health_json(); };
   routes.metrics_text = [this] { return metrics_.render_prometheus(hub_->subscriber_metrics()); };
   routes.web_root = config.web_root;
   if (!config.web_root.empty() && !std::filesystem::is_directory(config.web_root))
     throw FileError(config.web_root, "web root is not a directory");
-  http_ = std::make_unique<HttpServer>(io_, config.bind_address, config.http_port, *hub_, std::move(routes));
+  http_ = std::make_unique<HttpServer>(io_, config.bind_address, config.http_port, *hub_, std::move(routes),
+                                       config.subscriber_tcp_congestion);
 }
 
 Daemon::~Daemon() { stop(); }
@@ -363,6 +364,7 @@ std::string Daemon::health_json() const {
       {"subscribers", hub_->subscriber_count()},
       {"deform", {{"threads", config_.deform_threads}, {"cpus", deform_cpus_}, {"spin_lead_us", config_.deform_spin_lead_us}}},
       {"publish_threads", publish_.count()},
+      {"subscriber_tcp_congestion", config_.subscriber_tcp_congestion},  // empty: the system's
       {"subject", {{"markers", subject_.model.marker_count()}, {"vertices", pipeline_->vertex_count()}}}};
   return health.dump();
 }

@@ -25,6 +25,7 @@
 #include <functional>
 #include <mutex>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 #include <sys/wait.h>
 #include <thread>
@@ -148,6 +149,13 @@ std::string file_text(const std::string& path) {
   return text.str();
 }
 
+std::string first_word(const std::string& text) {
+  std::istringstream in(text);
+  std::string word;
+  in >> word;
+  return word;
+}
+
 // Waits for the daemon's ports file; fails when the daemon exits first.
 nlohmann::json wait_for_ports(const std::string& path, pid_t pid, const std::string& log_path) {
   for (int i = 0; i < 300; ++i) {
@@ -214,6 +222,7 @@ int main(int argc, char** argv) {
   std::string recording = "replay_data/cmu/85_12.c3d", subject, vicon_subject_name, deform_cpus;
   int deform_spin_lead_us = -1;  // -1: the daemon's default
   int publish_threads = -1;      // -1: the daemon's default
+  std::optional<std::string> tcp_congestion;  // unset: the daemon's default
   bool json = false, normals = false, quantised = false;
   app.add_option("--seconds", seconds, "how long to measure")->check(CLI::Range(0.5, 3600.0))->capture_default_str();
   app.add_option("--subscribers", subscriber_count, "subscribers connected in-process, one thread each")->check(CLI::Range(1, 256))->capture_default_str();
@@ -224,6 +233,8 @@ int main(int argc, char** argv) {
   app.add_option("--deform-spin-lead-us", deform_spin_lead_us, "skinstreamd --deform-spin-lead-us (default: the daemon's)")
       ->check(CLI::Range(0, 1'000'000));
   app.add_option("--publish-threads", publish_threads, "skinstreamd --publish-threads (default: the daemon's)")->check(CLI::Range(0, 16));
+  app.add_option("--subscriber-tcp-congestion", tcp_congestion,
+                 "skinstreamd --subscriber-tcp-congestion (default: the daemon's, reno; \"\" = the system's)");
   app.add_option("--vicon-subject-name", vicon_subject_name, "subject name the replay announces (default: the recording's file name)");
   app.add_flag("--normals", normals, "subscribers ask for normals too");
   app.add_flag("--quantised", quantised, "subscribers ask for the quantised encoding (half the bytes)");
@@ -273,6 +284,7 @@ int main(int argc, char** argv) {
     if (!deform_cpus.empty()) daemon_args.insert(daemon_args.end(), {"--deform-cpus", deform_cpus});
     if (deform_spin_lead_us >= 0) daemon_args.insert(daemon_args.end(), {"--deform-spin-lead-us", std::to_string(deform_spin_lead_us)});
     if (publish_threads >= 0) daemon_args.insert(daemon_args.end(), {"--publish-threads", std::to_string(publish_threads)});
+    if (tcp_congestion) daemon_args.insert(daemon_args.end(), {"--subscriber-tcp-congestion", *tcp_congestion});
     pid = launch(daemon_args, log_path);
     const nlohmann::json ports = wait_for_ports(ports_path, pid, log_path);
     const int sub_port = ports.at("sub"), http_port = ports.at("http");
@@ -371,6 +383,9 @@ int main(int argc, char** argv) {
         {"deform_threads", deform_threads},
         {"deform", health["deform"]},  // as the daemon applied it: threads, CPUs pinned to, spin lead
         {"publish_threads", health["publish_threads"]},
+        // The daemon's subscriber connections ("" = the system's, given next).
+        {"subscriber_tcp_congestion", health["subscriber_tcp_congestion"]},
+        {"system_tcp_congestion", first_word(file_text("/proc/sys/net/ipv4/tcp_congestion_control"))},
         {"recording", recording},
         {"vertices", health["subject"]["vertices"]},
         {"markers", health["subject"]["markers"]},

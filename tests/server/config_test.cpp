@@ -100,6 +100,20 @@ TEST(Config, PublishThreadsComeFromFileAndFlags) {
   EXPECT_NE(error_of([] { parse({"--publish-threads", "17"}); }).find("publish_threads"), std::string::npos);
 }
 
+TEST(Config, SubscriberTcpCongestionComesFromFileAndFlags) {
+  EXPECT_EQ(DaemonConfig{}.subscriber_tcp_congestion, "reno");
+  const std::string path = write_file("congestion.json", R"({"subscriber_tcp_congestion": "cubic"})");
+  const auto from_file = parse({"--config", path});
+  ASSERT_TRUE(from_file);
+  EXPECT_EQ(from_file->config.subscriber_tcp_congestion, "cubic");
+  const auto system_default = parse({"--config", path, "--subscriber-tcp-congestion", ""});
+  ASSERT_TRUE(system_default);
+  EXPECT_EQ(system_default->config.subscriber_tcp_congestion, "");
+  for (const char* bad : {"Reno", "re no", "a_name_too_long_16"})
+    EXPECT_NE(error_of([&] { parse({"--subscriber-tcp-congestion", bad}); }).find("subscriber_tcp_congestion must be"), std::string::npos)
+        << bad;
+}
+
 TEST(Config, OutOfRangeValuesAndConflictsAreErrors) {
   EXPECT_NE(error_of([] { parse({"--deform-threads", "0"}); }).find("deform_threads"), std::string::npos);
   EXPECT_NE(error_of([] { parse({"--deform-cpus", "1;2"}); }).find("deform_cpus must be"), std::string::npos);
