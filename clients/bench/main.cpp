@@ -223,6 +223,7 @@ int main(int argc, char** argv) {
   int deform_spin_lead_us = -1;  // -1: the daemon's default
   int publish_threads = -1;      // -1: the daemon's default
   std::optional<std::string> tcp_congestion;  // unset: the daemon's default
+  std::string replay_tcp_congestion = server::ViconServerOptions{}.tcp_congestion;
   bool json = false, normals = false, quantised = false;
   app.add_option("--seconds", seconds, "how long to measure")->check(CLI::Range(0.5, 3600.0))->capture_default_str();
   app.add_option("--subscribers", subscriber_count, "subscribers connected in-process, one thread each")->check(CLI::Range(1, 256))->capture_default_str();
@@ -235,6 +236,9 @@ int main(int argc, char** argv) {
   app.add_option("--publish-threads", publish_threads, "skinstreamd --publish-threads (default: the daemon's)")->check(CLI::Range(0, 16));
   app.add_option("--subscriber-tcp-congestion", tcp_congestion,
                  "skinstreamd --subscriber-tcp-congestion (default: the daemon's, reno; \"\" = the system's)");
+  app.add_option("--replay-tcp-congestion", replay_tcp_congestion,
+                 "TCP congestion control of the replay server's connection to the daemon (\"\" = the system's)")
+      ->capture_default_str();
   app.add_option("--vicon-subject-name", vicon_subject_name, "subject name the replay announces (default: the recording's file name)");
   app.add_flag("--normals", normals, "subscribers ask for normals too");
   app.add_flag("--quantised", quantised, "subscribers ask for the quantised encoding (half the bytes)");
@@ -263,6 +267,7 @@ int main(int argc, char** argv) {
     replay_options.bind_address = "127.0.0.1";
     replay_options.port = 0;
     replay_options.loop = true;
+    replay_options.tcp_congestion = replay_tcp_congestion;
     replay_options.subject_name = vicon_subject_name.empty() ? fs::path(recording).stem().string() : vicon_subject_name;
     server::ViconServer replay(replay_io, capture, replay_options);
     SendTimes send_times;
@@ -385,6 +390,7 @@ int main(int argc, char** argv) {
         {"publish_threads", health["publish_threads"]},
         // The daemon's subscriber connections ("" = the system's, given next).
         {"subscriber_tcp_congestion", health["subscriber_tcp_congestion"]},
+        {"replay_tcp_congestion", replay_tcp_congestion},
         {"system_tcp_congestion", first_word(file_text("/proc/sys/net/ipv4/tcp_congestion_control"))},
         {"recording", recording},
         {"vertices", health["subject"]["vertices"]},

@@ -20,6 +20,7 @@
 #include "protocol/capture_file.h"
 #include "protocol/file_error.h"
 #include "server/asio.h"
+#include "server/tcp_congestion.h"
 #include "server/vicon/vicon_server.h"
 
 namespace {
@@ -39,6 +40,7 @@ struct Arguments {
   std::string multicast;
   int multicast_ttl = 1;
   int max_queued = 4;
+  std::string tcp_congestion = "reno";
 };
 
 // "239.1.2.3:44801" or "239.1.2.3" -> address and port.
@@ -65,6 +67,7 @@ int run(const Arguments& args) {
   options.start_on_first_request = !args.start_now;
   options.max_queued_frames = static_cast<size_t>(args.max_queued);
   options.multicast_ttl = args.multicast_ttl;
+  options.tcp_congestion = args.tcp_congestion;
 
   server::asio::io_context io;
   server::ViconServer vicon_server(io, capture, options);
@@ -139,6 +142,13 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--max-queued", args.max_queued, "frames queued per client before the oldest is dropped")
       ->check(CLI::Range(1, 1000))
+      ->capture_default_str();
+  app.add_option("--tcp-congestion", args.tcp_congestion,
+                 "TCP congestion control of client connections (\"\" = the system's; reno does not pace a frame out)")
+      ->check([](const std::string& name) {
+        return name.empty() || skinstream::server::is_tcp_congestion_name(name) ? std::string()
+                                                                               : "not a congestion control name: " + name;
+      })
       ->capture_default_str();
   app.footer(
       "The recording starts when the first client asks for a frame (RequestFrame), unless --start-now.\n"

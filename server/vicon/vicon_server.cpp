@@ -13,6 +13,7 @@
 #include "protocol/vicon_packet_framer.h"
 #include "protocol/vicon_packet_reader.h"
 #include "protocol/vicon_packet_writer.h"
+#include "server/tcp_congestion.h"
 
 namespace skinstream::server {
 namespace {
@@ -75,6 +76,7 @@ struct ViconServer::State : std::enable_shared_from_this<ViconServer::State> {
   bool running = false;
   bool timeline_started = false;
   bool done = false;
+  bool congestion_refused = false;  // said once
   Clock::time_point timeline_start;
   uint64_t next_sequence = 0;      // k of the next frame to produce
   uint64_t latest_sequence = 0;    // k of the newest produced frame (valid when produced > 0)
@@ -280,6 +282,14 @@ struct ViconServer::State : std::enable_shared_from_this<ViconServer::State> {
         socket.set_option(tcp::no_delay(true), ignored);
         if (self->options.socket_send_buffer_bytes > 0)
           socket.set_option(asio::socket_base::send_buffer_size(self->options.socket_send_buffer_bytes), ignored);
+        if (!self->options.tcp_congestion.empty()) {
+          const std::string problem = set_tcp_congestion(socket.native_handle(), self->options.tcp_congestion);
+          if (!problem.empty() && !self->congestion_refused) {
+            self->congestion_refused = true;
+            spdlog::warn("vicon server: cannot use TCP congestion control \"{}\": {}; clients keep the system's (said once)",
+                         self->options.tcp_congestion, problem);
+          }
+        }
         auto session = std::make_shared<Session>(*self, std::move(socket));
         self->sessions.push_back(session);
         ++self->stats.clients_accepted;

@@ -45,6 +45,9 @@ struct ViconServerOptions {
   bool start_on_first_request = true;
   size_t max_queued_frames = 4;     // per client, frames waiting behind the one being written
   int socket_send_buffer_bytes = 0;  // SO_SNDBUF per client; 0: the system's default
+  // TCP congestion control per client; empty: the system's. Reno, because BBR (the default on
+  // some hosts) paces each frame's packet out instead of sending it at once (server/tcp_congestion.h).
+  std::string tcp_congestion = "reno";
   int multicast_ttl = 1;
 };
 

@@ -29,8 +29,9 @@ if(TARGET skinstreamd AND TARGET skinstream-sub AND TARGET skinstream-replay)
   add_test(NAME sub.without_address COMMAND skinstream-sub)
   add_test(NAME sub.bad_address COMMAND skinstream-sub nohost)
   add_test(NAME daemon.deform_cpus_twice COMMAND skinstreamd --deform-cpus 1,1 --print-config)
+  add_test(NAME daemon.bad_tcp_congestion_name COMMAND skinstreamd --subscriber-tcp-congestion "Not A Name" --print-config)
   set_tests_properties(daemon.unknown_flag daemon.without_subject daemon.vicon_without_port sub.without_address sub.bad_address
-    daemon.deform_cpus_twice PROPERTIES WILL_FAIL TRUE LABELS clients)
+    daemon.deform_cpus_twice daemon.bad_tcp_congestion_name PROPERTIES WILL_FAIL TRUE LABELS clients)
   # A CPU the process may not use is refused at start with the reason (a daemon that started
   # anyway would run until the timeout and fail this).
   add_test(NAME daemon.deform_cpu_not_allowed COMMAND skinstreamd --subject ${CMAKE_BINARY_DIR}/demo/subject.sksubj

@@ -47,10 +47,12 @@ add_test(NAME replay.port_message COMMAND skinstream-replay ${replay_capture} --
 set_tests_properties(replay.port_message PROPERTIES PASS_REGULAR_EXPRESSION "--port")
 add_test(NAME replay.bad_speed COMMAND skinstream-replay ${replay_capture} --port 0 --speed 0)
 add_test(NAME replay.loop_and_hold COMMAND skinstream-replay ${replay_capture} --port 0 --loop --hold)
+add_test(NAME replay.bad_tcp_congestion COMMAND skinstream-replay ${replay_capture} --port 0 --tcp-congestion "Not A Name")
+set_tests_properties(replay.bad_tcp_congestion PROPERTIES PASS_REGULAR_EXPRESSION "not a congestion control name")
 
 set_tests_properties(replay.missing_file replay.truncated_file replay.port_out_of_range replay.port_not_a_number
   replay.bad_speed replay.loop_and_hold PROPERTIES WILL_FAIL TRUE)
 set_tests_properties(replay.help replay.plays_to_the_end replay.prints_port_json replay.serves_a_tcp_client
   replay.missing_file replay.missing_file_message replay.truncated_file replay.truncated_file_message
   replay.port_out_of_range replay.port_not_a_number replay.port_message replay.bad_speed replay.loop_and_hold
-  PROPERTIES LABELS clients)
+  replay.bad_tcp_congestion PROPERTIES LABELS clients)

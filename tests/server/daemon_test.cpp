@@ -4,14 +4,10 @@
 // fill of the same take frame by frame.
 #include "server/daemon.h"
 
-#include <arpa/inet.h>
 #include <gtest/gtest.h>
-#include <sys/socket.h>
 #include <unistd.h>
 
 #include <nlohmann/json.hpp>
-#include <filesystem>
-#include <fstream>
 #include <set>
 #include <thread>
 
@@ -23,6 +19,7 @@
 #include "server/client/subscriber_client.h"
 #include "server/publish/subscriber_hub.h"
 #include "server/tcp_congestion.h"
+#include "support/socket_lookup.h"
 #include "support/test_data.h"
 #include "support/thread_names.h"
 
@@ -435,28 +432,6 @@ TEST(Daemon, ServesHealthMetricsWebSocketAndSubscribersWithoutHello) {
   daemon.stop();
 }
 
-// This process's end of a loopback connection whose other end is `client` (the daemon's side,
-// since the daemon runs in-process): found by its addresses among /proc/self/fd. -1 if none.
-int daemon_side_of(const tcp::socket& client) {
-  const tcp::endpoint local = client.local_endpoint(), remote = client.remote_endpoint();
-  for (const auto& entry : std::filesystem::directory_iterator("/proc/self/fd")) {
-    const int fd = std::stoi(entry.path().filename().string());
-    sockaddr_in own{}, peer{};
-    socklen_t own_length = sizeof own, peer_length = sizeof peer;
-    if (::getsockname(fd, reinterpret_cast<sockaddr*>(&own), &own_length) != 0 || own.sin_family != AF_INET) continue;
-    if (::getpeername(fd, reinterpret_cast<sockaddr*>(&peer), &peer_length) != 0) continue;
-    if (ntohs(own.sin_port) == remote.port() && ntohs(peer.sin_port) == local.port()) return fd;
-  }
-  return -1;
-}
-
-std::string system_congestion() {
-  std::ifstream in("/proc/sys/net/ipv4/tcp_congestion_control");
-  std::string name;
-  in >> name;
-  return name;
-}
-
 // The congestion control the daemon gave a TCP subscriber and a WebSocket subscriber, each
 // read once the daemon has sent it something (so it was accepted and set up).
 std::pair<std::string, std::string> subscriber_congestion(const Daemon& daemon) {
@@ -474,7 +449,7 @@ std::pair<std::string, std::string> subscriber_congestion(const Daemon& daemon) 
   websocket::stream<beast::tcp_stream> ws(io);
   beast::get_lowest_layer(ws).connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), static_cast<unsigned short>(daemon.http_port())));
   ws.handshake("127.0.0.1", "/stream");
-  const int sub_fd = daemon_side_of(sub), ws_fd = daemon_side_of(beast::get_lowest_layer(ws).socket());
+  const int sub_fd = test::server_side_of(sub), ws_fd = test::server_side_of(beast::get_lowest_layer(ws).socket());
   EXPECT_GE(sub_fd, 0);
   EXPECT_GE(ws_fd, 0);
   return {tcp_congestion_of(sub_fd), tcp_congestion_of(ws_fd)};
@@ -492,7 +467,7 @@ TEST(Daemon, SubscriberConnectionsGetTheConfiguredCongestionControl) {
   config.subscriber_tcp_congestion = "";  // the system's
   Daemon daemon(config);
   daemon.start();
-  EXPECT_EQ(subscriber_congestion(daemon), std::make_pair(system_congestion(), system_congestion()));
+  EXPECT_EQ(subscriber_congestion(daemon), std::make_pair(test::system_tcp_congestion(), test::system_tcp_congestion()));
   daemon.stop();
 }
 
@@ -502,7 +477,7 @@ TEST(Daemon, RefusedCongestionControlStillServesEverySubscriber) {
   Daemon daemon(config);
   daemon.start();
   // Frames still reach both kinds of subscriber, on the system's congestion control.
-  EXPECT_EQ(subscriber_congestion(daemon), std::make_pair(system_congestion(), system_congestion()));
+  EXPECT_EQ(subscriber_congestion(daemon), std::make_pair(test::system_tcp_congestion(), test::system_tcp_congestion()));
   daemon.stop();
 }
 

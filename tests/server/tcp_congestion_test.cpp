@@ -3,9 +3,8 @@
 
 #include <gtest/gtest.h>
 
-#include <fstream>
-
 #include "server/asio.h"
+#include "support/socket_lookup.h"
 
 namespace skinstream::server {
 namespace {
@@ -20,17 +19,10 @@ struct LoopbackPair {
   }
 };
 
-std::string system_congestion() {
-  std::ifstream in("/proc/sys/net/ipv4/tcp_congestion_control");
-  std::string name;
-  in >> name;
-  return name;
-}
-
 TEST(TcpCongestion, RenoIsSetAndReadBack) {
   LoopbackPair pair;
   const std::string before = tcp_congestion_of(pair.server.native_handle());
-  EXPECT_EQ(before, system_congestion());  // what a new socket gets
+  EXPECT_EQ(before, test::system_tcp_congestion());  // what a new socket gets
   EXPECT_EQ(set_tcp_congestion(pair.server.native_handle(), "reno"), "");
   EXPECT_EQ(tcp_congestion_of(pair.server.native_handle()), "reno");
   // Still a working connection.

@@ -18,8 +18,10 @@
 #include "server/asio.h"
 #include "server/ingest/vicon_multicast_source.h"
 #include "server/ingest/vicon_source.h"
+#include "server/tcp_congestion.h"
 #include "server/vicon/vicon_server.h"
 #include "support/allocation_counter.h"
+#include "support/socket_lookup.h"
 #include "support/test_data.h"
 
 namespace skinstream::server {
@@ -348,6 +350,32 @@ tcp::socket stalled_client(asio::io_context& io, uint16_t port) {
   const auto request = vicon::encode_packet(vicon::RequestFrame{true});
   asio::write(socket, asio::buffer(request));
   return socket;
+}
+
+// The congestion control the server gave a raw client's connection, read once the server has
+// sent it something (the ObjectEnums that opens every connection).
+std::string server_congestion(const ViconServerOptions& options) {
+  const Capture capture = synthetic_capture();
+  Loopback net;
+  net.start_server(capture, options);
+  asio::io_context raw_io;
+  tcp::socket client(raw_io);
+  client.connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), net.port));
+  std::array<unsigned char, 64> first;
+  client.read_some(asio::buffer(first));
+  const int fd = test::server_side_of(client);
+  EXPECT_GE(fd, 0);
+  return tcp_congestion_of(fd);
+}
+
+TEST(ViconStream, ClientConnectionsGetTheConfiguredCongestionControl) {
+  ViconServerOptions options = fast_options(1.0);
+  EXPECT_EQ(options.tcp_congestion, "reno");
+  EXPECT_EQ(server_congestion(options), "reno");
+  options.tcp_congestion = "";
+  EXPECT_EQ(server_congestion(options), test::system_tcp_congestion());
+  options.tcp_congestion = "no_such_cc";  // refused by the kernel: said once, the connection still served
+  EXPECT_EQ(server_congestion(options), test::system_tcp_congestion());
 }
 
 TEST(ViconStream, StalledClientDoesNotStopAnother) {
