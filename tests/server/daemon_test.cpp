@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <thread>
@@ -281,14 +282,15 @@ TEST(Daemon, NamesItsThreads) {
   config.publish_threads = 2;
   Daemon daemon(config);
   daemon.start_serving();
+  const char* const expected[] = {"io", "pipeline", "publish-0", "publish-1"};
   std::multiset<std::string> names;
-  // Each thread names itself once it runs.
+  // Each thread names itself once it runs, in no set order: wait for all of them.
   wait_until([&] {
     names = test::process_thread_names();
-    return names.count("io") == 1 && names.count("pipeline") == 1 && names.count("publish-1") == 1;
+    return std::all_of(std::begin(expected), std::end(expected), [&](const char* name) { return names.count(name) == 1; });
   });
   daemon.stop();
-  for (const char* expected : {"io", "pipeline", "publish-0", "publish-1"}) EXPECT_EQ(names.count(expected), 1u) << expected;
+  for (const char* name : expected) EXPECT_EQ(names.count(name), 1u) << name;
 }
 
 // Reads a raw subscriber socket, decoding Frames, until `deadline` or until `enough` frames
