@@ -40,7 +40,7 @@ struct Arguments {
   std::string multicast;
   int multicast_ttl = 1;
   int max_queued = 4;
-  std::string tcp_congestion = "reno";
+  std::string tcp_congestion;  // the system's
 };
 
 // "239.1.2.3:44801" or "239.1.2.3" -> address and port.
@@ -144,7 +144,7 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1, 1000))
       ->capture_default_str();
   app.add_option("--tcp-congestion", args.tcp_congestion,
-                 "TCP congestion control of client connections (\"\" = the system's; reno does not pace a frame out)")
+                 "TCP congestion control of client connections, e.g. reno (default: the system's)")
       ->check([](const std::string& name) {
         return name.empty() || skinstream::server::is_tcp_congestion_name(name) ? std::string()
                                                                                : "not a congestion control name: " + name;

@@ -45,9 +45,10 @@ struct ViconServerOptions {
   bool start_on_first_request = true;
   size_t max_queued_frames = 4;     // per client, frames waiting behind the one being written
   int socket_send_buffer_bytes = 0;  // SO_SNDBUF per client; 0: the system's default
-  // TCP congestion control per client; empty: the system's. Reno, because BBR (the default on
-  // some hosts) paces each frame's packet out instead of sending it at once (server/tcp_congestion.h).
-  std::string tcp_congestion = "reno";
+  // TCP congestion control per client (server/tcp_congestion.h); empty: the system's. Not reno
+  // by default as for the daemon's subscribers: a frame of 350 markers is small enough to leave
+  // at once even under BBR, and reno measured no different here (README).
+  std::string tcp_congestion;
   int multicast_ttl = 1;
 };
 
