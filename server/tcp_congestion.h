@@ -1,8 +1,9 @@
 #pragma once
 // The TCP congestion control of one socket (Linux TCP_CONGESTION). Why the daemon sets it on
 // the sockets it publishes frames on: under BBR, the default on some hosts, Linux paces every
-// send, so a 640 kB frame leaves over a third of a millisecond or more instead of at once, and
-// on loopback the four subscribers' deliveries took twice as long (measured in the README).
+// send, so a 640 kB frame leaves over up to a third of a millisecond of pacing timers instead
+// of at once, and on loopback the four subscribers' deliveries took twice as long (measured in
+// the README).
 // Reno and CUBIC do not pace; reno is the one any process may choose (CAP_NET_ADMIN is needed
 // for those not in /proc/sys/net/ipv4/tcp_allowed_congestion_control).
 
