@@ -87,6 +87,8 @@ std::string Metrics::render_prometheus(const std::vector<SubscriberMetrics>& sub
     for (const auto& [category, count] : bad_input_)
       out += "skinstream_bad_input_total{category=\"" + label_value(category) + "\"} " + std::to_string(count) + "\n";
   }
+  receive_to_take.render(out, "receive_to_take_seconds",
+                         "From frame received to taken by the pipeline thread (the wait and the thread's wake-up).");
   fill.render(out, "fill_seconds", "Gap filler time per frame.");
   deform.render(out, "deform_seconds", "Mesh deformation time per frame (parts and vertices).");
   normals.render(out, "normals_seconds", "Normal computation time per frame.");

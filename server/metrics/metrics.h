@@ -54,7 +54,8 @@ class Metrics {
   std::atomic<uint64_t> frame_buffers_allocated{0};              // every encoded frame buffer made
   std::atomic<uint64_t> frame_buffers_allocated_by_pipeline{0};  // of those, made on the 120 Hz thread (none prepared)
 
-  LatencyHistogram fill, deform, normals, encode, receive_to_publish;
+  // receive_to_take: waiting in the mailbox, the pipeline thread's wake-up included.
+  LatencyHistogram receive_to_take, fill, deform, normals, encode, receive_to_publish;
 
   void count_bad_input(std::string_view category);
   uint64_t bad_input(std::string_view category) const;

@@ -78,6 +78,7 @@ void Pipeline::run() {
     uint64_t generation = 0;
     const MarkerFrame* frame = mailbox_.take(std::chrono::milliseconds(100), generation);
     if (!frame) continue;
+    if (frame->receive_time_ns > 0) metrics_.receive_to_take.observe_ns(wall_clock_ns() - frame->receive_time_ns);
     try {
       process(*frame, generation);
     } catch (const std::exception& e) {

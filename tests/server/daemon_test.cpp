@@ -425,7 +425,7 @@ TEST(Daemon, ServesHealthMetricsWebSocketAndSubscribersWithoutHello) {
   EXPECT_EQ(status, 200);
   for (const char* name : {"skinstream_frames_received_total ", "skinstream_frames_published_total ", "skinstream_frames_dropped_total ",
                            "skinstream_frames_dropped_mailbox_full_total ", "skinstream_markers_filled_total ", "skinstream_fill_seconds_bucket{le=\"+Inf\"}",
-                           "skinstream_encode_seconds_count", "skinstream_bad_subscriber_messages_total 1"})
+                           "skinstream_encode_seconds_count", "skinstream_receive_to_take_seconds_count", "skinstream_bad_subscriber_messages_total 1"})
     EXPECT_NE(metrics.find(name), std::string::npos) << name;
   http_get(daemon.http_port(), "/nothing-here", &status);
   EXPECT_EQ(status, 404);
