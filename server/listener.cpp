@@ -4,13 +4,12 @@
 
 #include <stdexcept>
 
-#include "server/tcp_congestion.h"
-
 namespace skinstream::server {
 
 Listener::Listener(asio::io_context& io, const std::string& address, int port, std::string name, Accept on_accept,
                    std::string tcp_congestion)
-    : io_(io), acceptor_(io), name_(std::move(name)), on_accept_(std::move(on_accept)), tcp_congestion_(std::move(tcp_congestion)) {
+    : io_(io), acceptor_(io), name_(std::move(name)), on_accept_(std::move(on_accept)),
+      congestion_(name_, std::move(tcp_congestion)) {
   boost::system::error_code ec;
   const auto ip = asio::ip::make_address(address, ec);
   if (ec) throw std::runtime_error(name_ + ": bad listen address \"" + address + "\"");
@@ -43,14 +42,7 @@ void Listener::accept_next() {
     } else {
       boost::system::error_code ignored;
       socket.set_option(tcp::no_delay(true), ignored);
-      if (!tcp_congestion_.empty()) {
-        const std::string problem = set_tcp_congestion(socket.native_handle(), tcp_congestion_);
-        if (!problem.empty() && !congestion_refused_) {
-          congestion_refused_ = true;
-          spdlog::warn("{}: cannot use TCP congestion control \"{}\": {}; connections keep the system's (said once)", name_,
-                       tcp_congestion_, problem);
-        }
-      }
+      congestion_.apply(socket.native_handle());
       on_accept_(std::move(socket));
     }
     accept_next();

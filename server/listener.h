@@ -9,6 +9,7 @@
 #include <string>
 
 #include "server/asio.h"
+#include "server/tcp_congestion.h"
 
 namespace skinstream::server {
 
@@ -28,8 +29,7 @@ class Listener {
   tcp::acceptor acceptor_;
   std::string name_;
   Accept on_accept_;
-  std::string tcp_congestion_;  // empty: the system's
-  bool congestion_refused_ = false;  // said once
+  AcceptedSocketCongestion congestion_;
   int port_ = 0;
 };
 

@@ -4,8 +4,11 @@
 #include <netinet/tcp.h>
 #include <sys/socket.h>
 
+#include <spdlog/spdlog.h>
+
 #include <cerrno>
 #include <cstring>
+#include <fstream>
 
 namespace skinstream::server {
 
@@ -33,6 +36,22 @@ bool is_tcp_congestion_name(const std::string& algorithm) {
   for (const char c : algorithm)
     if (!((c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_' || c == '-')) return false;
   return true;
+}
+
+std::string system_tcp_congestion() {
+  std::ifstream in("/proc/sys/net/ipv4/tcp_congestion_control");
+  std::string name;
+  in >> name;
+  return name;
+}
+
+void AcceptedSocketCongestion::apply(int socket_handle) {
+  if (algorithm_.empty()) return;
+  const std::string problem = set_tcp_congestion(socket_handle, algorithm_);
+  if (problem.empty() || refusal_said_) return;
+  refusal_said_ = true;
+  spdlog::warn("{}: cannot use TCP congestion control \"{}\": {}; connections keep the system's (said once)", who_, algorithm_,
+               problem);
 }
 
 }  // namespace skinstream::server

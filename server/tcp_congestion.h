@@ -21,4 +21,21 @@ std::string tcp_congestion_of(int socket_handle);
 // The name is one Linux could know: 1-15 characters of a-z, 0-9, '_' and '-'.
 bool is_tcp_congestion_name(const std::string& algorithm);
 
+// What new TCP sockets get on this machine (/proc/sys/net/ipv4/tcp_congestion_control); empty
+// when it cannot be read.
+std::string system_tcp_congestion();
+
+// For a server's accept handler (one thread): sets `algorithm` on every accepted socket, and the
+// first time the kernel refuses it logs why, naming `who`; the sockets then keep the system's.
+// An empty algorithm does nothing.
+class AcceptedSocketCongestion {
+ public:
+  AcceptedSocketCongestion(std::string who, std::string algorithm) : who_(std::move(who)), algorithm_(std::move(algorithm)) {}
+  void apply(int socket_handle);
+
+ private:
+  std::string who_, algorithm_;
+  bool refusal_said_ = false;
+};
+
 }  // namespace skinstream::server

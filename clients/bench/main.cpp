@@ -35,6 +35,7 @@
 #include "protocol/capture_file.h"
 #include "protocol/file_error.h"
 #include "server/client/subscriber_client.h"
+#include "server/tcp_congestion.h"
 #include "server/vicon/vicon_server.h"
 
 namespace {
@@ -147,13 +148,6 @@ std::string file_text(const std::string& path) {
   std::stringstream text;
   text << in.rdbuf();
   return text.str();
-}
-
-std::string first_word(const std::string& text) {
-  std::istringstream in(text);
-  std::string word;
-  in >> word;
-  return word;
 }
 
 // Waits for the daemon's ports file; fails when the daemon exits first.
@@ -391,7 +385,7 @@ int main(int argc, char** argv) {
         // The daemon's subscriber connections ("" = the system's, given next).
         {"subscriber_tcp_congestion", health["subscriber_tcp_congestion"]},
         {"replay_tcp_congestion", replay_tcp_congestion},
-        {"system_tcp_congestion", first_word(file_text("/proc/sys/net/ipv4/tcp_congestion_control"))},
+        {"system_tcp_congestion", server::system_tcp_congestion()},
         {"recording", recording},
         {"vertices", health["subject"]["vertices"]},
         {"markers", health["subject"]["markers"]},

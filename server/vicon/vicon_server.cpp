@@ -56,6 +56,7 @@ struct ViconServer::State : std::enable_shared_from_this<ViconServer::State> {
       : io(io_context),
         capture(capture_in),
         options(std::move(opts)),
+        congestion("vicon server", options.tcp_congestion),
         encoder(capture, options.subject_name, options.rate_hz),
         acceptor(io),
         timer(io),
@@ -64,6 +65,7 @@ struct ViconServer::State : std::enable_shared_from_this<ViconServer::State> {
   asio::io_context& io;
   const Capture& capture;
   ViconServerOptions options;
+  AcceptedSocketCongestion congestion;  // options.tcp_congestion on each client
   vicon::CaptureFrameEncoder encoder;
   vicon::PacketWriter writer;
   tcp::acceptor acceptor;
@@ -76,7 +78,6 @@ struct ViconServer::State : std::enable_shared_from_this<ViconServer::State> {
   bool running = false;
   bool timeline_started = false;
   bool done = false;
-  bool congestion_refused = false;  // said once
   Clock::time_point timeline_start;
   uint64_t next_sequence = 0;      // k of the next frame to produce
   uint64_t latest_sequence = 0;    // k of the newest produced frame (valid when produced > 0)
@@ -282,14 +283,7 @@ struct ViconServer::State : std::enable_shared_from_this<ViconServer::State> {
         socket.set_option(tcp::no_delay(true), ignored);
         if (self->options.socket_send_buffer_bytes > 0)
           socket.set_option(asio::socket_base::send_buffer_size(self->options.socket_send_buffer_bytes), ignored);
-        if (!self->options.tcp_congestion.empty()) {
-          const std::string problem = set_tcp_congestion(socket.native_handle(), self->options.tcp_congestion);
-          if (!problem.empty() && !self->congestion_refused) {
-            self->congestion_refused = true;
-            spdlog::warn("vicon server: cannot use TCP congestion control \"{}\": {}; clients keep the system's (said once)",
-                         self->options.tcp_congestion, problem);
-          }
-        }
+        self->congestion.apply(socket.native_handle());
         auto session = std::make_shared<Session>(*self, std::move(socket));
         self->sessions.push_back(session);
         ++self->stats.clients_accepted;

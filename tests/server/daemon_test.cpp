@@ -469,7 +469,7 @@ TEST(Daemon, SubscriberConnectionsGetTheConfiguredCongestionControl) {
   config.subscriber_tcp_congestion = "";  // the system's
   Daemon daemon(config);
   daemon.start();
-  EXPECT_EQ(subscriber_congestion(daemon), std::make_pair(test::system_tcp_congestion(), test::system_tcp_congestion()));
+  EXPECT_EQ(subscriber_congestion(daemon), std::make_pair(system_tcp_congestion(), system_tcp_congestion()));
   daemon.stop();
 }
 
@@ -479,7 +479,7 @@ TEST(Daemon, RefusedCongestionControlStillServesEverySubscriber) {
   Daemon daemon(config);
   daemon.start();
   // Frames still reach both kinds of subscriber, on the system's congestion control.
-  EXPECT_EQ(subscriber_congestion(daemon), std::make_pair(test::system_tcp_congestion(), test::system_tcp_congestion()));
+  EXPECT_EQ(subscriber_congestion(daemon), std::make_pair(system_tcp_congestion(), system_tcp_congestion()));
   daemon.stop();
 }
 

@@ -4,7 +4,6 @@
 #include <gtest/gtest.h>
 
 #include "server/asio.h"
-#include "support/socket_lookup.h"
 
 namespace skinstream::server {
 namespace {
@@ -22,7 +21,7 @@ struct LoopbackPair {
 TEST(TcpCongestion, RenoIsSetAndReadBack) {
   LoopbackPair pair;
   const std::string before = tcp_congestion_of(pair.server.native_handle());
-  EXPECT_EQ(before, test::system_tcp_congestion());  // what a new socket gets
+  EXPECT_EQ(before, system_tcp_congestion());  // what a new socket gets
   EXPECT_EQ(set_tcp_congestion(pair.server.native_handle(), "reno"), "");
   EXPECT_EQ(tcp_congestion_of(pair.server.native_handle()), "reno");
   // Still a working connection.

@@ -6,7 +6,6 @@
 #include <sys/socket.h>
 
 #include <filesystem>
-#include <fstream>
 #include <string>
 
 #include "server/asio.h"
@@ -25,14 +24,6 @@ inline int server_side_of(const server::tcp::socket& client) {
     if (ntohs(own.sin_port) == remote.port() && ntohs(peer.sin_port) == local.port()) return fd;
   }
   return -1;
-}
-
-// The congestion control new TCP sockets get on this machine.
-inline std::string system_tcp_congestion() {
-  std::ifstream in("/proc/sys/net/ipv4/tcp_congestion_control");
-  std::string name;
-  in >> name;
-  return name;
 }
 
 }  // namespace skinstream::test

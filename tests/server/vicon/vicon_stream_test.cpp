@@ -371,11 +371,11 @@ std::string server_congestion(const ViconServerOptions& options) {
 TEST(ViconStream, ClientConnectionsGetTheConfiguredCongestionControl) {
   ViconServerOptions options = fast_options(1.0);
   EXPECT_EQ(options.tcp_congestion, "");  // the system's
-  EXPECT_EQ(server_congestion(options), test::system_tcp_congestion());
+  EXPECT_EQ(server_congestion(options), system_tcp_congestion());
   options.tcp_congestion = "reno";
   EXPECT_EQ(server_congestion(options), "reno");
   options.tcp_congestion = "no_such_cc";  // refused by the kernel: said once, the connection still served
-  EXPECT_EQ(server_congestion(options), test::system_tcp_congestion());
+  EXPECT_EQ(server_congestion(options), system_tcp_congestion());
 }
 
 TEST(ViconStream, StalledClientDoesNotStopAnother) {
