@@ -96,6 +96,39 @@ std::vector<char> covered_vertices(const DeformationModel& model, const SubjectM
   return covered;
 }
 
+// Where a method's maximum comes from: the covered vertices with the largest error over the take,
+// with how far each lies from the nearest marker in the reference pose (a crease no marker reaches
+// shows here) and, for the part-based methods, the parts that move it (beta_{j,p}).
+nlohmann::ordered_json worst_vertices(const std::vector<double>& peak_error, const std::vector<int>& peak_frame,
+                                      const std::vector<char>& covered, const DeformationModel& model,
+                                      const SubjectModel& subject, bool with_parts, int count) {
+  std::vector<int> order;
+  for (int v = 0; v < static_cast<int>(covered.size()); ++v)
+    if (covered[v]) order.push_back(v);
+  count = std::min<int>(count, static_cast<int>(order.size()));
+  std::partial_sort(order.begin(), order.begin() + count, order.end(),
+                    [&](int a, int b) { return peak_error[a] > peak_error[b]; });
+  nlohmann::ordered_json out = nlohmann::ordered_json::array();
+  for (int i = 0; i < count; ++i) {
+    const int v = order[i];
+    const Vec3& at = model.reference_vertices[v];
+    double nearest = std::numeric_limits<double>::infinity();
+    for (const Vec3& m : subject.reference_positions) nearest = std::min(nearest, (m - at).norm());
+    nlohmann::ordered_json row = {{"vertex", v},
+                                  {"error_mm", peak_error[v]},
+                                  {"frame", peak_frame[v]},
+                                  {"reference_mm", {at.x(), at.y(), at.z()}},
+                                  {"nearest_marker_mm", nearest}};
+    if (with_parts) {
+      row["parts"] = nlohmann::ordered_json::array();
+      for (int k = model.vertex_influence_offsets[v]; k < model.vertex_influence_offsets[v + 1]; ++k)
+        row["parts"].push_back({{"part", model.vertex_influences[k].part}, {"weight", model.vertex_influences[k].weight}});
+    }
+    out.push_back(row);
+  }
+  return out;
+}
+
 std::vector<Vec3> markers_in_subject_order(const SynthCapture& take, const std::vector<int>& subject_to_truth, int frame) {
   std::vector<Vec3> markers(subject_to_truth.size());
   for (size_t i = 0; i < markers.size(); ++i) markers[i] = take.truth.at(frame, subject_to_truth[i]);
@@ -177,6 +210,9 @@ nlohmann::ordered_json evaluate_deformation(const DeformationSetup& setup, const
   for (char c : covered) covered_count += c;
   std::vector<std::vector<double>> vertex_errors(method_count), all_vertex_errors(method_count), marker_errors(method_count);
   std::vector<double> seconds(method_count, 0.0);
+  // Per method and vertex: its largest error over the take, and the frame.
+  std::vector<std::vector<double>> peak_error(method_count, std::vector<double>(vertices, 0.0));
+  std::vector<std::vector<int>> peak_frame(method_count, std::vector<int>(vertices, 0));
   std::vector<float> positions(static_cast<size_t>(vertices) * 3);
   int frames = 0;
   for (int f = 0; f < take.frame_count(); f += options.frame_stride, ++frames) {
@@ -195,6 +231,7 @@ nlohmann::ordered_json evaluate_deformation(const DeformationSetup& setup, const
         const double e = (vertex_at(positions, v) - truth[v]).norm();
         all_vertex_errors[k].push_back(e);
         if (covered[v]) vertex_errors[k].push_back(e);
+        if (e > peak_error[k][v]) peak_error[k][v] = e, peak_frame[k][v] = f;
       }
       for (size_t i = 0; i < sites.size(); ++i)
         marker_errors[k].push_back((site_position(positions, model.faces, sites[i]) - markers[i]).norm());
@@ -258,7 +295,9 @@ nlohmann::ordered_json evaluate_deformation(const DeformationSetup& setup, const
                     {"all_vertex_max_mm", all.max},
                     {"marker_mean_mm", m.mean},
                     {"marker_max_mm", m.max},
-                    {"ms_per_frame_single_thread", 1000.0 * seconds[k] / frames}});
+                    {"ms_per_frame_single_thread", 1000.0 * seconds[k] / frames},
+                    {"worst_vertices", worst_vertices(peak_error[k], peak_frame[k], covered, model, setup.subject,
+                                                      !kMethods[k].conventional, 3)}});
   }
   return {{"motion", motion},
           {"frames_evaluated", frames},

@@ -149,6 +149,41 @@ TEST(SkinstreamCli, SynthStatsOnAShortFlexTakeMeetTheRelabelAndFillTargets) {
   EXPECT_LE(s["deleted_then_filled_error"]["normalised"]["mean"].get<double>(), 0.015);
 }
 
+// eval-deform names where each method's maximum comes from: its worst covered vertices, the
+// first of which carries the row's maximum, with the frame, the distance to the nearest marker
+// and (part-based methods only) the vertex's part weights.
+TEST(SkinstreamCli, EvalDeformNamesTheVerticesBehindEachMaximum) {
+  const ProgramRun r = run("eval-deform --motions breathe --seconds 0.5 --train-seconds 5 --json --body " +
+                           std::string(SKINSTREAM_SHARED_DIR) + "/data/meshes/makehuman");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto j = nlohmann::json::parse(r.output);
+  const auto& take = j["takes"][0];
+  const int vertices = j["vertices"], frames = take["frames_evaluated"].get<int>() * 4;  // stride 4
+  ASSERT_EQ(take["methods"].size(), 5u);
+  for (const auto& method : take["methods"]) {
+    SCOPED_TRACE(method["method"].get<std::string>());
+    const auto& worst = method["worst_vertices"];
+    ASSERT_EQ(worst.size(), 3u);
+    EXPECT_DOUBLE_EQ(worst[0]["error_mm"].get<double>(), method["vertex_max_mm"].get<double>());
+    for (size_t i = 0; i < worst.size(); ++i) {
+      if (i > 0) {
+        EXPECT_LE(worst[i]["error_mm"].get<double>(), worst[i - 1]["error_mm"].get<double>());
+      }
+      EXPECT_GE(worst[i]["vertex"].get<int>(), 0);
+      EXPECT_LT(worst[i]["vertex"].get<int>(), vertices);
+      EXPECT_GE(worst[i]["frame"].get<int>(), 0);
+      EXPECT_LT(worst[i]["frame"].get<int>(), frames);
+      EXPECT_GT(worst[i]["nearest_marker_mm"].get<double>(), 0.0);
+      const bool part_based = method["method"] != "lbs_sparse";
+      ASSERT_EQ(worst[i].contains("parts"), part_based);
+      if (!part_based) continue;
+      double sum = 0.0;
+      for (const auto& part : worst[i]["parts"]) sum += part["weight"].get<double>();
+      EXPECT_NEAR(sum, 1.0, 1e-9);
+    }
+  }
+}
+
 TEST(SkinstreamCli, SynthRefusesAnUnknownMotion) {
   const ProgramRun r = run("synth --motion moonwalk --out " + test::scratch_path("m.c3d"));
   EXPECT_NE(r.exit_code, 0);
