@@ -4,7 +4,6 @@
 // away and come back; the demo subject's vertex buffers equal `skinstream fill` + `deform`.
 #include <gtest/gtest.h>
 
-#include <array>
 #include <functional>
 #include <csignal>
 #include <cstdio>
@@ -25,24 +24,14 @@
 #include "protocol/capture_file.h"
 #include "protocol/point_cache.h"
 #include "server/client/subscriber_client.h"
+#include "support/program_run.h"
 #include "support/test_data.h"
 
 namespace skinstream {
 namespace {
 
-struct ProgramRun {
-  int exit_code;
-  std::string output;  // stdout and stderr
-};
-
-ProgramRun run(const std::string& command_line) {
-  FILE* pipe = popen((command_line + " 2>&1").c_str(), "r");
-  std::string output;
-  std::array<char, 4096> buffer;
-  while (size_t n = fread(buffer.data(), 1, buffer.size(), pipe)) output.append(buffer.data(), n);
-  const int status = pclose(pipe);
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, output};
-}
+using test::ProgramRun;
+ProgramRun run(const std::string& command_line) { return test::run_program(command_line); }
 
 // A daemon in the background; stopped with SIGTERM.
 class DaemonProcess {
@@ -438,7 +427,9 @@ void expect_vicon_stream_in_order(const std::string& subject, const std::string&
   long measured = 0, measured_equal = 0;
   for (size_t i = 0; i < frames.size(); ++i) {
     const int number = frames[i]["frame"];
-    if (i > 0) EXPECT_GT(number, frames[i - 1]["frame"].get<int>()) << "frame " << i;  // numbers never go back, even across loops
+    if (i > 0) {  // numbers never go back, even across loops
+      EXPECT_GT(number, frames[i - 1]["frame"].get<int>()) << "frame " << i;
+    }
     ASSERT_GE(number, recording.first_frame);
     const int index = (number - recording.first_frame) % recording.frame_count;
     const std::vector<float> live = frames[i]["markers"];

@@ -1,36 +1,23 @@
 // The real `skinstream` program, run as a user would, on real captures.
 #include <gtest/gtest.h>
 
-#include <array>
-#include <cstdio>
 #include <fstream>
 #include <nlohmann/json.hpp>
-#include <sys/wait.h>
 
 #include "core/baselines/linear_interpolation_fill.h"
 #include "core/evaluation/fill_error.h"
 #include "core/evaluation/gap_plan.h"
 #include "protocol/capture_file.h"
 #include "protocol/subject_file.h"
+#include "support/program_run.h"
 #include "support/test_data.h"
 
 namespace skinstream {
 namespace {
 
-struct ProgramRun {
-  int exit_code;
-  std::string output;  // stdout and stderr
-};
-
-ProgramRun run(const std::string& arguments) {
-  const std::string command = std::string(SKINSTREAM_CLI) + " " + arguments + " 2>&1";
-  FILE* pipe = popen(command.c_str(), "r");
-  std::string output;
-  std::array<char, 4096> buffer;
-  while (size_t n = fread(buffer.data(), 1, buffer.size(), pipe)) output.append(buffer.data(), n);
-  const int status = pclose(pipe);
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, output};
-}
+using test::ProgramRun;
+// `skinstream ARGUMENTS`, stdout and stderr together.
+ProgramRun run(const std::string& arguments) { return test::run_program(std::string(SKINSTREAM_CLI) + " " + arguments); }
 
 const std::string kCmu02 = test::source_path("replay_data/cmu/85_02.c3d");
 const std::string kCmu12 = test::source_path("replay_data/cmu/85_12.c3d");
