@@ -31,6 +31,7 @@
 #include <thread>
 #include <unistd.h>
 
+#include "clients/bench/stall_log.h"
 #include "server/client/health_probe.h"
 #include "protocol/capture_file.h"
 #include "protocol/file_error.h"
@@ -58,6 +59,7 @@ struct SubscriberTally {
   Samples end_to_end, processing, ingest, delivery;  // see the report's keys
   long received = 0, unmatched = 0, out_of_order = 0;
   uint32_t dropped_first = 0, dropped_last = 0;  // the daemon's drop counter for it, first and last frame
+  double longest_gap_ms = 0.0;                   // between two consecutive frames' arrivals
 
   void reserve(size_t frames) {
     for (Samples* s : {&end_to_end, &processing, &ingest, &delivery}) s->ms.reserve(frames);
@@ -90,13 +92,18 @@ class SendTimes {
     if (counting_ && last_send_ns_ > 0) {
       const int64_t gap = send_ns - last_send_ns_;
       max_gap_ns_ = std::max(max_gap_ns_, gap);
-      if (gap > 3 * period_ns_) ++gaps_over_3_periods_;
+      if (gap > 3 * period_ns_) {
+        ++gaps_over_3_periods_;
+        if (stalls_) stalls_->add_gap(last_send_ns_, "replay", static_cast<double>(gap) / 1e6);
+      }
     }
     last_send_ns_ = send_ns;
   }
-  void start_counting(int64_t period_ns) {
+  // From now on, gaps are counted and those over 3 periods logged to `stalls`.
+  void start_counting(int64_t period_ns, bench::StallLog* stalls) {
     std::lock_guard lock(mutex_);
     period_ns_ = period_ns;
+    stalls_ = stalls;
     counting_ = true;
   }
   nlohmann::json regularity() const {
@@ -119,6 +126,7 @@ class SendTimes {
   mutable std::mutex mutex_;
   std::array<Slot, kSlots> slots_{};
   bool counting_ = false;
+  bench::StallLog* stalls_ = nullptr;
   int64_t period_ns_ = 0, last_send_ns_ = 0, max_gap_ns_ = 0;
   uint64_t gaps_over_3_periods_ = 0;
 };
@@ -264,6 +272,7 @@ int main(int argc, char** argv) {
     replay_options.tcp_congestion = replay_tcp_congestion;
     replay_options.subject_name = vicon_subject_name.empty() ? fs::path(recording).stem().string() : vicon_subject_name;
     server::ViconServer replay(replay_io, capture, replay_options);
+    bench::StallLog stalls;  // before send_times, which writes to it until the replay stops
     SendTimes send_times;
     replay.set_frame_hook([&send_times](uint32_t frame_number, int64_t send_ns) { send_times.record(frame_number, send_ns); });
     replay.start();
@@ -289,7 +298,9 @@ int main(int argc, char** argv) {
     const int sub_port = ports.at("sub"), http_port = ports.at("http");
     wait_for_streaming(http_port, pid, log_path);
     const nlohmann::json health_before = server::fetch_health(http_port);
-    send_times.start_counting(static_cast<int64_t>(1e9 / capture.rate_hz));
+    const int64_t period_ns = static_cast<int64_t>(1e9 / capture.rate_hz);
+    stalls.start(sub::wall_clock_ns());
+    send_times.start_counting(period_ns, &stalls);
     const uint64_t sent_before = replay.stats().frame_packets_sent.load();
     const uint64_t replay_dropped_before = replay.stats().frames_dropped.load();
     const double cpu_before = process_usage(pid).first;  // startup (loading the subject) is not counted
@@ -306,7 +317,8 @@ int main(int argc, char** argv) {
         try {
           sub::SubscriberClient client("127.0.0.1", std::to_string(sub_port), wants);
           tally.reserve(static_cast<size_t>(seconds * capture.rate_hz * 1.2) + 16);
-          int64_t last_frame = -1;
+          int64_t last_frame = -1, last_arrival = 0;
+          const std::string who = "subscriber " + std::to_string(s);
           client.run([&](subscriber::MessageType type, std::span<const unsigned char> payload, int64_t now) {
             if (type == subscriber::MessageType::Frame) {
               // The numbers only: copying the vertices out is a renderer's work, not the daemon's.
@@ -322,8 +334,16 @@ int main(int argc, char** argv) {
               tally.delivery.ms.push_back((now - info.publish_time_ns) * 1e-6);
               if (static_cast<int64_t>(info.frame_number) <= last_frame) ++tally.out_of_order;
               last_frame = info.frame_number;
-              if (tally.received++ == 0) tally.dropped_first = info.subscriber_dropped;
+              if (tally.received++ == 0) {
+                tally.dropped_first = info.subscriber_dropped;
+              } else {
+                const int64_t gap = now - last_arrival;
+                tally.longest_gap_ms = std::max(tally.longest_gap_ms, gap * 1e-6);
+                if (gap > 3 * period_ns) stalls.add_gap(last_arrival, who, gap * 1e-6);
+                if (info.subscriber_dropped != tally.dropped_last) stalls.add_drop(now, who, info.subscriber_dropped - tally.dropped_last);
+              }
               tally.dropped_last = info.subscriber_dropped;
+              last_arrival = now;
             }
             return std::chrono::steady_clock::now() < deadline;
           });
@@ -368,9 +388,11 @@ int main(int argc, char** argv) {
 
     SubscriberTally all;
     long total_dropped = 0;
+    nlohmann::json per_subscriber = nlohmann::json::array();
     for (const SubscriberTally& tally : tallies) {
       all.add(tally);
       total_dropped += tally.dropped();
+      per_subscriber.push_back({{"received", tally.received}, {"dropped", tally.dropped()}, {"longest_gap_ms", tally.longest_gap_ms}});
     }
     auto delta = [&](const char* key) { return health["frames"][key].get<uint64_t>() - health_before["frames"][key].get<uint64_t>(); };
     // CPU: the measured window only; peak RSS: the daemon's whole life.
@@ -405,6 +427,10 @@ int main(int argc, char** argv) {
                     {"dropped_for_subscribers", total_dropped},
                     {"out_of_order", all.out_of_order},
                     {"without_send_time", all.unmatched}}},
+        {"per_subscriber", per_subscriber},
+        // Gaps over 3 frame periods (the replay's sends, each subscriber's arrivals) and drops for
+        // a subscriber, in time order: a pause of the whole machine shows at one moment in all.
+        {"stalls", stalls.to_json()},
         {"daemon", {{"cpu_seconds", cpu_seconds}, {"cpu_share_of_one_core", cpu_seconds / seconds}, {"peak_rss_kb", peak_rss_kb},
                     {"rss_kb_after_1s", rss_samples.empty() ? 0 : rss_samples.front()},
                     {"rss_kb_at_end", rss_samples.empty() ? 0 : rss_samples.back()},
@@ -436,6 +462,14 @@ int main(int argc, char** argv) {
                   cpu_seconds, 100 * cpu_seconds / seconds, peak_rss_kb, rss_samples.empty() ? 0L : rss_samples.front(),
                   rss_samples.empty() ? 0L : rss_samples.back());
       for (const std::string& text : daemon_warnings) std::printf("daemon: %s\n", text.c_str());
+      for (const auto& event : report["stalls"]["events"]) {
+        if (event.contains("dropped"))
+          std::printf("at %.3f s: %s: %u frames dropped for it\n", event["at_s"].get<double>(),
+                      event["who"].get<std::string>().c_str(), event["dropped"].get<uint32_t>());
+        else
+          std::printf("at %.3f s: %s: nothing for %.1f ms\n", event["at_s"].get<double>(), event["who"].get<std::string>().c_str(),
+                      event["gap_ms"].get<double>());
+      }
     }
     fs::remove_all(work);
     return 0;

@@ -1,0 +1,19 @@
+# skinstream-bench, the real program, for a few seconds on loopback (its report checked for
+# consistency, not for speed: figures are measured by running it, see the README), bad paths
+# failing clearly; and its stall log alone.
+if(TARGET skinstream-bench AND TARGET skinstreamd)
+  add_executable(bench_tests ${CMAKE_CURRENT_LIST_DIR}/bench_e2e_test.cpp ${CMAKE_CURRENT_LIST_DIR}/bench/stall_log_test.cpp
+    ${PROJECT_SOURCE_DIR}/tests/support/test_data.cpp ${PROJECT_SOURCE_DIR}/tests/support/program_run.cpp)
+  target_include_directories(bench_tests PRIVATE ${PROJECT_SOURCE_DIR}/tests ${PROJECT_SOURCE_DIR})
+  target_link_libraries(bench_tests PRIVATE nlohmann_json::nlohmann_json GTest::gtest_main)
+  target_compile_definitions(bench_tests PRIVATE
+    SKINSTREAM_BENCH="$<TARGET_FILE:skinstream-bench>"
+    SKINSTREAM_DEMO_DIR="${CMAKE_BINARY_DIR}/demo"
+    SKINSTREAM_SHARED_DIR="${SKINSTREAM_SHARED_DIR}"
+    SKINSTREAM_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
+    SKINSTREAM_TEST_TMP_DIR="${CMAKE_BINARY_DIR}/test_tmp/bench")
+  add_dependencies(bench_tests skinstream-bench skinstreamd)
+  gtest_discover_tests(bench_tests TEST_FILTER "StallLog.*" DISCOVERY_TIMEOUT 60 PROPERTIES LABELS clients)
+  gtest_discover_tests(bench_tests TEST_FILTER "BenchProgram.*" DISCOVERY_TIMEOUT 60
+    PROPERTIES LABELS clients TIMEOUT 120 FIXTURES_REQUIRED demo_subject)
+endif()

@@ -1,0 +1,91 @@
+// skinstream-bench, the real program: a replay server, the real skinstreamd and subscribers on
+// loopback for a few seconds, and the report it prints checked for consistency; bad paths fail.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "support/program_run.h"
+#include "support/test_data.h"
+
+namespace skinstream {
+namespace {
+
+const std::string kDemo = SKINSTREAM_DEMO_DIR;
+
+std::string bench(const std::string& arguments) { return std::string(SKINSTREAM_BENCH) + " " + arguments; }
+
+TEST(BenchProgram, ShortRunReportsEveryFrameItCounted) {
+  constexpr int kSubscribers = 2;
+  const test::ProgramRun r = test::run_program(
+      bench("--subject " + kDemo + "/subject.sksubj --recording " + kDemo + "/live.c3d --seconds 3 --subscribers " +
+            std::to_string(kSubscribers) + " --json"),
+      /*stderr_too=*/false);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto j = nlohmann::json::parse(r.output);
+  const auto& frames = j["frames"];
+  // The replay keeps the take's 120 Hz schedule: 3 s of it, give or take the window's ends.
+  EXPECT_GT(frames["sent_by_replay"].get<int>(), 300);
+  EXPECT_LT(frames["sent_by_replay"].get<int>(), 400);
+  EXPECT_GT(frames["processed"].get<int>(), 0);
+  EXPECT_EQ(frames["out_of_order"], 0);
+
+  // The per-subscriber rows add up to the totals, and no subscriber is counted a frame the
+  // daemon did not publish in the window (the subscribers connect after it opens and are
+  // joined before it closes).
+  const auto& per = j["per_subscriber"];
+  ASSERT_EQ(per.size(), static_cast<size_t>(kSubscribers));
+  long received = 0, dropped = 0;
+  for (const auto& s : per) {
+    EXPECT_GT(s["received"].get<long>(), 0);
+    EXPECT_LE(s["received"].get<long>() + s["dropped"].get<long>(), frames["published"].get<long>());
+    EXPECT_GT(s["longest_gap_ms"].get<double>(), 0.0);
+    received += s["received"].get<long>();
+    dropped += s["dropped"].get<long>();
+  }
+  EXPECT_EQ(received, frames["received_by_subscribers"].get<long>());
+  EXPECT_EQ(dropped, frames["dropped_for_subscribers"].get<long>());
+
+  // Every received frame is timed, end to end and in the daemon.
+  EXPECT_EQ(j["end_to_end"]["count"].get<long>(), received - frames["without_send_time"].get<long>());
+  EXPECT_EQ(j["daemon_processing"]["count"].get<long>(), received);
+  for (const char* key : {"end_to_end", "daemon_processing", "ingest", "delivery"}) {
+    SCOPED_TRACE(key);
+    const auto& s = j[key];
+    EXPECT_GT(s["p50_ms"].get<double>(), 0.0);
+    EXPECT_LE(s["p50_ms"].get<double>(), s["p99_ms"].get<double>());
+    EXPECT_LE(s["p99_ms"].get<double>(), s["max_ms"].get<double>());
+  }
+
+  // Stalls: within the window, from the replay or one of the subscribers.
+  for (const auto& e : j["stalls"]["events"]) {
+    EXPECT_GE(e["at_s"].get<double>(), 0.0);
+    EXPECT_LT(e["at_s"].get<double>(), 4.0);
+    const std::string who = e["who"];
+    EXPECT_TRUE(who == "replay" || who == "subscriber 0" || who == "subscriber 1") << who;
+    EXPECT_TRUE(e.contains("gap_ms") != e.contains("dropped")) << e.dump();
+  }
+  EXPECT_EQ(j["daemon"]["exit_status"], 0);  // SIGTERM stops it cleanly
+}
+
+TEST(BenchProgram, MissingRecordingFailsNamingIt) {
+  const std::string absent = test::scratch_path("absent.c3d");
+  const test::ProgramRun r = test::run_program(bench("--subject " + kDemo + "/subject.sksubj --recording " + absent + " --seconds 1"));
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.output.find("absent.c3d"), std::string::npos) << r.output;
+}
+
+// The daemon refuses it; the bench says so with the daemon's own reason.
+TEST(BenchProgram, SubjectThatIsNotOneFailsWithTheDaemonsReason) {
+  const std::string corrupt = test::scratch_path("not_a_subject.sksubj");
+  { std::ofstream(corrupt) << "not a subject"; }
+  const test::ProgramRun r =
+      test::run_program(bench("--subject " + corrupt + " --recording " + kDemo + "/live.c3d --seconds 1 --json"));
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.output.find("skinstreamd exited before listening"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("not_a_subject.sksubj: not a skinstream subject file"), std::string::npos) << r.output;
+}
+
+}  // namespace
+}  // namespace skinstream
