@@ -1,16 +1,20 @@
 #include "protocol/subscriber_stream.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstring>
 #include <limits>
 
 #include "protocol/byte_buffer.h"
+#include "protocol/frame_quantisation.h"
 
 namespace skinstream::subscriber {
 namespace {
 
 // Writes little-endian values at a cursor in a caller's span (the frame path, no allocation).
+// The host's byte order is the protocol's, so values are copied as they are.
+static_assert(std::endian::native == std::endian::little, "the protocol is little-endian; a big-endian host must swap");
 class SpanWriter {
  public:
   explicit SpanWriter(std::span<unsigned char> out) : out_(out) {}
@@ -18,6 +22,18 @@ class SpanWriter {
   void put(T value) {
     std::memcpy(out_.data() + pos_, &value, sizeof(T));
     pos_ += sizeof(T);
+  }
+  // A whole array in one copy: value by value, the compiler must assume each byte written may
+  // be the cursor itself and reload it, which made the 640 kB of a mesh's positions a scalar loop.
+  void put_floats(std::span<const float> values) {
+    std::memcpy(out_.data() + pos_, values.data(), values.size_bytes());
+    pos_ += values.size_bytes();
+  }
+  // The next n bytes, for the caller to fill; the cursor moves past them.
+  unsigned char* reserve(size_t n) {
+    unsigned char* at = out_.data() + pos_;
+    pos_ += n;
+    return at;
   }
   void zeros(size_t n) {
     std::memset(out_.data() + pos_, 0, n);
@@ -181,40 +197,22 @@ void encode_frame(const FrameInfo& in, std::span<const float> positions, std::sp
   w.put<uint32_t>(info.subscriber_dropped);
 
   if (has_positions && !quantised) {
-    for (size_t i = 0; i < v3; ++i) w.put<float>(positions[i]);
+    w.put_floats(positions.first(v3));
   } else if (has_positions) {
-    float lo[3], hi[3], step[3];
-    for (int a = 0; a < 3; ++a) lo[a] = std::numeric_limits<float>::max(), hi[a] = std::numeric_limits<float>::lowest();
-    for (size_t i = 0; i < v3; ++i) {
-      const int a = static_cast<int>(i % 3);
-      if (!std::isfinite(positions[i])) continue;
-      lo[a] = std::min(lo[a], positions[i]);
-      hi[a] = std::max(hi[a], positions[i]);
-    }
-    for (int a = 0; a < 3; ++a) {
-      if (lo[a] > hi[a]) lo[a] = hi[a] = 0.0f;  // no finite value on this axis
-      step[a] = (hi[a] - lo[a]) / 65535.0f;
-    }
-    for (int a = 0; a < 3; ++a) w.put<float>(lo[a]);
-    for (int a = 0; a < 3; ++a) w.put<float>(step[a]);
-    for (size_t i = 0; i < v3; ++i) {
-      const int a = static_cast<int>(i % 3);
-      const double q = step[a] > 0 && std::isfinite(positions[i]) ? std::round((positions[i] - lo[a]) / step[a]) : 0.0;
-      w.put<uint16_t>(static_cast<uint16_t>(std::clamp(q, 0.0, 65535.0)));
-    }
+    const QuantisationBox box = quantisation_box(positions.first(v3));
+    for (int a = 0; a < 3; ++a) w.put<float>(box.lo[a]);
+    for (int a = 0; a < 3; ++a) w.put<float>(box.step[a]);
+    quantise_positions(positions.first(v3), box, w.reserve(2 * v3));
     w.zeros(padding_to_4(2 * v3));
   }
   if (has_normals && !quantised) {
-    for (size_t i = 0; i < v3; ++i) w.put<float>(normals[i]);
+    w.put_floats(normals.first(v3));
   } else if (has_normals) {
-    for (size_t i = 0; i < v3; ++i) {
-      const float n = std::isfinite(normals[i]) ? std::clamp(normals[i], -1.0f, 1.0f) : 0.0f;
-      w.put<int16_t>(static_cast<int16_t>(std::lround(n * 32767.0f)));
-    }
+    quantise_normals(normals.first(v3), w.reserve(2 * v3));
     w.zeros(padding_to_4(2 * v3));
   }
   if (has_markers) {
-    for (size_t i = 0; i < 3 * size_t{info.marker_count}; ++i) w.put<float>(markers[i]);
+    w.put_floats(markers.first(3 * size_t{info.marker_count}));
     for (uint32_t m = 0; m < info.marker_count; ++m) w.put<uint8_t>(marker_status[m]);
     w.zeros(padding_to_4(info.marker_count));
   }
