@@ -318,6 +318,7 @@ int main(int argc, char** argv) {
           sub::SubscriberClient client("127.0.0.1", std::to_string(sub_port), wants);
           tally.reserve(static_cast<size_t>(seconds * capture.rate_hz * 1.2) + 16);
           int64_t last_frame = -1, last_arrival = 0;
+          uint32_t pipeline_dropped = 0;
           const std::string who = "subscriber " + std::to_string(s);
           client.run([&](subscriber::MessageType type, std::span<const unsigned char> payload, int64_t now) {
             if (type == subscriber::MessageType::Frame) {
@@ -337,12 +338,16 @@ int main(int argc, char** argv) {
               if (tally.received++ == 0) {
                 tally.dropped_first = info.subscriber_dropped;
               } else {
+                // The pipeline's own drops, once (every subscriber sees the same counter).
+                if (s == 0 && info.pipeline_dropped != pipeline_dropped)
+                  stalls.add_drop(now, "pipeline", info.pipeline_dropped - pipeline_dropped);
                 const int64_t gap = now - last_arrival;
                 tally.longest_gap_ms = std::max(tally.longest_gap_ms, gap * 1e-6);
                 if (gap > 3 * period_ns) stalls.add_gap(last_arrival, who, gap * 1e-6);
                 if (info.subscriber_dropped != tally.dropped_last) stalls.add_drop(now, who, info.subscriber_dropped - tally.dropped_last);
               }
               tally.dropped_last = info.subscriber_dropped;
+              pipeline_dropped = info.pipeline_dropped;
               last_arrival = now;
             }
             return std::chrono::steady_clock::now() < deadline;
@@ -428,8 +433,9 @@ int main(int argc, char** argv) {
                     {"out_of_order", all.out_of_order},
                     {"without_send_time", all.unmatched}}},
         {"per_subscriber", per_subscriber},
-        // Gaps over 3 frame periods (the replay's sends, each subscriber's arrivals) and drops for
-        // a subscriber, in time order: a pause of the whole machine shows at one moment in all.
+        // Gaps over 3 frame periods (the replay's sends, each subscriber's arrivals), drops for a
+        // subscriber and drops in the pipeline, in time order: a pause of the whole machine shows
+        // at one moment in all.
         {"stalls", stalls.to_json()},
         {"daemon", {{"cpu_seconds", cpu_seconds}, {"cpu_share_of_one_core", cpu_seconds / seconds}, {"peak_rss_kb", peak_rss_kb},
                     {"rss_kb_after_1s", rss_samples.empty() ? 0 : rss_samples.front()},
@@ -464,8 +470,8 @@ int main(int argc, char** argv) {
       for (const std::string& text : daemon_warnings) std::printf("daemon: %s\n", text.c_str());
       for (const auto& event : report["stalls"]["events"]) {
         if (event.contains("dropped"))
-          std::printf("at %.3f s: %s: %u frames dropped for it\n", event["at_s"].get<double>(),
-                      event["who"].get<std::string>().c_str(), event["dropped"].get<uint32_t>());
+          std::printf("at %.3f s: %s: %u frames dropped%s\n", event["at_s"].get<double>(), event["who"].get<std::string>().c_str(),
+                      event["dropped"].get<uint32_t>(), event["who"] == "pipeline" ? "" : " for it");
         else
           std::printf("at %.3f s: %s: nothing for %.1f ms\n", event["at_s"].get<double>(), event["who"].get<std::string>().c_str(),
                       event["gap_ms"].get<double>());

@@ -1,7 +1,7 @@
 #pragma once
 // When a benchmark run hitched, and who saw it, on one time line: the replay server's late sends,
-// each subscriber's long waits between frames, and the frames the daemon dropped for a
-// subscriber. So a run with drops says whether the whole machine paused (the replay and every
+// each subscriber's long waits between frames, the frames the daemon dropped for a subscriber
+// and those its pipeline dropped. So a run with drops says whether the whole machine paused (the replay and every
 // subscriber at the same moment) or one subscriber fell behind on its own (its own gap, its own
 // drops). Written from the replay's io thread and the subscriber threads, only when something
 // happens, so a mutex costs nothing on the frames in between.

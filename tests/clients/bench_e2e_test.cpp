@@ -58,12 +58,12 @@ TEST(BenchProgram, ShortRunReportsEveryFrameItCounted) {
     EXPECT_LE(s["p99_ms"].get<double>(), s["max_ms"].get<double>());
   }
 
-  // Stalls: within the window, from the replay or one of the subscribers.
+  // Stalls: within the window, from the replay, the pipeline or one of the subscribers.
   for (const auto& e : j["stalls"]["events"]) {
     EXPECT_GE(e["at_s"].get<double>(), 0.0);
     EXPECT_LT(e["at_s"].get<double>(), 4.0);
     const std::string who = e["who"];
-    EXPECT_TRUE(who == "replay" || who == "subscriber 0" || who == "subscriber 1") << who;
+    EXPECT_TRUE(who == "replay" || who == "pipeline" || who == "subscriber 0" || who == "subscriber 1") << who;
     EXPECT_TRUE(e.contains("gap_ms") != e.contains("dropped")) << e.dump();
   }
   EXPECT_EQ(j["daemon"]["exit_status"], 0);  // SIGTERM stops it cleanly
