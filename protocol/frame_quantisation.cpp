@@ -51,13 +51,15 @@ inline __attribute__((always_inline)) I8 finite(F8 x) { return (x - x) == 0.0f; 
 
 inline __attribute__((always_inline)) U8 quantise_positions8(F8 x, F8 lo, F8 step) {
   const F8 zero = {};
-  const F8 t = (finite(x) & (step > 0.0f)) ? (x - lo) / step : zero;  // >= 0: lo is the least
+  // Not below 0 with the frame's own box (lo is the least); clamped for any other box.
+  F8 t = (finite(x) & (step > 0.0f)) ? (x - lo) / step : zero;
+  t = t > zero ? t : zero;
   I8 q = round_nonnegative(t);
   q = q > 65535 ? 65535 : q;
   return __builtin_convertvector(q, U8);
 }
 inline uint16_t quantise_position(float x, float lo, float step) {
-  const float t = step > 0.0f && std::isfinite(x) ? (x - lo) / step : 0.0f;
+  const float t = step > 0.0f && std::isfinite(x) ? std::max((x - lo) / step, 0.0f) : 0.0f;
   return static_cast<uint16_t>(std::min(round_nonnegative(t), 65535.0f));
 }
 

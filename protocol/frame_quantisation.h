@@ -17,7 +17,8 @@ struct QuantisationBox {
 // positions: 3 floats a vertex.
 QuantisationBox quantisation_box(std::span<const float> positions);
 
-// Each coordinate as round((x - lo) / step), 0 when not finite or its axis is flat;
+// Each coordinate as round((x - lo) / step) clamped to [0, 65535], 0 when not finite or its
+// axis is flat;
 // 2 * positions.size() little-endian bytes (u16) to `out`.
 void quantise_positions(std::span<const float> positions, const QuantisationBox& box, unsigned char* out);
 

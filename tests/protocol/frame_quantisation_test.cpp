@@ -91,6 +91,24 @@ TEST(FrameQuantisation, PositionsRoundHalvesUp) {
   expect_positions_match_reference(p);
 }
 
+// A box other than the frame's own (values beyond it on both sides): codes clamp to 0 and
+// 65535, as the reference's clamp does.
+TEST(FrameQuantisation, PositionsOutsideTheBoxClampToItsEnds) {
+  std::vector<float> p;
+  for (int v = 0; v < 40; ++v) {
+    const float x = -50.0f + 5.0f * static_cast<float>(v) + 0.3f;
+    p.insert(p.end(), {x, -x, 0.5f * x});
+  }
+  QuantisationBox box;
+  for (int a = 0; a < 3; ++a) box.lo[a] = -10.0f, box.step[a] = 40.0f / 65535.0f;
+  std::vector<unsigned char> out(2 * p.size());
+  quantise_positions(p, box, out.data());
+  EXPECT_EQ(code_at<uint16_t>(out, 0), 0u);             // below lo
+  EXPECT_EQ(code_at<uint16_t>(out, 3 * 39), 65535u);    // beyond lo + 65535 steps
+  for (size_t i = 0; i < p.size(); ++i)
+    ASSERT_EQ(code_at<uint16_t>(out, i), reference_position(p[i], box.lo[i % 3], box.step[i % 3])) << "value " << i;
+}
+
 TEST(FrameQuantisation, NonFiniteAndFlatAxesGiveZeroAndDoNotWidenTheBox) {
   std::vector<float> p;
   for (int v = 0; v < 30; ++v) {
