@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <bit>
-#include <cmath>
 #include <cstring>
 #include <limits>
 
@@ -41,10 +40,6 @@ inline __attribute__((always_inline)) I8 round_nonnegative(F8 t) {
   const F8 fraction = t - __builtin_convertvector(whole, F8);
   return whole - (fraction >= 0.5f);  // a true comparison is -1
 }
-inline float round_nonnegative(float t) {
-  const float whole = std::floor(t);
-  return t - whole >= 0.5f ? whole + 1.0f : whole;
-}
 
 // x - x is 0 exactly when x is finite (inf - inf and NaN give NaN).
 inline __attribute__((always_inline)) I8 finite(F8 x) { return (x - x) == 0.0f; }
@@ -58,10 +53,6 @@ inline __attribute__((always_inline)) U8 quantise_positions8(F8 x, F8 lo, F8 ste
   q = q > 65535 ? 65535 : q;
   return __builtin_convertvector(q, U8);
 }
-inline uint16_t quantise_position(float x, float lo, float step) {
-  const float t = step > 0.0f && std::isfinite(x) ? std::max((x - lo) / step, 0.0f) : 0.0f;
-  return static_cast<uint16_t>(std::min(round_nonnegative(t), 65535.0f));
-}
 
 inline __attribute__((always_inline)) S8 quantise_normals8(F8 n) {
   const F8 zero = {}, one = zero + 1.0f;
@@ -71,11 +62,23 @@ inline __attribute__((always_inline)) S8 quantise_normals8(F8 n) {
   const I8 magnitude = round_nonnegative(t < zero ? -t : t);
   return __builtin_convertvector(t < zero ? -magnitude : magnitude, S8);
 }
-inline int16_t quantise_normal(float n) {
-  const float c = std::isfinite(n) ? std::clamp(n, -1.0f, 1.0f) : 0.0f;
-  const float t = c * 32767.0f;
-  const float magnitude = round_nonnegative(std::fabs(t));
-  return static_cast<int16_t>(t < 0.0f ? -magnitude : magnitude);
+
+// Runs `block(values, codes)` over the floats kFloats at a time, codes being where the block's
+// 2 bytes a float go in `out` (null when out is: a block that writes nothing). The last, partial
+// block is padded with `pad` and its codes cut to size, so every value goes through the same
+// lane code.
+template <size_t kFloats, typename Block>
+inline __attribute__((always_inline)) void for_each_block(std::span<const float> in, float pad, unsigned char* out,
+                                                          Block block) {
+  const size_t whole = in.size() / kFloats, rest = in.size() % kFloats;
+  for (size_t b = 0; b < whole; ++b) block(in.data() + b * kFloats, out ? out + 2 * b * kFloats : nullptr);
+  if (rest == 0) return;
+  float tail[kFloats];
+  std::fill(tail, tail + kFloats, pad);
+  std::memcpy(tail, in.data() + whole * kFloats, rest * sizeof(float));
+  unsigned char codes[2 * kFloats];
+  block(tail, codes);
+  if (out) std::memcpy(out + 2 * whole * kFloats, codes, 2 * rest);
 }
 
 }  // namespace
@@ -83,29 +86,24 @@ inline int16_t quantise_normal(float n) {
 QuantisationBox quantisation_box(std::span<const float> positions) {
   float lo[3], hi[3];
   for (int a = 0; a < 3; ++a) lo[a] = std::numeric_limits<float>::max(), hi[a] = std::numeric_limits<float>::lowest();
-  const float* p = positions.data();
-  const size_t n = positions.size() - positions.size() % 3, groups = n / kGroup;
   F8 lo8[3], hi8[3];
   for (int k = 0; k < 3; ++k) lo8[k] = axis_pattern(lo, k), hi8[k] = axis_pattern(hi, k);
-  for (size_t g = 0; g < groups; ++g)
-    for (int k = 0; k < 3; ++k) {
-      const F8 x = load8(p + g * kGroup + k * kLanes);
-      const I8 ok = finite(x);
-      lo8[k] = (ok & (x < lo8[k])) ? x : lo8[k];
-      hi8[k] = (ok & (x > hi8[k])) ? x : hi8[k];
-    }
+  // Padding with NaN: not finite, so it moves no bound.
+  for_each_block<kGroup>(positions.first(positions.size() - positions.size() % 3), std::numeric_limits<float>::quiet_NaN(),
+                         nullptr, [&](const float* group, unsigned char*) {
+                           for (int k = 0; k < 3; ++k) {
+                             const F8 x = load8(group + k * kLanes);
+                             const I8 ok = finite(x);
+                             lo8[k] = (ok & (x < lo8[k])) ? x : lo8[k];
+                             hi8[k] = (ok & (x > hi8[k])) ? x : hi8[k];
+                           }
+                         });
   for (int k = 0; k < 3; ++k)
     for (int l = 0; l < kLanes; ++l) {
       const int a = (kLanes * k + l) % 3;
       lo[a] = std::min(lo[a], lo8[k][l]);
       hi[a] = std::max(hi[a], hi8[k][l]);
     }
-  for (size_t i = groups * kGroup; i < n; ++i) {
-    const int a = static_cast<int>(i % 3);
-    if (!std::isfinite(p[i])) continue;
-    lo[a] = std::min(lo[a], p[i]);
-    hi[a] = std::max(hi[a], p[i]);
-  }
   QuantisationBox box;
   for (int a = 0; a < 3; ++a) {
     if (lo[a] > hi[a]) lo[a] = hi[a] = 0.0f;  // no finite value on this axis
@@ -116,32 +114,21 @@ QuantisationBox quantisation_box(std::span<const float> positions) {
 }
 
 void quantise_positions(std::span<const float> positions, const QuantisationBox& box, unsigned char* out) {
-  const float* p = positions.data();
-  const size_t n = positions.size(), groups = n / kGroup;
   F8 lo8[3], step8[3];
   for (int k = 0; k < 3; ++k) lo8[k] = axis_pattern(box.lo, k), step8[k] = axis_pattern(box.step, k);
-  for (size_t g = 0; g < groups; ++g)
+  for_each_block<kGroup>(positions, 0.0f, out, [&](const float* group, unsigned char* codes) {
     for (int k = 0; k < 3; ++k) {
-      const U8 codes = quantise_positions8(load8(p + g * kGroup + k * kLanes), lo8[k], step8[k]);
-      std::memcpy(out + 2 * (g * kGroup + k * kLanes), &codes, sizeof codes);
+      const U8 block = quantise_positions8(load8(group + k * kLanes), lo8[k], step8[k]);
+      std::memcpy(codes + 2 * k * kLanes, &block, sizeof block);
     }
-  for (size_t i = groups * kGroup; i < n; ++i) {
-    const uint16_t code = quantise_position(p[i], box.lo[i % 3], box.step[i % 3]);
-    std::memcpy(out + 2 * i, &code, 2);
-  }
+  });
 }
 
 void quantise_normals(std::span<const float> normals, unsigned char* out) {
-  const float* p = normals.data();
-  const size_t n = normals.size(), blocks = n / kLanes;
-  for (size_t b = 0; b < blocks; ++b) {
-    const S8 codes = quantise_normals8(load8(p + b * kLanes));
-    std::memcpy(out + 2 * b * kLanes, &codes, sizeof codes);
-  }
-  for (size_t i = blocks * kLanes; i < n; ++i) {
-    const int16_t code = quantise_normal(p[i]);
-    std::memcpy(out + 2 * i, &code, 2);
-  }
+  for_each_block<kLanes>(normals, 0.0f, out, [](const float* block, unsigned char* codes) {
+    const S8 values = quantise_normals8(load8(block));
+    std::memcpy(codes, &values, sizeof values);
+  });
 }
 
 }  // namespace skinstream::subscriber
