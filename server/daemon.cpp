@@ -342,6 +342,29 @@ void Daemon::schedule_status() {
   });
 }
 
+namespace {
+
+// The /metrics histograms condensed for scripts, over the daemon's life: per stage its count,
+// the quantiles as bucket upper bounds ("le") and the largest value seen.
+nlohmann::json latency_summaries(const Metrics& metrics) {
+  nlohmann::json out = nlohmann::json::object();
+  auto add = [&](const char* name, const LatencyHistogram& histogram) {
+    const LatencyHistogram::Summary s = histogram.summary();
+    out[name] = {{"count", s.count}, {"p50_le", s.p50_le_ms}, {"p99_le", s.p99_le_ms}, {"p99_9_le", s.p99_9_le_ms}, {"max", s.max_ms}};
+  };
+  add("receive_to_take", metrics.receive_to_take);
+  add("fill", metrics.fill);
+  add("deform", metrics.deform);
+  add("normals", metrics.normals);
+  add("encode", metrics.encode);
+  add("receive_to_publish", metrics.receive_to_publish);
+  add("subscriber_queue_wait", metrics.subscriber_queue_wait);
+  add("subscriber_write", metrics.subscriber_write);
+  return out;
+}
+
+}  // namespace
+
 std::string Daemon::health_json() const {
   nlohmann::json source;
   {
@@ -365,7 +388,8 @@ std::string Daemon::health_json() const {
       {"deform", {{"threads", config_.deform_threads}, {"cpus", deform_cpus_}, {"spin_lead_us", config_.deform_spin_lead_us}}},
       {"publish_threads", publish_.count()},
       {"subscriber_tcp_congestion", config_.subscriber_tcp_congestion},  // empty: the system's
-      {"subject", {{"markers", subject_.model.marker_count()}, {"vertices", pipeline_->vertex_count()}}}};
+      {"subject", {{"markers", subject_.model.marker_count()}, {"vertices", pipeline_->vertex_count()}}},
+      {"latency_ms", latency_summaries(metrics_)}};
   return health.dump();
 }
 

@@ -421,6 +421,10 @@ int main(int argc, char** argv) {
         {"ingest", all.ingest.summary()},      // replay send -> daemon receive
         {"delivery", all.delivery.summary()},  // daemon publish -> subscriber arrival
         {"replay_sends", send_times.regularity()},  // gaps between the replay's consecutive sends
+        // The daemon's own stage histograms (/health's latency_ms) over its whole life, warm-up
+        // included: quantiles as bucket upper bounds. Delivery splits into subscriber_queue_wait
+        // (published -> the write starts) and subscriber_write (-> the socket took the frame).
+        {"daemon_stages_ms", health["latency_ms"]},
         {"frames", {{"sent_by_replay", sent},
                     {"dropped_by_replay", replay_dropped},
                     {"received_by_daemon", delta("received")},
@@ -463,6 +467,11 @@ int main(int argc, char** argv) {
       line("daemon processing", report["daemon_processing"]);
       line("  ingest", report["ingest"]);
       line("  delivery", report["delivery"]);
+      for (const char* stage : {"subscriber_queue_wait", "subscriber_write"}) {
+        const nlohmann::json& h = report["daemon_stages_ms"][stage];
+        std::printf("    %-22s p50 <= %.3f ms  p99 <= %.3f ms  max %.3f ms  (daemon side, %lu samples)\n", stage,
+                    h["p50_le"].get<double>(), h["p99_le"].get<double>(), h["max"].get<double>(), h["count"].get<unsigned long>());
+      }
       std::printf("frames: %s\n", report["frames"].dump().c_str());
       std::printf("daemon: %.2f s CPU (%.0f%% of one core), peak RSS %ld kB, RSS %ld kB after 1 s and %ld kB at the end\n",
                   cpu_seconds, 100 * cpu_seconds / seconds, peak_rss_kb, rss_samples.empty() ? 0L : rss_samples.front(),

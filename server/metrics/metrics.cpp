@@ -1,5 +1,7 @@
 #include "server/metrics/metrics.h"
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 
 namespace skinstream::server {
@@ -36,6 +38,33 @@ void LatencyHistogram::observe_ns(int64_t ns) {
   if (b < kBounds.size()) buckets_[b].fetch_add(1, std::memory_order_relaxed);
   count_.fetch_add(1, std::memory_order_relaxed);
   sum_ns_.fetch_add(ns, std::memory_order_relaxed);
+  for (int64_t seen = max_ns_.load(std::memory_order_relaxed);
+       ns > seen && !max_ns_.compare_exchange_weak(seen, ns, std::memory_order_relaxed);) {
+  }
+}
+
+double LatencyHistogram::quantile_upper_bound_ms(double q, uint64_t total, int64_t max_ns) const {
+  const double max_ms = max_ns * 1e-6;
+  // The rank of the quantile's observation, 1-based (nearest rank).
+  const uint64_t rank = std::max<uint64_t>(1, static_cast<uint64_t>(std::ceil(q * static_cast<double>(total))));
+  uint64_t cumulative = 0;
+  for (size_t b = 0; b < kBounds.size(); ++b) {
+    cumulative += buckets_[b].load(std::memory_order_relaxed);
+    if (cumulative >= rank) return std::min(kBounds[b] * 1e3, max_ms);
+  }
+  return max_ms;  // beyond the last bound
+}
+
+LatencyHistogram::Summary LatencyHistogram::summary() const {
+  Summary s;
+  s.count = count_.load(std::memory_order_relaxed);
+  if (s.count == 0) return s;
+  const int64_t max_ns = max_ns_.load(std::memory_order_relaxed);
+  s.max_ms = max_ns * 1e-6;
+  s.p50_le_ms = quantile_upper_bound_ms(0.5, s.count, max_ns);
+  s.p99_le_ms = quantile_upper_bound_ms(0.99, s.count, max_ns);
+  s.p99_9_le_ms = quantile_upper_bound_ms(0.999, s.count, max_ns);
+  return s;
 }
 
 void LatencyHistogram::render(std::string& out, std::string_view name, std::string_view help) const {
@@ -94,6 +123,10 @@ std::string Metrics::render_prometheus(const std::vector<SubscriberMetrics>& sub
   normals.render(out, "normals_seconds", "Normal computation time per frame.");
   encode.render(out, "encode_seconds", "Frame encoding time per frame.");
   receive_to_publish.render(out, "receive_to_publish_seconds", "From frame received to handed to the publishers.");
+  subscriber_queue_wait.render(out, "subscriber_queue_wait_seconds",
+                               "Per frame and subscriber: from published to its write starting (the subscriber's queue and its io thread's turn).");
+  subscriber_write.render(out, "subscriber_write_seconds",
+                          "Per frame and subscriber: from its write starting to the socket taking the last byte (longer when the subscriber reads slowly).");
   out += "# HELP skinstream_subscriber_frames_sent_total Frames written to each subscriber.\n"
          "# TYPE skinstream_subscriber_frames_sent_total counter\n";
   for (const SubscriberMetrics& s : subscribers)

@@ -25,10 +25,21 @@ class LatencyHistogram {
   void render(std::string& out, std::string_view name, std::string_view help) const;
   uint64_t count() const { return count_.load(std::memory_order_relaxed); }
 
+  // For /health and scripts: each quantile as an upper bound, the smaller of its bucket's bound
+  // and the largest value observed (which also bounds a quantile beyond the last bucket).
+  struct Summary {
+    uint64_t count = 0;
+    double p50_le_ms = 0, p99_le_ms = 0, p99_9_le_ms = 0, max_ms = 0;
+  };
+  Summary summary() const;
+
  private:
+  double quantile_upper_bound_ms(double q, uint64_t total, int64_t max_ns) const;
+
   std::array<std::atomic<uint64_t>, kBounds.size()> buckets_{};  // non-cumulative
   std::atomic<uint64_t> count_{0};
   std::atomic<int64_t> sum_ns_{0};
+  std::atomic<int64_t> max_ns_{0};
 };
 
 struct SubscriberMetrics {
@@ -56,6 +67,10 @@ class Metrics {
 
   // receive_to_take: waiting in the mailbox, the pipeline thread's wake-up included.
   LatencyHistogram receive_to_take, fill, deform, normals, encode, receive_to_publish;
+  // Delivery inside the daemon, per frame and subscriber: published -> its write starts (the
+  // subscriber's queue and its io thread's turn), and write started -> the socket took the last
+  // byte (a subscriber that reads slowly fills its socket buffers and lengthens this one).
+  LatencyHistogram subscriber_queue_wait, subscriber_write;
 
   void count_bad_input(std::string_view category);
   uint64_t bad_input(std::string_view category) const;

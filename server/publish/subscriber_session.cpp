@@ -134,6 +134,9 @@ void SubscriberSession::pump() {
     return;
   }
   if (paced_) ++unacked_;
+  write_started_ = std::chrono::steady_clock::now();
+  hub_.metrics().subscriber_queue_wait.observe_ns(
+      std::chrono::duration_cast<std::chrono::nanoseconds>(write_started_ - in_flight_.frame->published).count());
   const std::span<const unsigned char> message = in_flight_.frame->message(flags_.load());
   const size_t prefix = std::min(frame_prefix_.size(), message.size());
   std::memcpy(frame_prefix_.data(), message.data(), prefix);
@@ -150,7 +153,11 @@ void SubscriberSession::write_done(const boost::system::error_code& ec) {
     if (ec != asio::error::operation_aborted) on_disconnected(ec.message());
     return;
   }
-  if (was_frame) sent_.fetch_add(1, std::memory_order_relaxed);
+  if (was_frame) {
+    sent_.fetch_add(1, std::memory_order_relaxed);
+    hub_.metrics().subscriber_write.observe_ns(
+        std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - write_started_).count());
+  }
   pump();
 }
 

@@ -7,6 +7,7 @@
 
 #include <array>
 #include <atomic>
+#include <chrono>
 #include <memory>
 #include <span>
 #include <string>
@@ -72,6 +73,7 @@ class SubscriberSession : public std::enable_shared_from_this<SubscriberSession>
   std::atomic<uint32_t> flags_{0};
   std::atomic<uint64_t> sent_{0};
   SubscriberQueue::Item in_flight_;
+  std::chrono::steady_clock::time_point write_started_;  // of the frame in flight
   std::array<unsigned char, 64> frame_prefix_{};  // the frame's first bytes with this subscriber's drop count
 };
 

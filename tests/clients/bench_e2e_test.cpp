@@ -58,6 +58,20 @@ TEST(BenchProgram, ShortRunReportsEveryFrameItCounted) {
     EXPECT_LE(s["p99_ms"].get<double>(), s["max_ms"].get<double>());
   }
 
+  // The daemon's delivery split (the histograms also hold the warm-up before the window). Every
+  // frame a subscriber received had its write started; all but perhaps each subscriber's last
+  // have had the write's completion run too (it may still be queued on a publish thread when
+  // the bench asks /health).
+  EXPECT_GE(j["daemon_stages_ms"]["subscriber_queue_wait"]["count"].get<long>(), received);
+  EXPECT_GE(j["daemon_stages_ms"]["subscriber_write"]["count"].get<long>(), received - kSubscribers);
+  for (const char* stage : {"subscriber_queue_wait", "subscriber_write"}) {
+    SCOPED_TRACE(stage);
+    const auto& h = j["daemon_stages_ms"][stage];
+    EXPECT_LE(h["p50_le"].get<double>(), h["p99_le"].get<double>());
+    EXPECT_LE(h["p99_le"].get<double>(), h["max"].get<double>());
+    EXPECT_GT(h["max"].get<double>(), 0.0);
+  }
+
   // Stalls: within the window, from the replay, the pipeline or one of the subscribers.
   for (const auto& e : j["stalls"]["events"]) {
     EXPECT_GE(e["at_s"].get<double>(), 0.0);

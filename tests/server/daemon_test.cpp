@@ -421,11 +421,27 @@ TEST(Daemon, ServesHealthMetricsWebSocketAndSubscribersWithoutHello) {
   // Frames went out, so encoded buffers exist (the counter only grows, and frames keep coming).
   EXPECT_GE(health["frame_buffers_allocated"].get<long>(), 1);
   EXPECT_LE(health["frame_buffers_allocated"].get<uint64_t>(), daemon.metrics().frame_buffers_allocated.load());
+  // Every stage summarised for scripts, each summary ordered. Frames were filled, encoded and
+  // written to subscribers; this subject has no mesh, so nothing was deformed.
+  for (const char* stage : {"receive_to_take", "fill", "deform", "normals", "encode", "receive_to_publish",
+                            "subscriber_queue_wait", "subscriber_write"}) {
+    SCOPED_TRACE(stage);
+    const nlohmann::json& h = health["latency_ms"][stage];
+    const std::string name = stage;
+    if (name == "deform" || name == "normals")
+      EXPECT_EQ(h["count"].get<uint64_t>(), 0u);
+    else
+      EXPECT_GT(h["count"].get<uint64_t>(), 0u);
+    EXPECT_LE(h["p50_le"].get<double>(), h["p99_le"].get<double>());
+    EXPECT_LE(h["p99_le"].get<double>(), h["p99_9_le"].get<double>());
+    EXPECT_LE(h["p99_9_le"].get<double>(), h["max"].get<double>());
+  }
   const std::string metrics = http_get(daemon.http_port(), "/metrics", &status);
   EXPECT_EQ(status, 200);
   for (const char* name : {"skinstream_frames_received_total ", "skinstream_frames_published_total ", "skinstream_frames_dropped_total ",
                            "skinstream_frames_dropped_mailbox_full_total ", "skinstream_markers_filled_total ", "skinstream_fill_seconds_bucket{le=\"+Inf\"}",
-                           "skinstream_encode_seconds_count", "skinstream_receive_to_take_seconds_count", "skinstream_bad_subscriber_messages_total 1"})
+                           "skinstream_encode_seconds_count", "skinstream_receive_to_take_seconds_count",
+                           "skinstream_subscriber_queue_wait_seconds_count", "skinstream_subscriber_write_seconds_count", "skinstream_bad_subscriber_messages_total 1"})
     EXPECT_NE(metrics.find(name), std::string::npos) << name;
   http_get(daemon.http_port(), "/nothing-here", &status);
   EXPECT_EQ(status, 404);

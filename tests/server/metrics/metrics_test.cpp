@@ -49,6 +49,26 @@ TEST(LatencyHistogram, BoundsAscendAndEveryOneIsRendered) {
   EXPECT_EQ(buckets, LatencyHistogram::kBounds.size() + 1);  // and +Inf
 }
 
+TEST(LatencyHistogram, SummaryGivesEachQuantileAsItsBucketsBoundCappedByTheMaximum) {
+  LatencyHistogram h;
+  EXPECT_EQ(h.summary().count, 0u);
+  EXPECT_EQ(h.summary().max_ms, 0.0);
+  for (int i = 0; i < 98; ++i) h.observe_ns(400'000);  // 0.4 ms: bucket (0.3, 0.5] ms
+  h.observe_ns(1'900'000);                              // 1.9 ms: bucket (1.5, 2] ms
+  h.observe_ns(1'200'000);                              // 1.2 ms: bucket (1, 1.25] ms
+  LatencyHistogram::Summary s = h.summary();
+  EXPECT_EQ(s.count, 100u);
+  EXPECT_DOUBLE_EQ(s.p50_le_ms, 0.5);
+  EXPECT_DOUBLE_EQ(s.p99_le_ms, 1.25);  // the 99th of 100 values is 1.2 ms
+  EXPECT_DOUBLE_EQ(s.p99_9_le_ms, 1.9);  // the 100th: its bucket says <= 2 ms, the maximum 1.9
+  EXPECT_DOUBLE_EQ(s.max_ms, 1.9);
+  // Beyond the last bound (1 s) a quantile is bounded by the maximum alone.
+  for (int i = 0; i < 900; ++i) h.observe_ns(3'000'000'000);
+  s = h.summary();
+  EXPECT_DOUBLE_EQ(s.p50_le_ms, 3000.0);
+  EXPECT_DOUBLE_EQ(s.max_ms, 3000.0);
+}
+
 TEST(Metrics, BadInputIsCountedByCategoryAndLabelValuesAreEscaped) {
   Metrics m;
   m.count_bad_input("nan");
