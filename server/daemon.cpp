@@ -68,6 +68,25 @@ ViconSourceOptions vicon_options_of(const DaemonConfig& config) {
 
 subscriber::SourceStateCode code_of(SourceState s) { return static_cast<subscriber::SourceStateCode>(static_cast<uint32_t>(s)); }
 
+// The /metrics histograms condensed for scripts, over the daemon's life: per stage its count,
+// the quantiles as bucket upper bounds ("le") and the largest value seen.
+nlohmann::json latency_summaries(const Metrics& metrics) {
+  nlohmann::json out = nlohmann::json::object();
+  auto add = [&](const char* name, const LatencyHistogram& histogram) {
+    const LatencyHistogram::Summary s = histogram.summary();
+    out[name] = {{"count", s.count}, {"p50_le", s.p50_le_ms}, {"p99_le", s.p99_le_ms}, {"p99_9_le", s.p99_9_le_ms}, {"max", s.max_ms}};
+  };
+  add("receive_to_take", metrics.receive_to_take);
+  add("fill", metrics.fill);
+  add("deform", metrics.deform);
+  add("normals", metrics.normals);
+  add("encode", metrics.encode);
+  add("receive_to_publish", metrics.receive_to_publish);
+  add("subscriber_queue_wait", metrics.subscriber_queue_wait);
+  add("subscriber_write", metrics.subscriber_write);
+  return out;
+}
+
 }  // namespace
 
 Daemon::Daemon(const DaemonConfig& config)
@@ -341,29 +360,6 @@ void Daemon::schedule_status() {
     schedule_status();
   });
 }
-
-namespace {
-
-// The /metrics histograms condensed for scripts, over the daemon's life: per stage its count,
-// the quantiles as bucket upper bounds ("le") and the largest value seen.
-nlohmann::json latency_summaries(const Metrics& metrics) {
-  nlohmann::json out = nlohmann::json::object();
-  auto add = [&](const char* name, const LatencyHistogram& histogram) {
-    const LatencyHistogram::Summary s = histogram.summary();
-    out[name] = {{"count", s.count}, {"p50_le", s.p50_le_ms}, {"p99_le", s.p99_le_ms}, {"p99_9_le", s.p99_9_le_ms}, {"max", s.max_ms}};
-  };
-  add("receive_to_take", metrics.receive_to_take);
-  add("fill", metrics.fill);
-  add("deform", metrics.deform);
-  add("normals", metrics.normals);
-  add("encode", metrics.encode);
-  add("receive_to_publish", metrics.receive_to_publish);
-  add("subscriber_queue_wait", metrics.subscriber_queue_wait);
-  add("subscriber_write", metrics.subscriber_write);
-  return out;
-}
-
-}  // namespace
 
 std::string Daemon::health_json() const {
   nlohmann::json source;
