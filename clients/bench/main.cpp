@@ -299,7 +299,8 @@ int main(int argc, char** argv) {
     wait_for_streaming(http_port, pid, log_path);
     const nlohmann::json health_before = server::fetch_health(http_port);
     const int64_t period_ns = static_cast<int64_t>(1e9 / capture.rate_hz);
-    stalls.start(sub::wall_clock_ns());
+    const int64_t window_start_ns = sub::wall_clock_ns();  // the stall log's and the RSS steps' zero
+    stalls.start(window_start_ns);
     send_times.start_counting(period_ns, &stalls);
     const uint64_t sent_before = replay.stats().frame_packets_sent.load();
     const uint64_t replay_dropped_before = replay.stats().frames_dropped.load();
@@ -358,11 +359,17 @@ int main(int argc, char** argv) {
       });
     // RSS once a second: the first sample after warm-up against the last.
     std::vector<long> rss_samples;
+    nlohmann::json rss_steps = nlohmann::json::array();
     uint64_t buffers_after_1s = 0;  // the daemon's encoded frame buffers: RSS steps when they grow
     const auto first_sample = std::chrono::steady_clock::now() + std::chrono::seconds(1);
     for (auto next = first_sample; next < deadline; next += std::chrono::seconds(1)) {
       std::this_thread::sleep_until(next);
       rss_samples.push_back(resident_kb(pid));
+      // Every step of RSS, with its time on the stall log's clock: a leak climbs steadily, memory
+      // touched for the first time (a backlog reaching buffers never used before) steps once.
+      if (rss_samples.size() > 1 && rss_samples.back() != rss_samples[rss_samples.size() - 2])
+        rss_steps.push_back({{"at_s", (sub::wall_clock_ns() - window_start_ns) * 1e-9},
+                             {"kb", rss_samples.back() - rss_samples[rss_samples.size() - 2]}});
       if (rss_samples.size() == 1) buffers_after_1s = server::fetch_health(http_port).value("frame_buffers_allocated", 0);
     }
     for (std::thread& t : threads) t.join();
@@ -446,6 +453,7 @@ int main(int argc, char** argv) {
                     {"rss_kb_at_end", rss_samples.empty() ? 0 : rss_samples.back()},
                     {"rss_kb_max_sampled", rss_samples.empty() ? 0 : *std::max_element(rss_samples.begin(), rss_samples.end())},
                     {"rss_kb_every_60s", every_minute},
+                    {"rss_steps", rss_steps},  // each change between two 1 s samples: at_s, kb
                     {"frame_buffers_after_1s", buffers_after_1s},
                     {"frame_buffers_at_end", health.value("frame_buffers_allocated", 0)},
                     // Of those, made on the 120 Hz thread because no prepared one was ready: 0 when
@@ -476,6 +484,8 @@ int main(int argc, char** argv) {
       std::printf("daemon: %.2f s CPU (%.0f%% of one core), peak RSS %ld kB, RSS %ld kB after 1 s and %ld kB at the end\n",
                   cpu_seconds, 100 * cpu_seconds / seconds, peak_rss_kb, rss_samples.empty() ? 0L : rss_samples.front(),
                   rss_samples.empty() ? 0L : rss_samples.back());
+      for (const auto& step : report["daemon"]["rss_steps"])
+        std::printf("at %.0f s: daemon RSS %+ld kB\n", step["at_s"].get<double>(), step["kb"].get<long>());
       for (const std::string& text : daemon_warnings) std::printf("daemon: %s\n", text.c_str());
       for (const auto& event : report["stalls"]["events"]) {
         if (event.contains("dropped"))

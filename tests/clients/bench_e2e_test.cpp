@@ -80,6 +80,15 @@ TEST(BenchProgram, ShortRunReportsEveryFrameItCounted) {
     EXPECT_TRUE(who == "replay" || who == "pipeline" || who == "subscriber 0" || who == "subscriber 1") << who;
     EXPECT_TRUE(e.contains("gap_ms") != e.contains("dropped")) << e.dump();
   }
+  // RSS steps: within the window, and together the whole change from the first sample to the last.
+  long stepped = 0;
+  for (const auto& step : j["daemon"]["rss_steps"]) {
+    EXPECT_GT(step["at_s"].get<double>(), 1.0);  // the first sample is taken 1 s in
+    EXPECT_LT(step["at_s"].get<double>(), 4.0);
+    EXPECT_NE(step["kb"].get<long>(), 0);
+    stepped += step["kb"].get<long>();
+  }
+  EXPECT_EQ(stepped, j["daemon"]["rss_kb_at_end"].get<long>() - j["daemon"]["rss_kb_after_1s"].get<long>());
   EXPECT_EQ(j["daemon"]["exit_status"], 0);  // SIGTERM stops it cleanly
 }
 
