@@ -15,6 +15,10 @@ std::span<unsigned char> PacketFramer::prepare(size_t size) {
   return {buffer_.data() + end_, size};
 }
 
+void PacketFramer::reserve(size_t bytes) {
+  if (buffer_.size() < bytes) buffer_.resize(bytes);  // zero-filled: every page touched once, here
+}
+
 void PacketFramer::commit(size_t size) { end_ = std::min(end_ + size, buffer_.size()); }
 
 void PacketFramer::feed(Bytes bytes) {

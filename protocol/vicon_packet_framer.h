@@ -30,8 +30,14 @@ class PacketFramer {
   Status next(Bytes& out_packet);
   const std::vector<ObjectView>& objects() const { return objects_; }
 
+  // Sizes the buffer now (and writes it, so its pages are resident): a reader that asks
+  // prepare() for at most `bytes` minus the unread tail never grows it later, when a burst
+  // leaves a partial packet behind a full read.
+  void reserve(size_t bytes);
+
   const std::string& error() const { return error_; }
   size_t buffered() const { return end_ - begin_; }
+  size_t capacity() const { return buffer_.size(); }
   void reset();  // forget everything, including an error (a new connection)
 
  private:

@@ -28,6 +28,9 @@ uint64_t marker_key(uint32_t subject_id, uint32_t marker_id) {
 constexpr uint32_t kWantedTypes[] = {type::StreamInfo,      type::SubjectInfo, type::FrameInfo, type::LabeledRecons,
                                      type::UnlabeledRecons, type::Timecode,    type::Contents};
 
+// Bytes asked of the socket per read: many frames of 350 markers, so a backlog drains in few reads.
+constexpr size_t kReadBytes = 64 * 1024;
+
 }  // namespace
 
 // ---------------------------------------------------------------- ViconFrameAssembler
@@ -217,6 +220,9 @@ struct ViconSource::State : std::enable_shared_from_this<ViconSource::State> {
     if (stopped) return;
     const uint64_t gen = ++generation;
     framer.reset();
+    // A read plus the partial packet a burst can leave behind it: sized and touched now, so a
+    // backlog after a stall neither reallocates nor faults in fresh pages on the io thread.
+    framer.reserve(2 * kReadBytes);
     assembler.reset();
     handshake_sent = false;
     streaming = false;
@@ -242,7 +248,7 @@ struct ViconSource::State : std::enable_shared_from_this<ViconSource::State> {
   }
 
   void read(uint64_t gen) {
-    const auto room = framer.prepare(64 * 1024);
+    const auto room = framer.prepare(kReadBytes);
     socket.async_read_some(asio::buffer(room.data(), room.size()),
                            [self = shared_from_this(), gen](const boost::system::error_code& ec, size_t n) {
                              self->on_read(gen, ec, n);

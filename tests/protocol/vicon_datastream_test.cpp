@@ -329,6 +329,41 @@ TEST(ViconWire, FramerCutsAStreamFedByteByByte) {
   EXPECT_EQ(framer.buffered(), 0u);
 }
 
+// A backlog read in full chunks leaves a partial packet behind most reads; the next prepare()
+// then needs the chunk plus that tail. Without reserve() the buffer grows at the first such read
+// (on the daemon's io thread, after a stall); reserved for a chunk plus a tail it never does.
+TEST(ViconWire, FramerReservedForAReadAndATailNeverGrowsInABacklog) {
+  const ByteVector frame = fixture("frame_packet.bin");
+  ByteVector backlog;
+  for (int i = 0; i < 40; ++i) backlog.insert(backlog.end(), frame.begin(), frame.end());
+  constexpr size_t kRead = 1024;  // not a multiple of the 359-byte packet
+  auto drain_in_reads = [&](PacketFramer& framer, size_t& most) {
+    int packets = 0;
+    for (size_t at = 0; at < backlog.size();) {
+      const auto room = framer.prepare(kRead);
+      const size_t n = std::min(kRead, backlog.size() - at);
+      std::memcpy(room.data(), backlog.data() + at, n);
+      framer.commit(n);
+      at += n;
+      most = std::max(most, framer.capacity());
+      Bytes packet;
+      while (framer.next(packet) == PacketFramer::Status::Packet) ++packets;
+    }
+    return packets;
+  };
+  PacketFramer unreserved;
+  size_t most = 0;
+  EXPECT_EQ(drain_in_reads(unreserved, most), 40);
+  EXPECT_GT(most, kRead);  // grew past one read's room
+
+  PacketFramer reserved;
+  reserved.reserve(2 * kRead);
+  most = 0;
+  EXPECT_EQ(drain_in_reads(reserved, most), 40);
+  EXPECT_EQ(most, 2 * kRead);
+  EXPECT_EQ(reserved.buffered(), 0u);
+}
+
 TEST(ViconWire, FramerRejectsBadMagicAndOversizeFromTheHeaderAlone) {
   PacketFramer framer;
   const unsigned char bad_magic[] = {0x47, 0x45, 0x54, 0x20, 0x2F, 0x20, 0x48, 0x54};  // "GET / HT"
