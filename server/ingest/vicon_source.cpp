@@ -28,7 +28,7 @@ uint64_t marker_key(uint32_t subject_id, uint32_t marker_id) {
 constexpr uint32_t kWantedTypes[] = {type::StreamInfo,      type::SubjectInfo, type::FrameInfo, type::LabeledRecons,
                                      type::UnlabeledRecons, type::Timecode,    type::Contents};
 
-// Bytes asked of the socket per read: many frames of 350 markers, so a backlog drains in few reads.
+// Bytes asked of the socket per read: several frames of 350 markers, so a backlog drains in few reads.
 constexpr size_t kReadBytes = 64 * 1024;
 
 }  // namespace
