@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <numeric>
 #include <stdexcept>
 
 #include "core/deform/lane_vectors.h"
@@ -30,6 +31,44 @@ inline __attribute__((always_inline)) Lanes lane_sqrt(const Lanes& x) {
   return r;
 }
 
+// The unit area-weighted normals of one block of the normals' fans (see State::normal_rows and
+// vertex_normals), x y z _ per segment. Exactly: rows read with 3-float loads (the block reads
+// the buffer's last point); a template argument, so that the loop has no branch.
+template <bool kExactly>
+inline __attribute__((always_inline)) void block_normals(const float* __restrict p, const int* __restrict rows,
+                                                         int row_count, Lanes& unit) {
+  auto load = [p](const int* row, Lanes& points) __attribute__((always_inline)) {
+    if constexpr (kExactly)
+      load_quads_exactly(p, row, points);
+    else
+      load_quads(p, row, points);
+  };
+  Lanes centre, a, a_rotated;
+  load(rows, centre);
+  load(rows + kQuadsPerLanes, a);
+  a -= centre;
+  rotate_xyz(a, a_rotated);
+  Lanes plus = {}, minus = {};  // two sums: two independent multiply-add chains
+  for (int k = 2; k < row_count; ++k) {
+    Lanes b, b_rotated;
+    load(rows + static_cast<size_t>(k) * kQuadsPerLanes, b);
+    b -= centre;
+    rotate_xyz(b, b_rotated);
+    plus += a * b_rotated;  // twice the face's area: area-weighted
+    minus += a_rotated * b;
+    a = b, a_rotated = b_rotated;
+  }
+  Lanes n, squared_yzx, squared_zxy;
+  rotate_xyz(plus - minus, n);
+  const Lanes squared = n * n;
+  rotate_xyz(squared, squared_yzx);
+  rotate_xyz(squared_yzx, squared_zxy);
+  // 1 / |n| in x, y and z of each segment. A zero normal stays zero: the smallest normal float
+  // keeps the root finite, and is far below the squared area of any face of a mesh in mm (a
+  // comparison and select here was compiled to sixteen scalar compares).
+  unit = n * ((Lanes{} + 1.0f) / lane_sqrt(squared + squared_yzx + squared_zxy + __FLT_MIN__));
+}
+
 // What eq. 8 needs of one part at the solved frame, in float: the cluster stage broadcasts
 // these scalars over its vector lanes.
 struct SolvedPart {
@@ -50,6 +89,9 @@ struct InfluenceCluster {
 // 64 against 32: about 3% faster on one thread and on two (the cull of the part's centres is
 // shared by four lane blocks instead of two; the box it culls with grows a little).
 constexpr int kClusterSize = 64;
+// Vertex normals are computed in blocks of kQuadsPerLanes vertices formed within windows of
+// this many consecutive vertices (see State::normal_rows).
+constexpr int kNormalWindow = 64;
 // The indices of the centres near a cluster live on the stack; parts with more members than
 // this are culled and summed in several passes (never the case for ~350 markers in 17 parts).
 constexpr int kMaxGatheredCentres = 1024;
@@ -146,15 +188,21 @@ struct MeshDeformer::State {
   // per face, from the positions alone: vertex ranges run on different threads without a face
   // pass. Where the faces around v do not form one fan (border, non-manifold), the pieces are
   // separated by v itself, whose offset from v is zero and so adds nothing.
-  // Laid out for kLanes vertices at a time: block b (vertices kLanes*b ...) holds its fans
-  // lane by lane, row k the k-th neighbour of each lane (a float index, 3 * vertex, into the
-  // positions), padded to the block's longest fan with the lane's own vertex: a zero offset,
-  // so the pads add nothing either.
-  // Row 0 of a block is its own vertices; the rows' entries are in load order (load_points).
-  std::vector<int> fan_block_offsets;  // per block its first row in fan_rows, and one past the end
-  std::vector<int> fan_rows;           // kLanes entries per row
-  std::vector<uint8_t> fan_block_reads_last;  // per block: it reads the last vertex (load_points_exactly)
-
+  // Laid out for four vertices at a time, one per 128-bit segment of a Lanes register, each
+  // segment holding a point as x y z and one more float (see load_quads): a cross product is then
+  // two multiplies and two in-segment rotations, with no transpose. The vertices of a block need
+  // not be consecutive (each segment is stored to its own vertex), so blocks are formed inside
+  // windows of kNormalWindow consecutive vertices sorted by fan length: a block's fans are then
+  // about as long as each other, and padding them to the longest costs little (where vertices of
+  // 4 and 8 faces alternate, as in a triangulated quad mesh, consecutive blocks padded 20% of
+  // the rows). Block b's rows are normal_rows[4 * normal_block_rows[b] ...], row 0 its own
+  // vertices, row k the k-th entry of each lane's fan (a float index, 3 * vertex), padded to the
+  // block's longest fan with the lane's own vertex: a zero offset, so the pads add nothing. A
+  // window short of four vertices at the end repeats its last one, which is stored twice alike.
+  std::vector<int> normal_window_blocks;  // per window its first block, and one past the end
+  std::vector<int> normal_block_rows;     // per block its first row, and one past the end
+  std::vector<int> normal_rows;           // 4 entries per row
+  std::vector<uint8_t> normal_block_reads_last;  // per block: it reads the last vertex (load_quads_exactly)
 
   void store_solved(int p);
   void build_clusters(const DeformationModel& model);
@@ -289,25 +337,40 @@ void MeshDeformer::State::build_fans(const std::vector<std::array<int, 3>>& face
     fan_offsets[v + 1] = static_cast<int>(fans.size());
   }
 
-  const int blocks = (vertex_count + kLanes - 1) / kLanes;
-  fan_block_offsets.assign(static_cast<size_t>(blocks) + 1, 0);
-  fan_block_reads_last.assign(static_cast<size_t>(blocks), 0);
-  fan_rows.clear();
-  for (int b = 0; b < blocks; ++b) {
-    const int first = b * kLanes, last = std::min(first + kLanes, vertex_count);
-    int rows = 0;
-    for (int v = first; v < last; ++v) rows = std::max(rows, fan_offsets[v + 1] - fan_offsets[v]);
-    for (int k = -1; k < rows; ++k)  // -1: the block's own vertices
-      for (int l = 0; l < kLanes; ++l) {
-        const int v = std::min(first + load_lane(l), last - 1);  // lanes past the mesh repeat its last vertex
-        const int length = fan_offsets[v + 1] - fan_offsets[v];
-        const int read = k < 0 ? v : (k < length ? fans[fan_offsets[v] + k] : v);
-        fan_rows.push_back(3 * read);
-        fan_block_reads_last[b] |= read == vertex_count - 1;
+  const int windows = (vertex_count + kNormalWindow - 1) / kNormalWindow;
+  normal_window_blocks.assign(1, 0);
+  normal_block_rows.assign(1, 0);
+  normal_rows.clear();
+  normal_block_reads_last.clear();
+  std::vector<int> order;
+  auto fan_length = [&](int v) { return fan_offsets[v + 1] - fan_offsets[v]; };
+  for (int w = 0; w < windows; ++w) {
+    const int first = w * kNormalWindow, last = std::min(first + kNormalWindow, vertex_count);
+    order.resize(static_cast<size_t>(last - first));
+    std::iota(order.begin(), order.end(), first);
+    std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return fan_length(a) < fan_length(b); });
+    for (size_t q = 0; q < order.size(); q += kQuadsPerLanes) {
+      int lane_vertex[kQuadsPerLanes];
+      int rows = 0;
+      for (int l = 0; l < kQuadsPerLanes; ++l) {
+        lane_vertex[l] = order[std::min(q + l, order.size() - 1)];
+        rows = std::max(rows, fan_length(lane_vertex[l]));
       }
-    fan_block_offsets[b + 1] = fan_block_offsets[b] + rows + 1;
+      bool reads_last = false;
+      for (int k = -1; k < rows; ++k)  // -1: the block's own vertices
+        for (int v : lane_vertex) {
+          const int read = k < 0 ? v : (k < fan_length(v) ? fans[fan_offsets[v] + k] : v);
+          normal_rows.push_back(3 * read);
+          reads_last |= read == vertex_count - 1;
+        }
+      normal_block_reads_last.push_back(reads_last);
+      normal_block_rows.push_back(normal_block_rows.back() + rows + 1);
+    }
+    normal_window_blocks.push_back(static_cast<int>(normal_block_rows.size()) - 1);
   }
-  fan_rows.shrink_to_fit();
+  normal_rows.shrink_to_fit();
+  normal_block_rows.shrink_to_fit();
+  normal_block_reads_last.shrink_to_fit();
 }
 
 MeshDeformer::~MeshDeformer() = default;
@@ -461,11 +524,13 @@ void MeshDeformer::blend_vertices(int begin, int end, std::span<float> positions
   }
 }
 
-// kLanes vertices at a time, one per lane: the neighbours are loaded row by row, so each lane
-// runs its own fan, and the normalisation follows in the same registers. Measured against one
-// vertex at a time: about 4% of the whole frame faster; loading the rows with AVX2/AVX-512
-// gather instructions (-mtune-ctrl=use_gather) was 20% slower than element loads, and the
-// 4-float loads and transposes of load_points and store_points another 3-5% faster than those.
+// Four vertices at a time, one per 128-bit segment: each row of neighbours is four 4-float
+// loads, and the area-weighted sum of (n_i - v) x (n_i+1 - v) is accumulated as
+// a * rotated(b) - rotated(a) * b, the cross product with its components rotated, which one
+// more rotation per vertex puts right. This replaced sixteen vertices per register with x, y
+// and z in separate registers, which needed a transpose of every row loaded and a fan padded
+// to the longest of sixteen (see State::normal_rows): the frame's work fell from about 1170 to
+// 1070 us on one thread (deform_benchmark's frame_work_p50_us).
 // Every vertex goes through the same lane code whatever the range, so a normal does not
 // depend on how the vertices were cut into ranges; a range only limits what is written.
 __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
@@ -475,43 +540,22 @@ void MeshDeformer::vertex_normals(int begin, int end, std::span<const float> pos
   const size_t needed = static_cast<size_t>(s.vertex_count) * 3;
   if (positions.size() < needed || normals.size() < needed) return;
   begin = std::max(begin, 0);
+  if (begin >= end) return;
   const float* __restrict p = positions.data();
   float* __restrict out = normals.data();
-  const Lanes zero = {}, one = zero + 1.0f;
-  for (int block = begin / kLanes; block * kLanes < end; ++block) {
-    const int first = block * kLanes;
-    const bool exactly = s.fan_block_reads_last[block];
-    const int* rows = &s.fan_rows[static_cast<size_t>(s.fan_block_offsets[block]) * kLanes];
-    const int row_count = s.fan_block_offsets[block + 1] - s.fan_block_offsets[block];
-    Lanes x, y, z;
-    if (exactly)
-      load_points_exactly(p, rows, x, y, z);
+  const int first_block = s.normal_window_blocks[begin / kNormalWindow];
+  const int end_block = s.normal_window_blocks[(end - 1) / kNormalWindow + 1];
+  for (int block = first_block; block < end_block; ++block) {
+    const int* rows = &s.normal_rows[static_cast<size_t>(s.normal_block_rows[block]) * kQuadsPerLanes];
+    const int row_count = s.normal_block_rows[block + 1] - s.normal_block_rows[block];
+    Lanes unit;
+    if (s.normal_block_reads_last[block])
+      block_normals<true>(p, rows, row_count, unit);
     else
-      load_points(p, rows, x, y, z);
-    Lanes nx = zero, ny = zero, nz = zero, px = zero, py = zero, pz = zero;
-    for (int k = 1; k < row_count; ++k) {
-      const int* row = rows + static_cast<size_t>(k) * kLanes;
-      Lanes rx, ry, rz;
-      if (exactly)
-        load_points_exactly(p, row, rx, ry, rz);
-      else
-        load_points(p, row, rx, ry, rz);
-      rx -= x, ry -= y, rz -= z;
-      nx += py * rz - pz * ry;  // twice the face's area: area-weighted
-      ny += pz * rx - px * rz;
-      nz += px * ry - py * rx;
-      px = rx, py = ry, pz = rz;
-    }
-    const Lanes squared = nx * nx + ny * ny + nz * nz;
-    const Lanes scale = squared > zero ? one / lane_sqrt(squared) : zero;
-    nx *= scale, ny *= scale, nz *= scale;
-    if (first >= begin && first + kLanes <= end) {
-      store_points(out + static_cast<size_t>(first) * 3, nx, ny, nz);
-      continue;
-    }
-    for (int l = std::max(begin - first, 0); l < std::min(kLanes, end - first); ++l) {
-      float* n = out + static_cast<size_t>(first + l) * 3;
-      n[0] = nx[l], n[1] = ny[l], n[2] = nz[l];
+      block_normals<false>(p, rows, row_count, unit);
+    for (int q = 0; q < kQuadsPerLanes; ++q) {
+      const int at = rows[q];
+      if (at >= 3 * begin && at < 3 * end) __builtin_memcpy(out + at, reinterpret_cast<const float*>(&unit) + 4 * q, 3 * sizeof(float));
     }
   }
 }
@@ -525,6 +569,7 @@ bool MeshDeformer::deform(std::span<const Vec3> markers, std::span<float> positi
 }
 
 int MeshDeformer::vertex_count() const { return state_->vertex_count; }
+int MeshDeformer::normal_group_size() const { return kNormalWindow; }
 DeformationMode MeshDeformer::mode() const { return state_->mode; }
 
 size_t MeshDeformer::memory_bytes() const {
@@ -533,7 +578,7 @@ size_t MeshDeformer::memory_bytes() const {
   size_t total = sizeof(State) + bytes(s.member_offsets) + bytes(s.member_markers) +
                  bytes(s.member_scratch) + bytes(s.influence_offsets) + bytes(s.influence_slots) +
                  bytes(s.solved) + bytes(s.centres) +
-                 bytes(s.fan_block_offsets) + bytes(s.fan_rows) + bytes(s.fan_block_reads_last) + bytes(s.clusters) +
+                 bytes(s.normal_window_blocks) + bytes(s.normal_block_rows) + bytes(s.normal_rows) + bytes(s.normal_block_reads_last) + bytes(s.clusters) +
                  bytes(s.cluster_lanes) + bytes(s.cluster_result);
   for (const PartDeformer& part : s.parts) {
     const int y = part.model().member_count();

@@ -53,6 +53,10 @@ class MeshDeformer {
   // Unit area-weighted vertex normals [begin, end) (3 floats per vertex) from the whole
   // mesh's deformed positions.
   void vertex_normals(int begin, int end, std::span<const float> positions, std::span<float> normals) const;
+  // Normals are computed for groups of this many consecutive vertices: a range that starts or
+  // ends inside a group computes the whole group and writes only its own part of it, so callers
+  // cutting the mesh into ranges should cut at multiples of this.
+  int normal_group_size() const;
 
   // All stages on the calling thread. `normals` may be empty (not wanted).
   bool deform(std::span<const Vec3> markers, std::span<float> positions, std::span<float> normals);

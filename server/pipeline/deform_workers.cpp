@@ -12,7 +12,7 @@ namespace skinstream::server {
 namespace {
 
 constexpr int kClustersPerTask = 8;  // ~6 us of work: small enough to share, large enough to count
-constexpr int kVertexTasks = 32;     // per vertex stage
+constexpr int kVertexTasks = 32;     // per vertex stage, at most (chunks are whole normal groups)
 constexpr int kMaxTasks = 0xffff;    // per stage: tasks are counted in 16 bits
 // A woken worker spins this long for its frame before it sleeps again: longer than the fill
 // that get_ready() overlaps, short enough not to hold a core when frames stop.
@@ -66,7 +66,8 @@ DeformWorkers::DeformWorkers(MeshDeformer& deformer, const DeformWorkerOptions& 
       cluster_chunks_.push_back({*it, begin, c});
     }
   fits_and_clusters_.tasks = static_cast<uint32_t>(parts + cluster_chunks_.size());
-  vertex_chunk_ = std::max(1, (deformer_.vertex_count() + kVertexTasks - 1) / kVertexTasks);
+  const int group = deformer_.normal_group_size();  // chunks of whole groups: no normal computed twice
+  vertex_chunk_ = std::max(1, (deformer_.vertex_count() + kVertexTasks * group - 1) / (kVertexTasks * group)) * group;
   vertices_.tasks = normals_stage_.tasks =
       static_cast<uint32_t>((deformer_.vertex_count() + vertex_chunk_ - 1) / vertex_chunk_);
   for (int i = 1; i < threads_; ++i) {

@@ -1,10 +1,12 @@
-// The normals' transposes (16 points as x y z triples <-> x, y, z in lanes) at every ISA level
-// MeshDeformer is cloned for: GCC lowers the same shuffles differently for AVX-512, AVX2 and
-// SSE2, and the deformer's other tests only run the clone of the machine they run on.
+// The normals' point loads (four points as x y z _ in the segments of one register) and the
+// in-segment rotation at every ISA level MeshDeformer is cloned for: GCC lowers the same
+// shuffles differently for AVX-512, AVX2 and SSE2, and the deformer's other tests only run the
+// clone of the machine they run on.
 #include "core/deform/lane_vectors.h"
 
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <random>
 #include <string>
 #include <vector>
@@ -12,68 +14,59 @@
 namespace skinstream::simd {
 namespace {
 
-struct Transposed {
-  Lanes x, y, z;        // load_points
-  Lanes ex, ey, ez;     // load_points_exactly
-  float stored[3 * kLanes];  // store_points of x, y, z
+struct Loaded {
+  Lanes quads;     // load_quads
+  Lanes exactly;   // load_quads_exactly
+  Lanes rotated;   // rotate_xyz of quads
 };
 
 // The helpers inlined into a function compiled for one ISA level.
-#define SKINSTREAM_TRANSPOSE_AT(name, ...)                                                        \
-  __VA_ARGS__ void name(const float* p, const int* index, Transposed& out) {                      \
-    load_points(p, index, out.x, out.y, out.z);                                                    \
-    load_points_exactly(p, index, out.ex, out.ey, out.ez);                                         \
-    store_points(out.stored, out.x, out.y, out.z);                                                 \
+#define SKINSTREAM_LOAD_AT(name, ...)                                    \
+  __VA_ARGS__ void name(const float* p, const int* index, Loaded& out) { \
+    load_quads(p, index, out.quads);                                     \
+    load_quads_exactly(p, index, out.exactly);                           \
+    rotate_xyz(out.quads, out.rotated);                                  \
   }
-SKINSTREAM_TRANSPOSE_AT(transpose_baseline)
+SKINSTREAM_LOAD_AT(load_baseline)
 #if defined(__x86_64__)
-SKINSTREAM_TRANSPOSE_AT(transpose_v3, __attribute__((target("arch=x86-64-v3"))))
-SKINSTREAM_TRANSPOSE_AT(transpose_v4, __attribute__((target("arch=x86-64-v4"))))
+SKINSTREAM_LOAD_AT(load_v3, __attribute__((target("arch=x86-64-v3"))))
+SKINSTREAM_LOAD_AT(load_v4, __attribute__((target("arch=x86-64-v4"))))
 #endif
 
-void check(void (*transpose)(const float*, const int*, Transposed&), const std::string& level) {
+void check(void (*load)(const float*, const int*, Loaded&), const std::string& level) {
   constexpr int kPoints = 500;
   std::mt19937 rng(7);
   std::uniform_real_distribution<float> value(-1000.0f, 1000.0f);
-  std::vector<float> p(3 * kPoints + 1);  // load_points reads one float past a point
+  std::vector<float> p(3 * kPoints + 1);  // load_quads reads one float past a point
   for (float& f : p) f = value(rng);
   std::uniform_int_distribution<int> point(0, kPoints - 1);
   for (int trial = 0; trial < 200; ++trial) {
-    int index[kLanes];
+    int index[kQuadsPerLanes];
     for (int& i : index) i = 3 * point(rng);
-    Transposed t;
-    transpose(p.data(), index, t);
-    for (int l = 0; l < kLanes; ++l) {
-      const int lane = load_lane(l);  // the point loaded l-th lands in this lane
-      const float* expected = &p[index[l]];
-      ASSERT_EQ(t.x[lane], expected[0]) << level << ", trial " << trial << ", load " << l;
-      ASSERT_EQ(t.y[lane], expected[1]) << level;
-      ASSERT_EQ(t.z[lane], expected[2]) << level;
-      ASSERT_EQ(t.ex[lane], expected[0]) << level;
-      ASSERT_EQ(t.ey[lane], expected[1]) << level;
-      ASSERT_EQ(t.ez[lane], expected[2]) << level;
-    }
-    for (int lane = 0; lane < kLanes; ++lane) {
-      ASSERT_EQ(t.stored[3 * lane], t.x[lane]) << level << ", lane " << lane;
-      ASSERT_EQ(t.stored[3 * lane + 1], t.y[lane]) << level;
-      ASSERT_EQ(t.stored[3 * lane + 2], t.z[lane]) << level;
+    Loaded l;
+    load(p.data(), index, l);
+    for (int q = 0; q < kQuadsPerLanes; ++q) {
+      const float* expected = &p[index[q]];
+      for (int a = 0; a < 4; ++a) ASSERT_EQ(l.quads[4 * q + a], expected[a]) << level << ", trial " << trial << ", point " << q;
+      for (int a = 0; a < 3; ++a) ASSERT_EQ(l.exactly[4 * q + a], expected[a]) << level << ", point " << q;
+      ASSERT_EQ(l.exactly[4 * q + 3], 0.0f) << level << ", point " << q;
+      ASSERT_EQ(l.rotated[4 * q + 0], expected[1]) << level << ", point " << q;  // y z x, the fourth kept
+      ASSERT_EQ(l.rotated[4 * q + 1], expected[2]) << level;
+      ASSERT_EQ(l.rotated[4 * q + 2], expected[0]) << level;
+      ASSERT_EQ(l.rotated[4 * q + 3], expected[3]) << level;
     }
   }
 }
 
-TEST(LaneVectors, LoadLaneIsItsOwnInverse) {
-  for (int l = 0; l < kLanes; ++l) EXPECT_EQ(load_lane(load_lane(l)), l);
-}
-
-TEST(LaneVectors, TransposesAtEveryIsaLevelTheDeformerIsClonedFor) {
-  check(transpose_baseline, "baseline");
+TEST(LaneVectors, LoadsAndRotatesAtEveryIsaLevelTheDeformerIsClonedFor) {
+  check(load_baseline, "baseline");
 #if defined(__x86_64__)
   if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma"))
-    check(transpose_v3, "x86-64-v3");
+    check(load_v3, "x86-64-v3");
   else
     std::printf("x86-64-v3 not run: this CPU lacks AVX2/FMA\n");
   if (__builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") && __builtin_cpu_supports("avx512bw"))
-    check(transpose_v4, "x86-64-v4");
+    check(load_v4, "x86-64-v4");
   else
     std::printf("x86-64-v4 not run: this CPU lacks AVX-512\n");
 #endif
