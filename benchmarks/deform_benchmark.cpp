@@ -121,13 +121,11 @@ void BM_DeformThreads(benchmark::State& state) {
   report(state, micros, deformer);
 }
 
-// One thread fed at 120 Hz: against BM_DeformOneThread, what the 7 ms between frames costs a
-// frame with no thread to wake. On this shared machine it is the caches: spinning between
-// frames instead of sleeping gave the same median (see the README). The wait is not timed.
-void BM_DeformOneThreadAt120Hz(benchmark::State& state) {
+// Runs `deform(frame markers)` once per frame of the take at 120 Hz, timing each run but not
+// the wait before it, and returns the times in microseconds.
+template <typename Deform>
+std::vector<double> deform_at_120hz(benchmark::State& state, Deform&& deform) {
   const Scenario& s = scenario();
-  MeshDeformer deformer(s.model, s.subject);
-  std::vector<float> positions(static_cast<size_t>(deformer.vertex_count()) * 3), normals(positions.size());
   std::vector<double> micros;
   micros.reserve(1 << 14);
   const auto period = std::chrono::nanoseconds(1'000'000'000 / 120);
@@ -139,11 +137,24 @@ void BM_DeformOneThreadAt120Hz(benchmark::State& state) {
     std::this_thread::sleep_until(due);
     state.ResumeTiming();
     const auto start = std::chrono::steady_clock::now();
-    deformer.deform(s.frames[frame], positions, normals);
+    deform(s.frames[frame]);
     micros.push_back(std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count());
-    benchmark::DoNotOptimize(positions.data());
     frame = (frame + 1) % s.frames.size();
   }
+  return micros;
+}
+
+// One thread fed at 120 Hz: against BM_DeformOneThread, what the 7 ms between frames costs a
+// frame with no thread to wake. On this shared machine it is the caches: spinning between
+// frames instead of sleeping gave the same median (see the README).
+void BM_DeformOneThreadAt120Hz(benchmark::State& state) {
+  const Scenario& s = scenario();
+  MeshDeformer deformer(s.model, s.subject);
+  std::vector<float> positions(static_cast<size_t>(deformer.vertex_count()) * 3), normals(positions.size());
+  std::vector<double> micros = deform_at_120hz(state, [&](const std::vector<Vec3>& markers) {
+    deformer.deform(markers, positions, normals);
+    benchmark::DoNotOptimize(positions.data());
+  });
   report(state, micros, deformer);
 }
 
@@ -151,7 +162,7 @@ void BM_DeformOneThreadAt120Hz(benchmark::State& state) {
 // sleeps, and each frame pays for waking it unless it anticipated the frame. Argument 0: the
 // worker woken by run() (deform_spin_lead_us 0); 1: a 1000 us spin lead (the daemon's
 // default); 2: the lead and both threads pinned to the last two CPUs (deform_cpus "0,1" on a
-// 2-core machine, where "auto" does not pin). The wait between frames is not timed.
+// 2-core machine, where "auto" does not pin).
 void BM_DeformTwoThreadsAt120Hz(benchmark::State& state) {
   const Scenario& s = scenario();
   MeshDeformer deformer(s.model, s.subject);
@@ -165,23 +176,12 @@ void BM_DeformTwoThreadsAt120Hz(benchmark::State& state) {
     server::pin_this_thread(options.cpus[0]);
   }
   std::vector<double> micros;
-  micros.reserve(1 << 14);
   {
     server::DeformWorkers workers(deformer, options);
-    const auto period = std::chrono::nanoseconds(1'000'000'000 / 120);
-    auto due = std::chrono::steady_clock::now();
-    size_t frame = 0;
-    for (auto _ : state) {
-      state.PauseTiming();
-      due += period;
-      std::this_thread::sleep_until(due);
-      state.ResumeTiming();
-      const auto start = std::chrono::steady_clock::now();
-      workers.run(s.frames[frame], positions, normals);
-      micros.push_back(std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count());
+    micros = deform_at_120hz(state, [&](const std::vector<Vec3>& markers) {
+      workers.run(markers, positions, normals);
       benchmark::DoNotOptimize(positions.data());
-      frame = (frame + 1) % s.frames.size();
-    }
+    });
   }
   state.counters["pinned"] = options.cpus.empty() ? 0 : 1;
   if (!options.cpus.empty()) server::set_this_thread_cpus(allowed);  // the benchmarks after this one run unpinned
