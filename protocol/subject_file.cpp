@@ -86,6 +86,8 @@ void encode(const DeformationModel* d, ByteWriter& w) {
   w.put<double>(d->registration_rms_mm);
   w.put<uint32_t>(static_cast<uint32_t>(d->part_rbf_ridge.size()));  // version 3
   for (double ridge : d->part_rbf_ridge) w.put<double>(ridge);
+  w.put<uint32_t>(static_cast<uint32_t>(d->part_quadratic_ridge.size()));  // version 4
+  for (double ridge : d->part_quadratic_ridge) w.put<double>(ridge);
 }
 
 std::optional<DeformationModel> decode_deformation(ByteReader& r, uint32_t version) {
@@ -114,6 +116,10 @@ std::optional<DeformationModel> decode_deformation(ByteReader& r, uint32_t versi
   if (version >= 3) {
     d.part_rbf_ridge.resize(r.get_count(8));
     for (double& ridge : d.part_rbf_ridge) ridge = r.get<double>();
+  }
+  if (version >= 4) {
+    d.part_quadratic_ridge.resize(r.get_count(8));
+    for (double& ridge : d.part_quadratic_ridge) ridge = r.get<double>();
   }
   return d;
 }

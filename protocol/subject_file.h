@@ -22,7 +22,8 @@
 
 namespace skinstream {
 
-inline constexpr uint32_t kSubjectFileVersion = 3;  // reads 1 (no deformation model), 2 (no ridges) and 3
+// Reads 1 (no deformation model), 2 (no ridges), 3 (no quadratic ridges) and 4.
+inline constexpr uint32_t kSubjectFileVersion = 4;
 
 struct SubjectFile {
   SubjectModel model;

@@ -129,6 +129,7 @@ void add_build_subject(CLI::App& app) {
                      {"max_part_rigid_rms_mm", d.max_part_rigid_rms_mm},
                      {"boundary_markers", d.boundary_markers},
                      {"mean_parts_per_vertex", d.mean_influences_per_vertex},
+                     {"part_quadratic_ridges", to_json(d.part_quadratic_ridges)},
                      {"part_rbf_ridges", to_json(d.part_ridges)}};
     }
     std::printf("%s\n", out.dump(2).c_str());

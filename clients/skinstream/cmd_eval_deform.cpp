@@ -90,6 +90,7 @@ void add_eval_deform(CLI::App& app) {
     result["max_part_rigid_rms_mm"] = setup.build.max_part_rigid_rms_mm;
     result["boundary_markers"] = setup.build.boundary_markers;
     result["mean_parts_per_vertex"] = setup.build.mean_influences_per_vertex;
+    result["part_quadratic_ridges"] = to_json(setup.build.part_quadratic_ridges);
     result["part_rbf_ridges"] = to_json(setup.build.part_ridges);
     result["build_seconds"] = setup.build_seconds;
     result["takes"] = nlohmann::ordered_json::array();

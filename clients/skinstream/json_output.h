@@ -3,6 +3,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/evaluation/error_stats.h"
+#include "core/offline/quadratic_ridge_selection.h"
 #include "core/offline/rbf_ridge_selection.h"
 
 namespace skinstream::cli {
@@ -15,6 +16,15 @@ inline nlohmann::json to_json(const ErrorStats& s) {
 inline nlohmann::json to_json(const std::vector<RidgeChoice>& parts) {
   nlohmann::json out = nlohmann::json::array();
   for (const RidgeChoice& c : parts)
+    out.push_back({{"ridge", c.ridge}, {"loo_rms_mm", c.loo_rms_mm}, {"loo_rms_exact_mm", c.loo_rms_exact_mm}});
+  return out;
+}
+
+// Per part the ridge on eq. 6's quadratic modes and the leave-one-out miss that chose it
+// (null for the exact fit where it interpolates a member).
+inline nlohmann::json to_json(const std::vector<QuadraticRidgeChoice>& parts) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const QuadraticRidgeChoice& c : parts)
     out.push_back({{"ridge", c.ridge}, {"loo_rms_mm", c.loo_rms_mm}, {"loo_rms_exact_mm", c.loo_rms_exact_mm}});
   return out;
 }

@@ -85,6 +85,16 @@ std::string DeformationModel::validate(int marker_count) const {
       return out.str();
     }
   }
+  if (!part_quadratic_ridge.empty() && part_quadratic_ridge.size() != part_names.size()) {
+    out << "deformation model: " << part_quadratic_ridge.size() << " quadratic ridges for " << part_count() << " parts";
+    return out.str();
+  }
+  for (size_t p = 0; p < part_quadratic_ridge.size(); ++p) {
+    if (!(part_quadratic_ridge[p] >= 0.0 && part_quadratic_ridge[p] <= 1e4)) {
+      out << "deformation model: part " << p << " has quadratic ridge " << part_quadratic_ridge[p] << " (0 to 10000)";
+      return out.str();
+    }
+  }
   if (auto e = check_csr(vertex_influence_offsets, reference_vertices.size(), vertex_influences.size(), "vertex influences"); !e.empty()) return "deformation model: " + e;
   for (int v = 0; v < n; ++v) {
     double sum = 0.0;

@@ -29,6 +29,9 @@ struct DeformationModel {
   // Per part the ridge of eq. 7 (PartModel::rbf_ridge), chosen by leave-one-out error over the
   // training take; empty (a subject file before version 3): 0 for every part.
   std::vector<double> part_rbf_ridge;
+  // Per part the ridge on eq. 6's quadratic modes (PartModel::quadratic_ridge), chosen by
+  // leave-one-out error over the training take; empty (a subject file before version 4): 0.
+  std::vector<double> part_quadratic_ridge;
 
   std::vector<int> vertex_influence_offsets{0};  // CSR over vertices
   std::vector<PartInfluence> vertex_influences;  // beta_{j,p}, each vertex sums to 1

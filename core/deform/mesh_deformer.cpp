@@ -234,7 +234,7 @@ MeshDeformer::MeshDeformer(const DeformationModel& model, const SubjectModel& su
     }
     s.solved[p].first_centre = s.member_offsets[p];
     s.solved[p].centre_count = static_cast<int>(reference.size());
-    PartModel part = build_part_model(reference);
+    PartModel part = build_part_model(reference, model.part_quadratic_ridge.empty() ? 0.0 : model.part_quadratic_ridge[p]);
     if (!model.part_rbf_ridge.empty()) part.rbf_ridge = model.part_rbf_ridge[p];
     s.parts.emplace_back(std::move(part), mode);
   }

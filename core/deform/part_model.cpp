@@ -44,12 +44,15 @@ double largest_nearest_member_distance(const std::vector<Vec3>& points) {
 
 }  // namespace
 
-PartModel build_part_model(const std::vector<Vec3>& reference_member_positions) {
+PartModel build_part_model(const std::vector<Vec3>& reference_member_positions, double quadratic_ridge) {
   if (reference_member_positions.empty()) throw std::invalid_argument("build_part_model: no members");
   for (const Vec3& p : reference_member_positions)
     if (!is_present(p)) throw std::invalid_argument("build_part_model: non-finite member position");
+  if (!(quadratic_ridge >= 0.0) || !std::isfinite(quadratic_ridge))
+    throw std::invalid_argument("build_part_model: quadratic ridge must be finite and not negative");
 
   PartModel model;
+  model.quadratic_ridge = quadratic_ridge;
   const int count = static_cast<int>(reference_member_positions.size());
   model.reference_frame = principal_frame(reference_member_positions);
   model.local_reference_points.resize(count);
@@ -83,6 +86,19 @@ PartModel build_part_model(const std::vector<Vec3>& reference_member_positions) 
     }
   }
   Eigen::MatrixXd scaled_pinv = svd.matrixV() * inverse_singular.asDiagonal() * svd.matrixU().transpose();
+  if (count >= 9 && quadratic_ridge > 0.0) {
+    // Ridge regression of the deviations on the modes, penalising the quadratic ones:
+    // M = Q^T (Q Q^T + ridge * Y * D)^+ with D = diag(0 0 0 1 1 1 1 1 1). Per member (times Y),
+    // so that a ridge means the same for a part of 9 members as for one of 150.
+    Eigen::Matrix<double, 9, 9> normal = scaled * scaled.transpose();
+    normal.diagonal().tail<6>().array() += quadratic_ridge * count;
+    const Eigen::JacobiSVD<Eigen::Matrix<double, 9, 9>> normal_svd(normal, Eigen::ComputeFullU | Eigen::ComputeFullV);
+    const auto& values = normal_svd.singularValues();
+    Eigen::Matrix<double, 9, 1> inverse_values = Eigen::Matrix<double, 9, 1>::Zero();
+    for (int k = 0; k < 9; ++k)
+      if (values(k) > values(0) * kRelativeRankTolerance && values(k) > 0) inverse_values(k) = 1.0 / values(k);
+    scaled_pinv = scaled.transpose() * (normal_svd.matrixV() * inverse_values.asDiagonal() * normal_svd.matrixU().transpose());
+  }
   if (count < 9) {
     // Eq. 6 needs Q0 Q0^T invertible, which fewer members than the 9 modes can never give: the
     // minimum-norm fit then puts arbitrary curvature between them (measured: up to 500 mm

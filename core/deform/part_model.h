@@ -30,6 +30,13 @@ struct PartModel {
   // the identity instead of a minimum-norm A, which would shrink unconstrained directions).
   QuadraticTransform reference_projection = QuadraticTransform::Zero();
   int quadratic_rank = 0;  // numerical rank of Q0 (9 = full quadratic fit)
+  // Ridge on the six quadratic modes of eq. 6, per member, in the scaled coordinates of the
+  // fit: 0 is the paper's least-squares fit; larger values draw the fit towards the linear
+  // modes alone. With only a few members more than the 9 modes, the exact fit follows every
+  // wobble of the skin with curvature between the markers (measured: 70-126 mm maxima on a held
+  // out synthetic subject); the subject builder chooses it per part by leave-one-out error over
+  // the training take (core/offline/quadratic_ridge_selection.h).
+  double quadratic_ridge = 0.0;
 
   // sigma of eq. 7: twice the largest nearest-member distance. 0 when the residual cannot be
   // interpolated (fewer than 2 distinct members); the RBF term is then skipped.
@@ -54,7 +61,8 @@ struct PartModel {
   }
 };
 
-// Throws std::invalid_argument for no members or a non-finite position.
-PartModel build_part_model(const std::vector<Vec3>& reference_member_positions);
+// Throws std::invalid_argument for no members, a non-finite position or a negative or
+// non-finite ridge.
+PartModel build_part_model(const std::vector<Vec3>& reference_member_positions, double quadratic_ridge = 0.0);
 
 }  // namespace skinstream

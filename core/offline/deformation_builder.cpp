@@ -61,7 +61,8 @@ DeformationModel build_deformation_model(const SubjectModel& subject, std::span<
   report.mean_influences_per_vertex =
       static_cast<double>(model.vertex_influences.size()) / static_cast<double>(model.vertex_count());
 
-  // Eq. 7's ridge per part, from the members' leave-one-out misses over the training take.
+  // Eq. 6's and then eq. 7's ridge per part, from the members' leave-one-out misses over the
+  // training take (eq. 7 fits what eq. 6 leaves, so its ridge is chosen on that fit).
   for (int p = 0; p < model.part_count(); ++p) {
     std::vector<Vec3> reference;
     std::vector<int> members;
@@ -69,8 +70,12 @@ DeformationModel build_deformation_model(const SubjectModel& subject, std::span<
       members.push_back(model.part_members[k].marker);
       reference.push_back(subject.reference_positions[members.back()]);
     }
-    const RidgeChoice choice =
-        choose_rbf_ridge(build_part_model(reference), members, training, frame_count, subject.marker_count());
+    const QuadraticRidgeChoice quadratic =
+        choose_quadratic_ridge(reference, members, training, frame_count, subject.marker_count());
+    model.part_quadratic_ridge.push_back(quadratic.ridge);
+    report.part_quadratic_ridges.push_back(quadratic);
+    const RidgeChoice choice = choose_rbf_ridge(build_part_model(reference, quadratic.ridge), members, training,
+                                                frame_count, subject.marker_count());
     model.part_rbf_ridge.push_back(choice.ridge);
     report.part_ridges.push_back(choice);
   }

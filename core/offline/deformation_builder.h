@@ -11,6 +11,7 @@
 #include "core/offline/marker_part_weights.h"
 #include "core/offline/mesh_registration.h"
 #include "core/offline/part_segmentation.h"
+#include "core/offline/quadratic_ridge_selection.h"
 #include "core/offline/rbf_ridge_selection.h"
 #include "core/subject_model.h"
 
@@ -37,6 +38,7 @@ struct DeformationBuildReport {
   int boundary_markers = 0;
   int markers_added_for_min_members = 0;
   double mean_influences_per_vertex = 0.0;
+  std::vector<QuadraticRidgeChoice> part_quadratic_ridges;  // eq. 6's per part, by leave-one-out error
   std::vector<RidgeChoice> part_ridges;  // eq. 7's ridge per part, by leave-one-out error
 };
 

@@ -123,6 +123,7 @@ DeformationModel limb_deformation(const SubjectModel& model) {
   }
   d.registration_rms_mm = 0.25;
   d.part_rbf_ridge = {0.0316};
+  d.part_quadratic_ridge = {3.16};
   return d;
 }
 
@@ -139,34 +140,58 @@ TEST_F(SubjectFile, DeformationModelRoundTripsExactly) {
   EXPECT_EQ(back.deformation->vertex_influence_offsets, d.vertex_influence_offsets);
   EXPECT_EQ(back.deformation->registration_rms_mm, 0.25);
   EXPECT_EQ(back.deformation->part_rbf_ridge, d.part_rbf_ridge);
+  EXPECT_EQ(back.deformation->part_quadratic_ridge, d.part_quadratic_ridge);
   EXPECT_EQ(back.model.marker_names, model_.marker_names);
   // Without a mesh: no deformation model, and read_subject still gives the markers.
   EXPECT_FALSE(read_subject_file(path_).deformation.has_value());
   EXPECT_EQ(read_subject(path).marker_names, model_.marker_names);
 }
 
-// A version 2 file (before the per-part ridges): the same layout without the ridge count at
-// the end of the deformation section. It still reads, with no ridges (0 for every part).
-TEST_F(SubjectFile, VersionTwoFileReadsWithoutRidges) {
-  DeformationModel d = limb_deformation(model_);
-  d.part_rbf_ridge.clear();
-  const std::string path = test::scratch_path("limb_v2.subject");
-  write_subject(model_, &d, path);
+// Rewrites a file written now as an older version: drops the last `dropped` bytes before the
+// CRC (the fields that version lacks, all at the end of the deformation section), then mends
+// the version, the size and the CRC.
+void make_older(const std::string& path, uint32_t version, size_t dropped) {
   std::vector<char> bytes = slurp(path);
-  bytes.erase(bytes.end() - 8, bytes.end() - 4);  // the ridge count (0), just before the CRC
-  const uint32_t version = 2;
+  bytes.erase(bytes.end() - 4 - static_cast<std::ptrdiff_t>(dropped), bytes.end() - 4);
   std::memcpy(bytes.data() + 8, &version, 4);
   uint64_t size = 0;
   std::memcpy(&size, bytes.data() + 12, 8);
-  size -= 4;
+  size -= dropped;
   std::memcpy(bytes.data() + 12, &size, 8);
   const uint32_t crc = crc32(reinterpret_cast<const unsigned char*>(bytes.data()) + 20, size);
   std::memcpy(bytes.data() + bytes.size() - 4, &crc, 4);
   spit(path, bytes);
+}
+
+// A version 2 file (before the per-part ridges): the same layout without the two ridge counts at
+// the end of the deformation section. It still reads, with no ridges (0 for every part).
+TEST_F(SubjectFile, VersionTwoFileReadsWithoutRidges) {
+  DeformationModel d = limb_deformation(model_);
+  d.part_rbf_ridge.clear();
+  d.part_quadratic_ridge.clear();
+  const std::string path = test::scratch_path("limb_v2.subject");
+  write_subject(model_, &d, path);
+  make_older(path, 2, 8);  // the two ridge counts (0 each)
   const auto back = read_subject_file(path);
   ASSERT_TRUE(back.deformation.has_value());
   EXPECT_TRUE(back.deformation->part_rbf_ridge.empty());
+  EXPECT_TRUE(back.deformation->part_quadratic_ridge.empty());
   EXPECT_EQ(back.deformation->registration_rms_mm, 0.25);
+  EXPECT_EQ(back.deformation->validate(model_.marker_count()), "");
+}
+
+// A version 3 file (eq. 7's ridges, before eq. 6's): reads with no quadratic ridges, which
+// means the paper's exact fit for every part.
+TEST_F(SubjectFile, VersionThreeFileReadsWithoutQuadraticRidges) {
+  DeformationModel d = limb_deformation(model_);
+  d.part_quadratic_ridge.clear();
+  const std::string path = test::scratch_path("limb_v3.subject");
+  write_subject(model_, &d, path);
+  make_older(path, 3, 4);  // the quadratic ridge count (0)
+  const auto back = read_subject_file(path);
+  ASSERT_TRUE(back.deformation.has_value());
+  EXPECT_EQ(back.deformation->part_rbf_ridge, d.part_rbf_ridge);
+  EXPECT_TRUE(back.deformation->part_quadratic_ridge.empty());
   EXPECT_EQ(back.deformation->validate(model_.marker_count()), "");
 }
 
@@ -187,6 +212,14 @@ TEST_F(SubjectFile, RefusesToWriteADeformationModelOfAnotherSubject) {
       FAIL() << "wrote unusable ridges";
     } catch (const FileError& e) {
       EXPECT_NE(std::string(e.what()).find("ridge"), std::string::npos) << e.what();
+    }
+    DeformationModel bad_quadratic = limb_deformation(model_);
+    bad_quadratic.part_quadratic_ridge = ridges;
+    try {
+      write_subject(model_, &bad_quadratic, test::scratch_path("quadratic_ridges.subject"));
+      FAIL() << "wrote unusable quadratic ridges";
+    } catch (const FileError& e) {
+      EXPECT_NE(std::string(e.what()).find("quadratic ridge"), std::string::npos) << e.what();
     }
   }
 }

@@ -87,5 +87,47 @@ TEST(PartModel, DegenerateMemberSetsStayFinite) {
   EXPECT_EQ(build_part_model({Vec3(1, 1, 1), Vec3(1, 1, 1)}).rbf_dilation, 0.0);
 }
 
+// The ridge on the quadratic modes: 0 is eq. 6 as before; any ridge keeps the rest pose; a
+// large one leaves the linear fit alone; a bad one is refused.
+TEST(PartModel, QuadraticRidgeShrinksOnlyTheQuadraticModes) {
+  std::mt19937_64 rng(5);
+  const std::vector<Vec3> members = random_points(rng, 20, Vec3(100, 80, 60));
+  const PartModel exact = build_part_model(members);
+  EXPECT_EQ(build_part_model(members, 0.0).pseudo_inverse, exact.pseudo_inverse);
+  EXPECT_THROW(build_part_model(members, -1.0), std::invalid_argument);
+  EXPECT_THROW(build_part_model(members, std::numeric_limits<double>::quiet_NaN()), std::invalid_argument);
+  EXPECT_THROW(build_part_model(members, std::numeric_limits<double>::infinity()), std::invalid_argument);
+
+  // A field with both linear and quadratic parts, as eq. 6 fits it from the members.
+  QuadraticTransform truth = identity_quadratic_transform();
+  std::normal_distribution<double> g;
+  for (int c = 0; c < 3; ++c)
+    for (int r = 0; r < 3; ++r) truth(r, c) += 0.05 * g(rng);
+  for (int c = 3; c < 9; ++c)
+    for (int r = 0; r < 3; ++r) truth(r, c) = 1e-3 * g(rng);
+  const Eigen::Matrix3Xd now = truth * exact.quadratic_reference;
+  double previous_curvature = std::numeric_limits<double>::infinity();
+  for (double ridge : {1e-3, 1e-1, 10.0, 1e4}) {
+    const PartModel model = build_part_model(members, ridge);
+    EXPECT_DOUBLE_EQ(model.quadratic_ridge, ridge);
+    EXPECT_LT((model.reference_projection * model.quadratic_reference - model.local_reference).cwiseAbs().maxCoeff(), 1e-9)
+        << "the rest pose moves at ridge " << ridge;
+    const QuadraticTransform fitted =
+        identity_quadratic_transform() - model.reference_projection + now * model.pseudo_inverse;
+    const double curvature = fitted.rightCols<6>().norm();
+    EXPECT_LT(curvature, previous_curvature) << ridge;
+    previous_curvature = curvature;
+  }
+  // At the top of the range the quadratic modes are gone: the linear fit alone (what parts of
+  // fewer than 9 members get).
+  Eigen::MatrixXd linear = exact.quadratic_reference.topRows(3);
+  const Eigen::Matrix3d linear_only = now * linear.transpose() * (linear * linear.transpose()).inverse();
+  const QuadraticTransform top =
+      identity_quadratic_transform() - build_part_model(members, 1e4).reference_projection +
+      now * build_part_model(members, 1e4).pseudo_inverse;
+  EXPECT_LT(top.rightCols<6>().cwiseAbs().maxCoeff(), 1e-3 * truth.rightCols<6>().cwiseAbs().maxCoeff());
+  EXPECT_LT((top.leftCols<3>() - linear_only).cwiseAbs().maxCoeff(), 1e-3);
+}
+
 }  // namespace
 }  // namespace skinstream

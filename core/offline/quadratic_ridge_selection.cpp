@@ -1,0 +1,71 @@
+#include "core/offline/quadratic_ridge_selection.h"
+
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include "core/deform/part_deformation.h"
+#include "core/deform/part_model.h"
+
+namespace skinstream {
+
+std::vector<double> quadratic_ridge_candidates() {
+  std::vector<double> ridges{0.0};
+  for (int k = -8; k <= 8; ++k) ridges.push_back(std::pow(10.0, k / 2.0));  // 2 per decade, 1e-4 .. 1e4
+  return ridges;
+}
+
+QuadraticRidgeChoice choose_quadratic_ridge(const std::vector<Vec3>& reference, std::span<const int> member_markers,
+                                            std::span<const Vec3> training, int frame_count, int marker_count,
+                                            int sample_frames) {
+  if (frame_count <= 0 || training.size() != static_cast<size_t>(frame_count) * marker_count)
+    throw std::invalid_argument("choose_quadratic_ridge: training is not frame_count x marker_count");
+  if (member_markers.size() != reference.size())
+    throw std::invalid_argument("choose_quadratic_ridge: member list does not match the part");
+  QuadraticRidgeChoice choice;
+  const int count = static_cast<int>(reference.size());
+  if (count < 9) return choice;
+
+  // The members' deviations from the reference in the part's frame after the rigid fit, one
+  // 3 x Y block per sampled frame: what eq. 6 fits.
+  const PartModel exact = build_part_model(reference);
+  PartDeformer rigid(exact, DeformationMode::Rigid);
+  std::vector<Eigen::Matrix3Xd> deviations;
+  std::vector<Vec3> members(member_markers.size());
+  const int frames = std::min(std::max(sample_frames, 1), frame_count);
+  for (int s = 0; s < frames; ++s) {
+    const int frame = static_cast<int>((static_cast<long long>(s) * frame_count) / frames);
+    for (size_t i = 0; i < members.size(); ++i)
+      members[i] = training[static_cast<size_t>(frame) * marker_count + member_markers[i]];
+    if (!rigid.solve(members)) throw std::invalid_argument("choose_quadratic_ridge: a training frame misses a member");
+    deviations.push_back(rigid.local_positions() - exact.local_reference);
+  }
+  choice.frames = frames;
+
+  const std::vector<double> ridges = quadratic_ridge_candidates();
+  std::vector<double> total(ridges.size(), 0.0);
+  for (size_t k = 0; k < ridges.size(); ++k) {
+    const PartModel part = ridges[k] == 0.0 ? exact : build_part_model(reference, ridges[k]);
+    const Eigen::MatrixXd hat = part.pseudo_inverse * part.quadratic_reference;  // H = M Q0
+    const Eigen::VectorXd left_out = Eigen::VectorXd::Ones(count) - hat.diagonal();
+    if ((left_out.array() < 1e-9).any()) {  // a member the fit interpolates: no prediction of it
+      total[k] = std::numeric_limits<double>::infinity();
+      continue;
+    }
+    const Eigen::ArrayXd weight = left_out.array().square().inverse();
+    for (const Eigen::Matrix3Xd& d : deviations) {
+      const Eigen::Matrix3Xd residual = d - d * hat;
+      total[k] += (residual.colwise().squaredNorm().transpose().array() * weight).sum();
+    }
+  }
+  size_t best = 0;
+  for (size_t k = 1; k < ridges.size(); ++k)
+    if (total[k] < total[best]) best = k;
+  const double samples = static_cast<double>(frames) * count;
+  choice.ridge = ridges[best];
+  choice.loo_rms_mm = std::sqrt(total[best] / samples);
+  choice.loo_rms_exact_mm = std::sqrt(total[0] / samples);
+  return choice;
+}
+
+}  // namespace skinstream
