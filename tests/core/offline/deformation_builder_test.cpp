@@ -45,6 +45,7 @@ TEST(DeformationBuilder, DeformedFramesMatchTheSyntheticTruth) {
   EXPECT_EQ(model.validate(subject.marker_count()), "");
   EXPECT_EQ(model.part_count(), 17);
   ASSERT_EQ(model.part_rbf_ridge.size(), 17u);  // one per part, chosen by leave-one-out error
+  ASSERT_EQ(model.part_quadratic_ridge.size(), 17u);  // likewise, eq. 6's
   for (int v = 0; v < model.vertex_count(); ++v) {
     double sum = 0.0;
     for (int k = model.vertex_influence_offsets[v]; k < model.vertex_influence_offsets[v + 1]; ++k)
