@@ -12,19 +12,13 @@ inline nlohmann::json to_json(const ErrorStats& s) {
   return {{"count", s.count}, {"mean", s.mean}, {"median", s.median}, {"p95", s.p95}, {"max", s.max}};
 }
 
-// Per part the ridge of eq. 7 and the leave-one-out miss that chose it.
-inline nlohmann::json to_json(const std::vector<RidgeChoice>& parts) {
+// Per part the ridge of eq. 6's quadratic modes or of eq. 7 (QuadraticRidgeChoice,
+// RidgeChoice) and the leave-one-out miss that chose it (null where the exact fit interpolates
+// a member and so cannot predict it).
+template <typename Choice>
+nlohmann::json to_json(const std::vector<Choice>& parts) {
   nlohmann::json out = nlohmann::json::array();
-  for (const RidgeChoice& c : parts)
-    out.push_back({{"ridge", c.ridge}, {"loo_rms_mm", c.loo_rms_mm}, {"loo_rms_exact_mm", c.loo_rms_exact_mm}});
-  return out;
-}
-
-// Per part the ridge on eq. 6's quadratic modes and the leave-one-out miss that chose it
-// (null for the exact fit where it interpolates a member).
-inline nlohmann::json to_json(const std::vector<QuadraticRidgeChoice>& parts) {
-  nlohmann::json out = nlohmann::json::array();
-  for (const QuadraticRidgeChoice& c : parts)
+  for (const Choice& c : parts)
     out.push_back({{"ridge", c.ridge}, {"loo_rms_mm", c.loo_rms_mm}, {"loo_rms_exact_mm", c.loo_rms_exact_mm}});
   return out;
 }

@@ -75,26 +75,22 @@ std::string DeformationModel::validate(int marker_count) const {
       return out.str();
     }
   }
-  if (!part_rbf_ridge.empty() && part_rbf_ridge.size() != part_names.size()) {
-    out << "deformation model: " << part_rbf_ridge.size() << " part ridges for " << part_count() << " parts";
-    return out.str();
-  }
-  for (size_t p = 0; p < part_rbf_ridge.size(); ++p) {
-    if (!(part_rbf_ridge[p] >= 0.0 && part_rbf_ridge[p] <= 1e3)) {
-      out << "deformation model: part " << p << " has ridge " << part_rbf_ridge[p] << " (0 to 1000)";
-      return out.str();
+  // Per-part ridges: none (an older subject file), or one per part within [0, largest].
+  auto check_ridges = [&](const std::vector<double>& ridges, const char* what, double largest) {
+    if (!ridges.empty() && ridges.size() != part_names.size()) {
+      out << "deformation model: " << ridges.size() << " " << what << "s for " << part_count() << " parts";
+      return false;
     }
-  }
-  if (!part_quadratic_ridge.empty() && part_quadratic_ridge.size() != part_names.size()) {
-    out << "deformation model: " << part_quadratic_ridge.size() << " quadratic ridges for " << part_count() << " parts";
-    return out.str();
-  }
-  for (size_t p = 0; p < part_quadratic_ridge.size(); ++p) {
-    if (!(part_quadratic_ridge[p] >= 0.0 && part_quadratic_ridge[p] <= 1e4)) {
-      out << "deformation model: part " << p << " has quadratic ridge " << part_quadratic_ridge[p] << " (0 to 10000)";
-      return out.str();
+    for (size_t p = 0; p < ridges.size(); ++p) {
+      if (!(ridges[p] >= 0.0 && ridges[p] <= largest)) {
+        out << "deformation model: part " << p << " has " << what << " " << ridges[p] << " (0 to " << largest << ")";
+        return false;
+      }
     }
-  }
+    return true;
+  };
+  if (!check_ridges(part_rbf_ridge, "ridge", 1e3) || !check_ridges(part_quadratic_ridge, "quadratic ridge", 1e4))
+    return out.str();
   if (auto e = check_csr(vertex_influence_offsets, reference_vertices.size(), vertex_influences.size(), "vertex influences"); !e.empty()) return "deformation model: " + e;
   for (int v = 0; v < n; ++v) {
     double sum = 0.0;

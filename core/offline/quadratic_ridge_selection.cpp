@@ -1,11 +1,13 @@
 #include "core/offline/quadratic_ridge_selection.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
 
 #include "core/deform/part_deformation.h"
 #include "core/deform/part_model.h"
+#include "core/offline/training_frames.h"
 
 namespace skinstream {
 
@@ -24,22 +26,19 @@ QuadraticRidgeChoice choose_quadratic_ridge(const std::vector<Vec3>& reference, 
     throw std::invalid_argument("choose_quadratic_ridge: member list does not match the part");
   QuadraticRidgeChoice choice;
   const int count = static_cast<int>(reference.size());
-  if (count < 9) return choice;
+  if (count < 9) return choice;  // the linear modes only, whatever the ridge
 
   // The members' deviations from the reference in the part's frame after the rigid fit, one
   // 3 x Y block per sampled frame: what eq. 6 fits.
   const PartModel exact = build_part_model(reference);
   PartDeformer rigid(exact, DeformationMode::Rigid);
   std::vector<Eigen::Matrix3Xd> deviations;
-  std::vector<Vec3> members(member_markers.size());
-  const int frames = std::min(std::max(sample_frames, 1), frame_count);
-  for (int s = 0; s < frames; ++s) {
-    const int frame = static_cast<int>((static_cast<long long>(s) * frame_count) / frames);
-    for (size_t i = 0; i < members.size(); ++i)
-      members[i] = training[static_cast<size_t>(frame) * marker_count + member_markers[i]];
-    if (!rigid.solve(members)) throw std::invalid_argument("choose_quadratic_ridge: a training frame misses a member");
-    deviations.push_back(rigid.local_positions() - exact.local_reference);
-  }
+  const int frames = for_each_training_frame(
+      member_markers, training, frame_count, marker_count, sample_frames, "choose_quadratic_ridge",
+      [&](const std::vector<Vec3>& members) {
+        if (!rigid.solve(members)) throw std::invalid_argument("choose_quadratic_ridge: a training frame misses a member");
+        deviations.push_back(rigid.local_positions() - exact.local_reference);
+      });
   choice.frames = frames;
 
   const std::vector<double> ridges = quadratic_ridge_candidates();

@@ -8,6 +8,7 @@
 
 #include "core/deform/part_deformation.h"
 #include "core/deform/rbf_kernel.h"
+#include "core/offline/training_frames.h"
 
 namespace skinstream {
 
@@ -58,18 +59,15 @@ RidgeChoice choose_rbf_ridge(const PartModel& part, std::span<const int> member_
   const std::vector<double> ridges = rbf_ridge_candidates();
   std::vector<double> total(ridges.size(), 0.0);
   PartDeformer fit(part, DeformationMode::Quadratic);  // eq. 6: the centres and residuals of eq. 7
-  std::vector<Vec3> members(member_markers.size());
-  const int frames = std::min(std::max(sample_frames, 1), frame_count);
-  for (int s = 0; s < frames; ++s) {
-    const int frame = static_cast<int>((static_cast<long long>(s) * frame_count) / frames);
-    for (size_t i = 0; i < members.size(); ++i)
-      members[i] = training[static_cast<size_t>(frame) * marker_count + member_markers[i]];
-    if (!fit.solve(members)) throw std::invalid_argument("choose_rbf_ridge: a training frame misses a member");
-    const Eigen::MatrixX3d residuals = (fit.local_positions() - fit.rbf_centres()).transpose();
-    const std::vector<double> scores = leave_one_out_squared_errors(fit.rbf_centres(), residuals, part.rbf_dilation, ridges);
-    for (size_t k = 0; k < ridges.size(); ++k) total[k] += scores[k];
-    ++choice.frames;
-  }
+  choice.frames = for_each_training_frame(
+      member_markers, training, frame_count, marker_count, sample_frames, "choose_rbf_ridge",
+      [&](const std::vector<Vec3>& members) {
+        if (!fit.solve(members)) throw std::invalid_argument("choose_rbf_ridge: a training frame misses a member");
+        const Eigen::MatrixX3d residuals = (fit.local_positions() - fit.rbf_centres()).transpose();
+        const std::vector<double> scores =
+            leave_one_out_squared_errors(fit.rbf_centres(), residuals, part.rbf_dilation, ridges);
+        for (size_t k = 0; k < ridges.size(); ++k) total[k] += scores[k];
+      });
   size_t best = 0;
   for (size_t k = 1; k < ridges.size(); ++k)
     if (total[k] < total[best]) best = k;
