@@ -195,9 +195,12 @@ void Pipeline::publish(const Released& meta, std::span<const Vec3> positions, st
     if ((out.encoded_mask >> f) & 1u) subscriber::patch_publish_time(out.messages[f], out.publish_time_ns);
   metrics_.frames_dropped.store(mailbox_.dropped(), std::memory_order_relaxed);
   metrics_.frames_dropped_mailbox_full.store(mailbox_.dropped_mailbox_full(), std::memory_order_relaxed);
-  consumer_.publish(ref);
+  // Counted before the hand-over, so that no reader of the counters (/health, the bench) can
+  // find a subscriber holding a frame the count does not include yet: a publish thread may
+  // write it out before this thread runs its next line.
   published_.fetch_add(1, std::memory_order_relaxed);
   metrics_.frames_published.fetch_add(1, std::memory_order_relaxed);
+  consumer_.publish(ref);
   if (meta.receive_time_ns > 0) metrics_.receive_to_publish.observe_ns(wall_clock_ns() - meta.receive_time_ns);
 }
 
