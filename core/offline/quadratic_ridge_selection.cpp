@@ -20,8 +20,7 @@ std::vector<double> quadratic_ridge_candidates() {
 QuadraticRidgeChoice choose_quadratic_ridge(const std::vector<Vec3>& reference, std::span<const int> member_markers,
                                             std::span<const Vec3> training, int frame_count, int marker_count,
                                             int sample_frames) {
-  if (frame_count <= 0 || training.size() != static_cast<size_t>(frame_count) * marker_count)
-    throw std::invalid_argument("choose_quadratic_ridge: training is not frame_count x marker_count");
+  check_training_take("choose_quadratic_ridge", training, frame_count, marker_count);
   if (member_markers.size() != reference.size())
     throw std::invalid_argument("choose_quadratic_ridge: member list does not match the part");
   QuadraticRidgeChoice choice;
@@ -34,7 +33,7 @@ QuadraticRidgeChoice choose_quadratic_ridge(const std::vector<Vec3>& reference, 
   PartDeformer rigid(exact, DeformationMode::Rigid);
   std::vector<Eigen::Matrix3Xd> deviations;
   const int frames = for_each_training_frame(
-      member_markers, training, frame_count, marker_count, sample_frames, "choose_quadratic_ridge",
+      member_markers, training, frame_count, marker_count, sample_frames,
       [&](const std::vector<Vec3>& members) {
         if (!rigid.solve(members)) throw std::invalid_argument("choose_quadratic_ridge: a training frame misses a member");
         deviations.push_back(rigid.local_positions() - exact.local_reference);

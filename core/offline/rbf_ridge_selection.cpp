@@ -49,8 +49,7 @@ std::vector<double> leave_one_out_squared_errors(const Eigen::Matrix3Xd& centres
 
 RidgeChoice choose_rbf_ridge(const PartModel& part, std::span<const int> member_markers, std::span<const Vec3> training,
                              int frame_count, int marker_count, int sample_frames) {
-  if (frame_count <= 0 || training.size() != static_cast<size_t>(frame_count) * marker_count)
-    throw std::invalid_argument("choose_rbf_ridge: training is not frame_count x marker_count");
+  check_training_take("choose_rbf_ridge", training, frame_count, marker_count);
   if (static_cast<int>(member_markers.size()) != part.member_count())
     throw std::invalid_argument("choose_rbf_ridge: member list does not match the part");
   RidgeChoice choice;
@@ -60,7 +59,7 @@ RidgeChoice choose_rbf_ridge(const PartModel& part, std::span<const int> member_
   std::vector<double> total(ridges.size(), 0.0);
   PartDeformer fit(part, DeformationMode::Quadratic);  // eq. 6: the centres and residuals of eq. 7
   choice.frames = for_each_training_frame(
-      member_markers, training, frame_count, marker_count, sample_frames, "choose_rbf_ridge",
+      member_markers, training, frame_count, marker_count, sample_frames,
       [&](const std::vector<Vec3>& members) {
         if (!fit.solve(members)) throw std::invalid_argument("choose_rbf_ridge: a training frame misses a member");
         const Eigen::MatrixX3d residuals = (fit.local_positions() - fit.rbf_centres()).transpose();

@@ -12,15 +12,20 @@
 
 namespace skinstream {
 
-// Calls visit(members) for each sampled frame of `training` (frame_count x marker_count,
-// frame-major), with `members` the positions of `member_markers` in that frame, and returns how
-// many frames it visited. Throws std::invalid_argument, naming `who`, when the take is not
-// frame_count x marker_count.
-template <typename Visit>
-int for_each_training_frame(std::span<const int> member_markers, std::span<const Vec3> training, int frame_count,
-                            int marker_count, int sample_frames, const std::string& who, Visit&& visit) {
+// Throws std::invalid_argument, naming `who`, unless `training` is frame_count x marker_count
+// with at least one frame. The choices call it first, before any early return.
+inline void check_training_take(const std::string& who, std::span<const Vec3> training, int frame_count,
+                                int marker_count) {
   if (frame_count <= 0 || training.size() != static_cast<size_t>(frame_count) * marker_count)
     throw std::invalid_argument(who + ": training is not frame_count x marker_count");
+}
+
+// Calls visit(members) for each sampled frame of `training` (checked by check_training_take),
+// with `members` the positions of `member_markers` in that frame, and returns how many frames it
+// visited.
+template <typename Visit>
+int for_each_training_frame(std::span<const int> member_markers, std::span<const Vec3> training, int frame_count,
+                            int marker_count, int sample_frames, Visit&& visit) {
   std::vector<Vec3> members(member_markers.size());
   const int frames = std::min(std::max(sample_frames, 1), frame_count);
   for (int s = 0; s < frames; ++s) {
