@@ -571,6 +571,7 @@ bool MeshDeformer::deform(std::span<const Vec3> markers, std::span<float> positi
 int MeshDeformer::vertex_count() const { return state_->vertex_count; }
 int MeshDeformer::normal_group_size() const { return kNormalWindow; }
 DeformationMode MeshDeformer::mode() const { return state_->mode; }
+const PartDeformer& MeshDeformer::part(int part) const { return state_->parts.at(static_cast<size_t>(part)); }
 
 size_t MeshDeformer::memory_bytes() const {
   const State& s = *state_;

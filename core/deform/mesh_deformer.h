@@ -63,6 +63,9 @@ class MeshDeformer {
 
   int vertex_count() const;
   DeformationMode mode() const;
+  // One part's fit at the solved frame (for tools that ask how a single part would move a
+  // point, e.g. eval-deform's worst vertices).
+  const PartDeformer& part(int part) const;
   // Heap bytes held by the runtime state (precomputed per-vertex data and fans, parts).
   size_t memory_bytes() const;
 

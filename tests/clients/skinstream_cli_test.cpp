@@ -167,6 +167,12 @@ TEST(SkinstreamCli, EvalDeformNamesTheVerticesBehindEachMaximum) {
       double sum = 0.0;
       for (const auto& part : worst[i]["parts"]) sum += part["weight"].get<double>();
       EXPECT_NEAR(sum, 1.0, 1e-9);
+      // The part that alone would place it best (MeshDeformer::part, tested against the
+      // blended mesh in mesh_deformer_test): one of the subject's parts.
+      const auto& best = worst[i]["best_single_part"];
+      EXPECT_GE(best["part"].get<int>(), 0);
+      EXPECT_LT(best["part"].get<int>(), j["parts"].get<int>());
+      EXPECT_GE(best["error_mm"].get<double>(), 0.0);
     }
   }
 }

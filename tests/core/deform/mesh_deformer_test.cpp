@@ -125,6 +125,13 @@ TEST(MeshDeformer, MatchesThePerPartReferenceImplementation) {
     }
     // Float arithmetic on coordinates of ~1000 mm: a few 1e-4 mm.
     EXPECT_LT(worst, 2e-3) << "mode " << static_cast<int>(mode);
+    // The deformer's own parts (what eval-deform asks of single parts) are these fits.
+    for (int p = 0; p < 2; ++p) {
+      const Vec3 at = scene.model.reference_vertices[p * 100];
+      const Vec3 own = deformer.part(p).deform(deformer.part(p).model().local_from_world(at));
+      EXPECT_LT((own - parts[p].deform(parts[p].model().local_from_world(at))).norm(), 1e-9);
+    }
+    EXPECT_THROW(deformer.part(2), std::out_of_range);
   }
 }
 
