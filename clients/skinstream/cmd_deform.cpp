@@ -1,14 +1,16 @@
 // skinstream deform: a filled capture -> the deforming detailed mesh (section 5.3), as the daemon
 // computes it per frame, written as per-frame meshes and a point cache.
-//   skinstream deform --subject S.sksubj --capture FILLED.c3d --out DIR [--format ply|obj|none]
+//   skinstream deform --subject S.sksubj --capture FILLED.c3d --out DIR [--format ply|obj|pc2|none]
 //                     [--mode full|quadratic|rigid-rbf|rigid] [--fill] [--no-pc2]
-// Writes DIR/frame_<frame number, 6 digits>.<format> (frame number = the capture's first frame +
-// index, as the replay server numbers frames), DIR/deformed.pc2 (every frame) and DIR/rest.obj
-// (the registered reference mesh whose vertex order the point cache follows).
+// Writes DIR/frame_<frame number, 6 digits>.<format> for ply and obj (frame number = the
+// capture's first frame + index, as the replay server numbers frames), DIR/deformed.pc2 (every
+// frame; --format pc2 or none: the point cache alone) and DIR/rest.obj (the registered
+// reference mesh whose vertex order the point cache follows).
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <filesystem>
 #include <map>
+#include <stdexcept>
 #include <nlohmann/json.hpp>
 
 #include "clients/skinstream/commands.h"
@@ -37,13 +39,15 @@ void add_deform(CLI::App& app) {
   cmd->add_option("--subject", subject_path, "subject file built with build-subject --mesh")->required();
   cmd->add_option("--capture", capture_path, "filled capture (.c3d/.trc); see --fill")->required();
   cmd->add_option("--out", out_dir, "output folder")->required();
-  cmd->add_option("--format", format, "per-frame meshes: ply, obj or none")
-      ->check(CLI::IsMember({"ply", "obj", "none"}))->capture_default_str();
+  cmd->add_option("--format", format, "per-frame meshes: ply or obj; pc2 or none: the point cache only")
+      ->check(CLI::IsMember({"ply", "obj", "pc2", "none"}))->capture_default_str();
   cmd->add_option("--mode", mode, "full (quadratic + RBF), quadratic, rigid-rbf or rigid")
       ->check(CLI::IsMember({"full", "quadratic", "rigid-rbf", "rigid"}))->capture_default_str();
   cmd->add_flag("--fill", fill, "relabel and fill the capture online first (as the daemon does)");
   cmd->add_flag("--no-pc2", no_pc2, "do not write the point cache");
   cmd->callback([] {
+    if (format == "pc2" && no_pc2) throw std::invalid_argument("--format pc2 and --no-pc2: nothing would be written");
+    const bool per_frame_meshes = format == "ply" || format == "obj";
     const SubjectFile subject = read_subject_file(subject_path);
     if (!subject.deformation)
       throw std::runtime_error(subject_path + ": the subject has no detailed mesh; build it with build-subject --mesh");
@@ -79,7 +83,7 @@ void add_deform(CLI::App& app) {
         normals[v] = Vec3(normal_buffer[v * 3], normal_buffer[v * 3 + 1], normal_buffer[v * 3 + 2]);
       }
       if (cache) cache->append(vertices);
-      if (format != "none") {
+      if (per_frame_meshes) {
         char name[48];
         std::snprintf(name, sizeof name, "frame_%06d.%s", capture.first_frame + f, format.c_str());
         if (format == "ply")
