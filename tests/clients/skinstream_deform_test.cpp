@@ -47,7 +47,7 @@ std::vector<std::string> files_named(const std::string& dir, const std::string& 
   return names;
 }
 
-// The JSON object the command prints on stdout (the last line that starts one).
+// The JSON object the command prints (stdout; any stderr line after it has no braces).
 nlohmann::json summary(const std::string& output) {
   const size_t at = output.find('{');
   return nlohmann::json::parse(output.substr(at, output.rfind('}') - at + 1));
