@@ -41,6 +41,11 @@ class MeshDeformer {
   int part_count() const;
   int part_member_count(int part) const;
   int cluster_part(int cluster) const;
+  // Whether the cluster's influences are of vertices in the upper half of the numbering
+  // ([vertex_count / 2, vertex_count)); otherwise all are in the lower half. The clusters of a
+  // part come lower half first. DeformWorkers gives the two halves to threads that blend the
+  // same halves, so that eq. 9 mostly reads results its own core wrote.
+  bool cluster_in_upper_half(int cluster) const;
 
   // Eq. 8 for the influences (vertex, part) of clusters [begin, end), each weighted by its
   // beta. Influences are grouped in clusters of nearby vertices of one part, evaluated in

@@ -50,11 +50,15 @@ DeformWorkers::DeformWorkers(MeshDeformer& deformer, const DeformWorkerOptions& 
   part_fitted_ = std::make_unique<std::atomic<uint32_t>[]>(static_cast<size_t>(parts));
   for (int p = 0; p < parts; ++p) part_fitted_[p].store(0);
 
-  // The clusters of a part are contiguous; take the parts with the cheapest fit first, so that
-  // a thread reaches a part's clusters when its fit is most likely done.
+  // Cluster tasks: the clusters of the lower half of the vertex numbering from the front, those
+  // of the upper half from the back (the calling thread takes from the front, the workers from
+  // the back, as in the vertex stages: each mostly blends results it wrote itself). From either
+  // end the parts with the cheapest fit come first, so that a thread reaches a part's clusters
+  // when its fit is most likely done; the largest part's meet in the middle.
   // A stage counts its tasks in 16 bits: a mesh far beyond ~100k vertices gets larger chunks.
-  // (Each part may add one short chunk: room is left for those and for the fits.)
-  const int clusters_per_task = std::max(kClustersPerTask, deformer_.cluster_count() / (kMaxTasks - 2 * parts - 1) + 1);
+  // (Each part may add two short chunks: room is left for those and for the fits.)
+  const int clusters_per_task = std::max(kClustersPerTask, deformer_.cluster_count() / (kMaxTasks - 3 * parts - 1) + 1);
+  std::vector<ClusterChunk> upper_chunks;
   for (auto it = part_order_.rbegin(); it != part_order_.rend(); ++it)
     for (int c = 0; c < deformer_.cluster_count();) {
       if (deformer_.cluster_part(c) != *it) {
@@ -62,9 +66,13 @@ DeformWorkers::DeformWorkers(MeshDeformer& deformer, const DeformWorkerOptions& 
         continue;
       }
       const int begin = c;
-      while (c < deformer_.cluster_count() && deformer_.cluster_part(c) == *it && c - begin < clusters_per_task) ++c;
-      cluster_chunks_.push_back({*it, begin, c});
+      const bool upper = deformer_.cluster_in_upper_half(c);
+      while (c < deformer_.cluster_count() && deformer_.cluster_part(c) == *it &&
+             deformer_.cluster_in_upper_half(c) == upper && c - begin < clusters_per_task)
+        ++c;
+      (upper ? upper_chunks : cluster_chunks_).push_back({*it, begin, c});
     }
+  cluster_chunks_.insert(cluster_chunks_.end(), upper_chunks.rbegin(), upper_chunks.rend());
   fits_and_clusters_.tasks = static_cast<uint32_t>(parts + cluster_chunks_.size());
   const int group = deformer_.normal_group_size();  // chunks of whole groups: no normal computed twice
   vertex_chunk_ = std::max(1, (deformer_.vertex_count() + kVertexTasks * group - 1) / (kVertexTasks * group)) * group;
@@ -170,14 +178,18 @@ void DeformWorkers::work() {
 
 // One participant's share of a frame: the calling thread's (which times the stages from
 // `start`) or a worker's, which leaves as soon as it sees a later generation.
-// The vertex stages are taken from both ends, the calling thread from the front and the workers
-// from the back: with two threads each then computes the normals of mostly the vertices it
-// blended, whose positions are still in its own cache (reading the other core's writes made the
-// normals stage half as dear again in total; measured with stage timers).
+// Every stage after the fits is taken from both ends, the calling thread from the front and the
+// workers from the back. With two threads each then blends mostly the cluster results it wrote
+// (the clusters of the lower half of the vertex numbering come first, see the constructor) and
+// computes the normals of mostly the vertices it blended, whose positions are still in its own
+// cache. Reading the other core's writes made the normals stage half as dear again in total
+// (measured with stage timers); on this host, in stretches when moving data between the two
+// vCPUs is slow, taking the clusters this way cut the two-thread median from 1.11 to 1.00 ms.
 void DeformWorkers::run_frame(uint32_t generation, const std::chrono::steady_clock::time_point* start) {
   const End end = start ? End::Front : End::Back;
-  // Fits first, largest part first: every participant takes this stage from the front.
-  if (!run_stage(fits_and_clusters_, generation, End::Front, [&](uint32_t task) { fit_or_cluster_task(task, generation); }))
+  // Fits first, largest part first, from the front by everyone (see run_stage); then the
+  // clusters from this participant's end.
+  if (!run_stage(fits_and_clusters_, generation, end, [&](uint32_t task) { fit_or_cluster_task(task, generation); }))
     return;
   if (!run_stage(vertices_, generation, end, [&](uint32_t task) {
         deformer_.blend_vertices(static_cast<int>(task) * vertex_chunk_, static_cast<int>(task + 1) * vertex_chunk_, positions_);
@@ -198,8 +210,11 @@ bool DeformWorkers::run_stage(Stage& stage, uint32_t generation, End end, Task&&
     if (static_cast<uint32_t>(left >> 32) != generation) return false;
     const uint32_t front = static_cast<uint32_t>(left >> 16) & 0xffff, back = static_cast<uint32_t>(left) & 0xffff;
     if (front >= back) break;
-    const uint32_t index = end == End::Front ? front : back - 1;
-    const uint64_t after = end == End::Front ? pack_left(generation, front + 1, back) : pack_left(generation, front, back - 1);
+    // The fits lead the first stage: while one is left, it is taken whatever the end.
+    const bool fit_left = &stage == &fits_and_clusters_ && front < static_cast<uint32_t>(part_order_.size());
+    const End take = fit_left ? End::Front : end;
+    const uint32_t index = take == End::Front ? front : back - 1;
+    const uint64_t after = take == End::Front ? pack_left(generation, front + 1, back) : pack_left(generation, front, back - 1);
     if (!stage.left.compare_exchange_weak(left, after, std::memory_order_acquire, std::memory_order_acquire)) continue;
     task(index);
     stage.done.fetch_add(1, std::memory_order_release);

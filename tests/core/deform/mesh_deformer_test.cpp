@@ -290,6 +290,21 @@ TEST(MeshDeformer, VertexAndNormalRangesComposeToTheWholeFrame) {
   EXPECT_EQ(normals_whole, normals_split);
 }
 
+// Clusters never mix the two halves of the vertex numbering (DeformWorkers gives them to the
+// threads that blend those halves), and a part's lower-half clusters come first.
+TEST(MeshDeformer, ClustersKeepToOneHalfOfTheVertexNumbering) {
+  TwoPartScene scene;
+  const MeshDeformer deformer(scene.model, scene.subject);
+  // Per part 150 influences, 75 in each half: two clusters of at most 64 per half, where mixing
+  // the halves would need three per part.
+  ASSERT_EQ(deformer.cluster_count(), 8);
+  for (int c = 0; c < deformer.cluster_count(); ++c) {
+    SCOPED_TRACE(c);
+    EXPECT_EQ(deformer.cluster_part(c), c / 4);
+    EXPECT_EQ(deformer.cluster_in_upper_half(c), c % 4 >= 2);
+  }
+}
+
 TEST(MeshDeformer, PerFrameWorkAllocatesNothing) {
   TwoPartScene scene;
   std::mt19937_64 rng(13);
