@@ -184,7 +184,7 @@ void DeformWorkers::work() {
 // computes the normals of mostly the vertices it blended, whose positions are still in its own
 // cache. Reading the other core's writes made the normals stage half as dear again in total
 // (measured with stage timers); on this host, in stretches when moving data between the two
-// vCPUs is slow, taking the clusters this way cut the two-thread median from 1.11 to 1.00 ms.
+// vCPUs is slow, taking the clusters this way cut the two-thread median from 1.10 to 1.00 ms.
 void DeformWorkers::run_frame(uint32_t generation, const std::chrono::steady_clock::time_point* start) {
   const End end = start ? End::Front : End::Back;
   // Fits first, largest part first, from the front by everyone (see run_stage); then the
