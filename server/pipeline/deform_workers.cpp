@@ -74,6 +74,7 @@ DeformWorkers::DeformWorkers(MeshDeformer& deformer, const DeformWorkerOptions& 
     }
   cluster_chunks_.insert(cluster_chunks_.end(), upper_chunks.rbegin(), upper_chunks.rend());
   fits_and_clusters_.tasks = static_cast<uint32_t>(parts + cluster_chunks_.size());
+  fits_and_clusters_.leading = static_cast<uint32_t>(parts);  // the fits lead, taken by all from the front
   const int group = deformer_.normal_group_size();  // chunks of whole groups: no normal computed twice
   vertex_chunk_ = std::max(1, (deformer_.vertex_count() + kVertexTasks * group - 1) / (kVertexTasks * group)) * group;
   vertices_.tasks = normals_stage_.tasks =
@@ -187,7 +188,7 @@ void DeformWorkers::work() {
 // vCPUs is slow, taking the clusters this way cut the two-thread median from 1.10 to 1.00 ms.
 void DeformWorkers::run_frame(uint32_t generation, const std::chrono::steady_clock::time_point* start) {
   const End end = start ? End::Front : End::Back;
-  // Fits first, largest part first, from the front by everyone (see run_stage); then the
+  // Fits first, largest part first, from the front by everyone (Stage::leading); then the
   // clusters from this participant's end.
   if (!run_stage(fits_and_clusters_, generation, end, [&](uint32_t task) { fit_or_cluster_task(task, generation); }))
     return;
@@ -210,9 +211,7 @@ bool DeformWorkers::run_stage(Stage& stage, uint32_t generation, End end, Task&&
     if (static_cast<uint32_t>(left >> 32) != generation) return false;
     const uint32_t front = static_cast<uint32_t>(left >> 16) & 0xffff, back = static_cast<uint32_t>(left) & 0xffff;
     if (front >= back) break;
-    // The fits lead the first stage: while one is left, it is taken whatever the end.
-    const bool fit_left = &stage == &fits_and_clusters_ && front < static_cast<uint32_t>(part_order_.size());
-    const End take = fit_left ? End::Front : end;
+    const End take = front < stage.leading ? End::Front : end;
     const uint32_t index = take == End::Front ? front : back - 1;
     const uint64_t after = take == End::Front ? pack_left(generation, front + 1, back) : pack_left(generation, front, back - 1);
     if (!stage.left.compare_exchange_weak(left, after, std::memory_order_acquire, std::memory_order_acquire)) continue;

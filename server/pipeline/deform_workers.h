@@ -66,11 +66,13 @@ class DeformWorkers {
  private:
   // One stage's tasks: `left` holds the frame's generation in its high 32 bits and the tasks
   // not yet taken, [front, back), in its low 32 (16 bits each), so a worker that wakes after its
-  // frame ended can never take a task of the next one; `done` counts finished tasks.
+  // frame ended can never take a task of the next one; `done` counts finished tasks. The first
+  // `leading` tasks are taken from the front by every participant, whatever its end.
   struct alignas(64) Stage {  // own cache line: both threads hammer these counters
     std::atomic<uint64_t> left{0};
     std::atomic<uint32_t> done{0};
     uint32_t tasks = 0;
+    uint32_t leading = 0;
   };
   struct ClusterChunk {
     int part, begin, end;
