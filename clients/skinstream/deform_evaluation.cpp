@@ -4,7 +4,6 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
-#include <functional>
 #include <limits>
 #include <stdexcept>
 
@@ -97,16 +96,23 @@ std::vector<char> covered_vertices(const DeformationModel& model, const SubjectM
   return covered;
 }
 
+std::vector<Vec3> markers_in_subject_order(const SynthCapture& take, const std::vector<int>& subject_to_truth, int frame) {
+  std::vector<Vec3> markers(subject_to_truth.size());
+  for (size_t i = 0; i < markers.size(); ++i) markers[i] = take.truth.at(frame, subject_to_truth[i]);
+  return markers;
+}
+
 // Where a method's maximum comes from: the covered vertices with the largest error over the take,
 // with how far each lies from the nearest marker in the reference pose (a crease no marker reaches
 // shows here) and, for the part-based methods, the parts that move it (beta_{j,p}) and the part
 // that alone would have placed it best at that frame. A best part far below the error means the
 // vertex weights sent it with the wrong parts; a best part as far off means no part's motion fits.
-// `solve_at(frame)` fits the method's parts at that frame (null for a method without parts).
+// `deformer` is the method's (refitted here at each vertex's frame), null for one without parts.
 nlohmann::ordered_json worst_vertices(const std::vector<double>& peak_error, const std::vector<int>& peak_frame,
-                                      const std::vector<char>& covered, const DeformationModel& model,
-                                      const SubjectModel& subject, const std::function<const MeshDeformer*(int)>& solve_at,
-                                      const std::function<std::vector<Vec3>(int)>& truth_at, int count) {
+                                      const std::vector<char>& covered, const DeformationSetup& setup,
+                                      const SynthCapture& take, MeshDeformer* deformer, int count) {
+  const DeformationModel& model = setup.deformation;
+  const SubjectModel& subject = setup.subject;
   std::vector<int> order;
   for (int v = 0; v < static_cast<int>(covered.size()); ++v)
     if (covered[v]) order.push_back(v);
@@ -124,12 +130,12 @@ nlohmann::ordered_json worst_vertices(const std::vector<double>& peak_error, con
                                   {"frame", peak_frame[v]},
                                   {"reference_mm", {at.x(), at.y(), at.z()}},
                                   {"nearest_marker_mm", nearest}};
-    if (solve_at) {
+    if (deformer) {
       row["parts"] = nlohmann::ordered_json::array();
       for (int k = model.vertex_influence_offsets[v]; k < model.vertex_influence_offsets[v + 1]; ++k)
         row["parts"].push_back({{"part", model.vertex_influences[k].part}, {"weight", model.vertex_influences[k].weight}});
-      const MeshDeformer* deformer = solve_at(peak_frame[v]);
-      const Vec3 truth = truth_at(peak_frame[v])[v];
+      deformer->solve_parts(markers_in_subject_order(take, setup.subject_to_truth, peak_frame[v]));
+      const Vec3 truth = take.pose_mesh(peak_frame[v])[v];
       int best = 0;
       double best_error = std::numeric_limits<double>::infinity();
       for (int p = 0; p < model.part_count(); ++p) {
@@ -142,12 +148,6 @@ nlohmann::ordered_json worst_vertices(const std::vector<double>& peak_error, con
     out.push_back(row);
   }
   return out;
-}
-
-std::vector<Vec3> markers_in_subject_order(const SynthCapture& take, const std::vector<int>& subject_to_truth, int frame) {
-  std::vector<Vec3> markers(subject_to_truth.size());
-  for (size_t i = 0; i < markers.size(); ++i) markers[i] = take.truth.at(frame, subject_to_truth[i]);
-  return markers;
 }
 
 }  // namespace
@@ -297,14 +297,6 @@ nlohmann::ordered_json evaluate_deformation(const DeformationSetup& setup, const
     }
   }
 
-  // The parts of method k fitted at a frame, and the true mesh there (for the worst vertices).
-  auto solve_at = [&](int k) -> std::function<const MeshDeformer*(int)> {
-    return [&, k](int frame) {
-      deformers[k]->solve_parts(markers_in_subject_order(take, setup.subject_to_truth, frame));
-      return deformers[k].get();
-    };
-  };
-  const auto truth_at = [&](int frame) { return take.pose_mesh(frame); };
   nlohmann::ordered_json rows = nlohmann::ordered_json::array();
   for (int k = 0; k < method_count; ++k) {
     const ErrorStats v = summarize_errors(std::move(vertex_errors[k]));
@@ -319,8 +311,7 @@ nlohmann::ordered_json evaluate_deformation(const DeformationSetup& setup, const
                     {"marker_mean_mm", m.mean},
                     {"marker_max_mm", m.max},
                     {"ms_per_frame_single_thread", 1000.0 * seconds[k] / frames},
-                    {"worst_vertices", worst_vertices(peak_error[k], peak_frame[k], covered, model, setup.subject,
-                                                      kMethods[k].conventional ? nullptr : solve_at(k), truth_at, 3)}});
+                    {"worst_vertices", worst_vertices(peak_error[k], peak_frame[k], covered, setup, take, deformers[k].get(), 3)}});
   }
   return {{"motion", motion},
           {"frames_evaluated", frames},
