@@ -82,7 +82,7 @@ struct SolvedPart {
 };
 
 // A few influences of one part close together in the reference pose, all of vertices in the
-// lower or all in the upper half of the numbering.
+// lower or all in the upper half of the vertex sequence (see State::window_sequence).
 struct InfluenceCluster {
   int part = 0;
   int count = 0;  // lanes in use; the others copy lane 0 with beta 0
@@ -170,6 +170,17 @@ struct MeshDeformer::State {
   std::vector<int> member_markers;
   std::vector<Vec3> member_scratch;
 
+  // The order the vertex stages count vertices in (their "slots"): whole windows of
+  // kNormalWindow consecutive vertices, sorted by their centroid along the coordinate axis that
+  // cuts the fewest mesh edges at the middle slot, the short last window (if any) last. Cut in
+  // two at half_slot, the sequence is two spatially compact halves of the body, each touching
+  // the other only along the cut; DeformWorkers gives one to each thread, which then blends and
+  // computes the normals of vertices whose neighbours it blended itself. The windows keep the
+  // output buffers' cache lines whole: no line is written by both halves.
+  std::vector<int> window_sequence;  // per position in the sequence, the window (vertex / kNormalWindow)
+  std::vector<int> slot_of_window;   // the inverse
+  int half_slot = 0;                 // the first slot of the upper half (a window boundary)
+
   std::vector<SolvedPart> solved;
   // Per part (from SolvedPart::first_centre) its RBF centres and weights this frame.
   std::vector<RbfCentre> centres;
@@ -183,10 +194,11 @@ struct MeshDeformer::State {
   std::vector<InfluenceCluster> clusters;
   std::vector<ClusterLanes> cluster_lanes;    // parallel to clusters
   std::vector<ClusterResult> cluster_result;  // parallel to clusters
-  // Eq. 9: per vertex (CSR by the model's vertex_influence_offsets) where its influences'
-  // results are: cluster * 3 * kClusterSize + lane, as a float index into cluster_result.
+  // Eq. 9: per slot of the sequence (CSR) where the vertex's influences' results are:
+  // cluster * 3 * kClusterSize + lane, as a float index into cluster_result. In sequence order,
+  // so that a range of slots reads these as one stream.
   std::vector<int> influence_offsets;
-  std::vector<int> influence_slots;
+  std::vector<int> influence_results;
 
   // Normals: per vertex its neighbours in fan order, n_0, n_1, ..., where each consecutive
   // pair (n_i, n_i+1) closes a face (v, n_i, n_i+1) of the mesh (a closed fan repeats n_0 at
@@ -205,11 +217,15 @@ struct MeshDeformer::State {
   // vertices, row k the k-th entry of each lane's fan (a float index, 3 * vertex), padded to the
   // block's longest fan with the lane's own vertex: a zero offset, so the pads add nothing. A
   // window short of four vertices at the end repeats its last one, which is stored twice alike.
-  std::vector<int> normal_window_blocks;  // per window its first block, and one past the end
+  std::vector<int> normal_window_blocks;  // per window of the sequence its first block, and one past the end
   std::vector<int> normal_block_rows;     // per block its first row, and one past the end
   std::vector<int> normal_rows;           // 4 entries per row
   std::vector<uint8_t> normal_block_reads_last;  // per block: it reads the last vertex (load_quads_exactly)
 
+  int slot(int vertex) const {
+    return slot_of_window[vertex / kNormalWindow] * kNormalWindow + vertex % kNormalWindow;
+  }
+  void build_sequence(const DeformationModel& model);
   void store_solved(int p);
   void build_clusters(const DeformationModel& model);
   void build_fans(const std::vector<std::array<int, 3>>& faces);
@@ -247,7 +263,7 @@ MeshDeformer::MeshDeformer(const DeformationModel& model, const SubjectModel& su
   s.member_scratch.resize(s.member_markers.size());
   s.centres.assign(s.member_markers.size(), RbfCentre{});
 
-  s.influence_offsets = model.vertex_influence_offsets;
+  s.build_sequence(model);
   s.build_clusters(model);
   s.build_fans(model.faces);
 
@@ -256,13 +272,43 @@ MeshDeformer::MeshDeformer(const DeformationModel& model, const SubjectModel& su
   for (int c = 0; c < static_cast<int>(s.clusters.size()); ++c) s.deform_cluster(c);
 }
 
+void MeshDeformer::State::build_sequence(const DeformationModel& model) {
+  const int windows = (vertex_count + kNormalWindow - 1) / kNormalWindow;
+  const int full_windows = vertex_count / kNormalWindow;
+  half_slot = full_windows / 2 * kNormalWindow;
+  std::vector<int> best;
+  long best_cut = -1;
+  std::vector<int> order(static_cast<size_t>(full_windows)), position(static_cast<size_t>(windows));
+  std::vector<double> centroid(static_cast<size_t>(full_windows));
+  for (int axis = 0; axis < 3; ++axis) {
+    for (int w = 0; w < full_windows; ++w) {
+      double sum = 0.0;
+      for (int v = w * kNormalWindow; v < (w + 1) * kNormalWindow; ++v) sum += model.reference_vertices[v][axis];
+      centroid[w] = sum;
+    }
+    std::iota(order.begin(), order.end(), 0);
+    std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return centroid[a] < centroid[b]; });
+    if (windows > full_windows) order.push_back(full_windows);  // the short window, last
+    for (int i = 0; i < windows; ++i) position[order[i]] = i;
+    auto upper = [&](int v) { return position[v / kNormalWindow] * kNormalWindow >= half_slot; };
+    long cut = 0;
+    for (const auto& f : model.faces)
+      for (int c = 0; c < 3; ++c) cut += upper(f[c]) != upper(f[(c + 1) % 3]);
+    if (best_cut < 0 || cut < best_cut) best_cut = cut, best = order;
+    order.resize(static_cast<size_t>(full_windows));
+  }
+  window_sequence = best;
+  slot_of_window.assign(static_cast<size_t>(windows), 0);
+  for (int i = 0; i < windows; ++i) slot_of_window[window_sequence[i]] = i;
+}
+
 void MeshDeformer::State::build_clusters(const DeformationModel& model) {
   std::vector<std::vector<int>> by_part(parts.size());
   for (size_t k = 0; k < model.vertex_influences.size(); ++k) by_part[model.vertex_influences[k].part].push_back(static_cast<int>(k));
   std::vector<int> vertex_of(model.vertex_influences.size());
   for (int v = 0; v < vertex_count; ++v)
     for (int k = model.vertex_influence_offsets[v]; k < model.vertex_influence_offsets[v + 1]; ++k) vertex_of[k] = v;
-  influence_slots.assign(model.vertex_influences.size(), 0);
+  std::vector<int> result_of(model.vertex_influences.size(), 0);  // per influence of the model
   for (size_t p = 0; p < parts.size(); ++p) {
     const PartModel& part = parts[p].model();
     std::vector<Vec3> local(by_part[p].size()), inside(by_part[p].size());
@@ -273,10 +319,10 @@ void MeshDeformer::State::build_clusters(const DeformationModel& model) {
       inside[i] = part.clamp_to_bounds(local[i]);
       const Vec3 unit = (inside[i] - part.local_min).cwiseQuotient(extent);
       auto cell = [&](int a) { return static_cast<uint32_t>(std::clamp(unit[a], 0.0, 1.0) * 1023.0); };
-      const bool upper = vertex_of[by_part[p][i]] >= vertex_count / 2;
+      const bool upper = slot(vertex_of[by_part[p][i]]) >= half_slot;
       keyed.emplace_back((upper ? kUpperHalfKey : 0u) | morton3(cell(0), cell(1), cell(2)), static_cast<int>(i));
     }
-    // The lower half of the numbering first, then the upper; each along the Morton curve.
+    // The lower half of the sequence first, then the upper; each along the Morton curve.
     std::sort(keyed.begin(), keyed.end());
     const auto upper_begin = std::partition_point(keyed.begin(), keyed.end(), [](const auto& k) { return k.first < kUpperHalfKey; });
     const size_t halves[3] = {0, static_cast<size_t>(upper_begin - keyed.begin()), keyed.size()};
@@ -295,7 +341,7 @@ void MeshDeformer::State::build_clusters(const DeformationModel& model) {
           for (int c = 0; c < 3; ++c) lanes.outside[c][lane] = static_cast<float>(local[i][c] - inside[i][c]);
           if (lane >= cluster.count) continue;
           lanes.beta[lane] = static_cast<float>(model.vertex_influences[k].weight);
-          influence_slots[k] = static_cast<int>(clusters.size()) * 3 * kClusterSize + lane;
+          result_of[k] = static_cast<int>(clusters.size()) * 3 * kClusterSize + lane;
         }
         clusters.push_back(cluster);
         cluster_lanes.push_back(lanes);
@@ -305,6 +351,16 @@ void MeshDeformer::State::build_clusters(const DeformationModel& model) {
   cluster_result.assign(clusters.size(), ClusterResult{});
   clusters.shrink_to_fit();  // grown by push_back: up to half of it slack
   cluster_lanes.shrink_to_fit();
+
+  influence_offsets.assign(1, 0);
+  influence_results.clear();
+  influence_results.reserve(result_of.size());
+  for (int w : window_sequence)
+    for (int v = w * kNormalWindow; v < std::min((w + 1) * kNormalWindow, vertex_count); ++v) {
+      for (int k = model.vertex_influence_offsets[v]; k < model.vertex_influence_offsets[v + 1]; ++k)
+        influence_results.push_back(result_of[k]);
+      influence_offsets.push_back(static_cast<int>(influence_results.size()));
+    }
 }
 
 void MeshDeformer::State::build_fans(const std::vector<std::array<int, 3>>& faces) {
@@ -350,14 +406,13 @@ void MeshDeformer::State::build_fans(const std::vector<std::array<int, 3>>& face
     fan_offsets[v + 1] = static_cast<int>(fans.size());
   }
 
-  const int windows = (vertex_count + kNormalWindow - 1) / kNormalWindow;
   normal_window_blocks.assign(1, 0);
   normal_block_rows.assign(1, 0);
   normal_rows.clear();
   normal_block_reads_last.clear();
   std::vector<int> order;
   auto fan_length = [&](int v) { return fan_offsets[v + 1] - fan_offsets[v]; };
-  for (int w = 0; w < windows; ++w) {
+  for (int w : window_sequence) {  // in sequence order: a range of slots reads one stream of rows
     const int first = w * kNormalWindow, last = std::min(first + kNormalWindow, vertex_count);
     order.resize(static_cast<size_t>(last - first));
     std::iota(order.begin(), order.end(), first);
@@ -523,18 +578,24 @@ int MeshDeformer::cluster_count() const { return static_cast<int>(state_->cluste
 void MeshDeformer::blend_vertices(int begin, int end, std::span<float> positions) const {
   const State& s = *state_;
   end = std::min(end, s.vertex_count);
-  if (positions.size() < static_cast<size_t>(s.vertex_count) * 3) return;
+  begin = std::max(begin, 0);
+  if (positions.size() < static_cast<size_t>(s.vertex_count) * 3 || begin >= end) return;
   const float* results = s.cluster_result.empty() ? nullptr : s.cluster_result.front().xyz[0];
-  for (int v = std::max(begin, 0); v < end; ++v) {
-    float sum[3] = {0.0f, 0.0f, 0.0f};
-    for (int k = s.influence_offsets[v]; k < s.influence_offsets[v + 1]; ++k) {
-      const float* result = results + s.influence_slots[k];
-      sum[0] += result[0];
-      sum[1] += result[kClusterSize];
-      sum[2] += result[2 * kClusterSize];
+  for (int at = begin; at < end;) {  // window by window of the sequence
+    const int in_window = at % kNormalWindow, count = std::min(end - at, kNormalWindow - in_window);
+    const int first = s.window_sequence[at / kNormalWindow] * kNormalWindow + in_window;
+    for (int v = first, slot = at; v < first + count; ++v, ++slot) {
+      float sum[3] = {0.0f, 0.0f, 0.0f};
+      for (int k = s.influence_offsets[slot]; k < s.influence_offsets[slot + 1]; ++k) {
+        const float* result = results + s.influence_results[k];
+        sum[0] += result[0];
+        sum[1] += result[kClusterSize];
+        sum[2] += result[2 * kClusterSize];
+      }
+      float* out = &positions[static_cast<size_t>(v) * 3];
+      out[0] = sum[0], out[1] = sum[1], out[2] = sum[2];
     }
-    float* out = &positions[static_cast<size_t>(v) * 3];
-    out[0] = sum[0], out[1] = sum[1], out[2] = sum[2];
+    at += count;
   }
 }
 
@@ -557,20 +618,26 @@ void MeshDeformer::vertex_normals(int begin, int end, std::span<const float> pos
   if (begin >= end) return;
   const float* __restrict p = positions.data();
   float* __restrict out = normals.data();
-  const int first_block = s.normal_window_blocks[begin / kNormalWindow];
-  const int end_block = s.normal_window_blocks[(end - 1) / kNormalWindow + 1];
-  for (int block = first_block; block < end_block; ++block) {
-    const int* rows = &s.normal_rows[static_cast<size_t>(s.normal_block_rows[block]) * kQuadsPerLanes];
-    const int row_count = s.normal_block_rows[block + 1] - s.normal_block_rows[block];
-    Lanes unit;
-    if (s.normal_block_reads_last[block])
-      block_normals<true>(p, rows, row_count, unit);
-    else
-      block_normals<false>(p, rows, row_count, unit);
-    for (int q = 0; q < kQuadsPerLanes; ++q) {
-      const int at = rows[q];
-      if (at >= 3 * begin && at < 3 * end) __builtin_memcpy(out + at, reinterpret_cast<const float*>(&unit) + 4 * q, 3 * sizeof(float));
+  for (int at = begin; at < end;) {  // window by window of the sequence
+    const int in_window = at % kNormalWindow, count = std::min(end - at, kNormalWindow - in_window);
+    const int window = s.window_sequence[at / kNormalWindow];
+    // The range's vertices in this window, as float indices (3 * vertex), as the rows hold them.
+    const int write_begin = 3 * (window * kNormalWindow + in_window), write_end = write_begin + 3 * count;
+    for (int block = s.normal_window_blocks[at / kNormalWindow]; block < s.normal_window_blocks[at / kNormalWindow + 1]; ++block) {
+      const int* rows = &s.normal_rows[static_cast<size_t>(s.normal_block_rows[block]) * kQuadsPerLanes];
+      const int row_count = s.normal_block_rows[block + 1] - s.normal_block_rows[block];
+      Lanes unit;
+      if (s.normal_block_reads_last[block])
+        block_normals<true>(p, rows, row_count, unit);
+      else
+        block_normals<false>(p, rows, row_count, unit);
+      for (int q = 0; q < kQuadsPerLanes; ++q) {
+        const int vertex = rows[q];
+        if (vertex >= write_begin && vertex < write_end)
+          __builtin_memcpy(out + vertex, reinterpret_cast<const float*>(&unit) + 4 * q, 3 * sizeof(float));
+      }
     }
+    at += count;
   }
 }
 
@@ -583,6 +650,10 @@ bool MeshDeformer::deform(std::span<const Vec3> markers, std::span<float> positi
 }
 
 int MeshDeformer::vertex_count() const { return state_->vertex_count; }
+int MeshDeformer::sequence_vertex(int slot) const {
+  return state_->window_sequence.at(static_cast<size_t>(slot / kNormalWindow)) * kNormalWindow + slot % kNormalWindow;
+}
+int MeshDeformer::upper_half_slot() const { return state_->half_slot; }
 int MeshDeformer::normal_group_size() const { return kNormalWindow; }
 DeformationMode MeshDeformer::mode() const { return state_->mode; }
 const PartDeformer& MeshDeformer::part(int part) const { return state_->parts.at(static_cast<size_t>(part)); }
@@ -591,8 +662,8 @@ size_t MeshDeformer::memory_bytes() const {
   const State& s = *state_;
   auto bytes = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
   size_t total = sizeof(State) + bytes(s.member_offsets) + bytes(s.member_markers) +
-                 bytes(s.member_scratch) + bytes(s.influence_offsets) + bytes(s.influence_slots) +
-                 bytes(s.solved) + bytes(s.centres) +
+                 bytes(s.member_scratch) + bytes(s.influence_offsets) + bytes(s.influence_results) +
+                 bytes(s.solved) + bytes(s.centres) + bytes(s.window_sequence) + bytes(s.slot_of_window) +
                  bytes(s.normal_window_blocks) + bytes(s.normal_block_rows) + bytes(s.normal_rows) + bytes(s.normal_block_reads_last) + bytes(s.clusters) +
                  bytes(s.cluster_lanes) + bytes(s.cluster_result);
   for (const PartDeformer& part : s.parts) {

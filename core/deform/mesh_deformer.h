@@ -6,7 +6,10 @@
 // Split in stages so a caller with threads can share the work out by ranges (core/ has no
 // threads itself): solve_parts() once, then deform_clusters() over disjoint cluster ranges, then
 // blend_vertices() over vertex ranges, then vertex_normals() over vertex ranges; each stage
-// reads what the one before wrote.
+// reads what the one before wrote. Vertex ranges count in the deformer's own vertex sequence
+// (sequence_vertex): a permutation of the mesh's vertices whose two halves are spatially
+// compact, so that threads given one half each mostly read what they wrote themselves. The
+// buffers are always in the mesh's own vertex order.
 // Buffers are sized at construction; no stage allocates.
 
 #include <memory>
@@ -41,10 +44,10 @@ class MeshDeformer {
   int part_count() const;
   int part_member_count(int part) const;
   int cluster_part(int cluster) const;
-  // Whether the cluster's influences are of vertices in the upper half of the numbering
-  // ([vertex_count / 2, vertex_count)); otherwise all are in the lower half. The clusters of a
-  // part come lower half first. DeformWorkers gives the two halves to threads that blend the
-  // same halves, so that eq. 9 mostly reads results its own core wrote.
+  // Whether the cluster's influences are of vertices in the upper half of the vertex sequence
+  // (slots [upper_half_slot(), vertex_count)); otherwise all are in the lower half. The
+  // clusters of a part come lower half first. DeformWorkers gives the two halves to threads
+  // that blend the same halves, so that eq. 9 mostly reads results its own core wrote.
   bool cluster_in_upper_half(int cluster) const;
 
   // Eq. 8 for the influences (vertex, part) of clusters [begin, end), each weighted by its
@@ -52,16 +55,23 @@ class MeshDeformer {
   // vector lanes, so that only the RBF centres within the kernel's support are summed.
   void deform_clusters(int begin, int end);
   int cluster_count() const;
-  // Eq. 9 for vertices [begin, end) into `positions` (3 floats per vertex, the whole mesh's
-  // buffer): the sum of the vertex's weighted results from deform_clusters().
+  // Eq. 9 for the vertices at slots [begin, end) of the sequence into `positions` (3 floats
+  // per vertex, the whole mesh's buffer in mesh order): the sum of the vertex's weighted results
+  // from deform_clusters().
   void blend_vertices(int begin, int end, std::span<float> positions) const;
-  // Unit area-weighted vertex normals [begin, end) (3 floats per vertex) from the whole
-  // mesh's deformed positions.
+  // Unit area-weighted vertex normals of the vertices at slots [begin, end) (3 floats per
+  // vertex, mesh order) from the whole mesh's deformed positions.
   void vertex_normals(int begin, int end, std::span<const float> positions, std::span<float> normals) const;
-  // Normals are computed for groups of this many consecutive vertices: a range that starts or
+  // Normals are computed for groups of this many consecutive slots: a range that starts or
   // ends inside a group computes the whole group and writes only its own part of it, so callers
-  // cutting the mesh into ranges should cut at multiples of this.
+  // cutting the sequence into ranges should cut at multiples of this.
   int normal_group_size() const;
+  // The vertex at a slot of the sequence. The sequence is made of groups of normal_group_size()
+  // consecutive vertices (the last may be shorter, and comes last), so no cache line of the
+  // buffers holds vertices of both halves.
+  int sequence_vertex(int slot) const;
+  // The first slot of the upper half: a multiple of normal_group_size().
+  int upper_half_slot() const;
 
   // All stages on the calling thread. `normals` may be empty (not wanted).
   bool deform(std::span<const Vec3> markers, std::span<float> positions, std::span<float> normals);

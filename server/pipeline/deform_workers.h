@@ -8,8 +8,8 @@
 // Stages, in order: part fits and clusters (a cluster waits only for its own part's fit, so
 // the largest part's fit overlaps the other parts' clusters), then eq. 9 per vertex, then the
 // vertex normals. After the fits, the calling thread works from the front of each stage (the
-// lower half of the vertex numbering) and the workers from the back, so that each mostly reads
-// what it wrote itself. No thread is created and nothing is allocated per frame.
+// lower half of the deformer's vertex sequence) and the workers from the back, so that each
+// mostly reads what it wrote itself. No thread is created and nothing is allocated per frame.
 //
 // Waking a sleeping worker costs the OS's wake-up latency inside the frame: on a virtual
 // machine whose idle core has halted, 0.09 ms at the median and more than a millisecond in

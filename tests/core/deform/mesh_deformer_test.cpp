@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "core/deform/vertex_blend.h"
 #include "tests/core/deform/deform_test_support.h"
 #include "tests/support/allocation_counter.h"
@@ -290,19 +292,72 @@ TEST(MeshDeformer, VertexAndNormalRangesComposeToTheWholeFrame) {
   EXPECT_EQ(normals_whole, normals_split);
 }
 
-// Clusters never mix the two halves of the vertex numbering (DeformWorkers gives them to the
+// Clusters never mix the two halves of the vertex sequence (DeformWorkers gives them to the
 // threads that blend those halves), and a part's lower-half clusters come first.
-TEST(MeshDeformer, ClustersKeepToOneHalfOfTheVertexNumbering) {
+TEST(MeshDeformer, ClustersKeepToOneHalfOfTheVertexSequence) {
   TwoPartScene scene;
   const MeshDeformer deformer(scene.model, scene.subject);
-  // Per part 150 influences, 75 in each half: two clusters of at most 64 per half, where mixing
-  // the halves would need three per part.
-  ASSERT_EQ(deformer.cluster_count(), 8);
+  // 200 vertices: three whole groups of 64 and a short one; the lower half is one whole group.
+  ASSERT_EQ(deformer.normal_group_size(), 64);
+  ASSERT_EQ(deformer.upper_half_slot(), 64);
+  int influences[2][2] = {};  // [part][upper half]
+  for (int slot = 0; slot < deformer.vertex_count(); ++slot) {
+    const int v = deformer.sequence_vertex(slot);
+    for (int k = scene.model.vertex_influence_offsets[v]; k < scene.model.vertex_influence_offsets[v + 1]; ++k)
+      ++influences[scene.model.vertex_influences[k].part][slot >= deformer.upper_half_slot()];
+  }
+  std::vector<std::pair<int, bool>> expected;  // (part, upper half) per cluster
+  for (int part = 0; part < 2; ++part)
+    for (int half = 0; half < 2; ++half)
+      for (int n = 0; n < (influences[part][half] + 63) / 64; ++n) expected.emplace_back(part, half == 1);
+  ASSERT_EQ(deformer.cluster_count(), static_cast<int>(expected.size()));
   for (int c = 0; c < deformer.cluster_count(); ++c) {
     SCOPED_TRACE(c);
-    EXPECT_EQ(deformer.cluster_part(c), c / 4);
-    EXPECT_EQ(deformer.cluster_in_upper_half(c), c % 4 >= 2);
+    EXPECT_EQ(deformer.cluster_part(c), expected[c].first);
+    EXPECT_EQ(deformer.cluster_in_upper_half(c), expected[c].second);
   }
+}
+
+// A sheet of 8 rows of 64 vertices whose numbering alternates between its two ends (rows 0, 7,
+// 1, 6, ...): halves of the numbering would interleave in space, and every row's edges to its
+// neighbours would cross between threads. The sequence takes whole rows (groups of 64
+// consecutive vertices) and cuts the sheet once, across its length.
+TEST(MeshDeformer, TheVertexSequenceIsTwoSpatiallyCompactHalves) {
+  TwoPartScene scene;
+  constexpr int kRows = 8, kColumns = 64;
+  const int row_of_block[kRows] = {0, 7, 1, 6, 2, 5, 3, 4};
+  int block_of_row[kRows];
+  for (int b = 0; b < kRows; ++b) block_of_row[row_of_block[b]] = b;
+  DeformationModel& model = scene.model;
+  model.reference_vertices.clear();
+  model.vertex_influences.clear();
+  model.vertex_influence_offsets.assign(1, 0);
+  model.faces.clear();
+  for (int b = 0; b < kRows; ++b)
+    for (int c = 0; c < kColumns; ++c) {
+      model.reference_vertices.emplace_back(2.0 * c - 60.0, 10.0 * row_of_block[b] - 35.0, 0.0);
+      model.vertex_influences.push_back({0, 1.0});
+      model.vertex_influence_offsets.push_back(static_cast<int>(model.vertex_influences.size()));
+    }
+  auto at = [&](int row, int column) { return block_of_row[row] * kColumns + column; };
+  for (int r = 0; r + 1 < kRows; ++r)
+    for (int c = 0; c + 1 < kColumns; ++c) {
+      model.faces.push_back({at(r, c), at(r, c + 1), at(r + 1, c + 1)});
+      model.faces.push_back({at(r, c), at(r + 1, c + 1), at(r + 1, c)});
+    }
+  const MeshDeformer deformer(model, scene.subject);
+  ASSERT_EQ(deformer.upper_half_slot(), 4 * kColumns);
+  std::vector<int> seen(model.reference_vertices.size(), 0);
+  for (int slot = 0; slot < deformer.vertex_count(); ++slot) {
+    SCOPED_TRACE(slot);
+    const int v = deformer.sequence_vertex(slot);
+    ASSERT_GE(v, 0);
+    ASSERT_LT(v, deformer.vertex_count());
+    ++seen[v];
+    EXPECT_EQ(v % kColumns, slot % kColumns);  // whole groups of consecutive vertices
+    EXPECT_EQ(model.reference_vertices[v].y() < 0.0, slot < deformer.upper_half_slot());  // rows 0-3 below
+  }
+  EXPECT_EQ(std::count(seen.begin(), seen.end(), 1), deformer.vertex_count());  // a permutation
 }
 
 TEST(MeshDeformer, PerFrameWorkAllocatesNothing) {
