@@ -45,6 +45,45 @@ inline __attribute__((always_inline)) void load_quads_exactly(const float* __res
     for (int a = 0; a < 3; ++a) out[4 * q + a] = p[index[q] + a];
 }
 
+// Segment kSegment's x y z to `to` (12 bytes, nothing after them touched), straight from the
+// register: copying the register to memory and the floats from there stalled on forwarding the
+// store (a quarter of the normals stage in perf).
+template <int kSegment>
+inline __attribute__((always_inline)) void store_xyz(const Lanes& v, float* to) {
+  typedef float Pair __attribute__((vector_size(2 * sizeof(float))));
+  const Quad q = __builtin_shufflevector(v, v, 4 * kSegment, 4 * kSegment + 1, 4 * kSegment + 2, 4 * kSegment + 3);
+  const Pair xy = __builtin_shufflevector(q, q, 0, 1);
+  __builtin_memcpy(to, &xy, sizeof(Pair));
+  to[2] = q[2];
+}
+
+// The smallest and the largest of the lanes: four halving steps of shuffles and selects, where
+// reading the sixteen lanes one by one went through memory (a tenth of the cluster stage).
+inline __attribute__((always_inline)) void lane_min(const Lanes& v, float& out) {
+  Lanes m = v, s;
+  s = __builtin_shufflevector(m, m, 8, 9, 10, 11, 12, 13, 14, 15, 0, 1, 2, 3, 4, 5, 6, 7);
+  m = s < m ? s : m;
+  s = __builtin_shufflevector(m, m, 4, 5, 6, 7, 0, 1, 2, 3, 12, 13, 14, 15, 8, 9, 10, 11);
+  m = s < m ? s : m;
+  s = __builtin_shufflevector(m, m, 2, 3, 0, 1, 6, 7, 4, 5, 10, 11, 8, 9, 14, 15, 12, 13);
+  m = s < m ? s : m;
+  s = __builtin_shufflevector(m, m, 1, 0, 3, 2, 5, 4, 7, 6, 9, 8, 11, 10, 13, 12, 15, 14);
+  m = s < m ? s : m;
+  out = m[0];
+}
+inline __attribute__((always_inline)) void lane_max(const Lanes& v, float& out) {
+  Lanes m = v, s;
+  s = __builtin_shufflevector(m, m, 8, 9, 10, 11, 12, 13, 14, 15, 0, 1, 2, 3, 4, 5, 6, 7);
+  m = s > m ? s : m;
+  s = __builtin_shufflevector(m, m, 4, 5, 6, 7, 0, 1, 2, 3, 12, 13, 14, 15, 8, 9, 10, 11);
+  m = s > m ? s : m;
+  s = __builtin_shufflevector(m, m, 2, 3, 0, 1, 6, 7, 4, 5, 10, 11, 8, 9, 14, 15, 12, 13);
+  m = s > m ? s : m;
+  s = __builtin_shufflevector(m, m, 1, 0, 3, 2, 5, 4, 7, 6, 9, 8, 11, 10, 13, 12, 15, 14);
+  m = s > m ? s : m;
+  out = m[0];
+}
+
 // x y z w -> y z x w in every segment (one in-segment permute). Applied to a * rotated(b) -
 // rotated(a) * b it gives the cross product a x b.
 inline __attribute__((always_inline)) void rotate_xyz(const Lanes& v, Lanes& out) {

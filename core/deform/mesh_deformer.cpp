@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <numeric>
 #include <stdexcept>
+#include <type_traits>
 
 #include "core/deform/lane_vectors.h"
 #include "core/deform/part_model.h"
@@ -521,12 +522,13 @@ inline __attribute__((always_inline)) void MeshDeformer::State::deform_cluster(i
     float low[3], high[3];
     for (int a = 0; a < 3; ++a) {
       for (int b = 0; b < kBlocks; ++b) scaled[b][a] = local[b][a] * inverse_sigma;
-      low[a] = high[a] = scaled[0][a][0];
-      for (int b = 0; b < kBlocks; ++b)
-        for (int l = 0; l < kLanes; ++l) {
-          low[a] = scaled[b][a][l] < low[a] ? scaled[b][a][l] : low[a];
-          high[a] = scaled[b][a][l] > high[a] ? scaled[b][a][l] : high[a];
-        }
+      Lanes lowest = scaled[0][a], highest = scaled[0][a];
+      for (int b = 1; b < kBlocks; ++b) {
+        lowest = scaled[b][a] < lowest ? scaled[b][a] : lowest;
+        highest = scaled[b][a] > highest ? scaled[b][a] : highest;
+      }
+      lane_min(lowest, low[a]);
+      lane_max(highest, high[a]);
     }
     const float mid[3] = {0.5f * (low[0] + high[0]), 0.5f * (low[1] + high[1]), 0.5f * (low[2] + high[2])};
     const float hx = 0.5f * (high[0] - low[0]), hy = 0.5f * (high[1] - low[1]), hz = 0.5f * (high[2] - low[2]);
@@ -631,11 +633,14 @@ void MeshDeformer::vertex_normals(int begin, int end, std::span<const float> pos
         block_normals<true>(p, rows, row_count, unit);
       else
         block_normals<false>(p, rows, row_count, unit);
-      for (int q = 0; q < kQuadsPerLanes; ++q) {
-        const int vertex = rows[q];
-        if (vertex >= write_begin && vertex < write_end)
-          __builtin_memcpy(out + vertex, reinterpret_cast<const float*>(&unit) + 4 * q, 3 * sizeof(float));
-      }
+      auto store = [&](auto segment) __attribute__((always_inline)) {
+        const int vertex = rows[segment()];
+        if (vertex >= write_begin && vertex < write_end) store_xyz<segment()>(unit, out + vertex);
+      };
+      store(std::integral_constant<int, 0>{});
+      store(std::integral_constant<int, 1>{});
+      store(std::integral_constant<int, 2>{});
+      store(std::integral_constant<int, 3>{});
     }
     at += count;
   }
