@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <stdexcept>
 
 #include "core/deform/vertex_blend.h"
 #include "tests/core/deform/deform_test_support.h"
@@ -358,6 +359,8 @@ TEST(MeshDeformer, TheVertexSequenceIsTwoSpatiallyCompactHalves) {
     EXPECT_EQ(model.reference_vertices[v].y() < 0.0, slot < deformer.upper_half_slot());  // rows 0-3 below
   }
   EXPECT_EQ(std::count(seen.begin(), seen.end(), 1), deformer.vertex_count());  // a permutation
+  EXPECT_THROW(deformer.sequence_vertex(deformer.vertex_count()), std::out_of_range);
+  EXPECT_THROW(deformer.sequence_vertex(-1), std::out_of_range);
 }
 
 TEST(MeshDeformer, PerFrameWorkAllocatesNothing) {
