@@ -57,32 +57,21 @@ inline __attribute__((always_inline)) void store_xyz(const Lanes& v, float* to) 
   to[2] = q[2];
 }
 
-// The smallest and the largest of the lanes: four halving steps of shuffles and selects, where
-// reading the sixteen lanes one by one went through memory (a tenth of the cluster stage).
-inline __attribute__((always_inline)) void lane_min(const Lanes& v, float& out) {
-  Lanes m = v, s;
-  s = __builtin_shufflevector(m, m, 8, 9, 10, 11, 12, 13, 14, 15, 0, 1, 2, 3, 4, 5, 6, 7);
-  m = s < m ? s : m;
-  s = __builtin_shufflevector(m, m, 4, 5, 6, 7, 0, 1, 2, 3, 12, 13, 14, 15, 8, 9, 10, 11);
-  m = s < m ? s : m;
-  s = __builtin_shufflevector(m, m, 2, 3, 0, 1, 6, 7, 4, 5, 10, 11, 8, 9, 14, 15, 12, 13);
-  m = s < m ? s : m;
-  s = __builtin_shufflevector(m, m, 1, 0, 3, 2, 5, 4, 7, 6, 9, 8, 11, 10, 13, 12, 15, 14);
-  m = s < m ? s : m;
+// The smallest (kLargest false) or the largest of the lanes: four halving steps of shuffles and
+// selects, where reading the sixteen lanes one by one went through memory (a tenth of the
+// cluster stage).
+template <bool kLargest>
+inline __attribute__((always_inline)) void lane_extreme(const Lanes& v, float& out) {
+  Lanes m = v;
+  auto keep = [&m](const Lanes& s) __attribute__((always_inline)) { m = (kLargest ? s > m : s < m) ? s : m; };
+  keep(__builtin_shufflevector(m, m, 8, 9, 10, 11, 12, 13, 14, 15, 0, 1, 2, 3, 4, 5, 6, 7));
+  keep(__builtin_shufflevector(m, m, 4, 5, 6, 7, 0, 1, 2, 3, 12, 13, 14, 15, 8, 9, 10, 11));
+  keep(__builtin_shufflevector(m, m, 2, 3, 0, 1, 6, 7, 4, 5, 10, 11, 8, 9, 14, 15, 12, 13));
+  keep(__builtin_shufflevector(m, m, 1, 0, 3, 2, 5, 4, 7, 6, 9, 8, 11, 10, 13, 12, 15, 14));
   out = m[0];
 }
-inline __attribute__((always_inline)) void lane_max(const Lanes& v, float& out) {
-  Lanes m = v, s;
-  s = __builtin_shufflevector(m, m, 8, 9, 10, 11, 12, 13, 14, 15, 0, 1, 2, 3, 4, 5, 6, 7);
-  m = s > m ? s : m;
-  s = __builtin_shufflevector(m, m, 4, 5, 6, 7, 0, 1, 2, 3, 12, 13, 14, 15, 8, 9, 10, 11);
-  m = s > m ? s : m;
-  s = __builtin_shufflevector(m, m, 2, 3, 0, 1, 6, 7, 4, 5, 10, 11, 8, 9, 14, 15, 12, 13);
-  m = s > m ? s : m;
-  s = __builtin_shufflevector(m, m, 1, 0, 3, 2, 5, 4, 7, 6, 9, 8, 11, 10, 13, 12, 15, 14);
-  m = s > m ? s : m;
-  out = m[0];
-}
+inline __attribute__((always_inline)) void lane_min(const Lanes& v, float& out) { lane_extreme<false>(v, out); }
+inline __attribute__((always_inline)) void lane_max(const Lanes& v, float& out) { lane_extreme<true>(v, out); }
 
 // x y z w -> y z x w in every segment (one in-segment permute). Applied to a * rotated(b) -
 // rotated(a) * b it gives the cross product a x b.
