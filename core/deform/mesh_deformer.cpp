@@ -191,7 +191,7 @@ struct MeshDeformer::State {
 
   // Eq. 8 is evaluated per cluster of up to kClusterSize influences (vertex, part) of one part
   // that lie close together in the reference pose (sorted along a Morton curve), and of
-  // vertices from one half of the numbering (see cluster_in_upper_half): the quadratic
+  // vertices from one half of the vertex sequence (see window_sequence): the quadratic
   // field in vector lanes, and for the RBF term the cluster's deformed bounding box selects the
   // centres whose kernel can be non-zero for any of its members (the B-spline vanishes beyond
   // 2 sigma), exactly, without bounds on how the field stretches.
