@@ -182,7 +182,6 @@ struct MeshDeformer::State {
   // computes the normals of vertices whose neighbours it blended itself. The windows keep the
   // output buffers' cache lines whole: no line is written by both halves.
   std::vector<int> window_sequence;  // per position in the sequence, the window (vertex / kNormalWindow)
-  std::vector<int> slot_of_window;   // the inverse
   int half_slot = 0;                 // the first slot of the upper half (a window boundary)
 
   std::vector<SolvedPart> solved;
@@ -226,9 +225,6 @@ struct MeshDeformer::State {
   std::vector<int> normal_rows;           // 4 entries per row
   std::vector<uint8_t> normal_block_reads_last;  // per block: it reads the last vertex (load_quads_exactly)
 
-  int slot(int vertex) const {
-    return slot_of_window[vertex / kNormalWindow] * kNormalWindow + vertex % kNormalWindow;
-  }
   void build_sequence(const DeformationModel& model);
   void store_solved(int p);
   void build_clusters(const DeformationModel& model);
@@ -302,8 +298,6 @@ void MeshDeformer::State::build_sequence(const DeformationModel& model) {
     order.resize(static_cast<size_t>(full_windows));
   }
   window_sequence = best;
-  slot_of_window.assign(static_cast<size_t>(windows), 0);
-  for (int i = 0; i < windows; ++i) slot_of_window[window_sequence[i]] = i;
 }
 
 void MeshDeformer::State::build_clusters(const DeformationModel& model) {
@@ -313,6 +307,9 @@ void MeshDeformer::State::build_clusters(const DeformationModel& model) {
   for (int v = 0; v < vertex_count; ++v)
     for (int k = model.vertex_influence_offsets[v]; k < model.vertex_influence_offsets[v + 1]; ++k) vertex_of[k] = v;
   std::vector<int> result_of(model.vertex_influences.size(), 0);  // per influence of the model
+  std::vector<int> window_position(window_sequence.size());  // inverse of window_sequence
+  for (size_t i = 0; i < window_sequence.size(); ++i) window_position[window_sequence[i]] = static_cast<int>(i);
+  auto in_upper_half = [&](int v) { return window_position[v / kNormalWindow] * kNormalWindow >= half_slot; };
   for (size_t p = 0; p < parts.size(); ++p) {
     const PartModel& part = parts[p].model();
     std::vector<Vec3> local(by_part[p].size()), inside(by_part[p].size());
@@ -323,7 +320,7 @@ void MeshDeformer::State::build_clusters(const DeformationModel& model) {
       inside[i] = part.clamp_to_bounds(local[i]);
       const Vec3 unit = (inside[i] - part.local_min).cwiseQuotient(extent);
       auto cell = [&](int a) { return static_cast<uint32_t>(std::clamp(unit[a], 0.0, 1.0) * 1023.0); };
-      const bool upper = slot(vertex_of[by_part[p][i]]) >= half_slot;
+      const bool upper = in_upper_half(vertex_of[by_part[p][i]]);
       keyed.emplace_back((upper ? kUpperHalfKey : 0u) | morton3(cell(0), cell(1), cell(2)), static_cast<int>(i));
     }
     // The lower half of the sequence first, then the upper; each along the Morton curve.
@@ -675,7 +672,7 @@ size_t MeshDeformer::memory_bytes() const {
   auto bytes = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
   size_t total = sizeof(State) + bytes(s.member_offsets) + bytes(s.member_markers) +
                  bytes(s.member_scratch) + bytes(s.influence_offsets) + bytes(s.influence_results) +
-                 bytes(s.solved) + bytes(s.centres) + bytes(s.window_sequence) + bytes(s.slot_of_window) +
+                 bytes(s.solved) + bytes(s.centres) + bytes(s.window_sequence) +
                  bytes(s.normal_window_blocks) + bytes(s.normal_block_rows) + bytes(s.normal_rows) + bytes(s.normal_block_reads_last) + bytes(s.clusters) +
                  bytes(s.cluster_lanes) + bytes(s.cluster_result);
   for (const PartDeformer& part : s.parts) {
