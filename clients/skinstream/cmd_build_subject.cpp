@@ -49,7 +49,7 @@ void add_build_subject(CLI::App& app) {
   static std::string capture_path, out_path, surface_in, surface_out, mesh_path, landmarks_path, parts_path;
   static SubjectBuildOptions options;
   static DeformationBuildOptions deformation;
-  static bool no_register = false;
+  static bool no_register = false, no_joint_split = false;
   cmd->add_option("--capture", capture_path, "training capture (.c3d/.trc), ideally a range-of-motion take")->required();
   cmd->add_option("--out", out_path, "subject file to write")->required();
   cmd->add_option("--reference-frame", options.reference_frame, "frame index of the reference pose (default: chosen)");
@@ -64,6 +64,8 @@ void add_build_subject(CLI::App& app) {
   cmd->add_option("--marker-offset", deformation.registration.marker_offset_mm, "markers sit this far above the skin (mm)")
       ->capture_default_str();
   cmd->add_option("--parts", deformation.segmentation.target_parts, "number of near-rigid parts")->capture_default_str();
+  cmd->add_flag("--no-joint-split", no_joint_split,
+                "vertex weights by the nearest marker triangle alone, as in the paper (no split at the parts' joints)");
   cmd->add_option("--part-file", parts_path, "JSON {\"marker\": part index}: your segmentation instead of mean shift");
   cmd->add_option("--bandwidth", deformation.segmentation.bandwidth_degrees, "mean-shift bandwidth (degrees)")
       ->capture_default_str();
@@ -84,6 +86,7 @@ void add_build_subject(CLI::App& app) {
       for (int f = 0; f < filled.frame_count; ++f)
         for (int i = 0; i < n; ++i) positions[static_cast<size_t>(f) * n + i] = filled.at(f, i);
       deformation.register_mesh = !no_register;
+      deformation.split_at_joints = !no_joint_split;
       if (!landmarks_path.empty()) {
         const std::vector<int> vertex = read_marker_map(landmarks_path, model, "vertex index");
         for (int i = 0; i < n; ++i)
@@ -129,6 +132,7 @@ void add_build_subject(CLI::App& app) {
                      {"max_part_rigid_rms_mm", d.max_part_rigid_rms_mm},
                      {"boundary_markers", d.boundary_markers},
                      {"mean_parts_per_vertex", d.mean_influences_per_vertex},
+                     {"joints", joints_json(d.joints)},
                      {"part_quadratic_ridges", to_json(d.part_quadratic_ridges)},
                      {"part_rbf_ridges", to_json(d.part_ridges)}};
     }

@@ -62,8 +62,12 @@ void add_eval_deform(CLI::App& app) {
   cmd->add_option("--body", body_dir, "folder with the MakeHuman files (default: the shared data folder)");
   cmd->add_flag("--deform-registered", options.deform_registered_mesh,
                 "deform the registered artist's model instead of the reference frame's truth skin");
+  static bool no_joint_split = false;
+  cmd->add_flag("--no-joint-split", no_joint_split,
+                "vertex weights by the nearest marker triangle alone, as in the paper (no split at the parts' joints)");
   cmd->add_flag("--json", json, "JSON only");
   cmd->callback([] {
+    options.split_at_joints = !no_joint_split;
     const synth::Body body = load_makehuman(body_dir.empty() ? default_body_dir() : body_dir);
     synth::SynthOptions rom;
     rom.motion = "rom";
@@ -90,6 +94,7 @@ void add_eval_deform(CLI::App& app) {
     result["max_part_rigid_rms_mm"] = setup.build.max_part_rigid_rms_mm;
     result["boundary_markers"] = setup.build.boundary_markers;
     result["mean_parts_per_vertex"] = setup.build.mean_influences_per_vertex;
+    result["joints"] = joints_json(setup.build.joints);
     result["part_quadratic_ridges"] = to_json(setup.build.part_quadratic_ridges);
     result["part_rbf_ridges"] = to_json(setup.build.part_ridges);
     result["build_seconds"] = setup.build_seconds;

@@ -188,6 +188,7 @@ DeformationSetup prepare_deformation(const synth::Body& body, const SynthCapture
   for (size_t v = 0; v < registered.size(); ++v)
     setup.registration_vertex_error_mm += (registered[v] - truth_skin[v]).norm() / static_cast<double>(registered.size());
   build.register_mesh = false;
+  build.split_at_joints = options.split_at_joints;
   setup.deformation = build_deformation_model(setup.subject, positions, training.frame_count(),
                                               options.deform_registered_mesh ? registered : truth_skin, faces, build,
                                               &setup.build);

@@ -29,6 +29,7 @@ struct DeformEvaluationOptions {
   // (already registered: the table then measures sections 5.2-5.3 alone); registration is still
   // run and reported on its own. true: the deformation uses the registered artist's model.
   bool deform_registered_mesh = false;
+  bool split_at_joints = true;  // false: the paper's nearest-triangle vertex weights alone
 };
 
 // Everything built once from the range-of-motion take: the subject (section 4), the detailed

@@ -10,6 +10,7 @@
 #include "core/deform/deformation_model.h"
 #include "core/offline/marker_part_weights.h"
 #include "core/offline/mesh_registration.h"
+#include "core/offline/part_joints.h"
 #include "core/offline/part_segmentation.h"
 #include "core/offline/quadratic_ridge_selection.h"
 #include "core/offline/rbf_ridge_selection.h"
@@ -26,6 +27,8 @@ struct DeformationBuildOptions {
   std::vector<int> part_assignment;  // a user's parts (per marker or per triangle); empty: mean shift
   AssignmentKind assignment_kind = AssignmentKind::PerMarker;
   MarkerWeightOptions weights;
+  bool split_at_joints = true;  // false: the paper's nearest-triangle vertex weights alone
+  PartJointOptions joints;
 };
 
 struct DeformationBuildReport {
@@ -38,6 +41,7 @@ struct DeformationBuildReport {
   int boundary_markers = 0;
   int markers_added_for_min_members = 0;
   double mean_influences_per_vertex = 0.0;
+  std::vector<PartJoint> joints;  // the jointed part pairs the vertex weights split at
   std::vector<QuadraticRidgeChoice> part_quadratic_ridges;  // eq. 6's per part, by leave-one-out error
   std::vector<RidgeChoice> part_ridges;  // eq. 7's ridge per part, by leave-one-out error
 };

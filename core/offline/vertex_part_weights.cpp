@@ -24,7 +24,8 @@ constexpr double kZeroWeight = 1e-12;
 
 VertexPartWeights vertex_part_weights(std::span<const Vec3> vertices, std::span<const Vec3> markers,
                                       std::span<const std::array<int, 3>> triangles, std::span<const int> part_member_offsets,
-                                      std::span<const PartMember> part_members) {
+                                      std::span<const PartMember> part_members, std::span<const PartJoint> joints,
+                                      std::span<const char> under_marker) {
   const int m = static_cast<int>(markers.size());
   require(!triangles.empty(), "no marker-surface triangles");
   require(!part_member_offsets.empty() && part_member_offsets.front() == 0 &&
@@ -38,6 +39,13 @@ VertexPartWeights vertex_part_weights(std::span<const Vec3> vertices, std::span<
 
   // alpha rows per marker, sorted by part.
   const int part_count = static_cast<int>(part_member_offsets.size()) - 1;
+  require(under_marker.empty() || under_marker.size() == vertices.size(),
+          std::to_string(under_marker.size()) + " under-marker flags for " + std::to_string(vertices.size()) + " vertices");
+  for (const PartJoint& joint : joints)
+    require(joint.first >= 0 && joint.first < part_count && joint.second >= 0 && joint.second < part_count &&
+                joint.first != joint.second && joint.centre.allFinite() && joint.axis.allFinite(),
+            "a joint names parts " + std::to_string(joint.first) + " and " + std::to_string(joint.second) + " of " +
+                std::to_string(part_count) + " or is not finite");
   std::vector<std::vector<PartInfluence>> alpha(m);
   for (int p = 0; p < part_count; ++p) {
     require(part_member_offsets[p] <= part_member_offsets[p + 1], "part member offsets decrease at part " + std::to_string(p));
@@ -57,8 +65,14 @@ VertexPartWeights vertex_part_weights(std::span<const Vec3> vertices, std::span<
 
   VertexPartWeights out;
   out.vertex_influence_offsets.reserve(vertices.size() + 1);
-  std::vector<PartInfluence> blend;
+  std::vector<PartInfluence> blend, row;
+  auto add = [](std::vector<PartInfluence>& to, int part, double weight) {
+    auto it = std::find_if(to.begin(), to.end(), [&](const PartInfluence& b) { return b.part == part; });
+    if (it == to.end()) to.push_back({part, weight});
+    else it->weight += weight;
+  };
   for (size_t j = 0; j < vertices.size(); ++j) {
+    const bool keep_markers = !under_marker.empty() && under_marker[j];
     int t = -1;
     bvh.closest(vertices[j], &t);
     const synth::Triangle& tri = tris[t];
@@ -67,11 +81,26 @@ VertexPartWeights vertex_part_weights(std::span<const Vec3> vertices, std::span<
     blend.clear();
     for (int k = 0; k < 3; ++k) {
       if (!(bary[k] > kZeroWeight)) continue;
-      for (const PartInfluence& a : alpha[tri[k]]) {
-        auto it = std::find_if(blend.begin(), blend.end(), [&](const PartInfluence& b) { return b.part == a.part; });
-        if (it == blend.end()) blend.push_back({a.part, bary[k] * a.weight});
-        else it->weight += bary[k] * a.weight;
+      row = alpha[tri[k]];
+      if (!keep_markers) {
+        // Across a joint, a marker speaks for its side's part up to the joint's plane, or up to
+        // its own height when it lies past the plane; what it gives that part further on goes
+        // to the part of the vertex's side.
+        for (const PartJoint& joint : joints) {
+          const double vertex_side = joint.side(vertices[j]), marker_side = joint.side(points[tri[k]]);
+          const bool vertex_beyond = vertex_side > 0.0;
+          if (vertex_beyond ? !(vertex_side > std::max(marker_side, 0.0)) : !(vertex_side < std::min(marker_side, 0.0)))
+            continue;
+          const int from = vertex_beyond ? joint.first : joint.second;
+          const int to = vertex_beyond ? joint.second : joint.first;
+          auto it = std::find_if(row.begin(), row.end(), [&](const PartInfluence& b) { return b.part == from; });
+          if (it == row.end()) continue;
+          const double moved = it->weight;
+          row.erase(it);
+          add(row, to, moved);
+        }
       }
+      for (const PartInfluence& a : row) add(blend, a.part, bary[k] * a.weight);
     }
     std::erase_if(blend, [](const PartInfluence& b) { return !(b.weight > kZeroWeight); });
     require(!blend.empty(), "the markers of triangle " + std::to_string(t) + " belong to no part");
@@ -81,6 +110,26 @@ VertexPartWeights vertex_part_weights(std::span<const Vec3> vertices, std::span<
     out.vertex_influence_offsets.push_back(static_cast<int>(out.vertex_influences.size()));
   }
   return out;
+}
+
+std::vector<char> vertices_under_markers(std::span<const Vec3> vertices, std::span<const std::array<int, 3>> faces,
+                                         std::span<const Vec3> markers) {
+  require(!faces.empty(), "the mesh has no faces");
+  const int v = static_cast<int>(vertices.size());
+  for (size_t f = 0; f < faces.size(); ++f)
+    for (int corner : faces[f])
+      require(corner >= 0 && corner < v, "face " + std::to_string(f) + " refers to vertex " + std::to_string(corner) + " of " + std::to_string(v));
+  const std::vector<synth::Triangle> tris(faces.begin(), faces.end());
+  const std::vector<Vec3> points(vertices.begin(), vertices.end());
+  const synth::TriangleBvh bvh(points, tris);
+  std::vector<char> under(vertices.size(), 0);
+  for (const Vec3& marker : markers) {
+    int face = -1;
+    bvh.closest(marker, &face);
+    if (face >= 0)
+      for (int corner : faces[face]) under[corner] = 1;
+  }
+  return under;
 }
 
 }  // namespace skinstream

@@ -4,6 +4,14 @@
 // bounding volume hierarchy finds it), the barycentric coordinates of the projection (clamped
 // to the triangle) interpolate the three markers' alpha vectors, zeros are dropped and the
 // result normalised.
+//
+// One addition to the paper, at hinge joints (part_joints.h): a marker speaks for its own side's
+// part only up to the joint's plane (or up to its own height, when it lies past the plane); for
+// a vertex further on, what the marker gives that part goes to the part of the vertex's side.
+// The paper corrected the same region (upper arms and shoulders) by hand; with the nearest
+// triangle alone, the inner elbow and the back of the knee, where no marker sits, follow the
+// markers of the bone across the joint. Vertices under a marker (the corners of the mesh
+// triangle it sits on) keep its evidence whole: the marker says best how its own skin moves.
 
 #include <array>
 #include <span>
@@ -12,6 +20,7 @@
 #include "core/capture.h"
 #include "core/deform/deformation_model.h"
 #include "core/deform/vertex_blend.h"
+#include "core/offline/part_joints.h"
 
 namespace skinstream {
 
@@ -25,9 +34,16 @@ struct VertexPartWeights {
 // part_member_offsets / part_members: alpha as CSR over parts (marker_part_weights.h), where
 // every marker of a triangle must be a member of some part. Throws std::invalid_argument for an
 // index out of range, a non-finite position, a negative weight or a triangle whose three markers
-// have no weight at all.
+// have no weight at all. joints: empty for the paper's rule alone; their parts must be in range.
+// under_marker: empty, or #V flags of the vertices that keep their markers' weights at joints.
 VertexPartWeights vertex_part_weights(std::span<const Vec3> vertices, std::span<const Vec3> markers,
                                       std::span<const std::array<int, 3>> triangles,
-                                      std::span<const int> part_member_offsets, std::span<const PartMember> part_members);
+                                      std::span<const int> part_member_offsets, std::span<const PartMember> part_members,
+                                      std::span<const PartJoint> joints = {}, std::span<const char> under_marker = {});
+
+// #V flags: the three vertices of the mesh triangle nearest to each marker (where it sits).
+// Throws std::invalid_argument for a face index out of range or no faces.
+std::vector<char> vertices_under_markers(std::span<const Vec3> vertices, std::span<const std::array<int, 3>> faces,
+                                         std::span<const Vec3> markers);
 
 }  // namespace skinstream

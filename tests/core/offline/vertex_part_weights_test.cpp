@@ -7,6 +7,7 @@
 #include <random>
 
 #include "core/offline/marker_part_weights.h"
+#include "core/offline/part_joints.h"
 #include "core/offline/part_segmentation.h"
 #include "tests/core/offline/offline_test_support.h"
 
@@ -26,8 +27,10 @@ struct Fixture {
     test::move_halfway(limb, limb.marker(3, 2), 5, kFrames);
     alpha = marker_part_weights(limb.reference, limb.triangles, parts, 3, limb.positions, kFrames);
   }
-  VertexPartWeights weights(const std::vector<Vec3>& vertices) const {
-    return vertex_part_weights(vertices, limb.reference, limb.triangles, alpha.part_member_offsets, alpha.part_members);
+  VertexPartWeights weights(const std::vector<Vec3>& vertices, std::span<const PartJoint> joints = {},
+                            std::span<const char> under_marker = {}) const {
+    return vertex_part_weights(vertices, limb.reference, limb.triangles, alpha.part_member_offsets, alpha.part_members,
+                               joints, under_marker);
   }
 };
 
@@ -100,6 +103,80 @@ TEST(VertexPartWeights, SumToOneAndFollowTheNearestTriangle) {
   const VertexPartWeights ws = f.weights({near_split});
   EXPECT_GT(beta(ws, 0, 0), 0.0);
   EXPECT_GT(beta(ws, 0, 1), 0.0);
+}
+
+// A point on the limb's skin (radius 45 mm, markers at 40) at height z, between the markers
+// around the ring at `around` (in marker steps, may be fractional).
+Vec3 skin(double around, double z) {
+  const double angle = 2.0 * M_PI * around / 8.0;
+  return Vec3(45.0 * std::cos(angle), 45.0 * std::sin(angle), z);
+}
+
+// The limb's first joint is at z = 200, between ring 3 (z = 175, segment 0) and ring 4 (z = 225,
+// segment 1). The nearest triangle of skin just past it has markers of both segments.
+TEST(VertexPartWeights, SkinPastAJointFollowsThePartBeyondIt) {
+  const Fixture f;
+  const auto& l = f.limb;
+  const std::vector<PartJoint> joints =
+      fit_part_joints(l.reference, f.alpha.part_member_offsets, f.alpha.part_members, l.positions, kFrames);
+  ASSERT_EQ(joints.size(), 2u);
+  const std::vector<Vec3> vertices{skin(5.5, 210.0), skin(5.5, 190.0)};
+  const VertexPartWeights paper = f.weights(vertices), split = f.weights(vertices, joints);
+  // The nearest triangle alone blends the two segments on both sides of the joint.
+  EXPECT_GT(beta(paper, 0, 0), 0.1);
+  EXPECT_GT(beta(paper, 1, 1), 0.1);
+  // Split at the joint, each follows its own side's part only.
+  EXPECT_NEAR(beta(split, 0, 1), 1.0, 1e-12);
+  EXPECT_NEAR(beta(split, 1, 0), 1.0, 1e-12);
+  // Under a marker, the markers' own weights stand.
+  const std::vector<char> under{1, 0};
+  const VertexPartWeights kept = f.weights(vertices, joints, under);
+  for (int p = 0; p < 3; ++p) EXPECT_EQ(beta(kept, 0, p), beta(paper, 0, p)) << p;
+  EXPECT_NEAR(beta(kept, 1, 0), 1.0, 1e-12);
+}
+
+// A marker that lies past the joint's plane yet moves with the part before it (an elbow marker
+// slightly below the pivot) speaks for the skin up to its own height, not beyond.
+TEST(VertexPartWeights, AMarkerPastTheJointSpeaksForTheSkinUpToItself) {
+  const Fixture f;
+  PartJoint low;  // a plane at z = 150: ring 3 (z = 175, segment 0) lies 25 mm past it
+  low.first = 0;
+  low.second = 1;
+  low.centre = Vec3(0.0, 0.0, 150.0);
+  low.axis = Vec3::UnitZ();
+  const std::vector<PartJoint> joints{low};
+  const int ring3 = f.limb.marker(3, 5);
+  ASSERT_EQ(f.alpha.weight(ring3, 0), 1.0);
+  // By the ring-3 marker, a little below it: its part (all but the small share of the ring-2
+  // markers, which lie behind the plane and so cannot speak for skin past it).
+  const std::vector<Vec3> below{skin(5.0, 172.0)};
+  EXPECT_GT(beta(f.weights(below, joints), 0, 0), 0.9);
+  // Beyond it (and the joint): what ring 3 says for segment 0 goes to segment 1.
+  const std::vector<Vec3> beyond{skin(5.5, 200.0)};
+  EXPECT_GT(beta(f.weights(beyond), 0, 0), 0.1);
+  EXPECT_NEAR(beta(f.weights(beyond, joints), 0, 1), 1.0, 1e-12);
+}
+
+TEST(VertexPartWeights, RejectsBadJointsAndFlags) {
+  const Fixture f;
+  const std::vector<Vec3> vertices{skin(1.0, 100.0)};
+  PartJoint bad;
+  bad.first = 0;
+  bad.second = 3;  // 3 parts: 0, 1, 2
+  EXPECT_THROW(f.weights(vertices, std::vector<PartJoint>{bad}), std::invalid_argument);
+  const std::vector<char> two_flags{0, 0};
+  EXPECT_THROW(f.weights(vertices, {}, two_flags), std::invalid_argument);
+}
+
+TEST(VerticesUnderMarkers, FlagsTheCornersOfTheFaceEachMarkerSitsOn) {
+  // Two faces side by side in the z = 0 plane; one marker 4 mm above the second.
+  const std::vector<Vec3> vertices{Vec3(0, 0, 0), Vec3(10, 0, 0), Vec3(0, 10, 0), Vec3(10, 10, 0)};
+  const std::vector<std::array<int, 3>> faces{{0, 1, 2}, {1, 3, 2}};
+  const std::vector<Vec3> markers{Vec3(8, 8, 4)};
+  EXPECT_EQ(vertices_under_markers(vertices, faces, markers), (std::vector<char>{0, 1, 1, 1}));
+  EXPECT_THROW(vertices_under_markers(vertices, {}, markers), std::invalid_argument);
+  const std::vector<std::array<int, 3>> bad{{0, 1, 4}};
+  EXPECT_THROW(vertices_under_markers(vertices, bad, markers), std::invalid_argument);
 }
 
 }  // namespace
