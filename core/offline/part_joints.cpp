@@ -22,8 +22,8 @@ constexpr double kOwned = 1.0 - 1e-9;
 
 // The centre of a hinge is pinned down only weakly along its axis; a small pull (relative to the
 // turns' own stiffness) towards the parts' closest markers keeps it between them. (Taking the
-// centre along the axis from those markers alone, ignoring the turns there, was measured too: it
-// moved the mean vertex errors by 0.00-0.03 mm, all but one the worse way.)
+// centre along the axis from those markers alone, ignoring the turns there, was measured too:
+// over 25 synthetic takes the mean vertex error moved by -0.003 to +0.027 mm, 20 of them up.)
 constexpr double kCentrePrior = 1e-3;
 
 }  // namespace
