@@ -61,7 +61,7 @@ TEST(PartJoints, FindsTheHingesOfAnArticulatedLimb) {
 
 TEST(PartJoints, PartsWithoutACommonPivotAreNotJointed) {
   Limb l(2);
-  // The second segment also slides along the limb, 60 mm to and fro: no point stays shared.
+  // The second segment also slides 60 mm up and down (world z): no point stays shared.
   const size_t m = l.limb.reference.size();
   for (int f = 0; f < kFrames; ++f)
     for (size_t i = 0; i < m; ++i)
