@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "core/absolute_orientation.h"
+#include "core/offline/part_motions.h"
 
 namespace skinstream {
 namespace {
@@ -73,27 +74,21 @@ MarkerPartWeights marker_part_weights(std::span<const Vec3> reference, std::span
     else ++out.boundary_markers;
 
   // Each part's rigid motion per frame from its inside markers, and its sigma.
-  std::vector<RigidTransform> motion(static_cast<size_t>(part_count) * frame_count);
+  std::vector<std::vector<int>> fitted(part_count);
+  for (int p = 0; p < part_count; ++p) {
+    for (int i : part_markers[p])
+      if (marker_parts[i].size() == 1) fitted[p].push_back(i);
+    if (fitted[p].size() < 3) fitted[p] = part_markers[p];  // too few inside markers to pin a rotation
+  }
+  const std::vector<RigidTransform> motion = fit_part_motions(reference, fitted, positions, frame_count);
   out.part_sigma_mm.assign(part_count, options.sigma_floor_mm);
-  {
-    std::vector<Vec3> source, target;
-    for (int p = 0; p < part_count; ++p) {
-      std::vector<int> fit;
-      for (int i : part_markers[p])
-        if (marker_parts[i].size() == 1) fit.push_back(i);
-      if (fit.size() < 3) fit = part_markers[p];  // too few inside markers to pin a rotation
-      source.clear();
-      for (int i : fit) source.push_back(reference[i]);
-      target.resize(fit.size());
-      double sum = 0.0;
-      for (int f = 0; f < frame_count; ++f) {
-        for (size_t k = 0; k < fit.size(); ++k) target[k] = positions[static_cast<size_t>(f) * m + fit[k]];
-        RigidTransform& t = motion[static_cast<size_t>(p) * frame_count + f];
-        fit_rigid(source, target, t);
-        for (size_t k = 0; k < fit.size(); ++k) sum += (t.apply(source[k]) - target[k]).squaredNorm();
-      }
-      out.part_sigma_mm[p] = std::max(options.sigma_floor_mm, std::sqrt(sum / (fit.size() * frame_count)));
+  for (int p = 0; p < part_count; ++p) {
+    double sum = 0.0;
+    for (int f = 0; f < frame_count; ++f) {
+      const RigidTransform& t = motion[static_cast<size_t>(p) * frame_count + f];
+      for (int i : fitted[p]) sum += (t.apply(reference[i]) - positions[static_cast<size_t>(f) * m + i]).squaredNorm();
     }
+    out.part_sigma_mm[p] = std::max(options.sigma_floor_mm, std::sqrt(sum / (fitted[p].size() * frame_count)));
   }
 
   // Normalised Gaussian likelihoods of marker i over `parts` (log domain: no underflow).

@@ -8,7 +8,7 @@
 
 #include <Eigen/Dense>
 
-#include "core/absolute_orientation.h"
+#include "core/offline/part_motions.h"
 
 namespace skinstream {
 namespace {
@@ -59,20 +59,10 @@ std::vector<PartJoint> fit_part_joints(std::span<const Vec3> reference, std::spa
   }
 
   // Each part's rigid motion per frame, and the centroid of the markers it is fitted to.
-  std::vector<RigidTransform> motion(static_cast<size_t>(part_count) * frame_count);
+  const std::vector<RigidTransform> motion = fit_part_motions(reference, fitted, training, frame_count);
   std::vector<Vec3> centroid(part_count, Vec3::Zero());
-  std::vector<Vec3> source, target;
-  for (int p = 0; p < part_count; ++p) {
-    if (fitted[p].empty()) continue;
-    source.clear();
-    for (int i : fitted[p]) source.push_back(reference[i]);
-    for (const Vec3& s : source) centroid[p] += s / static_cast<double>(source.size());
-    target.resize(source.size());
-    for (int f = 0; f < frame_count; ++f) {
-      for (size_t k = 0; k < source.size(); ++k) target[k] = training[static_cast<size_t>(f) * m + fitted[p][k]];
-      fit_rigid(source, target, motion[static_cast<size_t>(p) * frame_count + f]);
-    }
-  }
+  for (int p = 0; p < part_count; ++p)
+    for (int i : fitted[p]) centroid[p] += reference[i] / static_cast<double>(fitted[p].size());
 
   std::vector<PartJoint> joints;
   for (int a = 0; a < part_count; ++a) {
