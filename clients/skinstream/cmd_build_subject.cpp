@@ -42,11 +42,33 @@ std::vector<int> read_marker_map(const std::string& path, const SubjectModel& mo
   return out;
 }
 
+// {"marker name": part, ...} in the subject's marker order; markers in no triangle left out.
+void write_part_file(const std::string& path, const SubjectModel& model, const std::vector<int>& marker_part) {
+  nlohmann::ordered_json j = nlohmann::ordered_json::object();
+  for (int i = 0; i < model.marker_count(); ++i)
+    if (marker_part[i] >= 0) j[model.marker_names[i]] = marker_part[i];
+  std::ofstream out(path);
+  if (!(out << j.dump(1) << '\n')) throw FileError(path, "cannot write");
+}
+
+// Per part: its marker-surface triangles, its members (inside and boundary markers) and the
+// rigid fit's RMS over the training take. A part of a few triangles and markers, with a large
+// residual, is one a hand adjustment should fold into a neighbour.
+nlohmann::ordered_json part_sizes_json(const DeformationBuildReport& report, const DeformationModel& model) {
+  nlohmann::ordered_json out = nlohmann::ordered_json::array();
+  for (int p = 0; p < model.part_count(); ++p)
+    out.push_back({{"part", p},
+                   {"triangles", report.part_triangles[p]},
+                   {"members", model.part_member_offsets[p + 1] - model.part_member_offsets[p]},
+                   {"rigid_rms_mm", report.part_rigid_rms_mm[p]}});
+  return out;
+}
+
 }  // namespace
 
 void add_build_subject(CLI::App& app) {
   auto* cmd = app.add_subcommand("build-subject", "Build the subject model (marker surface, local frames, PCA) from a training capture");
-  static std::string capture_path, out_path, surface_in, surface_out, mesh_path, landmarks_path, parts_path;
+  static std::string capture_path, out_path, surface_in, surface_out, mesh_path, landmarks_path, parts_path, parts_out;
   static SubjectBuildOptions options;
   static DeformationBuildOptions deformation;
   static bool no_register = false, no_joint_split = false;
@@ -67,9 +89,12 @@ void add_build_subject(CLI::App& app) {
   cmd->add_flag("--no-joint-split", no_joint_split,
                 "vertex weights by the nearest marker triangle alone, as in the paper (no split at the parts' joints)");
   cmd->add_option("--part-file", parts_path, "JSON {\"marker\": part index}: your segmentation instead of mean shift");
+  cmd->add_option("--part-file-out", parts_out,
+                  "also write the segmentation used, in --part-file's form, to adjust by hand and read back");
   cmd->add_option("--bandwidth", deformation.segmentation.bandwidth_degrees, "mean-shift bandwidth (degrees)")
       ->capture_default_str();
   cmd->callback([] {
+    if (!parts_out.empty() && mesh_path.empty()) throw std::invalid_argument("--part-file-out needs --mesh (parts are made with the mesh)");
     const Capture training = read_capture(capture_path);
     std::vector<std::array<int, 3>> triangles;
     if (!surface_in.empty()) triangles = read_marker_surface_obj(surface_in, static_cast<int>(training.labelled_points().size()));
@@ -99,14 +124,30 @@ void add_build_subject(CLI::App& app) {
       }
       if (!parts_path.empty()) {
         deformation.part_assignment = read_marker_map(parts_path, model, "part index");
+        // A marker in no triangle of the surface decides no part: it may be left out.
+        std::vector<char> in_triangle(n, 0);
+        for (const auto& t : model.triangles)
+          for (int v : t) in_triangle[v] = 1;
         for (int i = 0; i < n; ++i)
-          if (deformation.part_assignment[i] < 0) throw FileError(parts_path, "marker " + model.marker_names[i] + " has no part");
+          if (deformation.part_assignment[i] < 0) {
+            if (in_triangle[i]) throw FileError(parts_path, "marker " + model.marker_names[i] + " has no part");
+            deformation.part_assignment[i] = 0;
+          }
         deformation.assignment_kind = AssignmentKind::PerMarker;
       }
       deformation_model = build_deformation_model(model, positions, filled.frame_count, mesh.vertices, mesh.faces,
                                                   deformation, &deformation_report);
+      if (!deformation_report.unused_parts.empty()) {
+        std::string list;
+        for (int p : deformation_report.unused_parts) list += (list.empty() ? "" : ", ") + std::to_string(p);
+        std::fprintf(stderr,
+                     "skinstream: warning: %s: part(s) %s hold no triangle of the marker surface (a triangle takes the part "
+                     "most of its markers have); dropped, the other parts renumbered in order\n",
+                     parts_path.c_str(), list.c_str());
+      }
     }
     write_subject(model, deformation_model ? &*deformation_model : nullptr, out_path);
+    if (!parts_out.empty()) write_part_file(parts_out, model, deformation_report.marker_part);
     if (!surface_out.empty())
       write_marker_surface_obj(surface_out, model.marker_names, model.reference_positions, model.triangles);
     nlohmann::ordered_json out = {{"subject", out_path},
@@ -130,6 +171,8 @@ void add_build_subject(CLI::App& app) {
                      {"parts", d.parts},
                      {"mean_shift_groups", d.mean_shift_groups},
                      {"max_part_rigid_rms_mm", d.max_part_rigid_rms_mm},
+                     {"part_sizes", part_sizes_json(d, *deformation_model)},
+                     {"part_file_unused_parts", d.unused_parts},
                      {"boundary_markers", d.boundary_markers},
                      {"mean_parts_per_vertex", d.mean_influences_per_vertex},
                      {"joints", joints_json(d.joints)},

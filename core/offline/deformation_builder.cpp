@@ -45,6 +45,11 @@ DeformationModel build_deformation_model(const SubjectModel& subject, std::span<
   report.parts = parts.part_count;
   report.mean_shift_groups = parts.mean_shift_groups;
   for (double rms : parts.part_rigid_rms_mm) report.max_part_rigid_rms_mm = std::max(report.max_part_rigid_rms_mm, rms);
+  report.part_rigid_rms_mm = parts.part_rigid_rms_mm;
+  report.unused_parts = parts.unused_parts;
+  report.part_triangles.assign(parts.part_count, 0);
+  for (int p : parts.triangle_part) ++report.part_triangles[p];
+  report.marker_part = marker_parts(subject.triangles, parts.triangle_part, subject.marker_count());
 
   const MarkerPartWeights alpha = marker_part_weights(markers, subject.triangles, parts.triangle_part, parts.part_count,
                                                       training, frame_count, options.weights);

@@ -38,6 +38,10 @@ struct DeformationBuildReport {
   int parts = 0;
   int mean_shift_groups = 0;
   double max_part_rigid_rms_mm = 0.0;
+  std::vector<int> part_triangles;         // marker-surface triangles per part
+  std::vector<double> part_rigid_rms_mm;   // per part, over the training take (PartSegmentation)
+  std::vector<int> marker_part;            // each marker's main part (marker_parts): a part file's content
+  std::vector<int> unused_parts;           // of a user's assignment: indices that hold no triangle (dropped)
   int boundary_markers = 0;
   int markers_added_for_min_members = 0;
   double mean_influences_per_vertex = 0.0;

@@ -330,8 +330,13 @@ PartSegmentation segmentation_from_assignment(std::span<const Vec3> reference, T
   const size_t expected = kind == AssignmentKind::PerTriangle ? triangles.size() : reference.size();
   require(assignment.size() == expected, std::to_string(assignment.size()) + " part indices for " + std::to_string(expected) +
                                              (kind == AssignmentKind::PerTriangle ? " triangles" : " markers"));
-  for (size_t k = 0; k < assignment.size(); ++k)
+  for (size_t k = 0; k < assignment.size(); ++k) {
     require(assignment[k] >= 0, "part index " + std::to_string(assignment[k]) + " at " + std::to_string(k) + " is negative");
+    // More parts than triangles cannot all hold one: a typo, not a segmentation.
+    require(assignment[k] < static_cast<int>(triangles.size()), "part index " + std::to_string(assignment[k]) + " at " +
+                                                                     std::to_string(k) + " is beyond the " +
+                                                                     std::to_string(triangles.size()) + " triangles");
+  }
   std::vector<int> part(triangles.size());
   for (size_t t = 0; t < triangles.size(); ++t) {
     if (kind == AssignmentKind::PerTriangle) {
@@ -341,7 +346,41 @@ PartSegmentation segmentation_from_assignment(std::span<const Vec3> reference, T
     const int a = assignment[triangles[t][0]], b = assignment[triangles[t][1]], c = assignment[triangles[t][2]];
     part[t] = (a == b || a == c) ? a : (b == c ? b : std::min({a, b, c}));
   }
-  return finish(triangles, std::move(part), RigidError(reference, positions, sample_frame_indices(frame_count, sample_frames)), false);
+  // Parts left with no triangle are dropped; the rest keep their order.
+  const int largest = *std::max_element(assignment.begin(), assignment.end());
+  std::vector<int> used(largest + 1, 0);
+  for (int p : part) used[p] = 1;
+  std::vector<int> renumbered(largest + 1, -1), unused;
+  for (int p = 0, next = 0; p <= largest; ++p) {
+    if (used[p]) renumbered[p] = next++;
+    else unused.push_back(p);
+  }
+  for (int& p : part) p = renumbered[p];
+  PartSegmentation out =
+      finish(triangles, std::move(part), RigidError(reference, positions, sample_frame_indices(frame_count, sample_frames)), false);
+  out.unused_parts = std::move(unused);
+  return out;
+}
+
+std::vector<int> marker_parts(Triangles triangles, std::span<const int> triangle_part, int marker_count) {
+  require(triangle_part.size() == triangles.size(), std::to_string(triangle_part.size()) + " part indices for " +
+                                                        std::to_string(triangles.size()) + " triangles");
+  std::vector<std::map<int, int>> count(marker_count);  // marker -> part -> triangles
+  for (size_t t = 0; t < triangles.size(); ++t)
+    for (int v : triangles[t]) {
+      require(v >= 0 && v < marker_count, "triangle " + std::to_string(t) + " refers to marker " + std::to_string(v));
+      ++count[v][triangle_part[t]];
+    }
+  std::vector<int> out(marker_count, -1);
+  for (int m = 0; m < marker_count; ++m) {
+    int best = 0;
+    for (const auto& [part, n] : count[m])  // ascending part index: ties keep the lowest
+      if (n > best) {
+        best = n;
+        out[m] = part;
+      }
+  }
+  return out;
 }
 
 }  // namespace skinstream

@@ -36,6 +36,7 @@ struct PartSegmentation {
                                           // the best rigid fit per sampled frame
   int mean_shift_groups = 0;        // modes found by mean shift
   int connected_groups = 0;         // after splitting modes into connected pieces
+  std::vector<int> unused_parts;    // a user's part indices that hold no triangle (dropped)
 };
 
 // reference: #M marker positions of the reference pose (mm); triangles: #T x 3 marker indices
@@ -51,13 +52,23 @@ enum class AssignmentKind { PerTriangle, PerMarker };
 
 // A user's segmentation instead: `assignment` holds one part index per triangle (#T entries)
 // or per marker (#M entries; a triangle takes the part most of its markers have, ties to the
-// lowest part index). Part indices are kept as given (part_count = largest + 1; a part may be
-// empty or disconnected, the user's choice) and the rigid residuals are measured;
-// mean_shift_groups and connected_groups are 0. Throws std::invalid_argument for a wrong
-// length, a negative index or the errors of segment_parts.
+// lowest part index). A part may be disconnected (the user's choice), but every part must hold
+// a triangle: indices that end with none (unused, or outvoted on every triangle) are listed in
+// unused_parts and the others renumbered in their order (0, 1, ...; unchanged when none is
+// unused). The rigid residuals are measured; mean_shift_groups and connected_groups are 0.
+// Throws std::invalid_argument for a wrong length, a negative index, an index not below the
+// triangle count, or the errors of segment_parts.
 PartSegmentation segmentation_from_assignment(std::span<const Vec3> reference, std::span<const std::array<int, 3>> triangles,
                                               std::span<const Vec3> positions, int frame_count,
                                               std::span<const int> assignment, AssignmentKind kind,
                                               int sample_frames = 40);
+
+// Each marker's part in a user's terms: the part holding most of the marker's triangles (ties
+// to the lowest part index), -1 for a marker in no triangle. It is what
+// segmentation_from_assignment(PerMarker) reads, so a segmentation can be written out, adjusted
+// by hand (as the paper did) and read back. Throws std::invalid_argument for a triangle_part of
+// the wrong length or a marker index out of range.
+std::vector<int> marker_parts(std::span<const std::array<int, 3>> triangles, std::span<const int> triangle_part,
+                              int marker_count);
 
 }  // namespace skinstream

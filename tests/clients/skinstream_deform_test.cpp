@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <set>
 
 #include "protocol/capture_file.h"
 #include "protocol/mesh_file.h"
@@ -182,6 +183,89 @@ TEST(SkinstreamDeform, RefusesAnUnknownFormat) {
       run("deform --subject " + kSubject + " --capture " + take.truth + " --out " + test::scratch_path("x") + " --format stl");
   EXPECT_NE(r.exit_code, 0);
   EXPECT_NE(r.output.find("stl"), std::string::npos) << r.output;
+}
+
+
+// build-subject's segmentation written out (--part-file-out) and read back (--part-file), as a
+// technician adjusting the parts by hand would, on the demo fixture's inputs (20 s range of
+// motion, the subdivided body already on the markers).
+class SkinstreamPartFile : public ::testing::Test {
+ protected:
+  const std::string demo = SKINSTREAM_DEMO_DIR;
+  std::string build(const std::string& extra, const std::string& name) {
+    return "build-subject --capture " + demo + "/rom_truth.c3d --reference-frame 0 --mesh " + demo +
+           "/rest/mesh_000000.ply --no-register --marker-offset 4 --out " + test::scratch_path(name + ".sksubj") + " " + extra;
+  }
+  static nlohmann::json read_json(const std::string& path) {
+    std::ifstream in(path);
+    return nlohmann::json::parse(in);
+  }
+};
+
+TEST_F(SkinstreamPartFile, WrittenPartsReadBackAndUnusedOnesAreReported) {
+  const std::string first = test::scratch_path("parts_a.json"), second = test::scratch_path("parts_b.json");
+  const ProgramRun a = run(build("--part-file-out " + first, "a"));
+  ASSERT_EQ(a.exit_code, 0) << a.output;
+  const nlohmann::json report_a = summary(a.output)["mesh"];
+  const int parts = report_a["parts"];
+  ASSERT_EQ(report_a["part_sizes"].size(), static_cast<size_t>(parts));
+  int triangles = 0;
+  for (const auto& p : report_a["part_sizes"]) {
+    EXPECT_GT(p["triangles"].get<int>(), 0);
+    EXPECT_GE(p["members"].get<int>(), 3);
+    EXPECT_GE(p["rigid_rms_mm"].get<double>(), 0.0);
+    triangles += p["triangles"].get<int>();
+  }
+  EXPECT_EQ(triangles, summary(a.output)["triangles"].get<int>());
+
+  // One entry per marker (every marker of the demo surface is in a triangle), a part each.
+  const nlohmann::json file_a = read_json(first);
+  EXPECT_EQ(file_a.size(), summary(a.output)["markers"].get<size_t>());
+  for (const auto& [marker, part] : file_a.items()) {
+    ASSERT_TRUE(part.is_number_integer()) << marker;
+    EXPECT_GE(part.get<int>(), 0);
+    EXPECT_LT(part.get<int>(), parts);
+  }
+
+  // Read back, every index up to the largest the file names is kept or reported unused. Per
+  // marker is not exact: a part that no marker mostly belongs to (a few triangles between
+  // others) cannot be named, and a small part can be outvoted on its triangles.
+  auto check_read_back = [](const nlohmann::json& file, const ProgramRun& run_back) {
+    std::set<int> named;
+    for (const auto& [marker, part] : file.items()) named.insert(part.get<int>());
+    const nlohmann::json report = summary(run_back.output)["mesh"];
+    const std::vector<int> unused = report["part_file_unused_parts"];
+    for (int p = 0; p <= *named.rbegin(); ++p)
+      if (!named.count(p)) {
+        EXPECT_NE(std::find(unused.begin(), unused.end(), p), unused.end()) << "part " << p;
+      }
+    EXPECT_EQ(report["parts"].get<int>() + static_cast<int>(unused.size()), *named.rbegin() + 1);
+    if (!unused.empty()) {
+      EXPECT_NE(run_back.output.find("hold no triangle"), std::string::npos) << run_back.output;
+    }
+  };
+  const ProgramRun b = run(build("--part-file " + first + " --part-file-out " + second, "b"));
+  ASSERT_EQ(b.exit_code, 0) << b.output;
+  check_read_back(file_a, b);
+  const ProgramRun c = run(build("--part-file " + second, "c"));
+  ASSERT_EQ(c.exit_code, 0) << c.output;
+  check_read_back(read_json(second), c);
+}
+
+TEST_F(SkinstreamPartFile, BadPartFilesAndMissingMeshAreRefused) {
+  const std::string bad = test::scratch_path("parts_bad.json");
+  std::ofstream(bad) << "{\"not_a_marker\": 0}\n";
+  const ProgramRun unknown = run(build("--part-file " + bad, "bad"));
+  EXPECT_NE(unknown.exit_code, 0);
+  EXPECT_NE(unknown.output.find("unknown marker \"not_a_marker\""), std::string::npos) << unknown.output;
+  std::ofstream(bad) << "{}\n";
+  const ProgramRun empty = run(build("--part-file " + bad, "empty"));
+  EXPECT_NE(empty.exit_code, 0);
+  EXPECT_NE(empty.output.find("has no part"), std::string::npos) << empty.output;
+  const ProgramRun no_mesh = run("build-subject --capture " + demo + "/rom_truth.c3d --out " + test::scratch_path("x.sksubj") +
+                                 " --part-file-out " + test::scratch_path("x.json"));
+  EXPECT_NE(no_mesh.exit_code, 0);
+  EXPECT_NE(no_mesh.output.find("--part-file-out needs --mesh"), std::string::npos) << no_mesh.output;
 }
 
 }  // namespace

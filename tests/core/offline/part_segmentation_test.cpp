@@ -165,5 +165,70 @@ TEST(PartSegmentation, SegmentsTheSyntheticRangeOfMotionTake) {
   }
 }
 
+
+// A segmentation written per marker (marker_parts) reads back as the same parts: the form of
+// `build-subject --part-file-out`, which a user adjusts by hand and gives to --part-file.
+TEST(PartSegmentation, MarkerPartsReadBackAsTheSameParts) {
+  const int frames = 240;
+  const ArticulatedLimb limb = make_articulated_limb(3, frames);
+  SegmentationOptions o;
+  o.target_parts = 3;
+  const PartSegmentation s = segment_parts(limb.reference, limb.triangles, limb.positions, frames, o);
+  const int markers = static_cast<int>(limb.reference.size());
+  const std::vector<int> per_marker = marker_parts(limb.triangles, s.triangle_part, markers);
+  ASSERT_EQ(per_marker.size(), limb.reference.size());
+  for (int m = 0; m < markers; ++m) {
+    // The part holding most of the marker's triangles.
+    std::map<int, int> count;
+    for (size_t t = 0; t < limb.triangles.size(); ++t)
+      for (int v : limb.triangles[t])
+        if (v == m) ++count[s.triangle_part[t]];
+    int most = 0;
+    for (const auto& [part, n] : count) most = std::max(most, n);
+    ASSERT_GT(most, 0) << "marker " << m << " is in no triangle";
+    EXPECT_EQ(count[per_marker[m]], most) << "marker " << m;
+  }
+  const PartSegmentation back = segmentation_from_assignment(limb.reference, limb.triangles, limb.positions, frames,
+                                                             per_marker, AssignmentKind::PerMarker);
+  ASSERT_EQ(back.part_count, s.part_count);
+  EXPECT_TRUE(back.unused_parts.empty());
+  // Only triangles between parts can change: one whose three markers share a main part keeps it.
+  int changed = 0;
+  for (size_t t = 0; t < limb.triangles.size(); ++t) {
+    const auto& tri = limb.triangles[t];
+    changed += back.triangle_part[t] != s.triangle_part[t];
+    if (per_marker[tri[0]] != per_marker[tri[1]] || per_marker[tri[1]] != per_marker[tri[2]]) continue;
+    EXPECT_EQ(back.triangle_part[t], s.triangle_part[t]) << "triangle " << t;
+  }
+  EXPECT_LE(changed, static_cast<int>(limb.triangles.size()) / 20);
+  EXPECT_THROW(marker_parts(limb.triangles, std::vector<int>(3, 0), markers), std::invalid_argument);
+  EXPECT_THROW(marker_parts(limb.triangles, s.triangle_part, markers - 1), std::invalid_argument);
+}
+
+// A user's part indices with gaps (or a part outvoted on every triangle) are dropped and the
+// others renumbered in order, rather than left as empty parts nothing downstream can fit.
+TEST(PartSegmentation, UnusedPartIndicesAreDroppedAndTheRestRenumbered) {
+  const int frames = 20;
+  const ArticulatedLimb limb = make_articulated_limb(3, frames);
+  std::vector<int> gaps = limb.segment;
+  for (int& p : gaps) p = p == 0 ? 0 : (p == 1 ? 2 : 5);
+  // One marker of segment 0 alone in part 7: outvoted on each of its triangles.
+  gaps[limb.marker(1, 3)] = 7;
+  const PartSegmentation s = segmentation_from_assignment(limb.reference, limb.triangles, limb.positions, frames, gaps,
+                                                          AssignmentKind::PerMarker);
+  EXPECT_EQ(s.part_count, 3);
+  EXPECT_EQ(s.unused_parts, (std::vector<int>{1, 3, 4, 6, 7}));
+  const PartSegmentation plain = segmentation_from_assignment(limb.reference, limb.triangles, limb.positions, frames,
+                                                              limb.segment, AssignmentKind::PerMarker);
+  EXPECT_EQ(s.triangle_part, plain.triangle_part);
+  EXPECT_TRUE(plain.unused_parts.empty());
+  // An index no smaller than the triangle count is refused, not turned into a list of empties.
+  std::vector<int> typo = limb.segment;
+  typo[0] = static_cast<int>(limb.triangles.size());
+  EXPECT_THROW(segmentation_from_assignment(limb.reference, limb.triangles, limb.positions, frames, typo,
+                                            AssignmentKind::PerMarker),
+               std::invalid_argument);
+}
+
 }  // namespace
 }  // namespace skinstream
