@@ -8,6 +8,7 @@
 
 #include "clients/skinstream/commands.h"
 #include "clients/skinstream/json_output.h"
+#include "clients/skinstream/part_file.h"
 #include "core/capture_filler.h"
 #include "core/offline/deformation_builder.h"
 #include "core/offline/subject_builder.h"
@@ -18,53 +19,6 @@
 #include "protocol/subject_file.h"
 
 namespace skinstream::cli {
-
-namespace {
-
-// {"marker name": number, ...} -> one number per subject marker (-1 when not listed).
-std::vector<int> read_marker_map(const std::string& path, const SubjectModel& model, const char* what) {
-  std::ifstream in(path);
-  if (!in) throw FileError(path, "cannot open");
-  nlohmann::json j;
-  try {
-    j = nlohmann::json::parse(in);
-  } catch (const nlohmann::json::exception& e) {
-    throw FileError(path, std::string("not valid JSON: ") + e.what());
-  }
-  if (!j.is_object()) throw FileError(path, std::string("expected an object {\"marker name\": ") + what + "}");
-  std::vector<int> out(model.marker_count(), -1);
-  for (const auto& [name, value] : j.items()) {
-    const int i = model.marker_index(name);
-    if (i < 0) throw FileError(path, "unknown marker \"" + name + "\"");
-    if (!value.is_number_integer() || value.get<int>() < 0) throw FileError(path, "\"" + name + "\": expected a non-negative integer " + what);
-    out[i] = value.get<int>();
-  }
-  return out;
-}
-
-// {"marker name": part, ...} in the subject's marker order; markers in no triangle left out.
-void write_part_file(const std::string& path, const SubjectModel& model, const std::vector<int>& marker_part) {
-  nlohmann::ordered_json j = nlohmann::ordered_json::object();
-  for (int i = 0; i < model.marker_count(); ++i)
-    if (marker_part[i] >= 0) j[model.marker_names[i]] = marker_part[i];
-  std::ofstream out(path);
-  if (!(out << j.dump(1) << '\n')) throw FileError(path, "cannot write");
-}
-
-// Per part: its marker-surface triangles, its members (inside and boundary markers) and the
-// rigid fit's RMS over the training take. A part of a few triangles and markers, with a large
-// residual, is one a hand adjustment should fold into a neighbour.
-nlohmann::ordered_json part_sizes_json(const DeformationBuildReport& report, const DeformationModel& model) {
-  nlohmann::ordered_json out = nlohmann::ordered_json::array();
-  for (int p = 0; p < model.part_count(); ++p)
-    out.push_back({{"part", p},
-                   {"triangles", report.part_triangles[p]},
-                   {"members", model.part_member_offsets[p + 1] - model.part_member_offsets[p]},
-                   {"rigid_rms_mm", report.part_rigid_rms_mm[p]}});
-  return out;
-}
-
-}  // namespace
 
 void add_build_subject(CLI::App& app) {
   auto* cmd = app.add_subcommand("build-subject", "Build the subject model (marker surface, local frames, PCA) from a training capture");
@@ -123,28 +77,12 @@ void add_build_subject(CLI::App& app) {
           }
       }
       if (!parts_path.empty()) {
-        deformation.part_assignment = read_marker_map(parts_path, model, "part index");
-        // A marker in no triangle of the surface decides no part: it may be left out.
-        std::vector<char> in_triangle(n, 0);
-        for (const auto& t : model.triangles)
-          for (int v : t) in_triangle[v] = 1;
-        for (int i = 0; i < n; ++i)
-          if (deformation.part_assignment[i] < 0) {
-            if (in_triangle[i]) throw FileError(parts_path, "marker " + model.marker_names[i] + " has no part");
-            deformation.part_assignment[i] = 0;
-          }
+        deformation.part_assignment = read_part_file(parts_path, model);
         deformation.assignment_kind = AssignmentKind::PerMarker;
       }
       deformation_model = build_deformation_model(model, positions, filled.frame_count, mesh.vertices, mesh.faces,
                                                   deformation, &deformation_report);
-      if (!deformation_report.unused_parts.empty()) {
-        std::string list;
-        for (int p : deformation_report.unused_parts) list += (list.empty() ? "" : ", ") + std::to_string(p);
-        std::fprintf(stderr,
-                     "skinstream: warning: %s: part(s) %s hold no triangle of the marker surface (a triangle takes the part "
-                     "most of its markers have); dropped, the other parts renumbered in order\n",
-                     parts_path.c_str(), list.c_str());
-      }
+      warn_unused_parts(parts_path, deformation_report.unused_parts);
     }
     write_subject(model, deformation_model ? &*deformation_model : nullptr, out_path);
     if (!parts_out.empty()) write_part_file(parts_out, model, deformation_report.marker_part);

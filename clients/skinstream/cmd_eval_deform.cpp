@@ -1,7 +1,7 @@
 // skinstream eval-deform: section 5 against the synthetic ground truth, every method side by
 // side (rigid, quadratic, rigid + RBF, the full method, and sparse-marker linear blend skinning).
 //   skinstream eval-deform [--motions breathe,flex,...] [--seconds 5] [--seed 1] [--subdivided]
-//                          [--stride 4] [--render DIR] [--json]
+//                          [--stride 4] [--render DIR] [--part-file P.json] [--part-file-out P.json] [--json]
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <nlohmann/json.hpp>
@@ -11,6 +11,7 @@
 #include "clients/skinstream/default_paths.h"
 #include "clients/skinstream/deform_evaluation.h"
 #include "clients/skinstream/json_output.h"
+#include "clients/skinstream/part_file.h"
 #include "core/synth/synth_capture.h"
 #include "core/synth/subdivision.h"
 #include "protocol/makehuman.h"
@@ -65,6 +66,10 @@ void add_eval_deform(CLI::App& app) {
   static bool no_joint_split = false;
   cmd->add_flag("--no-joint-split", no_joint_split,
                 "vertex weights by the nearest marker triangle alone, as in the paper (no split at the parts' joints)");
+  cmd->add_option("--part-file", options.part_file,
+                  "JSON {\"marker\": part index}: your segmentation instead of mean shift (build-subject --part-file-out writes one)");
+  static std::string parts_out;
+  cmd->add_option("--part-file-out", parts_out, "also write the segmentation used, in --part-file's form");
   cmd->add_flag("--json", json, "JSON only");
   cmd->callback([] {
     options.split_at_joints = !no_joint_split;
@@ -76,6 +81,8 @@ void add_eval_deform(CLI::App& app) {
     rom.subdivided = subdivided;
     const synth::SynthCapture training = synth::generate(body, rom);
     const DeformationSetup setup = prepare_deformation(body, training, options);
+    warn_unused_parts(options.part_file, setup.build.unused_parts);
+    if (!parts_out.empty()) write_part_file(parts_out, setup.subject, setup.build.marker_part);
 
     nlohmann::ordered_json result;
     result["seed"] = seed;
@@ -92,6 +99,8 @@ void add_eval_deform(CLI::App& app) {
                               {"iterations", setup.registration.iterations},
                               {"used_for_deformation", options.deform_registered_mesh}};
     result["max_part_rigid_rms_mm"] = setup.build.max_part_rigid_rms_mm;
+    result["part_sizes"] = part_sizes_json(setup.build, setup.deformation);
+    result["part_file_unused_parts"] = setup.build.unused_parts;
     result["boundary_markers"] = setup.build.boundary_markers;
     result["mean_parts_per_vertex"] = setup.build.mean_influences_per_vertex;
     result["joints"] = joints_json(setup.build.joints);

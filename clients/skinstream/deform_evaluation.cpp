@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "clients/skinstream/json_output.h"
+#include "clients/skinstream/part_file.h"
 #include "core/deform/mesh_deformer.h"
 #include "core/offline/subject_builder.h"
 #include "core/render/software_rasterizer.h"
@@ -189,6 +190,10 @@ DeformationSetup prepare_deformation(const synth::Body& body, const SynthCapture
     setup.registration_vertex_error_mm += (registered[v] - truth_skin[v]).norm() / static_cast<double>(registered.size());
   build.register_mesh = false;
   build.split_at_joints = options.split_at_joints;
+  if (!options.part_file.empty()) {
+    build.part_assignment = read_part_file(options.part_file, setup.subject);
+    build.assignment_kind = AssignmentKind::PerMarker;
+  }
   setup.deformation = build_deformation_model(setup.subject, positions, training.frame_count(),
                                               options.deform_registered_mesh ? registered : truth_skin, faces, build,
                                               &setup.build);

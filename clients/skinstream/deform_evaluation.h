@@ -30,6 +30,7 @@ struct DeformEvaluationOptions {
   // run and reported on its own. true: the deformation uses the registered artist's model.
   bool deform_registered_mesh = false;
   bool split_at_joints = true;  // false: the paper's nearest-triangle vertex weights alone
+  std::string part_file;        // a user's parts ({"marker name": part}) instead of mean shift
 };
 
 // Everything built once from the range-of-motion take: the subject (section 4), the detailed

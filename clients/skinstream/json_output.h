@@ -3,6 +3,8 @@
 #include <nlohmann/json.hpp>
 
 #include "core/evaluation/error_stats.h"
+#include "core/deform/deformation_model.h"
+#include "core/offline/deformation_builder.h"
 #include "core/offline/part_joints.h"
 #include "core/offline/quadratic_ridge_selection.h"
 #include "core/offline/rbf_ridge_selection.h"
@@ -33,6 +35,19 @@ inline nlohmann::json joints_json(const std::vector<PartJoint>& joints) {
                    {"residual_mm", j.residual_mm},
                    {"relative_motion_mm", j.relative_motion_mm},
                    {"axis_spread", j.axis_spread}});
+  return out;
+}
+
+// Per part: its marker-surface triangles, its members (inside and boundary markers) and the
+// rigid fit's RMS over the training take. A part of a few triangles and markers with a large
+// residual is one a hand adjustment (build-subject --part-file-out) should fold into a neighbour.
+inline nlohmann::json part_sizes_json(const DeformationBuildReport& report, const DeformationModel& model) {
+  nlohmann::json out = nlohmann::json::array();
+  for (int p = 0; p < model.part_count(); ++p)
+    out.push_back({{"part", p},
+                   {"triangles", report.part_triangles[p]},
+                   {"members", model.part_member_offsets[p + 1] - model.part_member_offsets[p]},
+                   {"rigid_rms_mm", report.part_rigid_rms_mm[p]}});
   return out;
 }
 

@@ -204,6 +204,47 @@ TEST(SkinstreamCli, EvalDeformFullMethodLeadsOnAHeldOutSubject) {
   }
 }
 
+// eval-deform measures a user's segmentation too: the parts it used written per marker
+// (--part-file-out), and a hand-made file (--part-file: here the left side against the rest)
+// building the model from exactly those parts; a file naming an unknown marker is refused.
+TEST(SkinstreamCli, EvalDeformReadsAndWritesPartFiles) {
+  const std::string base = "eval-deform --motions breathe --seconds 0.5 --train-seconds 5 --json --body " +
+                           std::string(SKINSTREAM_SHARED_DIR) + "/data/meshes/makehuman";
+  const std::string written = test::scratch_path("eval_parts.json"), sides = test::scratch_path("eval_sides.json");
+  const ProgramRun automatic = run(base + " --part-file-out " + written);
+  ASSERT_EQ(automatic.exit_code, 0) << automatic.output;
+  const auto a = nlohmann::json::parse(automatic.output);
+  ASSERT_EQ(a["part_sizes"].size(), a["parts"].get<size_t>());
+  nlohmann::json file;
+  std::ifstream(written) >> file;
+  ASSERT_EQ(file.size(), a["markers"].get<size_t>());
+
+  nlohmann::json by_side = nlohmann::json::object();
+  for (const auto& [name, part] : file.items()) by_side[name] = name.find("_L_") != std::string::npos ? 1 : 0;
+  std::ofstream(sides) << by_side.dump();
+  const ProgramRun two = run(base + " --part-file " + sides);
+  ASSERT_EQ(two.exit_code, 0) << two.output;
+  const auto b = nlohmann::json::parse(two.output);
+  EXPECT_EQ(b["parts"], 2);
+  EXPECT_TRUE(b["part_file_unused_parts"].empty());
+  int triangles_a = 0, triangles_b = 0;
+  for (const auto& p : a["part_sizes"]) triangles_a += p["triangles"].get<int>();
+  for (const auto& p : b["part_sizes"]) triangles_b += p["triangles"].get<int>();
+  EXPECT_EQ(triangles_b, triangles_a);
+  // Two parts cannot follow the body as well as the automatic ones: the rigid rows say so.
+  auto mean_of = [](const nlohmann::json& j, const char* method) {
+    for (const auto& m : j["takes"][0]["methods"])
+      if (m["method"] == method) return m["vertex_mean_mm"].get<double>();
+    return -1.0;
+  };
+  EXPECT_GT(mean_of(b, "rigid"), mean_of(a, "rigid"));
+
+  std::ofstream(sides) << R"({"no_such_marker": 0})";
+  const ProgramRun bad = run(base + " --part-file " + sides);
+  EXPECT_NE(bad.exit_code, 0);
+  EXPECT_NE(bad.output.find("unknown marker \"no_such_marker\""), std::string::npos) << bad.output;
+}
+
 TEST(SkinstreamCli, SynthRefusesAnUnknownMotion) {
   const ProgramRun r = run("synth --motion moonwalk --out " + test::scratch_path("m.c3d"));
   EXPECT_NE(r.exit_code, 0);
