@@ -63,9 +63,10 @@ void add_eval_deform(CLI::App& app) {
   cmd->add_option("--body", body_dir, "folder with the MakeHuman files (default: the shared data folder)");
   cmd->add_flag("--deform-registered", options.deform_registered_mesh,
                 "deform the registered artist's model instead of the reference frame's truth skin");
-  static bool no_joint_split = false;
-  cmd->add_flag("--no-joint-split", no_joint_split,
-                "vertex weights by the nearest marker triangle alone, as in the paper (no split at the parts' joints)");
+  static bool no_joint_split = false, no_fold_blend = false;
+  cmd->add_flag("--no-joint-split", no_joint_split, "no split of the vertex weights at hinge joints");
+  cmd->add_flag("--no-fold-blend", no_fold_blend,
+                "no blend of the vertex weights across folds (with --no-joint-split: the paper's nearest triangle alone)");
   cmd->add_option("--part-file", options.part_file,
                   "JSON {\"marker\": part index}: your segmentation instead of mean shift (build-subject --part-file-out writes one)");
   static std::string parts_out;
@@ -73,6 +74,7 @@ void add_eval_deform(CLI::App& app) {
   cmd->add_flag("--json", json, "JSON only");
   cmd->callback([] {
     options.split_at_joints = !no_joint_split;
+    options.blend_folds = !no_fold_blend;
     const synth::Body body = load_makehuman(body_dir.empty() ? default_body_dir() : body_dir);
     synth::SynthOptions rom;
     rom.motion = "rom";

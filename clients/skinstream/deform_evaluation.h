@@ -29,7 +29,8 @@ struct DeformEvaluationOptions {
   // (already registered: the table then measures sections 5.2-5.3 alone); registration is still
   // run and reported on its own. true: the deformation uses the registered artist's model.
   bool deform_registered_mesh = false;
-  bool split_at_joints = true;  // false: the paper's nearest-triangle vertex weights alone
+  bool split_at_joints = true;  // false: no split of the vertex weights at hinge joints
+  bool blend_folds = true;      // false: no blend across folds (both false: the paper's rule alone)
   std::string part_file;        // a user's parts ({"marker name": part}) instead of mean shift
 };
 

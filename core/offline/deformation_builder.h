@@ -27,7 +27,8 @@ struct DeformationBuildOptions {
   std::vector<int> part_assignment;  // a user's parts (per marker or per triangle); empty: mean shift
   AssignmentKind assignment_kind = AssignmentKind::PerMarker;
   MarkerWeightOptions weights;
-  bool split_at_joints = true;  // false: the paper's nearest-triangle vertex weights alone
+  bool split_at_joints = true;  // false: no split of the vertex weights at hinge joints
+  bool blend_folds = true;      // false: no blend across folds (both false: the paper's rule alone)
   PartJointOptions joints;
 };
 

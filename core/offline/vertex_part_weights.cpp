@@ -20,12 +20,38 @@ void require(bool ok, const std::string& what) {
 // triangle gets exactly what its markers have, not a trace of the opposite marker).
 constexpr double kZeroWeight = 1e-12;
 
+void add_influence(std::vector<PartInfluence>& to, int part, double weight) {
+  auto it = std::find_if(to.begin(), to.end(), [&](const PartInfluence& b) { return b.part == part; });
+  if (it == to.end()) to.push_back({part, weight});
+  else it->weight += weight;
+}
+
+// A vertex in a fold between two parts' skins (the armpit, the groin, the inner elbow) lies
+// between its nearest triangle and one of another part, on the far side of it: the nearest
+// triangle alone flips from one part to the other at the fold's middle, where the two are
+// equally far. There both sides share the vertex, by inverse distance, fading out as the far
+// side grows to kFoldRatio times the near one's distance, and as the two directions close from
+// 120 degrees apart to 90 (beyond 90 the other triangle is beside the vertex, not across it).
+// Shares below kMinFoldShare fade to nothing (the same continuous ramp keeps one half at the
+// middle): past the head, hands and feet, far from every marker, the rule would otherwise hand
+// thousands of vertices a trace of a distant part, each one more part to blend per frame.
+constexpr double kFoldRatio = 3.0;
+constexpr double kMinFoldShare = 0.05;
+
+double fold_share(double near, double far, double cos_between) {
+  const double ratio = far / near;
+  if (!(ratio < kFoldRatio) || !(cos_between < 0.0)) return 0.0;
+  const double across = std::min(1.0, -cos_between / 0.5);  // cos 120 degrees = -0.5
+  const double share = near / (near + far) * (kFoldRatio - ratio) / (kFoldRatio - 1.0) * across;
+  return share > kMinFoldShare ? 0.5 * (share - kMinFoldShare) / (0.5 - kMinFoldShare) : 0.0;
+}
+
 }  // namespace
 
 VertexPartWeights vertex_part_weights(std::span<const Vec3> vertices, std::span<const Vec3> markers,
                                       std::span<const std::array<int, 3>> triangles, std::span<const int> part_member_offsets,
                                       std::span<const PartMember> part_members, std::span<const PartJoint> joints,
-                                      std::span<const char> under_marker) {
+                                      std::span<const char> under_marker, bool blend_folds) {
   const int m = static_cast<int>(markers.size());
   require(!triangles.empty(), "no marker-surface triangles");
   require(!part_member_offsets.empty() && part_member_offsets.front() == 0 &&
@@ -63,44 +89,80 @@ VertexPartWeights vertex_part_weights(std::span<const Vec3> vertices, std::span<
   const std::vector<Vec3> points(markers.begin(), markers.end());
   const synth::TriangleBvh bvh(points, tris);
 
+  // Fold blending: each triangle's main part (largest summed alpha of its markers) and a sphere
+  // around it, to skip triangles that cannot be near enough.
+  std::vector<int> main_part(tris.size(), -1);
+  std::vector<Vec3> centre(tris.size());
+  std::vector<double> radius(tris.size());
+  if (blend_folds) {
+    std::vector<PartInfluence> sum;
+    for (size_t u = 0; u < tris.size(); ++u) {
+      sum.clear();
+      for (int k = 0; k < 3; ++k)
+        for (const PartInfluence& a : alpha[tris[u][k]]) add_influence(sum, a.part, a.weight);
+      double most = 0.0;
+      for (const PartInfluence& b : sum)
+        if (b.weight > most || (b.weight == most && b.part < main_part[u])) {
+          most = b.weight;
+          main_part[u] = b.part;
+        }
+      centre[u] = (points[tris[u][0]] + points[tris[u][1]] + points[tris[u][2]]) / 3.0;
+      radius[u] = 0.0;
+      for (int k = 0; k < 3; ++k) radius[u] = std::max(radius[u], (points[tris[u][k]] - centre[u]).norm());
+    }
+  }
+
   VertexPartWeights out;
   out.vertex_influence_offsets.reserve(vertices.size() + 1);
   std::vector<PartInfluence> blend, row;
-  auto add = [](std::vector<PartInfluence>& to, int part, double weight) {
-    auto it = std::find_if(to.begin(), to.end(), [&](const PartInfluence& b) { return b.part == part; });
-    if (it == to.end()) to.push_back({part, weight});
-    else it->weight += weight;
-  };
   for (size_t j = 0; j < vertices.size(); ++j) {
     const bool keep_markers = !under_marker.empty() && under_marker[j];
     int t = -1;
-    bvh.closest(vertices[j], &t);
-    const synth::Triangle& tri = tris[t];
-    Vec3 bary;
-    synth::closest_point_on_triangle(vertices[j], points[tri[0]], points[tri[1]], points[tri[2]], &bary);
-    blend.clear();
-    for (int k = 0; k < 3; ++k) {
-      if (!(bary[k] > kZeroWeight)) continue;
-      row = alpha[tri[k]];
-      if (!keep_markers) {
-        // Across a joint, a marker speaks for its side's part up to the joint's plane, or up to
-        // its own height when it lies past the plane; what it gives that part further on goes
-        // to the part of the vertex's side.
-        for (const PartJoint& joint : joints) {
-          const double vertex_side = joint.side(vertices[j]), marker_side = joint.side(points[tri[k]]);
-          const bool vertex_beyond = vertex_side > 0.0;
-          if (vertex_beyond ? !(vertex_side > std::max(marker_side, 0.0)) : !(vertex_side < std::min(marker_side, 0.0)))
-            continue;
-          const int from = vertex_beyond ? joint.first : joint.second;
-          const int to = vertex_beyond ? joint.second : joint.first;
-          auto it = std::find_if(row.begin(), row.end(), [&](const PartInfluence& b) { return b.part == from; });
-          if (it == row.end()) continue;
-          const double moved = it->weight;
-          row.erase(it);
-          add(row, to, moved);
-        }
+    Vec3 near_point;
+    const double near = bvh.closest(vertices[j], &t, &near_point);
+    // (triangle, share): the nearest alone, or with the other side of a fold.
+    std::array<std::pair<int, double>, 2> sides{{{t, 1.0}, {-1, 0.0}}};
+    if (blend_folds && !keep_markers && near > 0.0) {
+      const Vec3 towards_near = (near_point - vertices[j]) / near;
+      for (size_t u = 0; u < tris.size(); ++u) {
+        if (main_part[u] == main_part[t] || (centre[u] - vertices[j]).norm() - radius[u] >= kFoldRatio * near) continue;
+        Vec3 bary;
+        const Vec3 q = synth::closest_point_on_triangle(vertices[j], points[tris[u][0]], points[tris[u][1]], points[tris[u][2]], &bary);
+        const double far = (q - vertices[j]).norm();
+        const double share = fold_share(near, far, towards_near.dot((q - vertices[j]) / far));
+        if (share > sides[1].second) sides[1] = {static_cast<int>(u), share};
       }
-      for (const PartInfluence& a : row) add(blend, a.part, bary[k] * a.weight);
+      sides[0].second = 1.0 - sides[1].second;
+    }
+    blend.clear();
+    for (const auto& [side, share] : sides) {
+      if (side < 0 || !(share > 0.0)) continue;
+      const synth::Triangle& tri = tris[side];
+      Vec3 bary;
+      synth::closest_point_on_triangle(vertices[j], points[tri[0]], points[tri[1]], points[tri[2]], &bary);
+      for (int k = 0; k < 3; ++k) {
+        if (!(bary[k] > kZeroWeight)) continue;
+        row = alpha[tri[k]];
+        if (!keep_markers) {
+          // Across a joint, a marker speaks for its side's part up to the joint's plane, or up to
+          // its own height when it lies past the plane; what it gives that part further on goes
+          // to the part of the vertex's side.
+          for (const PartJoint& joint : joints) {
+            const double vertex_side = joint.side(vertices[j]), marker_side = joint.side(points[tri[k]]);
+            const bool vertex_beyond = vertex_side > 0.0;
+            if (vertex_beyond ? !(vertex_side > std::max(marker_side, 0.0)) : !(vertex_side < std::min(marker_side, 0.0)))
+              continue;
+            const int from = vertex_beyond ? joint.first : joint.second;
+            const int to = vertex_beyond ? joint.second : joint.first;
+            auto it = std::find_if(row.begin(), row.end(), [&](const PartInfluence& b) { return b.part == from; });
+            if (it == row.end()) continue;
+            const double moved = it->weight;
+            row.erase(it);
+            add_influence(row, to, moved);
+          }
+        }
+        for (const PartInfluence& a : row) add_influence(blend, a.part, share * bary[k] * a.weight);
+      }
     }
     std::erase_if(blend, [](const PartInfluence& b) { return !(b.weight > kZeroWeight); });
     require(!blend.empty(), "the markers of triangle " + std::to_string(t) + " belong to no part");

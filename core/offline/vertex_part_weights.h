@@ -12,6 +12,14 @@
 // triangle alone, the inner elbow and the back of the knee, where no marker sits, follow the
 // markers of the bone across the joint. Vertices under a marker (the corners of the mesh
 // triangle it sits on) keep its evidence whole: the marker says best how its own skin moves.
+//
+// A second addition, in folds (blend_folds): a vertex between its nearest triangle and a
+// triangle of another part across from it (the directions to the two more than 90 degrees
+// apart, the far one less than 3 times as far) takes that triangle's weights too, by inverse
+// distance and fading to nothing at those limits. The nearest triangle alone flips from one part
+// to the other at the middle of the fold (the armpit, the groin), where markers are 20-30 mm
+// away and both sides nearly as far; the blend makes the weights continuous there. Vertices
+// under a marker keep the nearest triangle alone.
 
 #include <array>
 #include <span>
@@ -35,11 +43,13 @@ struct VertexPartWeights {
 // every marker of a triangle must be a member of some part. Throws std::invalid_argument for an
 // index out of range, a non-finite position, a negative weight or a triangle whose three markers
 // have no weight at all. joints: empty for the paper's rule alone; their parts must be in range.
-// under_marker: empty, or #V flags of the vertices that keep their markers' weights at joints.
+// under_marker: empty, or #V flags of the vertices that keep their markers' weights at joints
+// and in folds. blend_folds: false for the nearest triangle alone.
 VertexPartWeights vertex_part_weights(std::span<const Vec3> vertices, std::span<const Vec3> markers,
                                       std::span<const std::array<int, 3>> triangles,
                                       std::span<const int> part_member_offsets, std::span<const PartMember> part_members,
-                                      std::span<const PartJoint> joints = {}, std::span<const char> under_marker = {});
+                                      std::span<const PartJoint> joints = {}, std::span<const char> under_marker = {},
+                                      bool blend_folds = false);
 
 // #V flags: the three vertices of the mesh triangle nearest to each marker (where it sits).
 // Throws std::invalid_argument for a face index out of range or no faces.

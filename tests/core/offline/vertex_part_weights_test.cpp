@@ -168,6 +168,65 @@ TEST(VertexPartWeights, RejectsBadJointsAndFlags) {
   EXPECT_THROW(f.weights(vertices, {}, two_flags), std::invalid_argument);
 }
 
+// Two parallel sheets of markers, 60 mm apart, each one part: the skin of a fold between them
+// (an armpit, a groin) as the blend across folds sees it.
+struct Fold {
+  std::vector<Vec3> markers;
+  std::vector<std::array<int, 3>> triangles;
+  std::vector<int> offsets{0};
+  std::vector<PartMember> members;
+  Fold() {
+    for (int sheet = 0; sheet < 2; ++sheet) {
+      const int first = static_cast<int>(markers.size());
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) markers.emplace_back(40.0 * i, 40.0 * j, 60.0 * sheet);
+      for (int i = 0; i < 2; ++i)
+        for (int j = 0; j < 2; ++j) {
+          const int a = first + 3 * i + j;
+          triangles.push_back({a, a + 3, a + 4});
+          triangles.push_back({a, a + 4, a + 1});
+        }
+      for (int k = 0; k < 9; ++k) members.push_back({first + k, 1.0});
+      offsets.push_back(static_cast<int>(members.size()));
+    }
+  }
+  VertexPartWeights weights(const std::vector<Vec3>& vertices, bool blend_folds, std::span<const char> under = {}) const {
+    return vertex_part_weights(vertices, markers, triangles, offsets, members, {}, under, blend_folds);
+  }
+};
+
+TEST(VertexPartWeights, SkinInAFoldSharesBothSidesByDistance) {
+  const Fold fold;
+  const std::vector<Vec3> vertices = {
+      {40, 40, 30},   // the middle: half each, whichever sheet is taken as the nearest
+      {40, 40, 20},   // 20 and 40 mm: ratio 2
+      {40, 40, 12},   // 12 and 48 mm: ratio 4, past the limit of 3
+      {40, 40, -10},  // outside the fold: both sheets the same way, nothing across
+      {40, 40, 29.9}, {40, 40, 30.1}};
+  const VertexPartWeights w = fold.weights(vertices, true);
+  for (int v = 0; v < static_cast<int>(vertices.size()); ++v) EXPECT_NEAR(beta(w, v, 0) + beta(w, v, 1), 1.0, 1e-12) << v;
+  EXPECT_NEAR(beta(w, 0, 0), 0.5, 1e-12);
+  EXPECT_NEAR(beta(w, 0, 1), 0.5, 1e-12);
+  // near / (near + far) * (3 - ratio) / 2 = 1/6, then the fade below 0.05: 0.5 (1/6 - 0.05) / 0.45.
+  EXPECT_NEAR(beta(w, 1, 1), 0.5 * (1.0 / 6.0 - 0.05) / 0.45, 1e-12);
+  EXPECT_EQ(beta(w, 2, 0), 1.0);
+  EXPECT_EQ(beta(w, 3, 0), 1.0);
+  // Continuous where the nearest sheet changes.
+  EXPECT_NEAR(beta(w, 4, 1), beta(w, 5, 0), 1e-12);
+  EXPECT_NEAR(beta(w, 4, 1), 0.5, 0.01);
+
+  // Without the blend, or under a marker: the nearest sheet alone.
+  const VertexPartWeights plain = fold.weights(vertices, false);
+  EXPECT_EQ(beta(plain, 1, 0), 1.0);
+  EXPECT_EQ(beta(plain, 4, 0), 1.0);
+  EXPECT_EQ(beta(plain, 5, 1), 1.0);
+  std::vector<char> under(vertices.size(), 0);
+  under[1] = 1;
+  const VertexPartWeights kept = fold.weights(vertices, true, under);
+  EXPECT_EQ(beta(kept, 1, 0), 1.0);
+  EXPECT_NEAR(beta(kept, 0, 1), 0.5, 1e-12);
+}
+
 TEST(VerticesUnderMarkers, FlagsTheCornersOfTheFaceEachMarkerSitsOn) {
   // Two faces side by side in the z = 0 plane; one marker 4 mm above the second.
   const std::vector<Vec3> vertices{Vec3(0, 0, 0), Vec3(10, 0, 0), Vec3(0, 10, 0), Vec3(10, 10, 0)};
