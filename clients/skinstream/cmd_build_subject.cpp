@@ -49,7 +49,9 @@ void add_build_subject(CLI::App& app) {
   cmd->add_option("--bandwidth", deformation.segmentation.bandwidth_degrees, "mean-shift bandwidth (degrees)")
       ->capture_default_str();
   cmd->callback([] {
+    // Parts belong to the deformation model: without a mesh they would be silently ignored.
     if (!parts_out.empty() && mesh_path.empty()) throw std::invalid_argument("--part-file-out needs --mesh (parts are made with the mesh)");
+    if (!parts_path.empty() && mesh_path.empty()) throw std::invalid_argument("--part-file needs --mesh (parts are made with the mesh)");
     const Capture training = read_capture(capture_path);
     std::vector<std::array<int, 3>> triangles;
     if (!surface_in.empty()) triangles = read_marker_surface_obj(surface_in, static_cast<int>(training.labelled_points().size()));

@@ -266,6 +266,10 @@ TEST_F(SkinstreamPartFile, BadPartFilesAndMissingMeshAreRefused) {
                                  " --part-file-out " + test::scratch_path("x.json"));
   EXPECT_NE(no_mesh.exit_code, 0);
   EXPECT_NE(no_mesh.output.find("--part-file-out needs --mesh"), std::string::npos) << no_mesh.output;
+  const ProgramRun ignored = run("build-subject --capture " + demo + "/rom_truth.c3d --out " + test::scratch_path("y.sksubj") +
+                                 " --part-file " + bad);
+  EXPECT_NE(ignored.exit_code, 0);
+  EXPECT_NE(ignored.output.find("--part-file needs --mesh"), std::string::npos) << ignored.output;
 }
 
 }  // namespace
