@@ -2,7 +2,6 @@
 // --mesh the detailed mesh registered, segmented and weighted for deformation (section 5.1-5.2).
 #include <CLI/CLI.hpp>
 #include <cstdio>
-#include <fstream>
 #include <optional>
 #include <nlohmann/json.hpp>
 

@@ -42,6 +42,13 @@ bool parts_connected(const std::vector<std::array<int, 3>>& triangles, const Par
   return true;
 }
 
+// The limb's three segments asked for as three parts.
+PartSegmentation segment_limb_in_three(const ArticulatedLimb& limb, int frames) {
+  SegmentationOptions o;
+  o.target_parts = 3;
+  return segment_parts(limb.reference, limb.triangles, limb.positions, frames, o);
+}
+
 TEST(PartSegmentation, RejectsBadInputs) {
   const ArticulatedLimb limb = make_articulated_limb(3, 20);
   const int frames = 20;
@@ -70,9 +77,7 @@ TEST(PartSegmentation, RejectsBadInputs) {
 TEST(PartSegmentation, FindsTheSegmentsOfAnArticulatedLimb) {
   const int frames = 240;
   const ArticulatedLimb limb = make_articulated_limb(3, frames);
-  SegmentationOptions o;
-  o.target_parts = 3;
-  const PartSegmentation s = segment_parts(limb.reference, limb.triangles, limb.positions, frames, o);
+  const PartSegmentation s = segment_limb_in_three(limb, frames);
   ASSERT_EQ(s.part_count, 3);
   ASSERT_EQ(s.triangle_part.size(), limb.triangles.size());
   EXPECT_TRUE(parts_connected(limb.triangles, s));
@@ -97,7 +102,7 @@ TEST(PartSegmentation, FindsTheSegmentsOfAnArticulatedLimb) {
   EXPECT_GE(s.connected_groups, 3);
 
   // Deterministic.
-  const PartSegmentation again = segment_parts(limb.reference, limb.triangles, limb.positions, frames, o);
+  const PartSegmentation again = segment_limb_in_three(limb, frames);
   EXPECT_EQ(again.triangle_part, s.triangle_part);
   EXPECT_EQ(again.part_rigid_rms_mm, s.part_rigid_rms_mm);
 
@@ -165,15 +170,12 @@ TEST(PartSegmentation, SegmentsTheSyntheticRangeOfMotionTake) {
   }
 }
 
-
 // A segmentation written per marker (marker_parts) reads back as the same parts: the form of
 // `build-subject --part-file-out`, which a user adjusts by hand and gives to --part-file.
 TEST(PartSegmentation, MarkerPartsReadBackAsTheSameParts) {
   const int frames = 240;
   const ArticulatedLimb limb = make_articulated_limb(3, frames);
-  SegmentationOptions o;
-  o.target_parts = 3;
-  const PartSegmentation s = segment_parts(limb.reference, limb.triangles, limb.positions, frames, o);
+  const PartSegmentation s = segment_limb_in_three(limb, frames);
   const int markers = static_cast<int>(limb.reference.size());
   const std::vector<int> per_marker = marker_parts(limb.triangles, s.triangle_part, markers);
   ASSERT_EQ(per_marker.size(), limb.reference.size());
