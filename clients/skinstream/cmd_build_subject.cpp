@@ -24,7 +24,7 @@ void add_build_subject(CLI::App& app) {
   static std::string capture_path, out_path, surface_in, surface_out, mesh_path, landmarks_path, parts_path, parts_out;
   static SubjectBuildOptions options;
   static DeformationBuildOptions deformation;
-  static bool no_register = false, no_joint_split = false, no_fold_blend = false;
+  static bool no_register = false, no_joint_split = false, no_joint_blend = false, no_fold_blend = false;
   cmd->add_option("--capture", capture_path, "training capture (.c3d/.trc), ideally a range-of-motion take")->required();
   cmd->add_option("--out", out_path, "subject file to write")->required();
   cmd->add_option("--reference-frame", options.reference_frame, "frame index of the reference pose (default: chosen)");
@@ -40,6 +40,8 @@ void add_build_subject(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--parts", deformation.segmentation.target_parts, "number of near-rigid parts")->capture_default_str();
   cmd->add_flag("--no-joint-split", no_joint_split, "no split of the vertex weights at hinge joints");
+  cmd->add_flag("--no-joint-blend", no_joint_blend,
+                "split at hinge joints with a hard switch at the plane, not a ramp half a marker spacing wide");
   cmd->add_flag("--no-fold-blend", no_fold_blend,
                 "no blend of the vertex weights across folds (with --no-joint-split: the paper's nearest triangle alone)");
   cmd->add_option("--part-file", parts_path, "JSON {\"marker\": part index}: your segmentation instead of mean shift");
@@ -68,6 +70,7 @@ void add_build_subject(CLI::App& app) {
         for (int i = 0; i < n; ++i) positions[static_cast<size_t>(f) * n + i] = filled.at(f, i);
       deformation.register_mesh = !no_register;
       deformation.split_at_joints = !no_joint_split;
+      deformation.blend_at_joints = !no_joint_blend;
       deformation.blend_folds = !no_fold_blend;
       if (!landmarks_path.empty()) {
         const std::vector<int> vertex = read_marker_map(landmarks_path, model, "vertex index");
@@ -117,6 +120,7 @@ void add_build_subject(CLI::App& app) {
                      {"boundary_markers", d.boundary_markers},
                      {"mean_parts_per_vertex", d.mean_influences_per_vertex},
                      {"joints", joints_json(d.joints)},
+                     {"joint_blend_mm", d.joint_blend_mm},
                      {"part_quadratic_ridges", to_json(d.part_quadratic_ridges)},
                      {"part_rbf_ridges", to_json(d.part_ridges)}};
     }

@@ -63,8 +63,10 @@ void add_eval_deform(CLI::App& app) {
   cmd->add_option("--body", body_dir, "folder with the MakeHuman files (default: the shared data folder)");
   cmd->add_flag("--deform-registered", options.deform_registered_mesh,
                 "deform the registered artist's model instead of the reference frame's truth skin");
-  static bool no_joint_split = false, no_fold_blend = false;
+  static bool no_joint_split = false, no_joint_blend = false, no_fold_blend = false;
   cmd->add_flag("--no-joint-split", no_joint_split, "no split of the vertex weights at hinge joints");
+  cmd->add_flag("--no-joint-blend", no_joint_blend,
+                "split at hinge joints with a hard switch at the plane, not a ramp half a marker spacing wide");
   cmd->add_flag("--no-fold-blend", no_fold_blend,
                 "no blend of the vertex weights across folds (with --no-joint-split: the paper's nearest triangle alone)");
   cmd->add_option("--part-file", options.part_file,
@@ -74,6 +76,7 @@ void add_eval_deform(CLI::App& app) {
   cmd->add_flag("--json", json, "JSON only");
   cmd->callback([] {
     options.split_at_joints = !no_joint_split;
+    options.blend_at_joints = !no_joint_blend;
     options.blend_folds = !no_fold_blend;
     const synth::Body body = load_makehuman(body_dir.empty() ? default_body_dir() : body_dir);
     synth::SynthOptions rom;
@@ -106,6 +109,7 @@ void add_eval_deform(CLI::App& app) {
     result["boundary_markers"] = setup.build.boundary_markers;
     result["mean_parts_per_vertex"] = setup.build.mean_influences_per_vertex;
     result["joints"] = joints_json(setup.build.joints);
+    result["joint_blend_mm"] = setup.build.joint_blend_mm;
     result["part_quadratic_ridges"] = to_json(setup.build.part_quadratic_ridges);
     result["part_rbf_ridges"] = to_json(setup.build.part_ridges);
     result["build_seconds"] = setup.build_seconds;

@@ -190,6 +190,7 @@ DeformationSetup prepare_deformation(const synth::Body& body, const SynthCapture
     setup.registration_vertex_error_mm += (registered[v] - truth_skin[v]).norm() / static_cast<double>(registered.size());
   build.register_mesh = false;
   build.split_at_joints = options.split_at_joints;
+  build.blend_at_joints = options.blend_at_joints;
   build.blend_folds = options.blend_folds;
   if (!options.part_file.empty()) {
     build.part_assignment = read_part_file(options.part_file, setup.subject);

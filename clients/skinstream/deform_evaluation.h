@@ -30,6 +30,7 @@ struct DeformEvaluationOptions {
   // run and reported on its own. true: the deformation uses the registered artist's model.
   bool deform_registered_mesh = false;
   bool split_at_joints = true;  // false: no split of the vertex weights at hinge joints
+  bool blend_at_joints = true;  // false: the split is a hard switch at the plane
   bool blend_folds = true;      // false: no blend across folds (both false: the paper's rule alone)
   std::string part_file;        // a user's parts ({"marker name": part}) instead of mean shift
 };

@@ -60,14 +60,16 @@ DeformationModel build_deformation_model(const SubjectModel& subject, std::span<
   for (int p = 0; p < parts.part_count; ++p) model.part_names.push_back("part_" + std::to_string(p));
 
   std::vector<char> under_marker;
-  if (options.split_at_joints)
+  if (options.split_at_joints) {
     report.joints = fit_part_joints(markers, model.part_member_offsets, model.part_members, training, frame_count,
                                     options.joints);
+    if (options.blend_at_joints) report.joint_blend_mm = 0.5 * median_nearest_marker_distance(markers);
+  }
   if (options.split_at_joints || options.blend_folds)
     under_marker = vertices_under_markers(model.reference_vertices, mesh_faces, markers);
   VertexPartWeights beta = vertex_part_weights(model.reference_vertices, markers, subject.triangles,
                                                model.part_member_offsets, model.part_members, report.joints, under_marker,
-                                               options.blend_folds);
+                                               options.blend_folds, report.joint_blend_mm);
   model.vertex_influence_offsets = std::move(beta.vertex_influence_offsets);
   model.vertex_influences = std::move(beta.vertex_influences);
   report.mean_influences_per_vertex =

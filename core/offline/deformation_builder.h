@@ -28,6 +28,7 @@ struct DeformationBuildOptions {
   AssignmentKind assignment_kind = AssignmentKind::PerMarker;
   MarkerWeightOptions weights;
   bool split_at_joints = true;  // false: no split of the vertex weights at hinge joints
+  bool blend_at_joints = true;  // false: the split is a hard switch at the plane (no ramp)
   bool blend_folds = true;      // false: no blend across folds (both false: the paper's rule alone)
   PartJointOptions joints;
 };
@@ -47,6 +48,7 @@ struct DeformationBuildReport {
   int markers_added_for_min_members = 0;
   double mean_influences_per_vertex = 0.0;
   std::vector<PartJoint> joints;  // the jointed part pairs the vertex weights split at
+  double joint_blend_mm = 0.0;    // half-width of the ramp across their planes (0: a hard switch)
   std::vector<QuadraticRidgeChoice> part_quadratic_ridges;  // eq. 6's per part, by leave-one-out error
   std::vector<RidgeChoice> part_ridges;  // eq. 7's ridge per part, by leave-one-out error
 };

@@ -1,6 +1,8 @@
 #include "core/offline/vertex_part_weights.h"
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 #include <map>
 #include <stdexcept>
 #include <string>
@@ -46,12 +48,20 @@ double fold_share(double near, double far, double cos_between) {
   return share > kMinFoldShare ? 0.5 * (share - kMinFoldShare) / (0.5 - kMinFoldShare) : 0.0;
 }
 
+// Share of a marker's weight for one side's part that goes to the part across the joint, for a
+// vertex `past` mm beyond the point up to which the marker speaks for its side (half at that
+// point, none `half_width` before it, all `half_width` after). 0 width: a hard switch.
+double joint_ramp(double past, double half_width) {
+  if (!(half_width > 0.0)) return past > 0.0 ? 1.0 : 0.0;
+  return std::clamp(0.5 + past / (2.0 * half_width), 0.0, 1.0);
+}
+
 }  // namespace
 
 VertexPartWeights vertex_part_weights(std::span<const Vec3> vertices, std::span<const Vec3> markers,
                                       std::span<const std::array<int, 3>> triangles, std::span<const int> part_member_offsets,
                                       std::span<const PartMember> part_members, std::span<const PartJoint> joints,
-                                      std::span<const char> under_marker, bool blend_folds) {
+                                      std::span<const char> under_marker, bool blend_folds, double joint_blend_mm) {
   const int m = static_cast<int>(markers.size());
   require(!triangles.empty(), "no marker-surface triangles");
   require(!part_member_offsets.empty() && part_member_offsets.front() == 0 &&
@@ -65,6 +75,8 @@ VertexPartWeights vertex_part_weights(std::span<const Vec3> vertices, std::span<
 
   // alpha rows per marker, sorted by part.
   const int part_count = static_cast<int>(part_member_offsets.size()) - 1;
+  require(joint_blend_mm >= 0.0 && std::isfinite(joint_blend_mm),
+          "the joint blend width " + std::to_string(joint_blend_mm) + " mm is not a distance");
   require(under_marker.empty() || under_marker.size() == vertices.size(),
           std::to_string(under_marker.size()) + " under-marker flags for " + std::to_string(vertices.size()) + " vertices");
   for (const PartJoint& joint : joints)
@@ -146,19 +158,24 @@ VertexPartWeights vertex_part_weights(std::span<const Vec3> vertices, std::span<
         if (!keep_markers) {
           // Across a joint, a marker speaks for its side's part up to the joint's plane, or up to
           // its own height when it lies past the plane; what it gives that part further on goes
-          // to the part of the vertex's side.
+          // to the part across, over a ramp joint_blend_mm either side of that threshold.
           for (const PartJoint& joint : joints) {
             const double vertex_side = joint.side(vertices[j]), marker_side = joint.side(points[tri[k]]);
-            const bool vertex_beyond = vertex_side > 0.0;
-            if (vertex_beyond ? !(vertex_side > std::max(marker_side, 0.0)) : !(vertex_side < std::min(marker_side, 0.0)))
-              continue;
-            const int from = vertex_beyond ? joint.first : joint.second;
-            const int to = vertex_beyond ? joint.second : joint.first;
-            auto it = std::find_if(row.begin(), row.end(), [&](const PartInfluence& b) { return b.part == from; });
-            if (it == row.end()) continue;
-            const double moved = it->weight;
-            row.erase(it);
-            add_influence(row, to, moved);
+            const double to_second = joint_ramp(vertex_side - std::max(marker_side, 0.0), joint_blend_mm);
+            const double to_first = joint_ramp(std::min(marker_side, 0.0) - vertex_side, joint_blend_mm);
+            double first_to_second = 0.0, second_to_first = 0.0;
+            for (PartInfluence& b : row) {
+              if (b.part == joint.first) {
+                first_to_second = b.weight * to_second;
+                b.weight -= first_to_second;
+              } else if (b.part == joint.second) {
+                second_to_first = b.weight * to_first;
+                b.weight -= second_to_first;
+              }
+            }
+            if (first_to_second > 0.0) add_influence(row, joint.second, first_to_second);
+            if (second_to_first > 0.0) add_influence(row, joint.first, second_to_first);
+            std::erase_if(row, [](const PartInfluence& b) { return !(b.weight > 0.0); });
           }
         }
         for (const PartInfluence& a : row) add_influence(blend, a.part, share * bary[k] * a.weight);
@@ -192,6 +209,19 @@ std::vector<char> vertices_under_markers(std::span<const Vec3> vertices, std::sp
       for (int corner : faces[face]) under[corner] = 1;
   }
   return under;
+}
+
+double median_nearest_marker_distance(std::span<const Vec3> markers) {
+  require(markers.size() >= 2, "the nearest-marker distance needs two markers");
+  std::vector<double> nearest(markers.size(), std::numeric_limits<double>::infinity());
+  for (size_t i = 0; i < markers.size(); ++i)
+    for (size_t k = i + 1; k < markers.size(); ++k) {
+      const double d = (markers[i] - markers[k]).norm();
+      nearest[i] = std::min(nearest[i], d);
+      nearest[k] = std::min(nearest[k], d);
+    }
+  std::nth_element(nearest.begin(), nearest.begin() + nearest.size() / 2, nearest.end());
+  return nearest[nearest.size() / 2];
 }
 
 }  // namespace skinstream

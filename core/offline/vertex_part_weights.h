@@ -12,6 +12,11 @@
 // triangle alone, the inner elbow and the back of the knee, where no marker sits, follow the
 // markers of the bone across the joint. Vertices under a marker (the corners of the mesh
 // triangle it sits on) keep its evidence whole: the marker says best how its own skin moves.
+// The switch is a linear ramp joint_blend_mm either side of the plane (or of the marker's
+// height): at the plane a vertex follows both parts by half, the bisector a hinge's crease
+// follows. The builder sets the width to half the median distance from a marker to its nearest
+// neighbour: no marker sits in the crease, so the markers place the plane no finer than their
+// spacing, and a hard switch there put the inner elbow's skin wholly on one bone.
 //
 // A second addition, in folds (blend_folds): a vertex between its nearest triangle and a
 // triangle of another part across from it (the directions to the two more than 90 degrees
@@ -44,12 +49,17 @@ struct VertexPartWeights {
 // index out of range, a non-finite position, a negative weight or a triangle whose three markers
 // have no weight at all. joints: empty for the paper's rule alone; their parts must be in range.
 // under_marker: empty, or #V flags of the vertices that keep their markers' weights at joints
-// and in folds. blend_folds: false for the nearest triangle alone.
+// and in folds. blend_folds: false for the nearest triangle alone. joint_blend_mm: the ramp's
+// half-width at joints, 0 for a hard switch; negative or not finite is refused.
 VertexPartWeights vertex_part_weights(std::span<const Vec3> vertices, std::span<const Vec3> markers,
                                       std::span<const std::array<int, 3>> triangles,
                                       std::span<const int> part_member_offsets, std::span<const PartMember> part_members,
                                       std::span<const PartJoint> joints = {}, std::span<const char> under_marker = {},
-                                      bool blend_folds = false);
+                                      bool blend_folds = false, double joint_blend_mm = 0.0);
+
+// The median over markers of the distance to the nearest other marker (mm). Throws
+// std::invalid_argument for fewer than two markers.
+double median_nearest_marker_distance(std::span<const Vec3> markers);
 
 // #V flags: the three vertices of the mesh triangle nearest to each marker (where it sits).
 // Throws std::invalid_argument for a face index out of range or no faces.

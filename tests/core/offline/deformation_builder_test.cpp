@@ -7,6 +7,7 @@
 
 #include "core/deform/mesh_deformer.h"
 #include "core/offline/subject_builder.h"
+#include "core/offline/vertex_part_weights.h"
 #include "core/synth/mannequin.h"
 #include "core/synth/synth_capture.h"
 
@@ -27,11 +28,11 @@ TEST(DeformationBuilder, RejectsAnEmptyMesh) {
 // and parts from a 4 s range-of-motion take, the truth skin of the reference frame as the
 // detailed model, then a 2 s flexing take of the same body deformed from its true markers.
 // Measured when written, over the vertices the markers cover (mean, deterministic: seed 1):
-// full method 3.286 mm, rigid parts 4.46 mm; with the paper's vertex weights alone (no split at
-// the parts' joints, no blend across folds) 3.34 mm; without the fold blend 3.295 mm. The
-// mannequin is not the MakeHuman body the joint criteria and the fold blend were measured on, so
-// the last two are checks on another body. Every vertex weight sums to 1 and the reference pose
-// reproduces the mesh.
+// full method 3.180 mm, rigid parts 4.28 mm; with a hard switch at the joints' planes (no ramp)
+// 3.286 mm; without the fold blend 3.189 mm; with the paper's vertex weights alone (no split at
+// the parts' joints, no blend across folds) 3.34 mm. The mannequin is not the MakeHuman body the
+// joint criteria, the ramp and the fold blend were measured on, so those comparisons are checks
+// on another body. Every vertex weight sums to 1 and the reference pose reproduces the mesh.
 TEST(DeformationBuilder, DeformedFramesMatchTheSyntheticTruth) {
   const synth::Body body = synth::make_mannequin();
   synth::SynthOptions rom;
@@ -48,6 +49,13 @@ TEST(DeformationBuilder, DeformedFramesMatchTheSyntheticTruth) {
       subject, training.truth.positions, training.frame_count(), training.pose_mesh(report.reference_frame, true),
       training.mesh_triangles(), options, &built);
   EXPECT_EQ(built.joints.size(), 4u);  // the elbows and the knees
+  EXPECT_GT(built.joint_blend_mm, 0.0);
+  EXPECT_DOUBLE_EQ(built.joint_blend_mm, 0.5 * median_nearest_marker_distance(subject.reference_positions));
+  options.blend_at_joints = false;
+  const DeformationModel hard_split = build_deformation_model(
+      subject, training.truth.positions, training.frame_count(), training.pose_mesh(report.reference_frame, true),
+      training.mesh_triangles(), options);
+  options.blend_at_joints = true;
   options.blend_folds = false;
   const DeformationModel unfolded = build_deformation_model(
       subject, training.truth.positions, training.frame_count(), training.pose_mesh(report.reference_frame, true),
@@ -71,6 +79,7 @@ TEST(DeformationBuilder, DeformedFramesMatchTheSyntheticTruth) {
   MeshDeformer full(model, subject, DeformationMode::QuadraticRbf), rigid(model, subject, DeformationMode::Rigid);
   MeshDeformer unsplit(paper_weights, subject, DeformationMode::QuadraticRbf);
   MeshDeformer no_folds(unfolded, subject, DeformationMode::QuadraticRbf);
+  MeshDeformer hard(hard_split, subject, DeformationMode::QuadraticRbf);
   // The reference frame's own markers give back the reference mesh.
   ASSERT_TRUE(full.deform(frame_markers(training.truth, report.reference_frame), positions, {}));
   double rest_error = 0.0;
@@ -102,7 +111,7 @@ TEST(DeformationBuilder, DeformedFramesMatchTheSyntheticTruth) {
     MeshDeformer* deformer;
     double sum = 0.0, max = 0.0;
   };
-  std::array<Tally, 4> tallies{{{&full}, {&rigid}, {&unsplit}, {&no_folds}}};
+  std::array<Tally, 5> tallies{{{&full}, {&rigid}, {&unsplit}, {&no_folds}, {&hard}}};
   long count = 0;
   for (int f = 0; f < take.frame_count(); f += 12) {
     const std::vector<Vec3> truth = take.pose_mesh(f);
@@ -119,14 +128,17 @@ TEST(DeformationBuilder, DeformedFramesMatchTheSyntheticTruth) {
     count += covered_count;
   }
   const double full_mean = tallies[0].sum / count, rigid_mean = tallies[1].sum / count,
-               unsplit_mean = tallies[2].sum / count, unfolded_mean = tallies[3].sum / count;
+               unsplit_mean = tallies[2].sum / count, unfolded_mean = tallies[3].sum / count,
+               hard_mean = tallies[4].sum / count;
   std::printf("deformation builder: mean (max) vertex error: full %.3f (%.1f) mm, rigid %.3f (%.1f), the paper's vertex "
-              "weights %.3f (%.1f), without the fold blend %.3f (%.1f)\n",
-              full_mean, tallies[0].max, rigid_mean, tallies[1].max, unsplit_mean, tallies[2].max, unfolded_mean, tallies[3].max);
+              "weights %.3f (%.1f), without the fold blend %.3f (%.1f), a hard switch at joints %.3f (%.1f)\n",
+              full_mean, tallies[0].max, rigid_mean, tallies[1].max, unsplit_mean, tallies[2].max, unfolded_mean, tallies[3].max,
+              hard_mean, tallies[4].max);
   EXPECT_LT(full_mean, 4.0);
   EXPECT_LT(full_mean, rigid_mean);
   EXPECT_LT(full_mean, unsplit_mean);
   EXPECT_LT(full_mean, unfolded_mean);
+  EXPECT_LT(full_mean, hard_mean);
 }
 
 }  // namespace

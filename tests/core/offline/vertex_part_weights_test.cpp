@@ -28,9 +28,9 @@ struct Fixture {
     alpha = marker_part_weights(limb.reference, limb.triangles, parts, 3, limb.positions, kFrames);
   }
   VertexPartWeights weights(const std::vector<Vec3>& vertices, std::span<const PartJoint> joints = {},
-                            std::span<const char> under_marker = {}) const {
+                            std::span<const char> under_marker = {}, double joint_blend_mm = 0.0) const {
     return vertex_part_weights(vertices, limb.reference, limb.triangles, alpha.part_member_offsets, alpha.part_members,
-                               joints, under_marker);
+                               joints, under_marker, false, joint_blend_mm);
   }
 };
 
@@ -155,6 +155,50 @@ TEST(VertexPartWeights, AMarkerPastTheJointSpeaksForTheSkinUpToItself) {
   const std::vector<Vec3> beyond{skin(5.5, 200.0)};
   EXPECT_GT(beta(f.weights(beyond), 0, 0), 0.1);
   EXPECT_NEAR(beta(f.weights(beyond, joints), 0, 1), 1.0, 1e-12);
+}
+
+// With a ramp 20 mm either side of the plane at z = 200 (ring 3 at 175, all segment 0; ring 4 at
+// 225, all segment 1), the skin between the rings goes from segment 0 to segment 1 linearly:
+// half each on the plane, as a hinge's crease follows the bisector.
+TEST(VertexPartWeights, SkinAtAJointBlendsBothPartsOverARamp) {
+  const Fixture f;
+  PartJoint joint;
+  joint.first = 0;
+  joint.second = 1;
+  joint.centre = Vec3(0.0, 0.0, 200.0);
+  joint.axis = Vec3::UnitZ();
+  const std::vector<PartJoint> joints{joint};
+  const std::vector<double> heights{180.0, 190.0, 200.0, 210.0, 220.0};
+  const std::vector<double> expected{0.0, 0.25, 0.5, 0.75, 1.0};  // segment 1's share
+  std::vector<Vec3> vertices;
+  for (double z : heights) vertices.push_back(skin(5.5, z));
+  const VertexPartWeights ramp = f.weights(vertices, joints, {}, 20.0), hard = f.weights(vertices, joints);
+  for (size_t v = 0; v < heights.size(); ++v) {
+    const int j = static_cast<int>(v);
+    EXPECT_NEAR(beta(ramp, j, 1), expected[v], 1e-12) << heights[v];
+    EXPECT_NEAR(beta(ramp, j, 0) + beta(ramp, j, 1), 1.0, 1e-12) << heights[v];
+  }
+  // Without the ramp: the hard switch at the plane.
+  EXPECT_NEAR(beta(hard, 1, 0), 1.0, 1e-12);
+  EXPECT_NEAR(beta(hard, 3, 1), 1.0, 1e-12);
+  // Under a marker the markers' own weights still stand.
+  std::vector<char> under(vertices.size(), 0);
+  under[2] = 1;
+  const VertexPartWeights kept = f.weights(vertices, joints, under, 20.0), paper = f.weights(vertices);
+  for (int p = 0; p < 3; ++p) EXPECT_EQ(beta(kept, 2, p), beta(paper, 2, p)) << p;
+  EXPECT_THROW(f.weights(vertices, joints, {}, -1.0), std::invalid_argument);
+  EXPECT_THROW(f.weights(vertices, joints, {}, std::numeric_limits<double>::quiet_NaN()), std::invalid_argument);
+}
+
+TEST(MedianNearestMarkerDistance, IsTheTypicalSpacing) {
+  // A 4 x 3 grid 40 mm apart, and one marker 10 mm from a corner: that pair is nearest at 10,
+  // the other ten markers at 40.
+  std::vector<Vec3> markers;
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 3; ++j) markers.emplace_back(40.0 * i, 40.0 * j, 0.0);
+  markers.emplace_back(-10.0, 0.0, 0.0);
+  EXPECT_DOUBLE_EQ(median_nearest_marker_distance(markers), 40.0);
+  EXPECT_THROW(median_nearest_marker_distance(std::vector<Vec3>{Vec3::Zero()}), std::invalid_argument);
 }
 
 TEST(VertexPartWeights, RejectsBadJointsAndFlags) {
