@@ -41,7 +41,7 @@ void add_build_subject(CLI::App& app) {
   cmd->add_option("--parts", deformation.segmentation.target_parts, "number of near-rigid parts")->capture_default_str();
   cmd->add_flag("--no-joint-split", no_joint_split, "no split of the vertex weights at hinge joints");
   cmd->add_flag("--no-joint-blend", no_joint_blend,
-                "split at hinge joints with a hard switch at the plane, not a ramp half a marker spacing wide");
+                "split at hinge joints with a hard switch at the plane, not a ramp half a marker spacing either side");
   cmd->add_flag("--no-fold-blend", no_fold_blend,
                 "no blend of the vertex weights across folds (with --no-joint-split: the paper's nearest triangle alone)");
   cmd->add_option("--part-file", parts_path, "JSON {\"marker\": part index}: your segmentation instead of mean shift");

@@ -66,7 +66,7 @@ void add_eval_deform(CLI::App& app) {
   static bool no_joint_split = false, no_joint_blend = false, no_fold_blend = false;
   cmd->add_flag("--no-joint-split", no_joint_split, "no split of the vertex weights at hinge joints");
   cmd->add_flag("--no-joint-blend", no_joint_blend,
-                "split at hinge joints with a hard switch at the plane, not a ramp half a marker spacing wide");
+                "split at hinge joints with a hard switch at the plane, not a ramp half a marker spacing either side");
   cmd->add_flag("--no-fold-blend", no_fold_blend,
                 "no blend of the vertex weights across folds (with --no-joint-split: the paper's nearest triangle alone)");
   cmd->add_option("--part-file", options.part_file,

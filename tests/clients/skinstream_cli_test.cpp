@@ -204,6 +204,24 @@ TEST(SkinstreamCli, EvalDeformFullMethodLeadsOnAHeldOutSubject) {
   }
 }
 
+// The ramp at hinge joints is on by default, half the subject's median nearest-marker spacing
+// wide either side (the 350-marker layout: about 46 mm), and --no-joint-blend turns it into the
+// hard switch: fewer vertices then blend two parts.
+TEST(SkinstreamCli, EvalDeformJointRampAndItsSwitch) {
+  const std::string base = "eval-deform --motions breathe --seconds 0.5 --train-seconds 5 --json --body " +
+                           std::string(SKINSTREAM_SHARED_DIR) + "/data/meshes/makehuman";
+  const ProgramRun ramp = run(base), hard = run(base + " --no-joint-blend");
+  ASSERT_EQ(ramp.exit_code, 0) << ramp.output;
+  ASSERT_EQ(hard.exit_code, 0) << hard.output;
+  const auto r = nlohmann::json::parse(ramp.output), h = nlohmann::json::parse(hard.output);
+  ASSERT_FALSE(r["joints"].empty());
+  EXPECT_EQ(r["joints"], h["joints"]);
+  EXPECT_GT(r["joint_blend_mm"].get<double>(), 15.0);
+  EXPECT_LT(r["joint_blend_mm"].get<double>(), 35.0);
+  EXPECT_EQ(h["joint_blend_mm"].get<double>(), 0.0);
+  EXPECT_GT(r["mean_parts_per_vertex"].get<double>(), h["mean_parts_per_vertex"].get<double>());
+}
+
 // eval-deform measures a user's segmentation too: the parts it used written per marker
 // (--part-file-out), and a hand-made file (--part-file: here the left side against the rest)
 // building the model from exactly those parts; a file naming an unknown marker is refused.
