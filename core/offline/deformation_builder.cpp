@@ -4,6 +4,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "core/offline/marker_distance_stats.h"
 #include "core/offline/vertex_part_weights.h"
 
 namespace skinstream {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 
 namespace skinstream {
 
@@ -50,6 +51,24 @@ MarkerDistanceStats compute_marker_distance_stats(const Capture& capture, const 
     }
   }
   return s;
+}
+
+std::vector<double> nearest_marker_distances(std::span<const Vec3> positions) {
+  std::vector<double> nearest(positions.size(), std::numeric_limits<double>::infinity());
+  for (size_t i = 0; i < positions.size(); ++i)
+    for (size_t k = i + 1; k < positions.size(); ++k) {
+      const double d = (positions[i] - positions[k]).norm();
+      nearest[i] = std::min(nearest[i], d);
+      nearest[k] = std::min(nearest[k], d);
+    }
+  return nearest;
+}
+
+double median_nearest_marker_distance(std::span<const Vec3> positions) {
+  if (positions.size() < 2) throw std::invalid_argument("the nearest-marker distance needs two markers");
+  std::vector<double> nearest = nearest_marker_distances(positions);
+  std::nth_element(nearest.begin(), nearest.begin() + nearest.size() / 2, nearest.end());
+  return nearest[nearest.size() / 2];
 }
 
 }  // namespace skinstream

@@ -14,17 +14,14 @@ int choose_reference_frame(const Capture& capture, const std::vector<int>& marke
   const int step = std::max(1, capture.frame_count / 400);
   int best = -1;
   double best_spread = -1.0;
+  std::vector<Vec3> frame(markers.size());
   for (int f = 0; f < capture.frame_count; f += step) {
     bool complete = true;
     for (int m : markers) complete = complete && capture.present(f, m);
     if (!complete) continue;
+    for (size_t i = 0; i < markers.size(); ++i) frame[i] = capture.at(f, markers[i]);
     double spread = 0.0;
-    for (int a : markers) {
-      double nearest = std::numeric_limits<double>::infinity();
-      for (int b : markers)
-        if (a != b) nearest = std::min(nearest, (capture.at(f, a) - capture.at(f, b)).norm());
-      spread += nearest;
-    }
+    for (double nearest : nearest_marker_distances(frame)) spread += nearest;
     if (spread > best_spread) {
       best_spread = spread;
       best = f;

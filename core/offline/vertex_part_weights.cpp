@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <map>
 #include <stdexcept>
 #include <string>
@@ -138,8 +137,7 @@ VertexPartWeights vertex_part_weights(std::span<const Vec3> vertices, std::span<
       const Vec3 towards_near = (near_point - vertices[j]) / near;
       for (size_t u = 0; u < tris.size(); ++u) {
         if (main_part[u] == main_part[t] || (centre[u] - vertices[j]).norm() - radius[u] >= kFoldRatio * near) continue;
-        Vec3 bary;
-        const Vec3 q = synth::closest_point_on_triangle(vertices[j], points[tris[u][0]], points[tris[u][1]], points[tris[u][2]], &bary);
+        const Vec3 q = synth::closest_point_on_triangle(vertices[j], points[tris[u][0]], points[tris[u][1]], points[tris[u][2]]);
         const double far = (q - vertices[j]).norm();
         const double share = fold_share(near, far, towards_near.dot((q - vertices[j]) / far));
         if (share > sides[1].second) sides[1] = {static_cast<int>(u), share};
@@ -209,19 +207,6 @@ std::vector<char> vertices_under_markers(std::span<const Vec3> vertices, std::sp
       for (int corner : faces[face]) under[corner] = 1;
   }
   return under;
-}
-
-double median_nearest_marker_distance(std::span<const Vec3> markers) {
-  require(markers.size() >= 2, "the nearest-marker distance needs two markers");
-  std::vector<double> nearest(markers.size(), std::numeric_limits<double>::infinity());
-  for (size_t i = 0; i < markers.size(); ++i)
-    for (size_t k = i + 1; k < markers.size(); ++k) {
-      const double d = (markers[i] - markers[k]).norm();
-      nearest[i] = std::min(nearest[i], d);
-      nearest[k] = std::min(nearest[k], d);
-    }
-  std::nth_element(nearest.begin(), nearest.begin() + nearest.size() / 2, nearest.end());
-  return nearest[nearest.size() / 2];
 }
 
 }  // namespace skinstream

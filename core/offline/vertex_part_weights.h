@@ -15,7 +15,7 @@
 // The switch is a linear ramp joint_blend_mm either side of the plane (or of the marker's
 // height): at the plane a vertex follows both parts by half, the bisector a hinge's crease
 // follows. The builder sets the width to half the median distance from a marker to its nearest
-// neighbour: no marker sits in the crease, so the markers place the plane no finer than their
+// neighbour (median_nearest_marker_distance, marker_distance_stats.h): no marker sits in the crease, so the markers place the plane no finer than their
 // spacing, and a hard switch there put the inner elbow's skin wholly on one bone.
 //
 // A second addition, in folds (blend_folds): a vertex between its nearest triangle and a
@@ -56,10 +56,6 @@ VertexPartWeights vertex_part_weights(std::span<const Vec3> vertices, std::span<
                                       std::span<const int> part_member_offsets, std::span<const PartMember> part_members,
                                       std::span<const PartJoint> joints = {}, std::span<const char> under_marker = {},
                                       bool blend_folds = false, double joint_blend_mm = 0.0);
-
-// The median over markers of the distance to the nearest other marker (mm). Throws
-// std::invalid_argument for fewer than two markers.
-double median_nearest_marker_distance(std::span<const Vec3> markers);
 
 // #V flags: the three vertices of the mesh triangle nearest to each marker (where it sits).
 // Throws std::invalid_argument for a face index out of range or no faces.

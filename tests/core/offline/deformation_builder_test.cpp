@@ -7,7 +7,7 @@
 
 #include "core/deform/mesh_deformer.h"
 #include "core/offline/subject_builder.h"
-#include "core/offline/vertex_part_weights.h"
+#include "core/offline/marker_distance_stats.h"
 #include "core/synth/mannequin.h"
 #include "core/synth/synth_capture.h"
 

@@ -190,17 +190,6 @@ TEST(VertexPartWeights, SkinAtAJointBlendsBothPartsOverARamp) {
   EXPECT_THROW(f.weights(vertices, joints, {}, std::numeric_limits<double>::quiet_NaN()), std::invalid_argument);
 }
 
-TEST(MedianNearestMarkerDistance, IsTheTypicalSpacing) {
-  // A 4 x 3 grid 40 mm apart, and one marker 10 mm from a corner: that pair is nearest at 10,
-  // the other ten markers at 40.
-  std::vector<Vec3> markers;
-  for (int i = 0; i < 4; ++i)
-    for (int j = 0; j < 3; ++j) markers.emplace_back(40.0 * i, 40.0 * j, 0.0);
-  markers.emplace_back(-10.0, 0.0, 0.0);
-  EXPECT_DOUBLE_EQ(median_nearest_marker_distance(markers), 40.0);
-  EXPECT_THROW(median_nearest_marker_distance(std::vector<Vec3>{Vec3::Zero()}), std::invalid_argument);
-}
-
 TEST(VertexPartWeights, RejectsBadJointsAndFlags) {
   const Fixture f;
   const std::vector<Vec3> vertices{skin(1.0, 100.0)};
