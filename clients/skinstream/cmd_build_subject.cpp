@@ -44,6 +44,9 @@ void add_build_subject(CLI::App& app) {
                 "split at hinge joints with a hard switch at the plane, not a ramp half a marker spacing either side");
   cmd->add_flag("--no-fold-blend", no_fold_blend,
                 "no blend of the vertex weights across folds (with --no-joint-split: the paper's nearest triangle alone)");
+  cmd->add_option("--boundary-rings", deformation.weights.boundary_rings,
+                  "widen the marker weights' part boundaries by this many rings of the marker surface (0: the paper's)")
+      ->capture_default_str()->check(CLI::NonNegativeNumber);
   cmd->add_option("--part-file", parts_path, "JSON {\"marker\": part index}: your segmentation instead of mean shift");
   cmd->add_option("--part-file-out", parts_out,
                   "also write the segmentation used, in --part-file's form, to adjust by hand and read back");
@@ -117,6 +120,7 @@ void add_build_subject(CLI::App& app) {
                      {"max_part_rigid_rms_mm", d.max_part_rigid_rms_mm},
                      {"part_sizes", part_sizes_json(d, *deformation_model)},
                      {"part_file_unused_parts", d.unused_parts},
+                     {"boundary_rings", deformation.weights.boundary_rings},
                      {"boundary_markers", d.boundary_markers},
                      {"mean_parts_per_vertex", d.mean_influences_per_vertex},
                      {"joints", joints_json(d.joints)},

@@ -69,6 +69,9 @@ void add_eval_deform(CLI::App& app) {
                 "split at hinge joints with a hard switch at the plane, not a ramp half a marker spacing either side");
   cmd->add_flag("--no-fold-blend", no_fold_blend,
                 "no blend of the vertex weights across folds (with --no-joint-split: the paper's nearest triangle alone)");
+  cmd->add_option("--boundary-rings", options.boundary_rings,
+                  "widen the marker weights' part boundaries by this many rings of the marker surface (0: the paper's)")
+      ->capture_default_str()->check(CLI::NonNegativeNumber);
   cmd->add_option("--part-file", options.part_file,
                   "JSON {\"marker\": part index}: your segmentation instead of mean shift (build-subject --part-file-out writes one)");
   static std::string parts_out;
@@ -106,6 +109,7 @@ void add_eval_deform(CLI::App& app) {
     result["max_part_rigid_rms_mm"] = setup.build.max_part_rigid_rms_mm;
     result["part_sizes"] = part_sizes_json(setup.build, setup.deformation);
     result["part_file_unused_parts"] = setup.build.unused_parts;
+    result["boundary_rings"] = options.boundary_rings;
     result["boundary_markers"] = setup.build.boundary_markers;
     result["mean_parts_per_vertex"] = setup.build.mean_influences_per_vertex;
     result["joints"] = joints_json(setup.build.joints);

@@ -23,6 +23,39 @@ constexpr double kAddedMemberFloor = 0.01;
 
 using Row = std::vector<std::pair<int, double>>;  // (part, weight), sorted by part
 
+// Per marker, the parts its weights are chosen among: those of the triangles of every marker
+// within `rings` marker-surface edges of it (itself alone at 0), sorted.
+std::vector<std::vector<int>> candidate_parts(std::span<const std::array<int, 3>> triangles,
+                                              const std::vector<std::vector<int>>& marker_parts, int rings) {
+  const int m = static_cast<int>(marker_parts.size());
+  std::vector<std::vector<int>> neighbours(m);
+  for (const auto& t : triangles)
+    for (int a : t)
+      for (int b : t)
+        if (a != b) neighbours[a].push_back(b);
+  std::vector<std::vector<int>> out(m);
+  std::vector<int> seen(m, -1), frontier, next;
+  for (int i = 0; i < m; ++i) {
+    frontier.assign(1, i);
+    seen[i] = i;
+    out[i] = marker_parts[i];
+    for (int ring = 0; ring < rings && !frontier.empty(); ++ring) {
+      next.clear();
+      for (int a : frontier)
+        for (int b : neighbours[a])
+          if (seen[b] != i) {
+            seen[b] = i;
+            next.push_back(b);
+            out[i].insert(out[i].end(), marker_parts[b].begin(), marker_parts[b].end());
+          }
+      frontier.swap(next);
+    }
+    std::sort(out[i].begin(), out[i].end());
+    out[i].erase(std::unique(out[i].begin(), out[i].end()), out[i].end());
+  }
+  return out;
+}
+
 }  // namespace
 
 double MarkerPartWeights::weight(int marker, int part) const {
@@ -46,6 +79,7 @@ MarkerPartWeights marker_part_weights(std::span<const Vec3> reference, std::span
   require(options.threshold >= 0.0 && options.threshold < 1.0, "threshold must be in [0, 1)");
   require(options.sigma_floor_mm > 0.0 && std::isfinite(options.sigma_floor_mm), "sigma_floor_mm must be > 0");
   require(options.min_members >= 1 && options.min_members <= m, "min_members must be in [1, marker count]");
+  require(options.boundary_rings >= 0, "boundary_rings must be >= 0");
   std::vector<std::vector<int>> part_markers(part_count);  // markers of the part's triangles
   std::vector<std::vector<int>> marker_parts(m);           // parts of the marker's triangles
   for (size_t t = 0; t < triangles.size(); ++t) {
@@ -71,7 +105,8 @@ MarkerPartWeights marker_part_weights(std::span<const Vec3> reference, std::span
   out.inside_markers.assign(part_count, 0);
   for (int i = 0; i < m; ++i)
     if (marker_parts[i].size() == 1) ++out.inside_markers[marker_parts[i][0]];
-    else ++out.boundary_markers;
+  const std::vector<std::vector<int>> candidates = candidate_parts(triangles, marker_parts, options.boundary_rings);
+  for (int i = 0; i < m; ++i) out.boundary_markers += candidates[i].size() != 1;
 
   // Each part's rigid motion per frame from its inside markers, and its sigma.
   std::vector<std::vector<int>> fitted(part_count);
@@ -119,11 +154,11 @@ MarkerPartWeights marker_part_weights(std::span<const Vec3> reference, std::span
   std::vector<Row> rows(m);
   std::vector<Row> unthresholded(m);
   for (int i = 0; i < m; ++i) {
-    if (marker_parts[i].size() == 1) {
-      rows[i] = {{marker_parts[i][0], 1.0}};
+    if (candidates[i].size() == 1) {
+      rows[i] = {{candidates[i][0], 1.0}};
       continue;
     }
-    unthresholded[i] = likelihoods(i, marker_parts[i].empty() ? all_parts : marker_parts[i]);
+    unthresholded[i] = likelihoods(i, candidates[i].empty() ? all_parts : candidates[i]);
     const auto strongest = std::max_element(unthresholded[i].begin(), unthresholded[i].end(),
                                             [](const auto& a, const auto& b) { return a.second < b.second; });
     for (const auto& [p, w] : unthresholded[i])

@@ -8,6 +8,14 @@
 // sigma_p is the RMS over the take of the part's inside markers' own errors under that motion
 // (how far a marker that truly belongs strays), floored at sigma_floor_mm so that a perfectly
 // rigid part does not turn every small error into a zero likelihood.
+//
+// One addition to the paper (boundary_rings): the boundary is widened by whole rings of the
+// marker surface. A marker within that many edges of another part's triangle is weighed by
+// likelihood too, among the parts of the triangles around it; the parts' motions are still
+// fitted from the inside markers in the paper's sense. With the paper's one-triangle boundary,
+// the skin a marker spacing (~45 mm) in from a seam follows its part alone, while the skin
+// there moves partly with the part across; and the markers of mean shift's small leftover
+// parts at the shoulders, nearly all a ring from a seam, follow those poorly rigid parts alone.
 
 #include <array>
 #include <span>
@@ -22,6 +30,7 @@ struct MarkerWeightOptions {
   double threshold = 0.2;       // drop a part whose normalised likelihood is not above this
   double sigma_floor_mm = 1.0;  // lower bound of a part's sigma
   int min_members = 4;          // every part keeps at least this many markers
+  int boundary_rings = 1;       // 0: the paper's boundary, a marker with triangles in several parts
 };
 
 struct MarkerPartWeights {
@@ -29,7 +38,7 @@ struct MarkerPartWeights {
   std::vector<PartMember> part_members;     // sorted by marker within a part; weights in (0, 1]
   std::vector<double> part_sigma_mm;        // #parts: sigma_p used
   std::vector<int> inside_markers;          // #parts: how many markers are inside each part
-  int boundary_markers = 0;                 // markers with triangles in several parts
+  int boundary_markers = 0;                 // markers weighed by likelihood (within boundary_rings of a seam)
   int markers_added_for_min_members = 0;    // memberships added so parts keep min_members
 
   // alpha_{i,p} of one marker, 0 when it is not a member (a linear scan; for tests and tools).

@@ -222,6 +222,28 @@ TEST(SkinstreamCli, EvalDeformJointRampAndItsSwitch) {
   EXPECT_GT(r["mean_parts_per_vertex"].get<double>(), h["mean_parts_per_vertex"].get<double>());
 }
 
+// The marker weights' part boundary is a ring of the marker surface wider than the paper's by
+// default; --boundary-rings 0 gives the paper's (fewer markers weighed by likelihood, the same
+// parts), and a negative count is refused before any work.
+TEST(SkinstreamCli, EvalDeformBoundaryRings) {
+  const std::string base = "eval-deform --motions breathe --seconds 0.5 --train-seconds 5 --json --body " +
+                           std::string(SKINSTREAM_SHARED_DIR) + "/data/meshes/makehuman";
+  const ProgramRun wide = run(base), paper = run(base + " --boundary-rings 0");
+  ASSERT_EQ(wide.exit_code, 0) << wide.output;
+  ASSERT_EQ(paper.exit_code, 0) << paper.output;
+  const auto w = nlohmann::json::parse(wide.output), p = nlohmann::json::parse(paper.output);
+  EXPECT_EQ(w["boundary_rings"], 1);
+  EXPECT_EQ(p["boundary_rings"], 0);
+  EXPECT_EQ(w["parts"], p["parts"]);
+  for (size_t k = 0; k < w["part_sizes"].size(); ++k)
+    EXPECT_EQ(w["part_sizes"][k]["triangles"], p["part_sizes"][k]["triangles"]);
+  EXPECT_GT(w["boundary_markers"].get<int>(), p["boundary_markers"].get<int>());
+  EXPECT_GT(w["mean_parts_per_vertex"].get<double>(), p["mean_parts_per_vertex"].get<double>());
+  const ProgramRun negative = run(base + " --boundary-rings -1");
+  EXPECT_NE(negative.exit_code, 0);
+  EXPECT_NE(negative.output.find("--boundary-rings"), std::string::npos) << negative.output;
+}
+
 // eval-deform measures a user's segmentation too: the parts it used written per marker
 // (--part-file-out), and a hand-made file (--part-file: here the left side against the rest)
 // building the model from exactly those parts; a file naming an unknown marker is refused.

@@ -46,13 +46,20 @@ TEST(MarkerPartWeights, RejectsBadInputs) {
   MarkerWeightOptions o;
   o.threshold = 1.0;
   EXPECT_THROW(marker_part_weights(l.reference, l.triangles, f.triangle_part, 3, l.positions, kFrames, o), std::invalid_argument);
+  MarkerWeightOptions rings;
+  rings.boundary_rings = -1;
+  EXPECT_THROW(marker_part_weights(l.reference, l.triangles, f.triangle_part, 3, l.positions, kFrames, rings),
+               std::invalid_argument);
 }
 
+// With the paper's boundary (no rings added).
 TEST(MarkerPartWeights, InsideMarkersWeighOneAndBoundaryMarkersFollowTheirSegment) {
   const Fixture f;
   const auto& l = f.limb;
   const int m = static_cast<int>(l.reference.size());
-  const MarkerPartWeights w = marker_part_weights(l.reference, l.triangles, f.triangle_part, 3, l.positions, kFrames);
+  MarkerWeightOptions paper;
+  paper.boundary_rings = 0;
+  const MarkerPartWeights w = marker_part_weights(l.reference, l.triangles, f.triangle_part, 3, l.positions, kFrames, paper);
   ASSERT_EQ(w.part_member_offsets.size(), 4u);
   for (double s : row_sums(w, m)) EXPECT_NEAR(s, 1.0, 1e-12);
   EXPECT_EQ(w.boundary_markers, 4 * l.around);  // the rings on either side of the two joints
@@ -71,7 +78,8 @@ TEST(MarkerPartWeights, InsideMarkersWeighOneAndBoundaryMarkersFollowTheirSegmen
     }
   for (int p = 0; p < 3; ++p) EXPECT_EQ(w.part_sigma_mm[p], 1.0);  // rigid parts: the floor
   // Deterministic.
-  const MarkerPartWeights again = marker_part_weights(l.reference, l.triangles, f.triangle_part, 3, l.positions, kFrames);
+  const MarkerPartWeights again =
+      marker_part_weights(l.reference, l.triangles, f.triangle_part, 3, l.positions, kFrames, paper);
   ASSERT_EQ(again.part_members.size(), w.part_members.size());
   for (size_t k = 0; k < w.part_members.size(); ++k) EXPECT_EQ(again.part_members[k].weight, w.part_members[k].weight);
 }
@@ -98,14 +106,46 @@ TEST(MarkerPartWeights, SplitsAMarkerBetweenPartsAndRespectsTheThreshold) {
   for (double s : row_sums(one, m)) EXPECT_NEAR(s, 1.0, 1e-12);
 }
 
-// A part of a single triangle has 3 markers: a fourth (the nearest) is added.
+// A marker one ring in from a seam is inside its part by the paper's rule (weight 1 whatever it
+// does) but weighed by likelihood with one ring added: moving wholly with the part across the
+// seam, it follows that part. Each ring widens the boundary band by a ring of the limb either side.
+TEST(MarkerPartWeights, AMarkerARingInFromASeamIsWeighedToo) {
+  Fixture f;
+  auto& l = f.limb;
+  const int m = static_cast<int>(l.reference.size());
+  const int i = l.marker(2, 5);  // segment 0; ring 3 is the seam with segment 1
+  test::move_with_ring(l, i, 5, kFrames, 1.0);
+  MarkerWeightOptions o;
+  o.boundary_rings = 0;
+  const MarkerPartWeights paper = marker_part_weights(l.reference, l.triangles, f.triangle_part, 3, l.positions, kFrames, o);
+  EXPECT_EQ(paper.weight(i, 0), 1.0);
+  EXPECT_EQ(paper.boundary_markers, 4 * l.around);  // rings 3-4 and 7-8
+  o.boundary_rings = 1;
+  const MarkerPartWeights one = marker_part_weights(l.reference, l.triangles, f.triangle_part, 3, l.positions, kFrames, o);
+  EXPECT_GT(one.weight(i, 1), 0.99);
+  EXPECT_EQ(one.weight(i, 0), 0.0);  // under the threshold
+  EXPECT_EQ(one.boundary_markers, 8 * l.around);  // rings 2-9
+  for (double s : row_sums(one, m)) EXPECT_NEAR(s, 1.0, 1e-12);
+  // Its neighbours still move with segment 0 and stay there.
+  EXPECT_GT(one.weight(l.marker(2, 4), 0), 0.99);
+  EXPECT_GT(one.weight(l.marker(1, 5), 0), 0.99);
+  o.boundary_rings = 2;
+  const MarkerPartWeights two = marker_part_weights(l.reference, l.triangles, f.triangle_part, 3, l.positions, kFrames, o);
+  EXPECT_EQ(two.boundary_markers, 10 * l.around);  // rings 1-10: the end rings are two rings from any seam
+  EXPECT_EQ(two.weight(l.marker(0, 0), 0), 1.0);
+}
+
+// A part of a single triangle has 3 markers: a fourth (the nearest) is added. (With the
+// paper's boundary: a ring added would weigh the triangle's 9 neighbours against it as well.)
 TEST(MarkerPartWeights, EveryPartKeepsFourMembers) {
   const Fixture f;
   const auto& l = f.limb;
   const int m = static_cast<int>(l.reference.size());
   std::vector<int> parts(l.triangles.size(), 0);
   parts[20] = 1;
-  const MarkerPartWeights w = marker_part_weights(l.reference, l.triangles, parts, 2, l.positions, kFrames);
+  MarkerWeightOptions paper;
+  paper.boundary_rings = 0;
+  const MarkerPartWeights w = marker_part_weights(l.reference, l.triangles, parts, 2, l.positions, kFrames, paper);
   EXPECT_EQ(w.part_member_offsets[2] - w.part_member_offsets[1], 4);
   EXPECT_EQ(w.markers_added_for_min_members, 1);
   for (double s : row_sums(w, m)) EXPECT_NEAR(s, 1.0, 1e-12);

@@ -61,9 +61,9 @@ inline ArticulatedLimb make_articulated_limb(int segments, int frames, double se
   return limb;
 }
 
-// Moves `marker` halfway between where its own segment carries it and where the segment of
-// `ring` (a ring of another segment) would carry it rigidly: a marker that belongs to both.
-inline void move_halfway(ArticulatedLimb& limb, int marker, int ring, int frames) {
+// Moves `marker` from where its own segment carries it toward where the segment of `ring` (a
+// ring of another segment) would carry it rigidly, by `share` of the way (1: wholly with it).
+inline void move_with_ring(ArticulatedLimb& limb, int marker, int ring, int frames, double share) {
   const size_t m = limb.reference.size();
   for (int f = 0; f < frames; ++f) {
     std::vector<Vec3> src, dst;
@@ -74,8 +74,13 @@ inline void move_halfway(ArticulatedLimb& limb, int marker, int ring, int frames
     RigidTransform other;
     fit_rigid(src, dst, other);
     Vec3& p = limb.positions[f * m + marker];
-    p = 0.5 * (p + other.apply(limb.reference[marker]));
+    p = (1.0 - share) * p + share * other.apply(limb.reference[marker]);
   }
+}
+
+// Halfway: a marker that belongs to both segments.
+inline void move_halfway(ArticulatedLimb& limb, int marker, int ring, int frames) {
+  move_with_ring(limb, marker, ring, frames, 0.5);
 }
 
 }  // namespace skinstream::test
