@@ -19,6 +19,12 @@ using test::ProgramRun;
 // `skinstream ARGUMENTS`, stdout and stderr together.
 ProgramRun run(const std::string& arguments) { return test::run_program(std::string(SKINSTREAM_CLI) + " " + arguments); }
 
+// eval-deform on one short breathe take from a 5 s training take: seconds, not minutes.
+std::string quick_eval_deform() {
+  return "eval-deform --motions breathe --seconds 0.5 --train-seconds 5 --json --body " +
+         std::string(SKINSTREAM_SHARED_DIR) + "/data/meshes/makehuman";
+}
+
 const std::string kCmu02 = test::source_path("replay_data/cmu/85_02.c3d");
 const std::string kCmu12 = test::source_path("replay_data/cmu/85_12.c3d");
 
@@ -140,8 +146,7 @@ TEST(SkinstreamCli, SynthStatsOnAShortFlexTakeMeetTheRelabelAndFillTargets) {
 // first of which carries the row's maximum, with the frame, the distance to the nearest marker
 // and (part-based methods only) the vertex's part weights.
 TEST(SkinstreamCli, EvalDeformNamesTheVerticesBehindEachMaximum) {
-  const ProgramRun r = run("eval-deform --motions breathe --seconds 0.5 --train-seconds 5 --json --body " +
-                           std::string(SKINSTREAM_SHARED_DIR) + "/data/meshes/makehuman");
+  const ProgramRun r = run(quick_eval_deform());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const auto j = nlohmann::json::parse(r.output);
   const auto& take = j["takes"][0];
@@ -208,8 +213,7 @@ TEST(SkinstreamCli, EvalDeformFullMethodLeadsOnAHeldOutSubject) {
 // wide either side (the 350-marker layout: about 46 mm), and --no-joint-blend turns it into the
 // hard switch: fewer vertices then blend two parts.
 TEST(SkinstreamCli, EvalDeformJointRampAndItsSwitch) {
-  const std::string base = "eval-deform --motions breathe --seconds 0.5 --train-seconds 5 --json --body " +
-                           std::string(SKINSTREAM_SHARED_DIR) + "/data/meshes/makehuman";
+  const std::string base = quick_eval_deform();
   const ProgramRun ramp = run(base), hard = run(base + " --no-joint-blend");
   ASSERT_EQ(ramp.exit_code, 0) << ramp.output;
   ASSERT_EQ(hard.exit_code, 0) << hard.output;
@@ -226,8 +230,7 @@ TEST(SkinstreamCli, EvalDeformJointRampAndItsSwitch) {
 // default; --boundary-rings 0 gives the paper's (fewer markers weighed by likelihood, the same
 // parts), and a negative count is refused before any work.
 TEST(SkinstreamCli, EvalDeformBoundaryRings) {
-  const std::string base = "eval-deform --motions breathe --seconds 0.5 --train-seconds 5 --json --body " +
-                           std::string(SKINSTREAM_SHARED_DIR) + "/data/meshes/makehuman";
+  const std::string base = quick_eval_deform();
   const ProgramRun wide = run(base), paper = run(base + " --boundary-rings 0");
   ASSERT_EQ(wide.exit_code, 0) << wide.output;
   ASSERT_EQ(paper.exit_code, 0) << paper.output;
@@ -248,8 +251,7 @@ TEST(SkinstreamCli, EvalDeformBoundaryRings) {
 // (--part-file-out), and a hand-made file (--part-file: here the left side against the rest)
 // building the model from exactly those parts; a file naming an unknown marker is refused.
 TEST(SkinstreamCli, EvalDeformReadsAndWritesPartFiles) {
-  const std::string base = "eval-deform --motions breathe --seconds 0.5 --train-seconds 5 --json --body " +
-                           std::string(SKINSTREAM_SHARED_DIR) + "/data/meshes/makehuman";
+  const std::string base = quick_eval_deform();
   const std::string written = test::scratch_path("eval_parts.json"), sides = test::scratch_path("eval_sides.json");
   const ProgramRun automatic = run(base + " --part-file-out " + written);
   ASSERT_EQ(automatic.exit_code, 0) << automatic.output;
