@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "core/absolute_orientation.h"
+#include "core/offline/marker_surface_builder.h"
 #include "core/offline/part_motions.h"
 
 namespace skinstream {
@@ -28,11 +29,7 @@ using Row = std::vector<std::pair<int, double>>;  // (part, weight), sorted by p
 std::vector<std::vector<int>> candidate_parts(std::span<const std::array<int, 3>> triangles,
                                               const std::vector<std::vector<int>>& marker_parts, int rings) {
   const int m = static_cast<int>(marker_parts.size());
-  std::vector<std::vector<int>> neighbours(m);
-  for (const auto& t : triangles)
-    for (int a : t)
-      for (int b : t)
-        if (a != b) neighbours[a].push_back(b);
+  const std::vector<std::vector<int>> neighbours = triangle_neighbours(triangles, m);
   std::vector<std::vector<int>> out(m);
   std::vector<int> seen(m, -1), frontier, next;
   for (int i = 0; i < m; ++i) {

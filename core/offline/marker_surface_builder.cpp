@@ -85,20 +85,14 @@ MarkerSurface finish_surface(const std::vector<Vec3>& x, std::vector<Triangle> t
   const int n = static_cast<int>(x.size());
   orient_triangles(x, tris);
   MarkerSurface s;
-  s.rings.assign(n, {});
+  s.rings = triangle_neighbours(tris, n);
   s.normals.assign(n, Vec3::Zero());
   for (const Triangle& t : tris) {
     const Vec3 area_normal = (x[t[1]] - x[t[0]]).cross(x[t[2]] - x[t[0]]);
-    for (int e = 0; e < 3; ++e) {
-      s.normals[t[e]] += area_normal;
-      for (int f = 0; f < 3; ++f)
-        if (f != e) s.rings[t[e]].push_back(t[f]);
-    }
+    for (int e = 0; e < 3; ++e) s.normals[t[e]] += area_normal;
   }
   for (int i = 0; i < n; ++i) {
     std::vector<int>& ring = s.rings[i];
-    std::sort(ring.begin(), ring.end());
-    ring.erase(std::unique(ring.begin(), ring.end()), ring.end());
     auto nearer = [&](int a, int b) { return skin(i, a) < skin(i, b); };
     if (static_cast<int>(ring.size()) < 3) {
       ++s.markers_given_extra_neighbours;
@@ -133,6 +127,19 @@ MarkerSurface finish_surface(const std::vector<Vec3>& x, std::vector<Triangle> t
 }
 
 }  // namespace
+
+std::vector<std::vector<int>> triangle_neighbours(std::span<const std::array<int, 3>> triangles, int marker_count) {
+  std::vector<std::vector<int>> neighbours(marker_count);
+  for (const auto& t : triangles)
+    for (int e = 0; e < 3; ++e)
+      for (int f = 0; f < 3; ++f)
+        if (f != e) neighbours[t[e]].push_back(t[f]);
+  for (auto& list : neighbours) {
+    std::sort(list.begin(), list.end());
+    list.erase(std::unique(list.begin(), list.end()), list.end());
+  }
+  return neighbours;
+}
 
 MarkerSurface build_marker_surface(const std::vector<Vec3>& x, const Eigen::MatrixXd& skin,
                                    const MarkerSurfaceOptions& options) {

@@ -12,6 +12,7 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <span>
 #include <vector>
 
 #include "core/capture.h"
@@ -30,6 +31,10 @@ struct MarkerSurfaceOptions {
   int max_ring = 12;
   double min_angle_degrees = 12.0;
 };
+
+// Per marker (0..marker_count-1), the markers it shares a triangle with, ascending, each once.
+// Indices must be in range (callers check).
+std::vector<std::vector<int>> triangle_neighbours(std::span<const std::array<int, 3>> triangles, int marker_count);
 
 // `skin_distance` is N x N (see MarkerDistanceStats::skin_distance); `reference` the pose.
 MarkerSurface build_marker_surface(const std::vector<Vec3>& reference, const Eigen::MatrixXd& skin_distance,
