@@ -510,7 +510,8 @@ inline __attribute__((always_inline)) void MeshDeformer::State::deform_cluster(i
   for (int b = 0; b < kBlocks; ++b) {
     const Lanes x = load_lanes(in.inside[0] + b * kLanes), y = load_lanes(in.inside[1] + b * kLanes),
                 z = load_lanes(in.inside[2] + b * kLanes);
-    const Lanes q[9] = {x, y, z, x * x, y * y, z * z, x * y, y * z, z * x};  // quadratic_basis
+    Lanes q[9];
+    quadratic_terms(x, y, z, q);
     for (int r = 0; r < 3; ++r) {
       Lanes sum = part.quadratic[r][0] * q[0];
       for (int k = 1; k < 9; ++k) sum += part.quadratic[r][k] * q[k];
