@@ -24,7 +24,8 @@ void add_build_subject(CLI::App& app) {
   static std::string capture_path, out_path, surface_in, surface_out, mesh_path, landmarks_path, parts_path, parts_out;
   static SubjectBuildOptions options;
   static DeformationBuildOptions deformation;
-  static bool no_register = false, no_joint_split = false, no_joint_blend = false, no_fold_blend = false;
+  static bool no_register = false, no_joint_split = false, no_joint_blend = false, no_fold_blend = false,
+              no_fold_smoothing = false;
   cmd->add_option("--capture", capture_path, "training capture (.c3d/.trc), ideally a range-of-motion take")->required();
   cmd->add_option("--out", out_path, "subject file to write")->required();
   cmd->add_option("--reference-frame", options.reference_frame, "frame index of the reference pose (default: chosen)");
@@ -44,6 +45,8 @@ void add_build_subject(CLI::App& app) {
                 "split at hinge joints with a hard switch at the plane, not a ramp half a marker spacing either side");
   cmd->add_flag("--no-fold-blend", no_fold_blend,
                 "no blend of the vertex weights across folds (with --no-joint-split: the paper's nearest triangle alone)");
+  cmd->add_flag("--no-fold-smoothing", no_fold_smoothing,
+                "keep the fold blend's vertex weights as they are, not smoothed over the mesh inside folds");
   cmd->add_option("--boundary-rings", deformation.weights.boundary_rings,
                   "widen the marker weights' part boundaries by this many rings of the marker surface (0: the paper's)")
       ->capture_default_str()->check(CLI::NonNegativeNumber);
@@ -75,6 +78,7 @@ void add_build_subject(CLI::App& app) {
       deformation.split_at_joints = !no_joint_split;
       deformation.blend_at_joints = !no_joint_blend;
       deformation.blend_folds = !no_fold_blend;
+      deformation.smooth_folds = !no_fold_smoothing;
       if (!landmarks_path.empty()) {
         const std::vector<int> vertex = read_marker_map(landmarks_path, model, "vertex index");
         for (int i = 0; i < n; ++i)
@@ -123,6 +127,7 @@ void add_build_subject(CLI::App& app) {
                      {"boundary_rings", deformation.weights.boundary_rings},
                      {"boundary_markers", d.boundary_markers},
                      {"mean_parts_per_vertex", d.mean_influences_per_vertex},
+                     {"fold_smoothed_vertices", d.fold_smoothed_vertices},
                      {"joints", joints_json(d.joints)},
                      {"joint_blend_mm", d.joint_blend_mm},
                      {"part_quadratic_ridges", to_json(d.part_quadratic_ridges)},

@@ -63,12 +63,14 @@ void add_eval_deform(CLI::App& app) {
   cmd->add_option("--body", body_dir, "folder with the MakeHuman files (default: the shared data folder)");
   cmd->add_flag("--deform-registered", options.deform_registered_mesh,
                 "deform the registered artist's model instead of the reference frame's truth skin");
-  static bool no_joint_split = false, no_joint_blend = false, no_fold_blend = false;
+  static bool no_joint_split = false, no_joint_blend = false, no_fold_blend = false, no_fold_smoothing = false;
   cmd->add_flag("--no-joint-split", no_joint_split, "no split of the vertex weights at hinge joints");
   cmd->add_flag("--no-joint-blend", no_joint_blend,
                 "split at hinge joints with a hard switch at the plane, not a ramp half a marker spacing either side");
   cmd->add_flag("--no-fold-blend", no_fold_blend,
                 "no blend of the vertex weights across folds (with --no-joint-split: the paper's nearest triangle alone)");
+  cmd->add_flag("--no-fold-smoothing", no_fold_smoothing,
+                "keep the fold blend's vertex weights as they are, not smoothed over the mesh inside folds");
   cmd->add_option("--boundary-rings", options.boundary_rings,
                   "widen the marker weights' part boundaries by this many rings of the marker surface (0: the paper's)")
       ->capture_default_str()->check(CLI::NonNegativeNumber);
@@ -81,6 +83,7 @@ void add_eval_deform(CLI::App& app) {
     options.split_at_joints = !no_joint_split;
     options.blend_at_joints = !no_joint_blend;
     options.blend_folds = !no_fold_blend;
+    options.smooth_folds = !no_fold_smoothing;
     const synth::Body body = load_makehuman(body_dir.empty() ? default_body_dir() : body_dir);
     synth::SynthOptions rom;
     rom.motion = "rom";
@@ -112,6 +115,7 @@ void add_eval_deform(CLI::App& app) {
     result["boundary_rings"] = options.boundary_rings;
     result["boundary_markers"] = setup.build.boundary_markers;
     result["mean_parts_per_vertex"] = setup.build.mean_influences_per_vertex;
+    result["fold_smoothed_vertices"] = setup.build.fold_smoothed_vertices;
     result["joints"] = joints_json(setup.build.joints);
     result["joint_blend_mm"] = setup.build.joint_blend_mm;
     result["part_quadratic_ridges"] = to_json(setup.build.part_quadratic_ridges);

@@ -192,6 +192,7 @@ DeformationSetup prepare_deformation(const synth::Body& body, const SynthCapture
   build.split_at_joints = options.split_at_joints;
   build.blend_at_joints = options.blend_at_joints;
   build.blend_folds = options.blend_folds;
+  build.smooth_folds = options.smooth_folds;
   build.weights.boundary_rings = options.boundary_rings;
   if (!options.part_file.empty()) {
     build.part_assignment = read_part_file(options.part_file, setup.subject);

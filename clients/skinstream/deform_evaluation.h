@@ -32,6 +32,7 @@ struct DeformEvaluationOptions {
   bool split_at_joints = true;  // false: no split of the vertex weights at hinge joints
   bool blend_at_joints = true;  // false: the split is a hard switch at the plane
   bool blend_folds = true;      // false: no blend across folds (both false: the paper's rule alone)
+  bool smooth_folds = true;     // false: the fold blend's weights unsmoothed
   int boundary_rings = 1;       // marker weights' boundary widened by rings (0: the paper's)
   std::string part_file;        // a user's parts ({"marker name": part}) instead of mean shift
 };

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "core/deform/deformation_model.h"
+#include "core/offline/fold_weight_smoothing.h"
 #include "core/offline/marker_part_weights.h"
 #include "core/offline/mesh_registration.h"
 #include "core/offline/part_joints.h"
@@ -30,6 +31,8 @@ struct DeformationBuildOptions {
   bool split_at_joints = true;  // false: no split of the vertex weights at hinge joints
   bool blend_at_joints = true;  // false: the split is a hard switch at the plane (no ramp)
   bool blend_folds = true;      // false: no blend across folds (both false: the paper's rule alone)
+  bool smooth_folds = true;     // false: the fold blend's weights as they are (fold_weight_smoothing.h)
+  FoldSmoothingOptions fold_smoothing;
   PartJointOptions joints;
 };
 
@@ -47,6 +50,7 @@ struct DeformationBuildReport {
   int boundary_markers = 0;
   int markers_added_for_min_members = 0;
   double mean_influences_per_vertex = 0.0;
+  int fold_smoothed_vertices = 0;  // vertices whose weights the fold smoothing re-solved
   std::vector<PartJoint> joints;  // the jointed part pairs the vertex weights split at
   double joint_blend_mm = 0.0;    // half-width of the ramp across their planes (0: a hard switch)
   std::vector<QuadraticRidgeChoice> part_quadratic_ridges;  // eq. 6's per part, by leave-one-out error

@@ -55,6 +55,13 @@ double joint_ramp(double past, double half_width) {
   return std::clamp(0.5 + past / (2.0 * half_width), 0.0, 1.0);
 }
 
+bool same_influences(const std::vector<PartInfluence>& a, const std::vector<PartInfluence>& b) {
+  if (a.size() != b.size()) return false;
+  for (size_t k = 0; k < a.size(); ++k)
+    if (a[k].part != b[k].part || std::abs(a[k].weight - b[k].weight) > 1e-9) return false;
+  return true;
+}
+
 }  // namespace
 
 VertexPartWeights vertex_part_weights(std::span<const Vec3> vertices, std::span<const Vec3> markers,
@@ -123,27 +130,10 @@ VertexPartWeights vertex_part_weights(std::span<const Vec3> vertices, std::span<
     }
   }
 
-  VertexPartWeights out;
-  out.vertex_influence_offsets.reserve(vertices.size() + 1);
-  std::vector<PartInfluence> blend, row;
-  for (size_t j = 0; j < vertices.size(); ++j) {
-    const bool keep_markers = !under_marker.empty() && under_marker[j];
-    int t = -1;
-    Vec3 near_point;
-    const double near = bvh.closest(vertices[j], &t, &near_point);
-    // (triangle, share): the nearest alone, or with the other side of a fold.
-    std::array<std::pair<int, double>, 2> sides{{{t, 1.0}, {-1, 0.0}}};
-    if (blend_folds && !keep_markers && near > 0.0) {
-      const Vec3 towards_near = (near_point - vertices[j]) / near;
-      for (size_t u = 0; u < tris.size(); ++u) {
-        if (main_part[u] == main_part[t] || (centre[u] - vertices[j]).norm() - radius[u] >= kFoldRatio * near) continue;
-        const Vec3 q = synth::closest_point_on_triangle(vertices[j], points[tris[u][0]], points[tris[u][1]], points[tris[u][2]]);
-        const double far = (q - vertices[j]).norm();
-        const double share = fold_share(near, far, towards_near.dot((q - vertices[j]) / far));
-        if (share > sides[1].second) sides[1] = {static_cast<int>(u), share};
-      }
-      sides[0].second = 1.0 - sides[1].second;
-    }
+  // A vertex's weights from (triangle, share) sides, sorted by part and normalised.
+  std::vector<PartInfluence> row;
+  auto weigh = [&](size_t j, bool keep_markers, int t, const std::array<std::pair<int, double>, 2>& sides,
+                   std::vector<PartInfluence>& blend) {
     blend.clear();
     for (const auto& [side, share] : sides) {
       if (side < 0 || !(share > 0.0)) continue;
@@ -183,6 +173,36 @@ VertexPartWeights vertex_part_weights(std::span<const Vec3> vertices, std::span<
     require(!blend.empty(), "the markers of triangle " + std::to_string(t) + " belong to no part");
     std::sort(blend.begin(), blend.end(), [](const PartInfluence& a, const PartInfluence& b) { return a.part < b.part; });
     normalize_influences(blend);
+  };
+
+  VertexPartWeights out;
+  out.vertex_influence_offsets.reserve(vertices.size() + 1);
+  out.in_fold.assign(vertices.size(), 0);
+  std::vector<PartInfluence> blend, nearest_only;
+  for (size_t j = 0; j < vertices.size(); ++j) {
+    const bool keep_markers = !under_marker.empty() && under_marker[j];
+    int t = -1;
+    Vec3 near_point;
+    const double near = bvh.closest(vertices[j], &t, &near_point);
+    // (triangle, share): the nearest alone, or with the other side of a fold.
+    std::array<std::pair<int, double>, 2> sides{{{t, 1.0}, {-1, 0.0}}};
+    if (blend_folds && !keep_markers && near > 0.0) {
+      const Vec3 towards_near = (near_point - vertices[j]) / near;
+      for (size_t u = 0; u < tris.size(); ++u) {
+        if (main_part[u] == main_part[t] || (centre[u] - vertices[j]).norm() - radius[u] >= kFoldRatio * near) continue;
+        const Vec3 q = synth::closest_point_on_triangle(vertices[j], points[tris[u][0]], points[tris[u][1]], points[tris[u][2]]);
+        const double far = (q - vertices[j]).norm();
+        const double share = fold_share(near, far, towards_near.dot((q - vertices[j]) / far));
+        if (share > sides[1].second) sides[1] = {static_cast<int>(u), share};
+      }
+      sides[0].second = 1.0 - sides[1].second;
+    }
+    weigh(j, keep_markers, t, sides, blend);
+    // Where the joints' split leaves both sides with the same weights, the blend changed nothing.
+    if (sides[1].second > 0.0) {
+      weigh(j, keep_markers, t, {{{t, 1.0}, {-1, 0.0}}}, nearest_only);
+      out.in_fold[j] = !same_influences(blend, nearest_only);
+    }
     out.vertex_influences.insert(out.vertex_influences.end(), blend.begin(), blend.end());
     out.vertex_influence_offsets.push_back(static_cast<int>(out.vertex_influences.size()));
   }

@@ -40,6 +40,9 @@ namespace skinstream {
 struct VertexPartWeights {
   std::vector<int> vertex_influence_offsets{0};  // CSR over vertices, as in DeformationModel
   std::vector<PartInfluence> vertex_influences;  // beta_{j,p} > 0, sorted by part, sum 1 per vertex
+  // #V: 1 where the fold blend changed the vertex's weights (a second triangle's share, which the
+  // joints' split did not make the same as the nearest triangle's)
+  std::vector<char> in_fold;
 };
 
 // vertices: #V detailed-mesh vertex positions in the reference pose (mm); markers: #M marker

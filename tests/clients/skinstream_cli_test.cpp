@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <utility>
 #include <nlohmann/json.hpp>
 
 #include "core/baselines/linear_interpolation_fill.h"
@@ -23,6 +24,19 @@ ProgramRun run(const std::string& arguments) { return test::run_program(std::str
 std::string quick_eval_deform() {
   return "eval-deform --motions breathe --seconds 0.5 --train-seconds 5 --json --body " +
          std::string(SKINSTREAM_SHARED_DIR) + "/data/meshes/makehuman";
+}
+
+// That run with its defaults and with `variant` added, each parsed; null for a run that failed
+// (reported as a test failure, with its output).
+std::pair<nlohmann::json, nlohmann::json> quick_eval_default_and(const std::string& variant) {
+  std::pair<nlohmann::json, nlohmann::json> parsed;
+  for (auto [arguments, to] : {std::pair{quick_eval_deform(), &parsed.first},
+                               std::pair{quick_eval_deform() + " " + variant, &parsed.second}}) {
+    const ProgramRun r = run(arguments);
+    if (r.exit_code == 0) *to = nlohmann::json::parse(r.output);
+    else ADD_FAILURE() << arguments << ":\n" << r.output;
+  }
+  return parsed;
 }
 
 const std::string kCmu02 = test::source_path("replay_data/cmu/85_02.c3d");
@@ -213,11 +227,8 @@ TEST(SkinstreamCli, EvalDeformFullMethodLeadsOnAHeldOutSubject) {
 // wide either side (the 350-marker layout: about 46 mm), and --no-joint-blend turns it into the
 // hard switch: fewer vertices then blend two parts.
 TEST(SkinstreamCli, EvalDeformJointRampAndItsSwitch) {
-  const std::string base = quick_eval_deform();
-  const ProgramRun ramp = run(base), hard = run(base + " --no-joint-blend");
-  ASSERT_EQ(ramp.exit_code, 0) << ramp.output;
-  ASSERT_EQ(hard.exit_code, 0) << hard.output;
-  const auto r = nlohmann::json::parse(ramp.output), h = nlohmann::json::parse(hard.output);
+  const auto [r, h] = quick_eval_default_and("--no-joint-blend");
+  ASSERT_FALSE(r.is_null() || h.is_null());
   ASSERT_FALSE(r["joints"].empty());
   EXPECT_EQ(r["joints"], h["joints"]);
   EXPECT_GT(r["joint_blend_mm"].get<double>(), 15.0);
@@ -230,11 +241,8 @@ TEST(SkinstreamCli, EvalDeformJointRampAndItsSwitch) {
 // default; --boundary-rings 0 gives the paper's (fewer markers weighed by likelihood, the same
 // parts), and a negative count is refused before any work.
 TEST(SkinstreamCli, EvalDeformBoundaryRings) {
-  const std::string base = quick_eval_deform();
-  const ProgramRun wide = run(base), paper = run(base + " --boundary-rings 0");
-  ASSERT_EQ(wide.exit_code, 0) << wide.output;
-  ASSERT_EQ(paper.exit_code, 0) << paper.output;
-  const auto w = nlohmann::json::parse(wide.output), p = nlohmann::json::parse(paper.output);
+  const auto [w, p] = quick_eval_default_and("--boundary-rings 0");
+  ASSERT_FALSE(w.is_null() || p.is_null());
   EXPECT_EQ(w["boundary_rings"], 1);
   EXPECT_EQ(p["boundary_rings"], 0);
   EXPECT_EQ(w["parts"], p["parts"]);
@@ -242,9 +250,23 @@ TEST(SkinstreamCli, EvalDeformBoundaryRings) {
     EXPECT_EQ(w["part_sizes"][k]["triangles"], p["part_sizes"][k]["triangles"]);
   EXPECT_GT(w["boundary_markers"].get<int>(), p["boundary_markers"].get<int>());
   EXPECT_GT(w["mean_parts_per_vertex"].get<double>(), p["mean_parts_per_vertex"].get<double>());
-  const ProgramRun negative = run(base + " --boundary-rings -1");
+  const ProgramRun negative = run(quick_eval_deform() + " --boundary-rings -1");
   EXPECT_NE(negative.exit_code, 0);
   EXPECT_NE(negative.output.find("--boundary-rings"), std::string::npos) << negative.output;
+}
+
+// Inside folds the vertex weights are smoothed over the mesh by default (a few hundred of the
+// 13,380 vertices, at the armpits and the groin); --no-fold-smoothing keeps the fold blend's
+// weights as they are, with the same parts and joints.
+TEST(SkinstreamCli, EvalDeformFoldSmoothing) {
+  const auto [smoothed, blend_only] = quick_eval_default_and("--no-fold-smoothing");
+  ASSERT_FALSE(smoothed.is_null() || blend_only.is_null());
+  EXPECT_GT(smoothed["fold_smoothed_vertices"].get<int>(), 100);
+  EXPECT_LT(smoothed["fold_smoothed_vertices"].get<int>(), 2000);
+  EXPECT_EQ(blend_only["fold_smoothed_vertices"], 0);
+  EXPECT_EQ(smoothed["parts"], blend_only["parts"]);
+  EXPECT_EQ(smoothed["joints"], blend_only["joints"]);
+  EXPECT_NE(smoothed["mean_parts_per_vertex"], blend_only["mean_parts_per_vertex"]);
 }
 
 // eval-deform measures a user's segmentation too: the parts it used written per marker

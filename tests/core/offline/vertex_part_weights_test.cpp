@@ -247,6 +247,9 @@ TEST(VertexPartWeights, SkinInAFoldSharesBothSidesByDistance) {
   // Continuous where the nearest sheet changes.
   EXPECT_NEAR(beta(w, 4, 1), beta(w, 5, 0), 1e-12);
   EXPECT_NEAR(beta(w, 4, 1), 0.5, 0.01);
+  // The vertices the blend changed are flagged (what fold_weight_smoothing re-solves).
+  const std::vector<char> in_fold{1, 1, 0, 0, 1, 1};
+  EXPECT_EQ(w.in_fold, in_fold);
 
   // Without the blend, or under a marker: the nearest sheet alone.
   const VertexPartWeights plain = fold.weights(vertices, false);
@@ -258,6 +261,23 @@ TEST(VertexPartWeights, SkinInAFoldSharesBothSidesByDistance) {
   const VertexPartWeights kept = fold.weights(vertices, true, under);
   EXPECT_EQ(beta(kept, 1, 0), 1.0);
   EXPECT_NEAR(beta(kept, 0, 1), 0.5, 1e-12);
+  EXPECT_EQ(kept.in_fold[1], 0);
+  EXPECT_EQ(plain.in_fold, std::vector<char>(vertices.size(), 0));
+}
+
+// A hinge joint whose plane lies below both sheets (a hard switch): every marker gives the skin
+// above its own height to the second part, so both sides of the fold weigh a vertex between the
+// sheets alike, and the blend, though it takes a share of the far sheet, changes nothing.
+TEST(VertexPartWeights, AFoldTheJointSplitAlreadyDecidedIsNotFlagged) {
+  const Fold fold;
+  const PartJoint joint{0, 1, Vec3(40, 40, -100), Vec3::UnitZ()};
+  const std::vector<Vec3> vertices = {{40, 40, 20}, {40, 40, 30}};
+  const VertexPartWeights w = vertex_part_weights(vertices, fold.markers, fold.triangles, fold.offsets, fold.members,
+                                                  {&joint, 1}, {}, true, 0.0);
+  for (int v = 0; v < 2; ++v) {
+    EXPECT_EQ(beta(w, v, 1), 1.0) << v;
+    EXPECT_EQ(w.in_fold[v], 0) << v;
+  }
 }
 
 TEST(VerticesUnderMarkers, FlagsTheCornersOfTheFaceEachMarkerSitsOn) {

@@ -1,0 +1,124 @@
+#include "core/offline/fold_weight_smoothing.h"
+
+#include <Eigen/Sparse>
+#include <Eigen/SparseCholesky>
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace skinstream {
+namespace {
+
+void require(bool ok, const std::string& what) {
+  if (!ok) throw std::invalid_argument("fold weight smoothing: " + what);
+}
+
+// A vertex's hold on its own weights when nothing else holds it (a piece of mesh in the fold with
+// no vertex around it keeping its weights): small enough not to matter anywhere else.
+constexpr double kSelfHold = 1e-6;
+
+}  // namespace
+
+int smooth_fold_weights(std::span<const std::array<int, 3>> faces, std::span<const char> under_marker, int part_count,
+                        VertexPartWeights& weights, const FoldSmoothingOptions& options) {
+  require(options.rings >= 0, "rings must be >= 0");
+  require(options.ring_pull >= 0.0 && std::isfinite(options.ring_pull), "ring_pull must be >= 0");
+  require(options.min_weight >= 0.0 && options.min_weight < 1.0, "min_weight must be in [0, 1)");
+  const std::vector<int>& offsets = weights.vertex_influence_offsets;
+  require(!offsets.empty() && offsets.front() == 0 && offsets.back() == static_cast<int>(weights.vertex_influences.size()),
+          "the influence offsets do not span the influences");
+  const int v_count = static_cast<int>(offsets.size()) - 1;
+  require(weights.in_fold.size() == static_cast<size_t>(v_count),
+          std::to_string(weights.in_fold.size()) + " fold flags for " + std::to_string(v_count) + " vertices");
+  require(under_marker.empty() || under_marker.size() == static_cast<size_t>(v_count),
+          std::to_string(under_marker.size()) + " under-marker flags for " + std::to_string(v_count) + " vertices");
+  for (size_t f = 0; f < faces.size(); ++f)
+    for (int c : faces[f])
+      require(c >= 0 && c < v_count, "face " + std::to_string(f) + " refers to vertex " + std::to_string(c) + " of " + std::to_string(v_count));
+  for (const PartInfluence& b : weights.vertex_influences)
+    require(b.part >= 0 && b.part < part_count, "an influence names part " + std::to_string(b.part) + " of " + std::to_string(part_count));
+
+  auto keeps = [&](int v) { return !under_marker.empty() && under_marker[v]; };
+  // The fold's vertices, then the rings around them.
+  std::vector<char> in_fold(v_count, 0), smoothed(v_count, 0);
+  for (int v = 0; v < v_count; ++v) in_fold[v] = smoothed[v] = weights.in_fold[v] && !keeps(v);
+  for (int r = 0; r < options.rings; ++r) {
+    std::vector<char> grown = smoothed;
+    for (const auto& f : faces)
+      if (smoothed[f[0]] || smoothed[f[1]] || smoothed[f[2]])
+        for (int c : f) grown[c] |= !keeps(c);
+    smoothed.swap(grown);
+  }
+  std::vector<int> row_of(v_count, -1);
+  int n = 0;
+  for (int v = 0; v < v_count; ++v)
+    if (smoothed[v]) row_of[v] = n++;
+  if (n == 0) return 0;
+
+  std::vector<std::vector<int>> neighbours(v_count);
+  for (const auto& f : faces)
+    for (int c = 0; c < 3; ++c) {
+      const int a = f[c], b = f[(c + 1) % 3];
+      if (!smoothed[a] && !smoothed[b]) continue;
+      neighbours[a].push_back(b);
+      neighbours[b].push_back(a);
+    }
+
+  // The graph Laplacian (every mesh edge counts alike) over the smoothed vertices; the others
+  // are fixed and move to the right-hand side, one column per part.
+  std::vector<Eigen::Triplet<double>> entries;
+  Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(n, part_count);
+  auto add_weights = [&](int v, double scale, int to_row) {
+    for (int k = offsets[v]; k < offsets[v + 1]; ++k)
+      rhs(to_row, weights.vertex_influences[k].part) += scale * weights.vertex_influences[k].weight;
+  };
+  for (int v = 0; v < v_count; ++v) {
+    if (!smoothed[v]) continue;
+    std::vector<int>& around = neighbours[v];
+    std::sort(around.begin(), around.end());
+    around.erase(std::unique(around.begin(), around.end()), around.end());
+    const int i = row_of[v];
+    for (int u : around) {
+      if (smoothed[u]) entries.emplace_back(i, row_of[u], -1.0);
+      else add_weights(u, 1.0, i);
+    }
+    const double hold = kSelfHold + (in_fold[v] ? 0.0 : options.ring_pull);
+    entries.emplace_back(i, i, static_cast<double>(around.size()) + hold);
+    add_weights(v, hold, i);
+  }
+  Eigen::SparseMatrix<double> laplacian(n, n);
+  laplacian.setFromTriplets(entries.begin(), entries.end());
+  const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(laplacian);
+  require(solver.info() == Eigen::Success, "the fold's system could not be factored");
+  const Eigen::MatrixXd solved = solver.solve(rhs);
+
+  VertexPartWeights out;
+  out.in_fold = std::move(weights.in_fold);
+  out.vertex_influences.reserve(weights.vertex_influences.size());
+  std::vector<PartInfluence> row;
+  for (int v = 0; v < v_count; ++v) {
+    if (!smoothed[v]) {
+      out.vertex_influences.insert(out.vertex_influences.end(), weights.vertex_influences.begin() + offsets[v],
+                                   weights.vertex_influences.begin() + offsets[v + 1]);
+    } else {
+      const auto w = solved.row(row_of[v]);
+      row.clear();
+      for (int p = 0; p < part_count; ++p)
+        if (w[p] > options.min_weight) row.push_back({p, w[p]});
+      if (row.empty()) {  // a vertex among many parts, each at most min_weight: its largest
+        int largest = 0;
+        w.maxCoeff(&largest);
+        row.push_back({largest, 1.0});
+      }
+      normalize_influences(row);
+      out.vertex_influences.insert(out.vertex_influences.end(), row.begin(), row.end());
+    }
+    out.vertex_influence_offsets.push_back(static_cast<int>(out.vertex_influences.size()));
+  }
+  weights = std::move(out);
+  return n;
+}
+
+}  // namespace skinstream
