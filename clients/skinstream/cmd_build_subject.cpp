@@ -128,6 +128,7 @@ void add_build_subject(CLI::App& app) {
                      {"boundary_markers", d.boundary_markers},
                      {"mean_parts_per_vertex", d.mean_influences_per_vertex},
                      {"fold_smoothed_vertices", d.fold_smoothed_vertices},
+                     {"fold_band_mm", d.fold_band_mm},
                      {"joints", joints_json(d.joints)},
                      {"joint_blend_mm", d.joint_blend_mm},
                      {"part_quadratic_ridges", to_json(d.part_quadratic_ridges)},

@@ -116,6 +116,7 @@ void add_eval_deform(CLI::App& app) {
     result["boundary_markers"] = setup.build.boundary_markers;
     result["mean_parts_per_vertex"] = setup.build.mean_influences_per_vertex;
     result["fold_smoothed_vertices"] = setup.build.fold_smoothed_vertices;
+    result["fold_band_mm"] = setup.build.fold_band_mm;
     result["joints"] = joints_json(setup.build.joints);
     result["joint_blend_mm"] = setup.build.joint_blend_mm;
     result["part_quadratic_ridges"] = to_json(setup.build.part_quadratic_ridges);

@@ -71,9 +71,13 @@ DeformationModel build_deformation_model(const SubjectModel& subject, std::span<
   VertexPartWeights beta = vertex_part_weights(model.reference_vertices, markers, subject.triangles,
                                                model.part_member_offsets, model.part_members, report.joints, under_marker,
                                                options.blend_folds, report.joint_blend_mm);
-  if (options.blend_folds && options.smooth_folds)
+  if (options.blend_folds && options.smooth_folds) {
+    FoldSmoothingOptions smoothing = options.fold_smoothing;
+    if (smoothing.band_mm < 0.0) smoothing.band_mm = 0.5 * median_nearest_marker_distance(markers);
+    report.fold_band_mm = smoothing.band_mm;
     report.fold_smoothed_vertices =
-        smooth_fold_weights(mesh_faces, under_marker, model.part_count(), beta, options.fold_smoothing);
+        smooth_fold_weights(model.reference_vertices, mesh_faces, under_marker, model.part_count(), beta, smoothing);
+  }
   model.vertex_influence_offsets = std::move(beta.vertex_influence_offsets);
   model.vertex_influences = std::move(beta.vertex_influences);
   report.mean_influences_per_vertex =

@@ -32,7 +32,7 @@ struct DeformationBuildOptions {
   bool blend_at_joints = true;  // false: the split is a hard switch at the plane (no ramp)
   bool blend_folds = true;      // false: no blend across folds (both false: the paper's rule alone)
   bool smooth_folds = true;     // false: the fold blend's weights as they are (fold_weight_smoothing.h)
-  FoldSmoothingOptions fold_smoothing;
+  FoldSmoothingOptions fold_smoothing{-1.0};  // band_mm < 0: half the median nearest-marker distance
   PartJointOptions joints;
 };
 
@@ -51,6 +51,7 @@ struct DeformationBuildReport {
   int markers_added_for_min_members = 0;
   double mean_influences_per_vertex = 0.0;
   int fold_smoothed_vertices = 0;  // vertices whose weights the fold smoothing re-solved
+  double fold_band_mm = 0.0;       // the band around the folds smoothed with them
   std::vector<PartJoint> joints;  // the jointed part pairs the vertex weights split at
   double joint_blend_mm = 0.0;    // half-width of the ramp across their planes (0: a hard switch)
   std::vector<QuadraticRidgeChoice> part_quadratic_ridges;  // eq. 6's per part, by leave-one-out error

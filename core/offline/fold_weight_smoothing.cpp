@@ -4,6 +4,10 @@
 #include <Eigen/SparseCholesky>
 #include <algorithm>
 #include <cmath>
+#include <functional>
+#include <limits>
+#include <queue>
+#include <utility>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -21,15 +25,18 @@ constexpr double kSelfHold = 1e-6;
 
 }  // namespace
 
-int smooth_fold_weights(std::span<const std::array<int, 3>> faces, std::span<const char> under_marker, int part_count,
+int smooth_fold_weights(std::span<const Vec3> vertices, std::span<const std::array<int, 3>> faces, std::span<const char> under_marker, int part_count,
                         VertexPartWeights& weights, const FoldSmoothingOptions& options) {
-  require(options.rings >= 0, "rings must be >= 0");
-  require(options.ring_pull >= 0.0 && std::isfinite(options.ring_pull), "ring_pull must be >= 0");
+  require(options.band_mm >= 0.0 && std::isfinite(options.band_mm), "band_mm must be >= 0");
+  require(options.band_pull >= 0.0 && std::isfinite(options.band_pull), "band_pull must be >= 0");
   require(options.min_weight >= 0.0 && options.min_weight < 1.0, "min_weight must be in [0, 1)");
   const std::vector<int>& offsets = weights.vertex_influence_offsets;
   require(!offsets.empty() && offsets.front() == 0 && offsets.back() == static_cast<int>(weights.vertex_influences.size()),
           "the influence offsets do not span the influences");
   const int v_count = static_cast<int>(offsets.size()) - 1;
+  require(vertices.size() == static_cast<size_t>(v_count),
+          std::to_string(vertices.size()) + " vertices for the weights of " + std::to_string(v_count));
+  for (int v = 0; v < v_count; ++v) require(vertices[v].allFinite(), "vertex " + std::to_string(v) + " is not finite");
   require(weights.in_fold.size() == static_cast<size_t>(v_count),
           std::to_string(weights.in_fold.size()) + " fold flags for " + std::to_string(v_count) + " vertices");
   require(under_marker.empty() || under_marker.size() == static_cast<size_t>(v_count),
@@ -41,15 +48,36 @@ int smooth_fold_weights(std::span<const std::array<int, 3>> faces, std::span<con
     require(b.part >= 0 && b.part < part_count, "an influence names part " + std::to_string(b.part) + " of " + std::to_string(part_count));
 
   auto keeps = [&](int v) { return !under_marker.empty() && under_marker[v]; };
-  // The fold's vertices, then the rings around them.
+  // The fold's vertices, then the band around them: every vertex within band_mm of one along the
+  // mesh's edges (Dijkstra from all of the fold's vertices; a vertex under a marker neither joins
+  // nor passes the band on).
+  std::vector<std::vector<std::pair<int, double>>> edges(v_count);
+  for (const auto& f : faces)
+    for (int c = 0; c < 3; ++c) {
+      const int a = f[c], b = f[(c + 1) % 3];
+      const double length = (vertices[a] - vertices[b]).norm();
+      edges[a].emplace_back(b, length);
+      edges[b].emplace_back(a, length);
+    }
   std::vector<char> in_fold(v_count, 0), smoothed(v_count, 0);
-  for (int v = 0; v < v_count; ++v) in_fold[v] = smoothed[v] = weights.in_fold[v] && !keeps(v);
-  for (int r = 0; r < options.rings; ++r) {
-    std::vector<char> grown = smoothed;
-    for (const auto& f : faces)
-      if (smoothed[f[0]] || smoothed[f[1]] || smoothed[f[2]])
-        for (int c : f) grown[c] |= !keeps(c);
-    smoothed.swap(grown);
+  std::vector<double> distance(v_count, std::numeric_limits<double>::infinity());
+  std::priority_queue<std::pair<double, int>, std::vector<std::pair<double, int>>, std::greater<>> queue;
+  for (int v = 0; v < v_count; ++v)
+    if (weights.in_fold[v] && !keeps(v)) {
+      in_fold[v] = 1;
+      distance[v] = 0.0;
+      queue.emplace(0.0, v);
+    }
+  while (!queue.empty()) {
+    const auto [d, v] = queue.top();
+    queue.pop();
+    if (d > distance[v]) continue;
+    smoothed[v] = 1;
+    for (const auto& [u, length] : edges[v])
+      if (!keeps(u) && d + length <= options.band_mm && d + length < distance[u]) {
+        distance[u] = d + length;
+        queue.emplace(distance[u], u);
+      }
   }
   std::vector<int> row_of(v_count, -1);
   int n = 0;
@@ -84,7 +112,7 @@ int smooth_fold_weights(std::span<const std::array<int, 3>> faces, std::span<con
       if (smoothed[u]) entries.emplace_back(i, row_of[u], -1.0);
       else add_weights(u, 1.0, i);
     }
-    const double hold = kSelfHold + (in_fold[v] ? 0.0 : options.ring_pull);
+    const double hold = kSelfHold + (in_fold[v] ? 0.0 : options.band_pull);
     entries.emplace_back(i, i, static_cast<double>(around.size()) + hold);
     add_weights(v, hold, i);
   }

@@ -4,13 +4,14 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <vector>
 
 namespace skinstream {
 namespace {
 
-// A strip of skin across a fold: kColumns columns of two vertices, quads split along one
-// diagonal. The first column follows part 0 (one side of the fold), the last part 1 (the other
+// A strip of skin across a fold: kColumns columns of two vertices 10 mm apart, quads split
+// along one diagonal. The first column follows part 0 (one side of the fold), the last part 1 (the other
 // side); the vertices between carry part 2, a small leftover part bridging the fold, and the
 // ones in kFold are the fold's (in_fold).
 constexpr int kColumns = 9;
@@ -18,15 +19,17 @@ constexpr int kParts = 3;
 int vertex(int column, int row) { return 2 * column + row; }
 
 struct Strip {
+  std::vector<Vec3> vertices;
   std::vector<std::array<int, 3>> faces;
   VertexPartWeights weights;
-  Strip(int fold_first, int fold_last) {
+  Strip(int fold_first, int fold_last, double spacing = 10.0) {
     for (int c = 0; c + 1 < kColumns; ++c) {
       faces.push_back({vertex(c, 0), vertex(c + 1, 0), vertex(c + 1, 1)});
       faces.push_back({vertex(c, 0), vertex(c + 1, 1), vertex(c, 1)});
     }
     for (int c = 0; c < kColumns; ++c)
       for (int r = 0; r < 2; ++r) {
+        vertices.emplace_back(spacing * c, spacing * r, 0.0);
         const int part = c == 0 ? 0 : (c == kColumns - 1 ? 1 : 2);
         weights.vertex_influences.push_back({part, 1.0});
         weights.vertex_influence_offsets.push_back(static_cast<int>(weights.vertex_influences.size()));
@@ -58,10 +61,9 @@ std::vector<std::vector<int>> mesh_neighbours(const std::vector<std::array<int, 
 
 TEST(FoldWeightSmoothing, InsideTheFoldEachVertexIsTheMeanOfItsMeshNeighbours) {
   Strip strip(1, kColumns - 2);  // every column between the two sides
-  FoldSmoothingOptions options;
-  options.rings = 0;
+  FoldSmoothingOptions options;  // band_mm 0: the fold's vertices alone
   options.min_weight = 0.0;
-  EXPECT_EQ(smooth_fold_weights(strip.faces, {}, kParts, strip.weights, options), 2 * (kColumns - 2));
+  EXPECT_EQ(smooth_fold_weights(strip.vertices, strip.faces, {}, kParts, strip.weights, options), 2 * (kColumns - 2));
   const auto w = dense(strip.weights);
   const auto neighbours = mesh_neighbours(strip.faces, strip.vertex_count());
   for (int c = 1; c + 1 < kColumns; ++c)
@@ -85,9 +87,8 @@ TEST(FoldWeightSmoothing, InsideTheFoldEachVertexIsTheMeanOfItsMeshNeighbours) {
 
 TEST(FoldWeightSmoothing, SmallSharesAreDroppedAndTheRestRenormalised) {
   Strip strip(1, kColumns - 2);
-  FoldSmoothingOptions options;
-  options.rings = 0;  // min_weight 0.02, the default
-  smooth_fold_weights(strip.faces, {}, kParts, strip.weights, options);
+  FoldSmoothingOptions options;  // min_weight 0.02, the default
+  smooth_fold_weights(strip.vertices, strip.faces, {}, kParts, strip.weights, options);
   for (int v = 0; v < strip.vertex_count(); ++v) {
     double sum = 0.0;
     for (int k = strip.weights.vertex_influence_offsets[v]; k < strip.weights.vertex_influence_offsets[v + 1]; ++k) {
@@ -99,14 +100,14 @@ TEST(FoldWeightSmoothing, SmallSharesAreDroppedAndTheRestRenormalised) {
   }
 }
 
-TEST(FoldWeightSmoothing, ARingAroundTheFoldAlsoHoldsItsOwnWeights) {
-  Strip strip(3, 5);  // the fold: columns 3-5; the ring: columns 2 and 6
+TEST(FoldWeightSmoothing, ABandAroundTheFoldAlsoHoldsItsOwnWeights) {
+  Strip strip(3, 5);  // the fold: columns 3-5; a band of 10 mm: columns 2 and 6
   const auto before = dense(strip.weights);
   FoldSmoothingOptions options;
-  options.rings = 1;
-  options.ring_pull = 1.0;
+  options.band_mm = 10.0;
+  options.band_pull = 1.0;
   options.min_weight = 0.0;
-  EXPECT_EQ(smooth_fold_weights(strip.faces, {}, kParts, strip.weights, options), 2 * 5);
+  EXPECT_EQ(smooth_fold_weights(strip.vertices, strip.faces, {}, kParts, strip.weights, options), 2 * 5);
   const auto w = dense(strip.weights);
   const auto neighbours = mesh_neighbours(strip.faces, strip.vertex_count());
   for (int c : {2, 6})
@@ -115,13 +116,28 @@ TEST(FoldWeightSmoothing, ARingAroundTheFoldAlsoHoldsItsOwnWeights) {
       for (int p = 0; p < kParts; ++p) {
         double sum = 0.0;
         for (int u : neighbours[v]) sum += w[u][p];
-        // (neighbours + pull) w = sum of the neighbours' + pull * its own weights
+        // (neighbours + pull) w = the sum of the neighbours' weights + pull * its own
         EXPECT_NEAR((neighbours[v].size() + 1.0) * w[v][p], sum + before[v][p], 1e-5) << "vertex " << v << " part " << p;
       }
     }
-  // Beyond the ring nothing moves; columns 1 and 7 still carry the leftover part alone.
+  // Beyond the band nothing moves; columns 1 and 7 still carry the leftover part alone.
   for (int c : {0, 1, 7, 8})
     for (int r = 0; r < 2; ++r) EXPECT_EQ(w[vertex(c, r)], before[vertex(c, r)]) << c;
+}
+
+// The band is a distance along the mesh, so a finer mesh smooths the same stretch of skin: 10 mm
+// is one column either side of the fold here, two on a strip twice as fine.
+TEST(FoldWeightSmoothing, TheBandIsADistanceNotAMeshRing) {
+  FoldSmoothingOptions options;
+  options.band_mm = 10.0;
+  Strip coarse(3, 5), fine(3, 5, 5.0);
+  EXPECT_EQ(smooth_fold_weights(coarse.vertices, coarse.faces, {}, kParts, coarse.weights, options), 2 * (3 + 2));
+  EXPECT_EQ(smooth_fold_weights(fine.vertices, fine.faces, {}, kParts, fine.weights, options), 2 * (3 + 4));
+  // A vertex under a marker neither joins the band nor carries it on.
+  Strip blocked(3, 5, 5.0);
+  std::vector<char> under(blocked.vertex_count(), 0);
+  under[vertex(2, 0)] = under[vertex(2, 1)] = 1;
+  EXPECT_EQ(smooth_fold_weights(blocked.vertices, blocked.faces, under, kParts, blocked.weights, options), 2 * (3 + 2));
 }
 
 TEST(FoldWeightSmoothing, VerticesUnderAMarkerAndOutsideFoldsKeepTheirWeights) {
@@ -129,14 +145,13 @@ TEST(FoldWeightSmoothing, VerticesUnderAMarkerAndOutsideFoldsKeepTheirWeights) {
   std::vector<char> under(strip.vertex_count(), 0);
   under[vertex(4, 0)] = 1;
   const auto before = dense(strip.weights);
-  FoldSmoothingOptions options;
-  options.rings = 0;
-  EXPECT_EQ(smooth_fold_weights(strip.faces, under, kParts, strip.weights, options), 2 * (kColumns - 2) - 1);
+  const FoldSmoothingOptions options;  // the fold's vertices alone
+  EXPECT_EQ(smooth_fold_weights(strip.vertices, strip.faces, under, kParts, strip.weights, options), 2 * (kColumns - 2) - 1);
   EXPECT_EQ(dense(strip.weights)[vertex(4, 0)], before[vertex(4, 0)]);
 
   Strip no_fold(1, 0);  // no column is in the fold
   const VertexPartWeights unchanged = no_fold.weights;
-  EXPECT_EQ(smooth_fold_weights(no_fold.faces, {}, kParts, no_fold.weights), 0);
+  EXPECT_EQ(smooth_fold_weights(no_fold.vertices, no_fold.faces, {}, kParts, no_fold.weights), 0);
   EXPECT_EQ(dense(no_fold.weights), dense(unchanged));
   EXPECT_EQ(no_fold.weights.vertex_influence_offsets, unchanged.vertex_influence_offsets);
 }
@@ -149,7 +164,7 @@ TEST(FoldWeightSmoothing, RejectsBadInputs) {
     int parts = kParts;
     FoldSmoothingOptions options;
     change(copy, under, parts, options);
-    return smooth_fold_weights(copy.faces, under, parts, copy.weights, options);
+    return smooth_fold_weights(copy.vertices, copy.faces, under, parts, copy.weights, options);
   };
   EXPECT_THROW(run([](Strip& s, auto&, int&, auto&) { s.weights.in_fold.pop_back(); }), std::invalid_argument);
   EXPECT_THROW(run([](Strip&, std::vector<char>& under, int&, auto&) { under.assign(3, 0); }), std::invalid_argument);
@@ -157,8 +172,10 @@ TEST(FoldWeightSmoothing, RejectsBadInputs) {
   EXPECT_THROW(run([](Strip& s, auto&, int&, auto&) { s.weights.vertex_influence_offsets.back() += 1; }),
                std::invalid_argument);
   EXPECT_THROW(run([](Strip&, auto&, int& parts, auto&) { parts = 2; }), std::invalid_argument);  // part 2 named
-  EXPECT_THROW(run([](Strip&, auto&, int&, FoldSmoothingOptions& o) { o.rings = -1; }), std::invalid_argument);
-  EXPECT_THROW(run([](Strip&, auto&, int&, FoldSmoothingOptions& o) { o.ring_pull = -1.0; }), std::invalid_argument);
+  EXPECT_THROW(run([](Strip& s, auto&, int&, auto&) { s.vertices.pop_back(); }), std::invalid_argument);
+  EXPECT_THROW(run([](Strip& s, auto&, int&, auto&) { s.vertices[3].x() = std::nan(""); }), std::invalid_argument);
+  EXPECT_THROW(run([](Strip&, auto&, int&, FoldSmoothingOptions& o) { o.band_mm = -1.0; }), std::invalid_argument);
+  EXPECT_THROW(run([](Strip&, auto&, int&, FoldSmoothingOptions& o) { o.band_pull = -1.0; }), std::invalid_argument);
   EXPECT_THROW(run([](Strip&, auto&, int&, FoldSmoothingOptions& o) { o.min_weight = 1.0; }), std::invalid_argument);
 }
 
