@@ -7,9 +7,9 @@
 #include <functional>
 #include <limits>
 #include <queue>
-#include <utility>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace skinstream {
@@ -25,8 +25,9 @@ constexpr double kSelfHold = 1e-6;
 
 }  // namespace
 
-int smooth_fold_weights(std::span<const Vec3> vertices, std::span<const std::array<int, 3>> faces, std::span<const char> under_marker, int part_count,
-                        VertexPartWeights& weights, const FoldSmoothingOptions& options) {
+int smooth_fold_weights(std::span<const Vec3> vertices, std::span<const std::array<int, 3>> faces,
+                        std::span<const char> under_marker, int part_count, VertexPartWeights& weights,
+                        const FoldSmoothingOptions& options) {
   require(options.band_mm >= 0.0 && std::isfinite(options.band_mm), "band_mm must be >= 0");
   require(options.band_pull >= 0.0 && std::isfinite(options.band_pull), "band_pull must be >= 0");
   require(options.min_weight >= 0.0 && options.min_weight < 1.0, "min_weight must be in [0, 1)");
@@ -85,15 +86,6 @@ int smooth_fold_weights(std::span<const Vec3> vertices, std::span<const std::arr
     if (smoothed[v]) row_of[v] = n++;
   if (n == 0) return 0;
 
-  std::vector<std::vector<int>> neighbours(v_count);
-  for (const auto& f : faces)
-    for (int c = 0; c < 3; ++c) {
-      const int a = f[c], b = f[(c + 1) % 3];
-      if (!smoothed[a] && !smoothed[b]) continue;
-      neighbours[a].push_back(b);
-      neighbours[b].push_back(a);
-    }
-
   // The graph Laplacian (every mesh edge counts alike) over the smoothed vertices; the others
   // are fixed and move to the right-hand side, one column per part.
   std::vector<Eigen::Triplet<double>> entries;
@@ -102,9 +94,11 @@ int smooth_fold_weights(std::span<const Vec3> vertices, std::span<const std::arr
     for (int k = offsets[v]; k < offsets[v + 1]; ++k)
       rhs(to_row, weights.vertex_influences[k].part) += scale * weights.vertex_influences[k].weight;
   };
+  std::vector<int> around;
   for (int v = 0; v < v_count; ++v) {
     if (!smoothed[v]) continue;
-    std::vector<int>& around = neighbours[v];
+    around.clear();
+    for (const auto& [u, length] : edges[v]) around.push_back(u);
     std::sort(around.begin(), around.end());
     around.erase(std::unique(around.begin(), around.end()), around.end());
     const int i = row_of[v];

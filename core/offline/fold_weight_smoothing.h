@@ -6,7 +6,7 @@
 // triangles nearest to it on either side, in straight-line distance. At the armpit those are the
 // triangles of mean shift's small leftover parts, which bridge the fold, while the skin there
 // moves mostly with the upper arm and the trunk, whose markers are a little farther away across
-// the mesh. So here the weights of the fold's vertices (and of one mesh ring around them) are
+// the mesh. So here the weights of the fold's vertices (and of a band around them) are
 // re-solved as a harmonic function over the detailed mesh: each is the mean of its mesh
 // neighbours' weights, held by the weights of the vertices around the fold, which keep theirs.
 // The weights then carry across the fold along the skin rather than through the air. A band
@@ -25,6 +25,8 @@
 #include <array>
 #include <span>
 
+#include "core/capture.h"
+
 #include "core/offline/vertex_part_weights.h"
 
 namespace skinstream {
@@ -35,12 +37,13 @@ struct FoldSmoothingOptions {
   double min_weight = 0.02;  // smoothed weights at or below this are dropped, the rest renormalised
 };
 
-// vertices, faces: the detailed mesh (mm); under_marker: empty, or #V flags of the
-// vertices that keep their weights (vertices_under_markers); weights: from vertex_part_weights
-// with the fold blend (its in_fold flags say where the folds are), changed in place. part_count:
-// the parts the weights index. Returns how many vertices were smoothed. Deterministic. Throws
+// vertices, faces: the detailed mesh (mm); under_marker: empty, or #V flags of the vertices that
+// keep their weights (vertices_under_markers); weights: from vertex_part_weights with the fold
+// blend (its in_fold flags say where the folds are), changed in place; part_count: the parts
+// the weights index. Returns how many vertices were smoothed. Deterministic. Throws
 // std::invalid_argument for sizes or indices that do not fit, or options out of range.
-int smooth_fold_weights(std::span<const Vec3> vertices, std::span<const std::array<int, 3>> faces, std::span<const char> under_marker, int part_count,
-                        VertexPartWeights& weights, const FoldSmoothingOptions& options = {});
+int smooth_fold_weights(std::span<const Vec3> vertices, std::span<const std::array<int, 3>> faces,
+                        std::span<const char> under_marker, int part_count, VertexPartWeights& weights,
+                        const FoldSmoothingOptions& options = {});
 
 }  // namespace skinstream
