@@ -257,15 +257,14 @@ TEST(SkinstreamCli, EvalDeformBoundaryRings) {
 
 // Inside folds, and in a band half a marker spacing around them, the vertex weights are smoothed
 // over the mesh by default (a few hundred of the 13,380 vertices, at the armpits and the groin);
-// --no-fold-smoothing keeps the fold blend's
-// weights as they are, with the same parts and joints.
+// --no-fold-smoothing keeps the fold blend's weights as they are, with the same parts and joints.
 TEST(SkinstreamCli, EvalDeformFoldSmoothing) {
   const auto [smoothed, blend_only] = quick_eval_default_and("--no-fold-smoothing");
   ASSERT_FALSE(smoothed.is_null() || blend_only.is_null());
   EXPECT_GT(smoothed["fold_smoothed_vertices"].get<int>(), 100);
   EXPECT_LT(smoothed["fold_smoothed_vertices"].get<int>(), 2000);
   EXPECT_EQ(blend_only["fold_smoothed_vertices"], 0);
-  // The band around the folds: half the median marker spacing (about 46 mm on this layout).
+  // The band around the folds: half the median marker spacing, as the joints' ramp (about 23 mm).
   EXPECT_EQ(smoothed["fold_band_mm"], smoothed["joint_blend_mm"]);
   EXPECT_EQ(smoothed["parts"], blend_only["parts"]);
   EXPECT_EQ(smoothed["joints"], blend_only["joints"]);
