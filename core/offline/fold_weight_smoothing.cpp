@@ -60,12 +60,11 @@ int smooth_fold_weights(std::span<const Vec3> vertices, std::span<const std::arr
       edges[a].emplace_back(b, length);
       edges[b].emplace_back(a, length);
     }
-  std::vector<char> in_fold(v_count, 0), smoothed(v_count, 0);
+  std::vector<char> smoothed(v_count, 0);
   std::vector<double> distance(v_count, std::numeric_limits<double>::infinity());
   std::priority_queue<std::pair<double, int>, std::vector<std::pair<double, int>>, std::greater<>> queue;
   for (int v = 0; v < v_count; ++v)
     if (weights.in_fold[v] && !keeps(v)) {
-      in_fold[v] = 1;
       distance[v] = 0.0;
       queue.emplace(0.0, v);
     }
@@ -106,7 +105,8 @@ int smooth_fold_weights(std::span<const Vec3> vertices, std::span<const std::arr
       if (smoothed[u]) entries.emplace_back(i, row_of[u], -1.0);
       else add_weights(u, 1.0, i);
     }
-    const double hold = kSelfHold + (in_fold[v] ? 0.0 : options.band_pull);
+    // A smoothed vertex is never under a marker, so its own flag says fold or band.
+    const double hold = kSelfHold + (weights.in_fold[v] ? 0.0 : options.band_pull);
     entries.emplace_back(i, i, static_cast<double>(around.size()) + hold);
     add_weights(v, hold, i);
   }
