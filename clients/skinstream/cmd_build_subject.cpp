@@ -8,6 +8,7 @@
 #include "clients/skinstream/commands.h"
 #include "clients/skinstream/json_output.h"
 #include "clients/skinstream/part_file.h"
+#include "clients/skinstream/weight_rule_flags.h"
 #include "core/capture_filler.h"
 #include "core/offline/deformation_builder.h"
 #include "core/offline/subject_builder.h"
@@ -24,8 +25,8 @@ void add_build_subject(CLI::App& app) {
   static std::string capture_path, out_path, surface_in, surface_out, mesh_path, landmarks_path, parts_path, parts_out;
   static SubjectBuildOptions options;
   static DeformationBuildOptions deformation;
-  static bool no_register = false, no_joint_split = false, no_joint_blend = false, no_fold_blend = false,
-              no_fold_smoothing = false;
+  static WeightRuleFlags weight_rules;
+  static bool no_register = false;
   cmd->add_option("--capture", capture_path, "training capture (.c3d/.trc), ideally a range-of-motion take")->required();
   cmd->add_option("--out", out_path, "subject file to write")->required();
   cmd->add_option("--reference-frame", options.reference_frame, "frame index of the reference pose (default: chosen)");
@@ -40,16 +41,7 @@ void add_build_subject(CLI::App& app) {
   cmd->add_option("--marker-offset", deformation.registration.marker_offset_mm, "markers sit this far above the skin (mm)")
       ->capture_default_str();
   cmd->add_option("--parts", deformation.segmentation.target_parts, "number of near-rigid parts")->capture_default_str();
-  cmd->add_flag("--no-joint-split", no_joint_split, "no split of the vertex weights at hinge joints");
-  cmd->add_flag("--no-joint-blend", no_joint_blend,
-                "split at hinge joints with a hard switch at the plane, not a ramp half a marker spacing either side");
-  cmd->add_flag("--no-fold-blend", no_fold_blend,
-                "no blend of the vertex weights across folds (with --no-joint-split: the paper's nearest triangle alone)");
-  cmd->add_flag("--no-fold-smoothing", no_fold_smoothing,
-                "keep the fold blend's vertex weights as they are, not smoothed over the mesh inside folds");
-  cmd->add_option("--boundary-rings", deformation.weights.boundary_rings,
-                  "widen the marker weights' part boundaries by this many rings of the marker surface (0: the paper's)")
-      ->capture_default_str()->check(CLI::NonNegativeNumber);
+  add_weight_rule_flags(*cmd, weight_rules);
   cmd->add_option("--part-file", parts_path, "JSON {\"marker\": part index}: your segmentation instead of mean shift");
   cmd->add_option("--part-file-out", parts_out,
                   "also write the segmentation used, in --part-file's form, to adjust by hand and read back");
@@ -75,10 +67,7 @@ void add_build_subject(CLI::App& app) {
       for (int f = 0; f < filled.frame_count; ++f)
         for (int i = 0; i < n; ++i) positions[static_cast<size_t>(f) * n + i] = filled.at(f, i);
       deformation.register_mesh = !no_register;
-      deformation.split_at_joints = !no_joint_split;
-      deformation.blend_at_joints = !no_joint_blend;
-      deformation.blend_folds = !no_fold_blend;
-      deformation.smooth_folds = !no_fold_smoothing;
+      apply_weight_rules(weight_rules, deformation);
       if (!landmarks_path.empty()) {
         const std::vector<int> vertex = read_marker_map(landmarks_path, model, "vertex index");
         for (int i = 0; i < n; ++i)

@@ -63,27 +63,13 @@ void add_eval_deform(CLI::App& app) {
   cmd->add_option("--body", body_dir, "folder with the MakeHuman files (default: the shared data folder)");
   cmd->add_flag("--deform-registered", options.deform_registered_mesh,
                 "deform the registered artist's model instead of the reference frame's truth skin");
-  static bool no_joint_split = false, no_joint_blend = false, no_fold_blend = false, no_fold_smoothing = false;
-  cmd->add_flag("--no-joint-split", no_joint_split, "no split of the vertex weights at hinge joints");
-  cmd->add_flag("--no-joint-blend", no_joint_blend,
-                "split at hinge joints with a hard switch at the plane, not a ramp half a marker spacing either side");
-  cmd->add_flag("--no-fold-blend", no_fold_blend,
-                "no blend of the vertex weights across folds (with --no-joint-split: the paper's nearest triangle alone)");
-  cmd->add_flag("--no-fold-smoothing", no_fold_smoothing,
-                "keep the fold blend's vertex weights as they are, not smoothed over the mesh inside folds");
-  cmd->add_option("--boundary-rings", options.boundary_rings,
-                  "widen the marker weights' part boundaries by this many rings of the marker surface (0: the paper's)")
-      ->capture_default_str()->check(CLI::NonNegativeNumber);
+  add_weight_rule_flags(*cmd, options.weight_rules);
   cmd->add_option("--part-file", options.part_file,
                   "JSON {\"marker\": part index}: your segmentation instead of mean shift (build-subject --part-file-out writes one)");
   static std::string parts_out;
   cmd->add_option("--part-file-out", parts_out, "also write the segmentation used, in --part-file's form");
   cmd->add_flag("--json", json, "JSON only");
   cmd->callback([] {
-    options.split_at_joints = !no_joint_split;
-    options.blend_at_joints = !no_joint_blend;
-    options.blend_folds = !no_fold_blend;
-    options.smooth_folds = !no_fold_smoothing;
     const synth::Body body = load_makehuman(body_dir.empty() ? default_body_dir() : body_dir);
     synth::SynthOptions rom;
     rom.motion = "rom";
@@ -112,7 +98,7 @@ void add_eval_deform(CLI::App& app) {
     result["max_part_rigid_rms_mm"] = setup.build.max_part_rigid_rms_mm;
     result["part_sizes"] = part_sizes_json(setup.build, setup.deformation);
     result["part_file_unused_parts"] = setup.build.unused_parts;
-    result["boundary_rings"] = options.boundary_rings;
+    result["boundary_rings"] = options.weight_rules.boundary_rings;
     result["boundary_markers"] = setup.build.boundary_markers;
     result["mean_parts_per_vertex"] = setup.build.mean_influences_per_vertex;
     result["fold_smoothed_vertices"] = setup.build.fold_smoothed_vertices;

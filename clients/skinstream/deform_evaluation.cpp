@@ -189,11 +189,7 @@ DeformationSetup prepare_deformation(const synth::Body& body, const SynthCapture
   for (size_t v = 0; v < registered.size(); ++v)
     setup.registration_vertex_error_mm += (registered[v] - truth_skin[v]).norm() / static_cast<double>(registered.size());
   build.register_mesh = false;
-  build.split_at_joints = options.split_at_joints;
-  build.blend_at_joints = options.blend_at_joints;
-  build.blend_folds = options.blend_folds;
-  build.smooth_folds = options.smooth_folds;
-  build.weights.boundary_rings = options.boundary_rings;
+  apply_weight_rules(options.weight_rules, build);
   if (!options.part_file.empty()) {
     build.part_assignment = read_part_file(options.part_file, setup.subject);
     build.assignment_kind = AssignmentKind::PerMarker;

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "clients/skinstream/weight_rule_flags.h"
 #include "core/baselines/segment_skinning.h"
 #include "core/deform/deformation_model.h"
 #include "core/offline/deformation_builder.h"
@@ -29,11 +30,7 @@ struct DeformEvaluationOptions {
   // (already registered: the table then measures sections 5.2-5.3 alone); registration is still
   // run and reported on its own. true: the deformation uses the registered artist's model.
   bool deform_registered_mesh = false;
-  bool split_at_joints = true;  // false: no split of the vertex weights at hinge joints
-  bool blend_at_joints = true;  // false: the split is a hard switch at the plane
-  bool blend_folds = true;      // false: no blend across folds (both false: the paper's rule alone)
-  bool smooth_folds = true;     // false: the fold blend's weights unsmoothed
-  int boundary_rings = 1;       // marker weights' boundary widened by rings (0: the paper's)
+  WeightRuleFlags weight_rules;  // the weight rules beyond the paper's, all on by default
   std::string part_file;        // a user's parts ({"marker name": part}) instead of mean shift
 };
 
