@@ -5,10 +5,8 @@
 #include <algorithm>
 #include <cstdint>
 #include <cstring>
-#include <fstream>
 #include <limits>
 #include <random>
-#include <sstream>
 
 #include "protocol/file_error.h"
 #include "protocol/makehuman.h"
@@ -19,21 +17,12 @@
 namespace skinstream {
 namespace {
 
+using test::read_bytes;
+using test::write_bytes;
+
 using Triangles = std::vector<std::array<int, 3>>;
 
 const char* kBody = "data/meshes/makehuman/makehuman_hm08_body_only.obj";
-
-void write_bytes(const std::string& path, const std::string& bytes) {
-  std::ofstream out(path, std::ios::binary);
-  out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-}
-
-std::string read_bytes(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 
 template <typename T>
 void put(std::string& out, T value, bool big_endian = false) {

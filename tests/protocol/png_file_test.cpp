@@ -5,9 +5,7 @@
 
 #include <cstdlib>
 #include <cstring>
-#include <fstream>
 #include <random>
-#include <sstream>
 
 #include "protocol/file_error.h"
 #include "protocol/makehuman.h"
@@ -18,19 +16,11 @@
 namespace skinstream {
 namespace {
 
+using test::read_bytes;
+using test::write_bytes;
+
 using render::Image;
 using render::Rgb;
-
-std::string read_bytes(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-void write_bytes(const std::string& path, const std::string& bytes) {
-  std::ofstream(path, std::ios::binary).write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-}
 
 Image random_image(int w, int h, unsigned seed) {
   std::mt19937 rng(seed);

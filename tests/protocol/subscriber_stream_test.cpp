@@ -221,14 +221,18 @@ TEST(SubscriberStream, EveryTruncationOfEveryMessageIsRejected) {
         }
       };
       EXPECT_THROW(decode(), DecodeError) << name << " cut at " << n;
-      if (header.type == MessageType::Frame) EXPECT_THROW(decode_frame_info(cut), DecodeError) << name << " cut at " << n;
+      if (header.type == MessageType::Frame) {
+        EXPECT_THROW(decode_frame_info(cut), DecodeError) << name << " cut at " << n;
+      }
     }
     // A byte too many is refused as well.
     std::vector<unsigned char> longer(message.begin() + kHeaderBytes, message.end());
     longer.push_back(0);
-    if (header.type == MessageType::Frame) EXPECT_THROW(decode_frame(longer), DecodeError) << name;
-    if (header.type == MessageType::Frame) EXPECT_THROW(decode_frame_info(longer), DecodeError) << name;
-    if (header.type == MessageType::Hello) EXPECT_THROW(decode_hello(longer), DecodeError) << name;
+    if (header.type == MessageType::Frame) {
+      EXPECT_THROW(decode_frame(longer), DecodeError) << name;
+      EXPECT_THROW(decode_frame_info(longer), DecodeError) << name;
+    }
+    if (header.type == MessageType::Hello) { EXPECT_THROW(decode_hello(longer), DecodeError) << name; }
   }
 }
 
@@ -262,7 +266,9 @@ TEST(SubscriberStream, StreamDecoderCutsMessagesAtAnyBoundary) {
       decoder.feed(std::span(stream).subspan(at, std::min(chunk, stream.size() - at)));
       while (auto message = decoder.next()) {
         types.push_back(message->type);
-        if (message->type == MessageType::Frame) EXPECT_EQ(decode_frame(message->payload).info.frame_number, 1234u);
+        if (message->type == MessageType::Frame) {
+          EXPECT_EQ(decode_frame(message->payload).info.frame_number, 1234u);
+        }
       }
     }
     EXPECT_EQ(types, (std::vector<MessageType>{MessageType::Status, MessageType::MeshInfo, MessageType::Frame, MessageType::Frame}))

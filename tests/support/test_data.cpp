@@ -1,6 +1,8 @@
 #include "support/test_data.h"
 
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <string>
 #include <unistd.h>
 
@@ -13,5 +15,14 @@ std::string scratch_path(const std::string& name) {
   static const std::string dir = std::string(SKINSTREAM_TEST_TMP_DIR) + "/" + std::to_string(getpid());
   std::filesystem::create_directories(dir);
   return dir + "/" + name;
+}
+std::string read_bytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+void write_bytes(const std::string& path, const std::string& bytes) {
+  std::ofstream(path, std::ios::binary).write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
 }
 }  // namespace skinstream::test
