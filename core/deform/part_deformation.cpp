@@ -14,9 +14,11 @@ PartDeformer::PartDeformer(PartModel model, DeformationMode mode)
       quadratic_(identity_quadratic_transform()),
       local_now_(model_.local_reference),
       centres_(model_.local_reference),
+      centres_by_row_(model_.local_reference.transpose()),
       residuals_(Eigen::MatrixX3d::Zero(model_.member_count(), 3)),
       weights_(Eigen::MatrixX3d::Zero(model_.member_count(), 3)),
       kernel_(Eigen::MatrixXd::Zero(model_.member_count(), model_.member_count())),
+      kernel_llt_(model_.member_count()),
       kernel_lu_(model_.member_count()) {}
 
 bool PartDeformer::uses_quadratic() const {
@@ -54,11 +56,28 @@ bool PartDeformer::solve(std::span<const Vec3> member_positions_now) {
   return true;
 }
 
-// weights = kernel^-1 residuals from the LU factors, one column at a time: Eigen's solve() with
-// a 3-column right-hand side takes a blocking workspace from the heap on every call once a part
-// has more than about 100 members (175 kB for the 148-marker trunk); a single column is solved
-// in place.
-void PartDeformer::solve_weights() {
+// weights = kernel^-1 residuals. Cholesky first: the kernel is symmetric and, with its ridge,
+// usually positive definite, and LLT takes half the work of LU (the factorisation is most of
+// fitting the benchmark's 148-member trunk part). The cubic B-spline kernel can be indefinite
+// too (see solve_residual); LLT then reports a non-positive pivot, LU with partial pivoting
+// solves it, and that part is solved by LU from then on, so it never pays for both. Either way
+// one right-hand column at a time, in place: Eigen's solve() with a 3-column right-hand side
+// takes a blocking workspace from the heap on every call once a part has more than about 100
+// members (175 kB for the 148-marker trunk).
+void PartDeformer::factor_and_solve() {
+  if (!kernel_indefinite_) {
+    kernel_llt_.compute(kernel_);
+    if (kernel_llt_.info() == Eigen::Success) {
+      weights_ = residuals_;
+      for (int c = 0; c < 3; ++c) {
+        kernel_llt_.matrixL().solveInPlace(weights_.col(c));
+        kernel_llt_.matrixU().solveInPlace(weights_.col(c));
+      }
+      return;
+    }
+    kernel_indefinite_ = true;
+  }
+  kernel_lu_.compute(kernel_);
   weights_ = kernel_lu_.permutationP() * residuals_;
   const Eigen::MatrixXd& lu = kernel_lu_.matrixLU();
   for (int c = 0; c < 3; ++c) {
@@ -68,14 +87,14 @@ void PartDeformer::solve_weights() {
 }
 
 // Eq. 7: weights w with sum_i w_i phi(|p~_i - p~_j| / sigma) = r_j. The centres move every
-// frame, so the kernel is rebuilt and LU-refactored in the preallocated storage.
+// frame, so the kernel is rebuilt and refactored in the preallocated storage.
 void PartDeformer::solve_residual() {
   residuals_ = (local_now_ - centres_).transpose();
-  fill_rbf_kernel(centres_, model_.rbf_dilation, kernel_);
+  centres_by_row_ = centres_.transpose();
+  fill_rbf_kernel(centres_by_row_, model_.rbf_dilation, kernel_);
   double added = model_.rbf_ridge;  // chosen offline, the same every frame
   kernel_.diagonal().array() += added;
-  kernel_lu_.compute(kernel_);
-  solve_weights();
+  factor_and_solve();
   // The cubic B-spline is not positive definite as a radial function in 3D: with many members
   // and a wide dilation the kernel matrix can be nearly singular, and the exact weights then
   // reach thousands of times the residual and swing the surface between the members by metres.
@@ -87,8 +106,7 @@ void PartDeformer::solve_residual() {
     if (ridge <= added) continue;
     kernel_.diagonal().array() += ridge - added;
     added = ridge;
-    kernel_lu_.compute(kernel_);
-    solve_weights();
+    factor_and_solve();
   }
   ridge_ = added;
   // Coincident centres make the kernel singular; then skip the residual rather than emit NaN.

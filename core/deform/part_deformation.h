@@ -4,6 +4,7 @@
 // All buffers are sized at construction; solve() and deform() allocate nothing.
 
 #include <Eigen/Core>
+#include <Eigen/Cholesky>
 #include <Eigen/LU>
 #include <span>
 
@@ -50,7 +51,7 @@ class PartDeformer {
   bool uses_quadratic() const;
   bool uses_rbf() const;
   void solve_residual();
-  void solve_weights();
+  void factor_and_solve();
 
   PartModel model_;
   DeformationMode mode_;
@@ -58,10 +59,13 @@ class PartDeformer {
   QuadraticTransform quadratic_;
   Eigen::Matrix3Xd local_now_;
   Eigen::Matrix3Xd centres_;
+  Eigen::MatrixX3d centres_by_row_;  // the same, one per row, as fill_rbf_kernel reads them
   Eigen::MatrixX3d residuals_;
   Eigen::MatrixX3d weights_;
   Eigen::MatrixXd kernel_;
+  Eigen::LLT<Eigen::MatrixXd> kernel_llt_;
   Eigen::PartialPivLU<Eigen::MatrixXd> kernel_lu_;
+  bool kernel_indefinite_ = false;  // LLT failed once: solved by LU from then on
   bool rbf_applied_ = false;
   double ridge_ = 0.0;
 };

@@ -22,7 +22,7 @@ std::vector<double> leave_one_out_squared_errors(const Eigen::Matrix3Xd& centres
                                                  double dilation, std::span<const double> ridges) {
   const int count = static_cast<int>(centres.cols());
   Eigen::MatrixXd kernel(count, count);
-  fill_rbf_kernel(centres, dilation, kernel);
+  fill_rbf_kernel(centres.transpose(), dilation, kernel);
   const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(kernel);
   const Eigen::MatrixXd& v = eigen.eigenvectors();
   const Eigen::VectorXd& mu = eigen.eigenvalues();

@@ -2,6 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Eigenvalues>
+
+#include "core/deform/rbf_kernel.h"
 #include "tests/core/deform/deform_test_support.h"
 #include "tests/support/allocation_counter.h"
 
@@ -118,6 +121,36 @@ TEST(PartDeformer, ResidualModesInterpolateMembersExactly) {
   ASSERT_TRUE(rigid.solve(now));
   ASSERT_TRUE(quadratic.solve(now));
   EXPECT_LT(max_member_error(quadratic, now), max_member_error(rigid, now));
+}
+
+// Eq. 7 is solved by Cholesky while the kernel is positive definite and by LU once it is not
+// (the cubic B-spline is not positive definite in 3D): either way the weights solve the system
+// and, with no ridge, the members are interpolated. 30 random members give a positive definite
+// kernel here and 60 an indefinite one, which no Cholesky factorisation exists for; both
+// asserted, so each path is known to run.
+TEST(PartDeformer, KernelSolvedExactlyWhetherPositiveDefiniteOrNot) {
+  for (int count : {30, 60}) {
+    std::mt19937_64 rng(12);
+    const std::vector<Vec3> members = random_points(rng, count, Vec3(120, 60, 40));
+    const std::vector<Vec3> now = deform_non_rigidly(members, random_motion(rng));
+    PartDeformer part(build_part_model(members), DeformationMode::QuadraticRbf);
+    for (int frame = 0; frame < 2; ++frame) {  // the second solve of an indefinite part takes LU directly
+      ASSERT_TRUE(part.solve(now));
+      ASSERT_TRUE(part.rbf_applied());
+      ASSERT_EQ(part.rbf_ridge(), 0.0);
+      Eigen::MatrixXd kernel(count, count);
+      fill_rbf_kernel(part.rbf_centres().transpose(), part.model().rbf_dilation, kernel);
+      const double lowest = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(kernel).eigenvalues().minCoeff();
+      if (count == 30) {
+        EXPECT_GT(lowest, 0.0);
+      } else {
+        EXPECT_LT(lowest, -1e-3);
+      }
+      const Eigen::MatrixX3d residuals = (part.local_positions() - part.rbf_centres()).transpose();
+      EXPECT_LT((kernel * part.rbf_weights() - residuals).cwiseAbs().maxCoeff(), 1e-9) << count;
+      EXPECT_LT(max_member_error(part, now), 1e-6) << count;
+    }
+  }
 }
 
 // A near-singular kernel (coplanar members under a wide dilation: the cubic B-spline is not

@@ -2,8 +2,6 @@
 
 #include <gtest/gtest.h>
 
-#include "core/deform/rbf_kernel.h"
-
 namespace skinstream {
 namespace {
 
@@ -25,21 +23,6 @@ TEST(QuadraticBasis, TermsOfAnyTypeInTheBasisOrder) {
 TEST(QuadraticBasis, IdentityTransformKeepsPosition) {
   const Vec3 p(-7.5, 12.25, 3.0);
   EXPECT_EQ(identity_quadratic_transform() * quadratic_basis(p), p);
-}
-
-TEST(RbfKernel, CubicBSplineValues) {
-  EXPECT_DOUBLE_EQ(cubic_bspline_kernel(0.0), 2.0 / 3.0);
-  EXPECT_DOUBLE_EQ(cubic_bspline_kernel(1.0), 1.0 / 6.0);
-  EXPECT_DOUBLE_EQ(cubic_bspline_kernel(0.5), (1.5 * 1.5 * 1.5 - 4 * 0.125) / 6.0);
-  EXPECT_DOUBLE_EQ(cubic_bspline_kernel(1.5), 0.125 / 6.0);
-  EXPECT_EQ(cubic_bspline_kernel(2.0), 0.0);
-  EXPECT_EQ(cubic_bspline_kernel(3.0), 0.0);
-  EXPECT_DOUBLE_EQ(cubic_bspline_kernel(-0.5), cubic_bspline_kernel(0.5));
-}
-
-TEST(RbfKernel, ContinuousAtKnots) {
-  for (double knot : {1.0, 2.0})
-    EXPECT_NEAR(cubic_bspline_kernel(knot - 1e-9), cubic_bspline_kernel(knot + 1e-9), 1e-8);
 }
 
 }  // namespace
