@@ -678,8 +678,9 @@ size_t MeshDeformer::memory_bytes() const {
                  bytes(s.cluster_lanes) + bytes(s.cluster_result);
   for (const PartDeformer& part : s.parts) {
     const int y = part.model().member_count();
-    // Members' reference data (points, Q0, pseudo-inverse) and the per-frame kernel and LU.
-    total += sizeof(PartDeformer) + static_cast<size_t>(y) * (3 + 3 + 9 + 9 + 3 + 3 + 3 + 3) * sizeof(double) +
+    // Members' reference data (points, Q0, pseudo-inverse), the per-frame centres (twice),
+    // positions, residuals and weights, the kernel (factored in place by LLT) and its LU.
+    total += sizeof(PartDeformer) + static_cast<size_t>(y) * (3 + 3 + 9 + 9 + 3 + 3 + 3 + 3 + 3) * sizeof(double) +
              2 * static_cast<size_t>(y) * y * sizeof(double);
   }
   return total;

@@ -18,7 +18,6 @@ PartDeformer::PartDeformer(PartModel model, DeformationMode mode)
       residuals_(Eigen::MatrixX3d::Zero(model_.member_count(), 3)),
       weights_(Eigen::MatrixX3d::Zero(model_.member_count(), 3)),
       kernel_(Eigen::MatrixXd::Zero(model_.member_count(), model_.member_count())),
-      kernel_llt_(model_.member_count()),
       kernel_lu_(model_.member_count()) {}
 
 bool PartDeformer::uses_quadratic() const {
@@ -56,26 +55,31 @@ bool PartDeformer::solve(std::span<const Vec3> member_positions_now) {
   return true;
 }
 
-// weights = kernel^-1 residuals. Cholesky first: the kernel is symmetric and, with its ridge,
-// usually positive definite, and LLT takes half the work of LU (the factorisation is most of
-// fitting the benchmark's 148-member trunk part). The cubic B-spline kernel can be indefinite
-// too (see solve_residual); LLT then reports a non-positive pivot, LU with partial pivoting
-// solves it, and that part is solved by LU from then on, so it never pays for both. Either way
-// one right-hand column at a time, in place: Eigen's solve() with a 3-column right-hand side
-// takes a blocking workspace from the heap on every call once a part has more than about 100
-// members (175 kB for the 148-marker trunk).
-void PartDeformer::factor_and_solve() {
+// Eq. 7's kernel with `ridge` on its diagonal, factored, and weights = kernel^-1 residuals.
+// Cholesky first, in place in the kernel's storage: the kernel is symmetric and, with its
+// ridge, usually positive definite, and LLT takes half the work of LU (the factorisation is
+// most of fitting the benchmark's 148-member trunk part). The cubic B-spline kernel can be
+// indefinite too (see solve_residual); LLT then reports a non-positive pivot, the kernel is
+// filled again and LU with partial pivoting solves it, and that part is solved by LU from then
+// on, so it never pays for both. Either way one right-hand column at a time, in place: Eigen's
+// solve() with a 3-column right-hand side takes a blocking workspace from the heap on every
+// call once a part has more than about 100 members (175 kB for the 148-marker trunk).
+void PartDeformer::factor_and_solve(double ridge) {
+  fill_rbf_kernel(centres_by_row_, model_.rbf_dilation, kernel_);
+  kernel_.diagonal().array() += ridge;
   if (!kernel_indefinite_) {
-    kernel_llt_.compute(kernel_);
-    if (kernel_llt_.info() == Eigen::Success) {
+    const Eigen::LLT<Eigen::Ref<Eigen::MatrixXd>> cholesky(kernel_);
+    if (cholesky.info() == Eigen::Success) {
       weights_ = residuals_;
       for (int c = 0; c < 3; ++c) {
-        kernel_llt_.matrixL().solveInPlace(weights_.col(c));
-        kernel_llt_.matrixU().solveInPlace(weights_.col(c));
+        cholesky.matrixL().solveInPlace(weights_.col(c));
+        cholesky.matrixU().solveInPlace(weights_.col(c));
       }
       return;
     }
     kernel_indefinite_ = true;
+    fill_rbf_kernel(centres_by_row_, model_.rbf_dilation, kernel_);
+    kernel_.diagonal().array() += ridge;
   }
   kernel_lu_.compute(kernel_);
   weights_ = kernel_lu_.permutationP() * residuals_;
@@ -91,10 +95,8 @@ void PartDeformer::factor_and_solve() {
 void PartDeformer::solve_residual() {
   residuals_ = (local_now_ - centres_).transpose();
   centres_by_row_ = centres_.transpose();
-  fill_rbf_kernel(centres_by_row_, model_.rbf_dilation, kernel_);
   double added = model_.rbf_ridge;  // chosen offline, the same every frame
-  kernel_.diagonal().array() += added;
-  factor_and_solve();
+  factor_and_solve(added);
   // The cubic B-spline is not positive definite as a radial function in 3D: with many members
   // and a wide dilation the kernel matrix can be nearly singular, and the exact weights then
   // reach thousands of times the residual and swing the surface between the members by metres.
@@ -104,9 +106,8 @@ void PartDeformer::solve_residual() {
   for (double ridge : {1e-3, 1e-2, 1e-1, 1.0}) {
     if (weights_.allFinite() && weights_.cwiseAbs().maxCoeff() <= limit) break;
     if (ridge <= added) continue;
-    kernel_.diagonal().array() += ridge - added;
     added = ridge;
-    factor_and_solve();
+    factor_and_solve(added);
   }
   ridge_ = added;
   // Coincident centres make the kernel singular; then skip the residual rather than emit NaN.

@@ -51,7 +51,7 @@ class PartDeformer {
   bool uses_quadratic() const;
   bool uses_rbf() const;
   void solve_residual();
-  void factor_and_solve();
+  void factor_and_solve(double ridge);
 
   PartModel model_;
   DeformationMode mode_;
@@ -62,8 +62,7 @@ class PartDeformer {
   Eigen::MatrixX3d centres_by_row_;  // the same, one per row, as fill_rbf_kernel reads them
   Eigen::MatrixX3d residuals_;
   Eigen::MatrixX3d weights_;
-  Eigen::MatrixXd kernel_;
-  Eigen::LLT<Eigen::MatrixXd> kernel_llt_;
+  Eigen::MatrixXd kernel_;  // eq. 7's kernel, or its Cholesky factor once factored in place
   Eigen::PartialPivLU<Eigen::MatrixXd> kernel_lu_;
   bool kernel_indefinite_ = false;  // LLT failed once: solved by LU from then on
   bool rbf_applied_ = false;
