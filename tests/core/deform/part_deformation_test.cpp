@@ -127,7 +127,7 @@ TEST(PartDeformer, ResidualModesInterpolateMembersExactly) {
 // (the cubic B-spline is not positive definite in 3D): either way the weights solve the system
 // and, with no ridge, the members are interpolated. 30 random members give a positive definite
 // kernel here and 60 an indefinite one, which no Cholesky factorisation exists for; both
-// asserted, so each path is known to run.
+// asserted, so each path is known to run, and neither allocates.
 TEST(PartDeformer, KernelSolvedExactlyWhetherPositiveDefiniteOrNot) {
   for (int count : {30, 60}) {
     std::mt19937_64 rng(12);
@@ -135,7 +135,13 @@ TEST(PartDeformer, KernelSolvedExactlyWhetherPositiveDefiniteOrNot) {
     const std::vector<Vec3> now = deform_non_rigidly(members, random_motion(rng));
     PartDeformer part(build_part_model(members), DeformationMode::QuadraticRbf);
     for (int frame = 0; frame < 2; ++frame) {  // the second solve of an indefinite part takes LU directly
-      ASSERT_TRUE(part.solve(now));
+      size_t allocations = 0;
+      {
+        test::CountAllocations counter;
+        ASSERT_TRUE(part.solve(now));
+        allocations = counter.count();
+      }
+      EXPECT_EQ(allocations, 0u) << count << " members, frame " << frame;
       ASSERT_TRUE(part.rbf_applied());
       ASSERT_EQ(part.rbf_ridge(), 0.0);
       Eigen::MatrixXd kernel(count, count);
