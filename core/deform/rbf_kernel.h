@@ -18,9 +18,9 @@ inline double cubic_bspline_kernel(double r) {
 // Eq. 7's kernel matrix, phi(|c_i - c_j| / sigma), into `kernel`: Y x Y, sized by the caller,
 // so the per-frame solve allocates nothing. The centres come one per row, so that each
 // coordinate lies contiguous and a column of distances is computed in vector lanes; the
-// kernel's pieces are written as ((2 - r)+^3 - 4 (1 - r)+^3) / 6, the same values without the
-// branches of cubic_bspline_kernel, which no predictor could learn. Branchy and strided, this
-// was the costliest step of fitting the 148-member trunk part.
+// kernel is written as ((2 - r)+^3 - 4 (1 - r)+^3) / 6, cubic_bspline_kernel's function without
+// its branches, which no predictor could learn. Branchy and strided, this was the costliest
+// step of fitting the 148-member trunk part after the factorisation.
 inline void fill_rbf_kernel(const Eigen::MatrixX3d& centres, double dilation, Eigen::MatrixXd& kernel) {
   const double inverse_sigma = 1.0 / dilation;
   const Eigen::Index count = centres.rows();
