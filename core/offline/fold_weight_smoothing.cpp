@@ -12,6 +12,8 @@
 #include <utility>
 #include <vector>
 
+#include "core/offline/mesh_edges.h"
+
 namespace skinstream {
 namespace {
 
@@ -52,14 +54,13 @@ int smooth_fold_weights(std::span<const Vec3> vertices, std::span<const std::arr
   // The fold's vertices, then the band around them: every vertex within band_mm of one along the
   // mesh's edges (Dijkstra from all of the fold's vertices; a vertex under a marker neither joins
   // nor passes the band on).
+  // Each vertex's mesh neighbours, each once and in ascending order, with the edge's length.
   std::vector<std::vector<std::pair<int, double>>> edges(v_count);
-  for (const auto& f : faces)
-    for (int c = 0; c < 3; ++c) {
-      const int a = f[c], b = f[(c + 1) % 3];
-      const double length = (vertices[a] - vertices[b]).norm();
-      edges[a].emplace_back(b, length);
-      edges[b].emplace_back(a, length);
-    }
+  for (const auto& [a, b] : unique_edges(faces)) {
+    const double length = (vertices[a] - vertices[b]).norm();
+    edges[a].emplace_back(b, length);
+    edges[b].emplace_back(a, length);
+  }
   std::vector<char> smoothed(v_count, 0);
   std::vector<double> distance(v_count, std::numeric_limits<double>::infinity());
   std::priority_queue<std::pair<double, int>, std::vector<std::pair<double, int>>, std::greater<>> queue;
@@ -93,21 +94,16 @@ int smooth_fold_weights(std::span<const Vec3> vertices, std::span<const std::arr
     for (int k = offsets[v]; k < offsets[v + 1]; ++k)
       rhs(to_row, weights.vertex_influences[k].part) += scale * weights.vertex_influences[k].weight;
   };
-  std::vector<int> around;
   for (int v = 0; v < v_count; ++v) {
     if (!smoothed[v]) continue;
-    around.clear();
-    for (const auto& [u, length] : edges[v]) around.push_back(u);
-    std::sort(around.begin(), around.end());
-    around.erase(std::unique(around.begin(), around.end()), around.end());
     const int i = row_of[v];
-    for (int u : around) {
+    for (const auto& [u, length] : edges[v]) {
       if (smoothed[u]) entries.emplace_back(i, row_of[u], -1.0);
       else add_weights(u, 1.0, i);
     }
     // A smoothed vertex is never under a marker, so its own flag says fold or band.
     const double hold = kSelfHold + (weights.in_fold[v] ? 0.0 : options.band_pull);
-    entries.emplace_back(i, i, static_cast<double>(around.size()) + hold);
+    entries.emplace_back(i, i, static_cast<double>(edges[v].size()) + hold);
     add_weights(v, hold, i);
   }
   Eigen::SparseMatrix<double> laplacian(n, n);

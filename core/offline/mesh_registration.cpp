@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "core/absolute_orientation.h"
+#include "core/offline/mesh_edges.h"
 #include "core/synth/body.h"
 #include "core/synth/bvh.h"
 
@@ -57,19 +58,6 @@ Normalisation normalisation_of(std::span<const Vec3> vertices) {
   n.scale = std::sqrt(s / vertices.size());
   if (!(n.scale > 0.0)) n.scale = 1.0;  // a single point or coincident vertices
   return n;
-}
-
-std::vector<std::pair<int, int>> unique_edges(Triangles triangles) {
-  std::vector<std::pair<int, int>> edges;
-  edges.reserve(triangles.size() * 3);
-  for (const auto& t : triangles)
-    for (int k = 0; k < 3; ++k) {
-      const int a = t[k], b = t[(k + 1) % 3];
-      if (a != b) edges.emplace_back(std::min(a, b), std::max(a, b));
-    }
-  std::sort(edges.begin(), edges.end());
-  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
-  return edges;
 }
 
 // The normal equations H X = B of the current linearised objective (X: 4n x 3).
