@@ -48,32 +48,28 @@ TEST(DeformationBuilder, DeformedFramesMatchTheSyntheticTruth) {
   ASSERT_EQ(subject.marker_names, training.truth.labels);  // same order: truth channels = markers
   DeformationBuildOptions options;
   options.register_mesh = false;
+  // The mannequin's truth skin of the reference frame, built into a model under `options`.
+  const std::vector<Vec3> reference_skin = training.pose_mesh(report.reference_frame, true);
+  auto build = [&](DeformationBuildReport* report_out = nullptr) {
+    return build_deformation_model(subject, training.truth.positions, training.frame_count(), reference_skin,
+                                   training.mesh_triangles(), options, report_out);
+  };
   DeformationBuildReport built;
-  const DeformationModel model = build_deformation_model(
-      subject, training.truth.positions, training.frame_count(), training.pose_mesh(report.reference_frame, true),
-      training.mesh_triangles(), options, &built);
+  const DeformationModel model = build(&built);
   EXPECT_EQ(built.joints.size(), 4u);  // the elbows and the knees
   EXPECT_GT(built.joint_blend_mm, 0.0);
   EXPECT_GT(built.fold_smoothed_vertices, 0);
   EXPECT_DOUBLE_EQ(built.joint_blend_mm, 0.5 * median_nearest_marker_distance(subject.reference_positions));
   options.blend_at_joints = false;
-  const DeformationModel hard_split = build_deformation_model(
-      subject, training.truth.positions, training.frame_count(), training.pose_mesh(report.reference_frame, true),
-      training.mesh_triangles(), options);
+  const DeformationModel hard_split = build();
   options.blend_at_joints = true;
   options.smooth_folds = false;
-  const DeformationModel unsmoothed = build_deformation_model(
-      subject, training.truth.positions, training.frame_count(), training.pose_mesh(report.reference_frame, true),
-      training.mesh_triangles(), options);
+  const DeformationModel unsmoothed = build();
   options.smooth_folds = true;
   options.blend_folds = false;
-  const DeformationModel unfolded = build_deformation_model(
-      subject, training.truth.positions, training.frame_count(), training.pose_mesh(report.reference_frame, true),
-      training.mesh_triangles(), options);
+  const DeformationModel unfolded = build();
   options.split_at_joints = false;  // and no fold blend: the paper's nearest triangle alone
-  const DeformationModel paper_weights = build_deformation_model(
-      subject, training.truth.positions, training.frame_count(), training.pose_mesh(report.reference_frame, true),
-      training.mesh_triangles(), options);
+  const DeformationModel paper_weights = build();
   EXPECT_EQ(model.validate(subject.marker_count()), "");
   EXPECT_EQ(model.part_count(), 17);
   ASSERT_EQ(model.part_rbf_ridge.size(), 17u);  // one per part, chosen by leave-one-out error
