@@ -6,17 +6,12 @@
 #include <string_view>
 
 #include "server/ingest/marker_frame.h"
+#include "server/ingest/source_frame.h"
 
 namespace skinstream::server {
 
-enum class SourceState {
-  Connecting,    // trying to reach the source (with backoff after a failure)
-  Streaming,     // frames arriving
-  Disconnected,  // the source went away; retrying
-  Finished,      // a replay reached its end (without --loop)
-};
-
-const char* to_string(SourceState state);
+// SourceState and the SourceSink that replaces FrameSink once every source hands on
+// SourceFrames: server/ingest/source_frame.h.
 
 class FrameSink {
  public:
