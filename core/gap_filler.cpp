@@ -39,6 +39,7 @@ GapFiller::GapFiller(const SubjectModel& model, const GapFillerOptions& options)
   observed_.assign(n_, 0);
   estimated_.assign(n_, 0);
   has_rotation_.assign(n_, 0);
+  suspects_.reserve(n_);
   estimate_.assign(n_, Vec3::Zero());
   rotation_.assign(n_, Eigen::Matrix3d::Identity());
   available_neighbours_.assign(n_, 0);
@@ -130,11 +131,13 @@ FillStats GapFiller::run(const FrameInput& in, const FrameOutput& out) {
   for (size_t p = 0; p < in.unlabelled.size(); ++p)
     add_free_point(in.unlabelled[p], in.unlabelled_ids.empty() ? static_cast<int>(p) : in.unlabelled_ids[p]);
 
-  if (options_.check_labels && has_previous_) check_labels();
+  suspects_.clear();
+  if (options_.check_labels && has_previous_) find_suspect_labels();
+  estimate_rigid();
+  if (!suspects_.empty()) judge_suspect_labels();
   for (int i = 0; i < n_; ++i)
     if (observed_[i]) assigned_id_[i] = kNoFragment;  // the capture system has it again
 
-  estimate_rigid();
   relabel();
   fill_missing();
 
@@ -142,6 +145,7 @@ FillStats GapFiller::run(const FrameInput& in, const FrameOutput& out) {
     out.positions[i] = current_[i];
     out.status[i] = status_[i];
     if (!out.fragments.empty()) out.fragments[i] = status_[i] == MarkerStatus::Relabelled ? assigned_id_[i] : kNoFragment;
+    if (is_present(in.labelled[i]) && current_[i] != in.labelled[i]) ++stats_.changed_measured;
     previous_[i] = current_[i];
     previous_status_[i] = status_[i];
     switch (status_[i]) {
@@ -156,30 +160,77 @@ FillStats GapFiller::run(const FrameInput& in, const FrameOutput& out) {
   return stats_;
 }
 
-// A correctly labelled point moves with its neighbours: within 8 ms its offset from them changes
-// by millimetres, while a swapped or mislabelled point is off by about the marker spacing. The
-// previous position (measured, or estimated during a gap) is carried by the mean displacement
-// of the observed one-ring; a labelled point farther than eps2 from there is taken as unlabelled.
-// Rotation within one frame moves a neighbour a few mm at most, far below eps2.
-void GapFiller::check_labels() {
+// Where marker i would be now had it moved with its neighbours since the last frame: its last
+// position (measured, or estimated during a gap) carried by the mean displacement of its
+// observed one-ring. False with fewer than two of them.
+bool GapFiller::carried_position(int i, Vec3& out) const {
+  Vec3 displacement = Vec3::Zero();
+  int count = 0;
+  for (int k = model_.ring_offsets[i]; k < model_.ring_offsets[i + 1]; ++k) {
+    const int j = model_.ring[k];
+    if (!observed_[j]) continue;
+    displacement += current_[j] - previous_[j];
+    ++count;
+  }
+  if (count < 2) return false;
+  out = previous_[i] + displacement / count;
+  return true;
+}
+
+// A correctly labelled point moves with its neighbours: within a frame its offset from them
+// changes by millimetres, while a swapped or mislabelled point is off by about the marker
+// spacing. A labelled point farther than eps2 from where its marker was carried is suspect, and
+// held back from the estimates until judged.
+void GapFiller::find_suspect_labels() {
   for (int i = 0; i < n_; ++i) {
-    if (!observed_[i] || previous_status_[i] == MarkerStatus::Held) continue;
-    Vec3 displacement = Vec3::Zero();
-    int count = 0;
-    for (int k = model_.ring_offsets[i]; k < model_.ring_offsets[i + 1]; ++k) {
-      const int j = model_.ring[k];
-      if (!observed_[j]) continue;
-      displacement += current_[j] - previous_[j];
-      ++count;
-    }
-    if (count < 2) continue;
-    const Vec3 expected = previous_[i] + displacement / count;
-    if ((current_[i] - expected).norm() > eps2_[i]) {
+    Vec3 expected;
+    if (!observed_[i] || previous_status_[i] == MarkerStatus::Held || !carried_position(i, expected)) continue;
+    if ((current_[i] - expected).norm() > eps2_[i]) suspects_.push_back(i);
+  }
+  for (int i : suspects_) observed_[i] = 0;
+}
+
+// Being off is not proof: a fast limb at a low frame rate, or the end of a gap whose estimate
+// was poor, puts a true measurement beyond eps2 too, and so does a rejected point that another
+// marker took last frame and carried along. A suspect point is judged against estimates made
+// this frame from the other markers alone. It stands when its own estimate agrees (within
+// eps2); it is taken as unlabelled when another marker explains it clearly better (a swap), or
+// when it was tracked last frame and its own estimate disagrees as well (two independent
+// estimates, the motion of its ring and the shape of its neighbourhood, against it).
+// Otherwise the measurement stands.
+void GapFiller::judge_suspect_labels() {
+  bool kept = false;
+  for (int i : suspects_) {
+    Vec3 own;
+    const bool has_own = expected_position(i, own);
+    const double own_distance = has_own ? (current_[i] - own).norm() : std::numeric_limits<double>::infinity();
+    const bool reject = own_distance > eps2_[i] &&
+                        (explained_by_another(i, own_distance) || (has_own && is_observed(previous_status_[i])));
+    if (reject) {
       add_free_point(current_[i], -(i + 1));
-      observed_[i] = 0;
       ++stats_.rejected_labels;
+    } else {
+      observed_[i] = 1;
+      kept = true;
     }
   }
+  if (kept) refresh_estimates();
+}
+
+// Whether a missing (or suspect) marker near i is expected within eps1 of i's labelled point and
+// at most half as far from it as i's own estimate.
+bool GapFiller::explained_by_another(int i, double own_distance) {
+  auto explains = [&](int j) {
+    Vec3 expected;
+    if (observed_[j] || j == i || !expected_position(j, expected)) return false;
+    const double d = (current_[i] - expected).norm();
+    return d <= eps1_[j] && d <= 0.5 * own_distance;
+  };
+  for (int k = model_.ring_offsets[i]; k < model_.ring_offsets[i + 1]; ++k)
+    if (explains(model_.ring[k])) return true;
+  for (int p = predictor_offsets_[i]; p < predictor_offsets_[i + 1]; ++p)
+    if (explains(predictor_marker_[p])) return true;
+  return false;
 }
 
 // Eq. 2, greedy: repeatedly estimate the missing marker with the most available neighbours

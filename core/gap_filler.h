@@ -3,8 +3,11 @@
 // (NaN = missing) and unlabelled points, and returns every marker of the subject.
 //
 //   1. Label check: a labelled point that did not move with its one-ring since the last frame
-//      (off by more than eps2) is treated as unlabelled: that is how swapped and mislabelled
-//      fragments look.
+//      (off by more than eps2) is suspect: that is how swapped and mislabelled fragments look,
+//      but also a true measurement after a gap whose estimate was poor. It is treated as
+//      unlabelled only on strong evidence, judged against this frame's estimates from the other
+//      markers: another missing marker explains it clearly better (a swap), or it was tracked
+//      and its neighbourhood's estimate disagrees too. Otherwise the measurement stands.
 //   2. Rigid estimates (eq. 2, Horn), greedy: the missing marker with the most available
 //      neighbours first, reusing earlier estimates.
 //   3. Relabelling: a tracked fragment stays with its marker while within eps2 (alpha2) of
@@ -70,6 +73,8 @@ struct FillStats {
   int filled = 0;           // PCA or rigid
   int held = 0;
   int rejected_labels = 0;  // labelled points taken as mislabelled this frame
+  int changed_measured = 0;  // labelled points whose marker was output elsewhere: rejected labels
+                             // that were not given back to their own marker
   int ignored_points = 0;   // non-finite or beyond capacity
 };
 
@@ -84,7 +89,10 @@ class GapFiller {
 
 
  private:
-  void check_labels();
+  void find_suspect_labels();
+  void judge_suspect_labels();
+  bool explained_by_another(int i, double own_distance);
+  bool carried_position(int i, Vec3& out) const;
   void estimate_rigid();
   void relabel();
   void precompute_single_gaps();
@@ -124,6 +132,7 @@ class GapFiller {
   std::vector<Vec3> current_;
   std::vector<MarkerStatus> status_;
   std::vector<char> observed_, estimated_, has_rotation_;
+  std::vector<int> suspects_;  // labelled points that did not move with their ring, held back
   std::vector<Vec3> estimate_;
   std::vector<Eigen::Matrix3d> rotation_;
   std::vector<int> available_neighbours_, missing_;

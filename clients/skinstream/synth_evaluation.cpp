@@ -93,7 +93,8 @@ nlohmann::ordered_json evaluate_on_synthetic(const synth::SynthCapture& take, co
   j["wrongly_labelled_rate"] = merge.wrong_rate();
   j["wrongly_labelled_samples"] = merge.wrong_samples;
   j["samples"] = {{"measured", report.measured}, {"relabelled", report.relabelled}, {"filled", report.filled},
-                  {"held", report.held}, {"rejected_labels", report.rejected_labels}};
+                  {"held", report.held}, {"rejected_labels", report.rejected_labels},
+                  {"changed_measured", report.changed_measured}};
   j["filled_error"] = {{"metric", "|filled - truth| over samples not measured or relabelled; normalised by the marker's mean one-ring distance in the reference pose"},
                        {"mm", to_json(summarize_errors(mm))},
                        {"normalised", to_json(summarize_errors(normalised))},
