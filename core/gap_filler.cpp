@@ -34,6 +34,16 @@ GapFiller::GapFiller(const SubjectModel& model, const GapFillerOptions& options)
   assigned_id_.assign(n_, kNoFragment);
   gap_offset_.assign(n_, Vec3::Zero());
   gap_age_.assign(n_, 0);
+  gap_start_known_.assign(n_, 0);
+  gap_start_position_.assign(n_, Vec3::Zero());
+  gap_start_anchor_.assign(model.anchors.size(), Vec3::Zero());
+  gap_start_anchor_seen_.assign(model.anchors.size(), 0);
+  carry_check_frames_ = std::max(1, static_cast<int>(std::lround(0.5 * options_.rate_hz)));
+  snapshot_frame_.assign(n_, -1);
+  snapshot_position_.assign(n_, Vec3::Zero());
+  snapshot_anchor_.assign(model.anchors.size(), Vec3::Zero());
+  snapshot_anchor_seen_.assign(model.anchors.size(), 0);
+  carry_drift_.assign(n_, -1.0);
   current_.assign(n_, Vec3::Zero());
   status_.assign(n_, MarkerStatus::Held);
   observed_.assign(n_, 0);
@@ -95,6 +105,9 @@ void GapFiller::reset() {
   std::fill(assigned_id_.begin(), assigned_id_.end(), kNoFragment);
   std::fill(gap_age_.begin(), gap_age_.end(), 0);
   std::fill(gap_offset_.begin(), gap_offset_.end(), Vec3::Zero());
+  std::fill(gap_start_known_.begin(), gap_start_known_.end(), 0);
+  std::fill(snapshot_frame_.begin(), snapshot_frame_.end(), -1);
+  std::fill(carry_drift_.begin(), carry_drift_.end(), -1.0);
 }
 
 void GapFiller::add_free_point(const Vec3& p, int id) {
@@ -140,6 +153,7 @@ FillStats GapFiller::run(const FrameInput& in, const FrameOutput& out) {
 
   relabel();
   fill_missing();
+  if (options_.carry_from_gap_start) check_carries();
 
   for (int i = 0; i < n_; ++i) {
     out.positions[i] = current_[i];
@@ -429,10 +443,10 @@ bool GapFiller::transfer_motion(int first, int last, const std::vector<int>& mem
 
 // The neighbours' PCA estimates of marker i, each weighted by its calibrated predictive
 // variance, fused with the rigid estimate weighed likewise. Returns how many PCA models spoke.
-int GapFiller::pca_estimate(int i, Vec3& out) {
+int GapFiller::pca_estimate(int i, Vec3& out, double* out_variance) {
   Vec3 sum = Vec3::Zero();
-  double weights = 0.0;
-  int count = 0;
+  double weights = 0.0, precision = 0.0;
+  int count = 0, opinions = 0;
   for (int p = predictor_offsets_[i]; p < predictor_offsets_[i + 1]; ++p) {
     const int j = predictor_marker_[p];
     if (!observed_[j]) continue;
@@ -442,6 +456,8 @@ int GapFiller::pca_estimate(int i, Vec3& out) {
     const double weight = options_.weight_by_variance ? 1.0 / pca_slot_variance_[at] : 1.0;
     sum += weight * (current_[j] + pca_rotation_[j].transpose() * pca_slot_local_[at]);
     weights += weight;
+    precision += 1.0 / pca_slot_variance_[at];
+    ++opinions;
     ++count;
   }
   // The rigid estimate joins as one more opinion, weighed by its error on the training take,
@@ -450,8 +466,13 @@ int GapFiller::pca_estimate(int i, Vec3& out) {
     const double variance = model_.pca[i].rigid_variance * model_.ring_size(i) / rigid_support_[i];
     sum += estimate_[i] / variance;
     weights += 1.0 / variance;
+    precision += 1.0 / variance;
+    ++opinions;
   }
   if (count > 0) out = sum / weights;
+  // The opinions rest on the same observed markers, so together they are no surer than a typical
+  // one: the harmonic mean of their variances, not the variance of independent ones' mean.
+  if (count > 0 && out_variance) *out_variance = opinions / precision;
   return count;
 }
 
@@ -465,21 +486,114 @@ bool GapFiller::expected_position(int i, Vec3& out) {
   return true;
 }
 
+// At the first frame of a gap: where the marker and its anchors were last frame.
+void GapFiller::remember_gap_start(int i) {
+  gap_start_known_[i] = 1;
+  gap_start_position_[i] = previous_[i];
+  for (int k = model_.anchor_offsets[i]; k < model_.anchor_offsets[i + 1]; ++k) {
+    const int a = model_.anchors[k];
+    gap_start_anchor_[k] = previous_[a];
+    gap_start_anchor_seen_[k] = is_observed(previous_status_[a]);
+  }
+}
+
+// A marker's position `from_position` at an earlier frame carried by the rigid motion, from then
+// to now, of its three steadiest anchors seen both then and now (`from_anchors`, `from_seen`:
+// parallel to its anchors). Also the fit's squared residual over those three, per degree of
+// freedom (how far they moved from rigid).
+bool GapFiller::carry_rigidly(int i, const Vec3& from_position, std::span<const Vec3> from_anchors,
+                              std::span<const char> from_seen, Vec3& out, double& out_residual) {
+  const int first = model_.anchor_offsets[i];
+  int count = 0;
+  for (int k = first; k < model_.anchor_offsets[i + 1] && count < kCarryAnchors; ++k) {
+    const int a = model_.anchors[k];
+    if (!from_seen[k - first] || !observed_[a]) continue;
+    scratch_source_[count] = from_anchors[k - first];
+    scratch_target_[count] = current_[a];
+    ++count;
+  }
+  if (count < kCarryAnchors) return false;
+  RigidTransform t;
+  fit_rigid({scratch_source_.data(), static_cast<size_t>(count)}, {scratch_target_.data(), static_cast<size_t>(count)}, t);
+  double residual = 0.0;
+  for (int k = 0; k < count; ++k) residual += (t.apply(scratch_source_[k]) - scratch_target_[k]).squaredNorm();
+  out = t.apply(from_position);
+  out_residual = residual / (3 * count - 6);
+  return true;
+}
+
+// The marker's last measurement carried from the start of its gap. Over a long gap this does not
+// drift as a chain of frame-to-frame motions does, and where the marker sits on a rigid segment
+// with its anchors (a head, a pelvis, a foot) it is nearly exact, while a neighbourhood spanning a
+// joint is not. Its variance per coordinate grows with the gap's age at the rate the same carry
+// drifted for this marker while it was seen, on top of the anchors' own departure from rigid;
+// never below the marker model's residual. No estimate before that rate is known.
+bool GapFiller::carried_from_gap_start(int i, Vec3& out, double& out_variance) {
+  if (!gap_start_known_[i] || carry_drift_[i] < 0.0) return false;
+  const int first = model_.anchor_offsets[i], count = model_.anchor_offsets[i + 1] - first;
+  double residual = 0.0;
+  if (!carry_rigidly(i, gap_start_position_[i], {&gap_start_anchor_[first], static_cast<size_t>(count)},
+                     {&gap_start_anchor_seen_[first], static_cast<size_t>(count)}, out, residual))
+    return false;
+  const double age = gap_age_[i] + 1.0;
+  out_variance = std::max(residual + carry_drift_[i] * age * age / 3.0, model_.pca[i].residual_variance);
+  return true;
+}
+
+// Every carry_check_frames_, for each marker seen now: how far the carry from its snapshot missed
+// it, then a new snapshot.
+void GapFiller::check_carries() {
+  for (int i = 0; i < n_; ++i) {
+    if (!is_observed(status_[i])) continue;
+    const long age = frame_ - snapshot_frame_[i];
+    if (snapshot_frame_[i] >= 0 && age < carry_check_frames_) continue;
+    const int first = model_.anchor_offsets[i], count = model_.anchor_offsets[i + 1] - first;
+    Vec3 carried;
+    double residual = 0.0;
+    if (snapshot_frame_[i] >= 0 &&
+        carry_rigidly(i, snapshot_position_[i], {&snapshot_anchor_[first], static_cast<size_t>(count)},
+                      {&snapshot_anchor_seen_[first], static_cast<size_t>(count)}, carried, residual)) {
+      const double drift = (carried - current_[i]).squaredNorm() / (static_cast<double>(age) * age);
+      carry_drift_[i] = carry_drift_[i] < 0.0 ? drift : 0.5 * (carry_drift_[i] + drift);
+    }
+    snapshot_frame_[i] = frame_;
+    snapshot_position_[i] = current_[i];
+    for (int k = first; k < first + count; ++k) {
+      snapshot_anchor_[k] = current_[model_.anchors[k]];
+      snapshot_anchor_seen_[k] = is_observed(status_[model_.anchors[k]]);
+    }
+  }
+}
+
 void GapFiller::fill_missing() {
   const double decay_frames = options_.continuity_seconds * options_.rate_hz;
+  const bool carry_on = options_.carry_from_gap_start && options_.weight_by_variance;
+  // Two estimates of one point weighed by their variances.
+  auto combine = [](const Vec3& a, double variance_a, const Vec3& b, double variance_b) {
+    return (a * variance_b + b * variance_a) / (variance_a + variance_b);
+  };
   for (int i : missing_) {
     if (observed_[i]) continue;  // relabelled
+    if (has_previous_ && is_observed(previous_status_[i])) remember_gap_start(i);
+    Vec3 carried;
+    double carried_variance = 0.0;
+    const bool carry = carry_on && carried_from_gap_start(i, carried, carried_variance);
     Vec3 fused;
-    if (options_.use_pca && pca_estimate(i, fused) > 0) {
-      current_[i] = fused;
+    double variance = 0.0;
+    if (options_.use_pca && pca_estimate(i, fused, &variance) > 0) {
+      current_[i] = carry ? combine(fused, variance, carried, carried_variance) : fused;
       status_[i] = MarkerStatus::FilledPca;
     } else if (estimated_[i]) {
-      current_[i] = estimate_[i];
+      const double rigid_variance = model_.pca[i].rigid_variance * model_.ring_size(i) / std::max(1, rigid_support_[i]);
+      current_[i] = carry ? combine(estimate_[i], rigid_variance, carried, carried_variance) : estimate_[i];
       status_[i] = MarkerStatus::FilledRigid;
     } else {
-      // Held: carried with the rigid motion of the anchors, else kept where it was.
+      // Held: carried with the rigid motion of the anchors (since the gap started, else since
+      // the last frame), else kept where it was.
       Vec3 moved;
-      if (has_previous_ && transfer_motion(model_.anchor_offsets[i], model_.anchor_offsets[i + 1], model_.anchors, previous_[i], moved))
+      if (carry)
+        current_[i] = carried;
+      else if (has_previous_ && transfer_motion(model_.anchor_offsets[i], model_.anchor_offsets[i + 1], model_.anchors, previous_[i], moved))
         current_[i] = moved;
       else
         current_[i] = has_previous_ ? previous_[i] : model_.reference_positions[i];

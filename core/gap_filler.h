@@ -45,6 +45,10 @@ struct GapFillerOptions {
   // or plainly as the paper does (false).
   bool weight_by_variance = true;
   bool fuse_rigid = true;  // with weighting: the rigid estimate (eq. 2) is one more weighed opinion
+  // With weighting: during a gap, the marker's last measurement carried by the rigid motion of
+  // its steadiest anchors since then is one more opinion too (and replaces the frame-to-frame
+  // hold when nothing else is known).
+  bool carry_from_gap_start = true;
   bool check_labels = true;
 };
 
@@ -97,7 +101,12 @@ class GapFiller {
   void relabel();
   void precompute_single_gaps();
   bool solve_pca(int j);
-  int pca_estimate(int i, Vec3& out);
+  int pca_estimate(int i, Vec3& out, double* out_variance = nullptr);
+  void remember_gap_start(int i);
+  bool carried_from_gap_start(int i, Vec3& out, double& out_variance);
+  bool carry_rigidly(int i, const Vec3& from_position, std::span<const Vec3> from_anchors,
+                     std::span<const char> from_seen, Vec3& out, double& out_residual);
+  void check_carries();
   bool expected_position(int i, Vec3& out);
   void take_free_point(int marker, int point);
   bool free_point_near(const Vec3& p, double reach) const;
@@ -127,6 +136,22 @@ class GapFiller {
   std::vector<int> assigned_id_;      // free-point trajectory currently standing for marker i
   std::vector<Vec3> gap_offset_;      // continuity offset in the local frame
   std::vector<int> gap_age_;
+  // At the start of each marker's gap: its last position and its anchors' (parallel to
+  // model.anchors; usable where the anchor was measured or relabelled then).
+  static constexpr int kCarryAnchors = 3;
+  std::vector<char> gap_start_known_;
+  std::vector<Vec3> gap_start_position_;
+  std::vector<Vec3> gap_start_anchor_;
+  std::vector<char> gap_start_anchor_seen_;
+  // While a marker is seen, every carry_check_frames_ the same carry is tried on it from a
+  // snapshot of then: the squared miss per frame squared, averaged (mm^2 / frame^2; negative
+  // until measured) is how fast the carry drifts for this marker in this take.
+  int carry_check_frames_ = 1;
+  std::vector<long> snapshot_frame_;
+  std::vector<Vec3> snapshot_position_;
+  std::vector<Vec3> snapshot_anchor_;
+  std::vector<char> snapshot_anchor_seen_;
+  std::vector<double> carry_drift_;
 
   // Per-frame scratch.
   std::vector<Vec3> current_;

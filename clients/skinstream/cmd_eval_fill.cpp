@@ -93,12 +93,13 @@ void add_eval_fill(CLI::App& app) {
     for (int m = 0; m < model.marker_count(); ++m) normaliser[m] = model.neighbour_distance(m);
 
     auto skinstream_fill = [&](CaptureFillOptions o) { return [&model, o](const Capture& c) { return fill_capture(model, c, o); }; };
-    CaptureFillOptions online, ahead, no_pca, no_continuity, plain_average, no_rigid_fusion;
+    CaptureFillOptions online, ahead, no_pca, no_continuity, plain_average, no_rigid_fusion, no_carry;
     ahead.lookahead = lookahead;
     no_pca.filler.use_pca = false;
     no_continuity.filler.continuity_seconds = 0.0;
     plain_average.filler.weight_by_variance = false;
     no_rigid_fusion.filler.fuse_rigid = false;
+    no_carry.filler.carry_from_gap_start = false;
     std::vector<Method> methods = {
         {"linear", "linear interpolation (offline)", fill_linear},
         {"spline", "cubic spline (offline)", [](const Capture& c) { return fill_cubic_spline(c); }},
@@ -111,6 +112,7 @@ void add_eval_fill(CLI::App& app) {
       methods.push_back({"skinstream_no_continuity", "skinstream online, no gap-start continuity", skinstream_fill(no_continuity)});
       methods.push_back({"skinstream_plain_average", "skinstream online, neighbours' PCA estimates averaged unweighted (as the paper)", skinstream_fill(plain_average)});
       methods.push_back({"skinstream_pca_only", "skinstream online, PCA estimates weighted, rigid estimate not fused", skinstream_fill(no_rigid_fusion)});
+      methods.push_back({"skinstream_no_carry", "skinstream online, no carry from the gap start by the steadiest anchors", skinstream_fill(no_carry)});
     }
 
     long gap_samples = 0;

@@ -101,6 +101,7 @@ TEST(GapFiller, PcaBeatsTheRigidEstimateOnADeformingLimb) {
   rigid.use_pca = false;
   GapFillerOptions pca;
   pca.continuity_seconds = rigid.continuity_seconds = 0.0;  // compare the estimators alone
+  pca.carry_from_gap_start = rigid.carry_from_gap_start = false;
   const double rigid_error = mean_fill_error(fx, rigid, 0);
   const double pca_error = mean_fill_error(fx, pca, 0);
   const double spacing = fx.model.neighbour_distance(kMiddle);
