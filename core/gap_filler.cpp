@@ -43,7 +43,8 @@ GapFiller::GapFiller(const SubjectModel& model, const GapFillerOptions& options)
   snapshot_position_.assign(n_, Vec3::Zero());
   snapshot_anchor_.assign(model.anchors.size(), Vec3::Zero());
   snapshot_anchor_seen_.assign(model.anchors.size(), 0);
-  carry_drift_.assign(n_, -1.0);
+  carry_drift_.assign(n_, 0.0);
+  carry_checks_.assign(n_, 0);
   current_.assign(n_, Vec3::Zero());
   status_.assign(n_, MarkerStatus::Held);
   observed_.assign(n_, 0);
@@ -107,7 +108,8 @@ void GapFiller::reset() {
   std::fill(gap_offset_.begin(), gap_offset_.end(), Vec3::Zero());
   std::fill(gap_start_known_.begin(), gap_start_known_.end(), 0);
   std::fill(snapshot_frame_.begin(), snapshot_frame_.end(), -1);
-  std::fill(carry_drift_.begin(), carry_drift_.end(), -1.0);
+  std::fill(carry_drift_.begin(), carry_drift_.end(), 0.0);
+  std::fill(carry_checks_.begin(), carry_checks_.end(), 0);
 }
 
 void GapFiller::add_free_point(const Vec3& p, int id) {
@@ -527,9 +529,10 @@ bool GapFiller::carry_rigidly(int i, const Vec3& from_position, std::span<const 
 // with its anchors (a head, a pelvis, a foot) it is nearly exact, while a neighbourhood spanning a
 // joint is not. Its variance per coordinate grows with the gap's age at the rate the same carry
 // drifted for this marker while it was seen, on top of the anchors' own departure from rigid;
-// never below the marker model's residual. No estimate before that rate is known.
+// never below the marker model's residual. No estimate before that rate was measured over two
+// seconds of the marker being seen: one half-second check says little about a joint.
 bool GapFiller::carried_from_gap_start(int i, Vec3& out, double& out_variance) {
-  if (!gap_start_known_[i] || carry_drift_[i] < 0.0) return false;
+  if (!gap_start_known_[i] || carry_checks_[i] < kCarryWarmupChecks) return false;
   const int first = model_.anchor_offsets[i], count = model_.anchor_offsets[i + 1] - first;
   double residual = 0.0;
   if (!carry_rigidly(i, gap_start_position_[i], {&gap_start_anchor_[first], static_cast<size_t>(count)},
@@ -554,7 +557,8 @@ void GapFiller::check_carries() {
         carry_rigidly(i, snapshot_position_[i], {&snapshot_anchor_[first], static_cast<size_t>(count)},
                       {&snapshot_anchor_seen_[first], static_cast<size_t>(count)}, carried, residual)) {
       const double drift = (carried - current_[i]).squaredNorm() / (static_cast<double>(age) * age);
-      carry_drift_[i] = carry_drift_[i] < 0.0 ? drift : 0.5 * (carry_drift_[i] + drift);
+      carry_drift_[i] = carry_checks_[i] == 0 ? drift : 0.5 * (carry_drift_[i] + drift);
+      ++carry_checks_[i];
     }
     snapshot_frame_[i] = frame_;
     snapshot_position_[i] = current_[i];

@@ -143,15 +143,17 @@ class GapFiller {
   std::vector<Vec3> gap_start_position_;
   std::vector<Vec3> gap_start_anchor_;
   std::vector<char> gap_start_anchor_seen_;
-  // While a marker is seen, every carry_check_frames_ the same carry is tried on it from a
-  // snapshot of then: the squared miss per frame squared, averaged (mm^2 / frame^2; negative
-  // until measured) is how fast the carry drifts for this marker in this take.
+  // While a marker is seen, every carry_check_frames_ (half a second) the same carry is tried on
+  // it from a snapshot of then: the squared miss per frame squared, averaged over the recent
+  // checks (mm^2 / frame^2), is how fast the carry drifts for this marker in this take.
+  static constexpr int kCarryWarmupChecks = 4;
   int carry_check_frames_ = 1;
   std::vector<long> snapshot_frame_;
   std::vector<Vec3> snapshot_position_;
   std::vector<Vec3> snapshot_anchor_;
   std::vector<char> snapshot_anchor_seen_;
   std::vector<double> carry_drift_;
+  std::vector<int> carry_checks_;  // how many checks carry_drift_ rests on
 
   // Per-frame scratch.
   std::vector<Vec3> current_;
