@@ -51,6 +51,7 @@ GapFiller::GapFiller(const SubjectModel& model, const GapFillerOptions& options)
   estimated_.assign(n_, 0);
   has_rotation_.assign(n_, 0);
   suspects_.reserve(n_);
+  changed_.reserve(n_);
   estimate_.assign(n_, Vec3::Zero());
   rotation_.assign(n_, Eigen::Matrix3d::Identity());
   available_neighbours_.assign(n_, 0);
@@ -66,6 +67,12 @@ GapFiller::GapFiller(const SubjectModel& model, const GapFillerOptions& options)
   pca_slot_variance_.assign(model.ring.size(), 1.0);
   rigid_support_.assign(n_, 0);
   precompute_single_gaps();
+  static_assert(SubjectModel::kMaxRing < 32, "observed slots are a 32-bit mask");
+  for (int j = 0; j < n_; ++j) {
+    pattern_offset_.push_back(static_cast<int>(pattern_factor_.size()));
+    pattern_factor_.resize(pattern_factor_.size() + model.pca[j].variance.size() * model.pca[j].variance.size());
+  }
+  pattern_mask_.assign(n_, 0);  // no pattern: a mask has at least two bits
   const size_t scratch = std::max<size_t>(n_, SubjectModel::kMaxRing);
   scratch_source_.assign(scratch, Vec3::Zero());
   scratch_target_.assign(scratch, Vec3::Zero());
@@ -215,7 +222,6 @@ void GapFiller::find_suspect_labels() {
 // estimates, the motion of its ring and the shape of its neighbourhood, against it).
 // Otherwise the measurement stands.
 void GapFiller::judge_suspect_labels() {
-  bool kept = false;
   for (int i : suspects_) {
     Vec3 own;
     const bool has_own = expected_position(i, own);
@@ -227,10 +233,10 @@ void GapFiller::judge_suspect_labels() {
       ++stats_.rejected_labels;
     } else {
       observed_[i] = 1;
-      kept = true;
+      changed_.push_back(i);
     }
   }
-  if (kept) refresh_estimates();
+  refresh_estimates();
 }
 
 // Whether a missing (or suspect) marker near i is expected within eps1 of i's labelled point and
@@ -271,30 +277,34 @@ void GapFiller::estimate_rigid() {
         best_count = available_neighbours_[i];
       }
     if (best < 0) break;
-    int count = 0;
-    for (int k = model_.ring_offsets[best]; k < model_.ring_offsets[best + 1]; ++k) {
-      const int j = model_.ring[k];
-      if (!estimated_[j]) continue;
-      scratch_source_[count] = model_.ring_local_reference[k];
-      scratch_target_[count] = estimate_[j];
-      ++count;
-    }
-    int observed_support = 0;
-    for (int k = model_.ring_offsets[best]; k < model_.ring_offsets[best + 1]; ++k) observed_support += observed_[model_.ring[k]];
-    rigid_support_[best] = observed_support;
-    RigidTransform t;
-    fit_rigid({scratch_source_.data(), static_cast<size_t>(count)}, {scratch_target_.data(), static_cast<size_t>(count)}, t);
-    estimate_[best] = t.translation;  // the local frame's origin is the marker
-    rotation_[best] = t.rotation;
-    has_rotation_[best] = 1;
-    estimated_[best] = 1;
+    fit_rigid_estimate(best);
     for (int p = predictor_offsets_[best]; p < predictor_offsets_[best + 1]; ++p)
       ++available_neighbours_[predictor_marker_[p]];
   }
 }
 
+// Eq. 2 for marker i from the ring members known (observed or estimated) now.
+void GapFiller::fit_rigid_estimate(int i) {
+  int count = 0, observed_support = 0;
+  for (int k = model_.ring_offsets[i]; k < model_.ring_offsets[i + 1]; ++k) {
+    const int j = model_.ring[k];
+    observed_support += observed_[j];
+    if (!estimated_[j]) continue;
+    scratch_source_[count] = model_.ring_local_reference[k];
+    scratch_target_[count] = estimate_[j];
+    ++count;
+  }
+  if (count < 3) return;
+  rigid_support_[i] = observed_support;
+  RigidTransform t;
+  fit_rigid({scratch_source_.data(), static_cast<size_t>(count)}, {scratch_target_.data(), static_cast<size_t>(count)}, t);
+  estimate_[i] = t.translation;  // the local frame's origin is the marker
+  rotation_[i] = t.rotation;
+  has_rotation_[i] = 1;
+  estimated_[i] = 1;
+}
+
 void GapFiller::relabel() {
-  bool changed = false;
   // Fragments already standing for a marker stay while within eps2 of where it is expected.
   for (int i : missing_) {
     const int id = assigned_id_[i];
@@ -309,12 +319,11 @@ void GapFiller::relabel() {
     if (found >= 0 && !expected_position(i, expected)) expected = previous_[i];  // no estimate: continuity
     if (found >= 0 && (free_points_[found] - expected).norm() <= eps2_[i]) {
       take_free_point(i, found);
-      changed = true;
     } else {
       assigned_id_[i] = kNoFragment;
     }
   }
-  if (changed) refresh_estimates();
+  refresh_estimates();
   // New matches: each still-missing marker's nearest free point within eps1 of where it is
   // expected, closest pairs first. Points taken at the edge of an occluded patch make the
   // estimates inside it better, so matching repeats while it finds something.
@@ -359,16 +368,24 @@ bool GapFiller::free_point_near(const Vec3& p, double reach) const {
 }
 
 void GapFiller::take_free_point(int marker, int point) {
+  changed_.push_back(marker);
   free_used_[point] = 1;
   current_[marker] = free_points_[point];
   observed_[marker] = 1;
   status_[marker] = MarkerStatus::Relabelled;
 }
 
-// After points were taken: rigid estimates again from the new set, PCA solves redone on demand.
+// After points were taken for the markers in changed_: rigid estimates again from the new set
+// (their chains reach past the ring), and the PCA solves that use those markers redone on
+// demand. A model's solve depends only on its ring's observed members, so the others stand.
 void GapFiller::refresh_estimates() {
+  if (changed_.empty()) return;
   estimate_rigid();
-  ++solve_stamp_;
+  for (int m : changed_) {
+    pca_stamp_[m] = -1;
+    for (int p = predictor_offsets_[m]; p < predictor_offsets_[m + 1]; ++p) pca_stamp_[predictor_marker_[p]] = -1;
+  }
+  changed_.clear();
 }
 
 // Section 4.3 for the model of marker j: rotate j's observed one-ring into its local frame
@@ -411,8 +428,18 @@ bool GapFiller::solve_pca(int j) {
     pca_ok_[j] = 1;
     return true;
   }
-  if (!pca_fit_.fit(m, {scratch_index_.data(), static_cast<size_t>(count)}, {scratch_source_.data(), static_cast<size_t>(count)}))
-    return false;
+  // Several missing: the pattern's factor, made when the pattern changes.
+  const std::span<const int> slots(scratch_index_.data(), static_cast<size_t>(count));
+  const size_t components = m.variance.size();
+  const std::span<double> factor(pattern_factor_.data() + pattern_offset_[j], components * components);
+  uint32_t mask = 0;
+  for (int slot : slots) mask |= 1u << slot;
+  if (pattern_mask_[j] != mask) {
+    pattern_mask_[j] = 0;
+    if (!PcaFit::factor_slots(m, slots, factor)) return false;
+    pattern_mask_[j] = mask;
+  }
+  pca_fit_.fit_factored(m, slots, {scratch_source_.data(), static_cast<size_t>(count)}, factor);
   for (int k = 0; k < ring; ++k) {
     if (observed_[model_.ring[first + k]]) continue;
     pca_slot_local_[first + k] = pca_fit_.reconstruct(m, k);

@@ -26,6 +26,7 @@
 // All buffers are sized in the constructor; run() allocates nothing.
 
 #include <Eigen/Core>
+#include <cstdint>
 #include <limits>
 #include <span>
 #include <vector>
@@ -98,6 +99,7 @@ class GapFiller {
   bool explained_by_another(int i, double own_distance);
   bool carried_position(int i, Vec3& out) const;
   void estimate_rigid();
+  void fit_rigid_estimate(int i);
   void relabel();
   void precompute_single_gaps();
   bool solve_pca(int j);
@@ -160,6 +162,7 @@ class GapFiller {
   std::vector<MarkerStatus> status_;
   std::vector<char> observed_, estimated_, has_rotation_;
   std::vector<int> suspects_;  // labelled points that did not move with their ring, held back
+  std::vector<int> changed_;   // markers that became observed since the estimates were made
   std::vector<Vec3> estimate_;
   std::vector<Eigen::Matrix3d> rotation_;
   std::vector<int> available_neighbours_, missing_;
@@ -185,6 +188,11 @@ class GapFiller {
   std::vector<double> single_gap_gain_;
   std::vector<int> single_gap_offset_;
   std::vector<double> single_gap_variance_;
+  // Several ring members missing: per model, the observed slots (a bit each) its factor below
+  // was made for, and that factor (PcaFit::factor_slots, components^2 at pattern_offset_).
+  std::vector<uint32_t> pattern_mask_;
+  std::vector<int> pattern_offset_;
+  std::vector<double> pattern_factor_;
   std::vector<Vec3> scratch_source_, scratch_target_;
   std::vector<int> scratch_index_;
   FillStats stats_;

@@ -282,6 +282,7 @@ TEST(GapFiller, AllocatesNothingPerFrame) {
     frame.labelled[kMiddle] = missing_point();
     if (f % 3 == 0) frame.labelled[kOther] = missing_point();
     if (f % 5 == 0) std::swap(frame.labelled[kOther], frame.labelled[b]);  // labels to judge
+    if (f % 7 < 3) frame.labelled[fx.model.ring[fx.model.ring_offsets[kMiddle]]] = missing_point();  // two of a ring
     if (f % 2 == 0) {
       frame.unlabelled.push_back(truth);
       frame.ids.push_back(f % 4);
