@@ -30,7 +30,8 @@ void apply_json(const nlohmann::json& json, DaemonConfig& c, const std::string& 
                                       "http_port", "sub_port", "web_root", "lookahead", "max_frame_wait_ms", "deform_threads",
                                       "deform_cpus", "deform_spin_lead_us",
                                       "continuity_seconds", "use_pca", "ports_file", "log_level", "hello_timeout_ms",
-                                      "subscriber_queue_frames", "subscriber_tcp_congestion", "publish_threads", "status_interval_ms", "default_rate_hz"};
+                                      "subscriber_queue_frames", "subscriber_tcp_congestion", "publish_threads", "status_interval_ms", "default_rate_hz",
+                                      "compressed_key_interval"};
   for (const auto& [key, value] : json.items()) {
     bool known = false;
     for (const char* k : kKeys) known = known || key == k;
@@ -58,6 +59,7 @@ void apply_json(const nlohmann::json& json, DaemonConfig& c, const std::string& 
   take(json, "log_level", c.log_level, origin);
   take(json, "hello_timeout_ms", c.hello_timeout_ms, origin);
   take(json, "subscriber_queue_frames", c.subscriber_queue_frames, origin);
+  take(json, "compressed_key_interval", c.compressed_key_interval, origin);
   take(json, "subscriber_tcp_congestion", c.subscriber_tcp_congestion, origin);
   take(json, "publish_threads", c.publish_threads, origin);
   take(json, "status_interval_ms", c.status_interval_ms, origin);
@@ -103,6 +105,7 @@ nlohmann::json to_json(const DaemonConfig& c) {
           {"log_level", c.log_level},
           {"hello_timeout_ms", c.hello_timeout_ms},
           {"subscriber_queue_frames", c.subscriber_queue_frames},
+          {"compressed_key_interval", c.compressed_key_interval},
           {"subscriber_tcp_congestion", c.subscriber_tcp_congestion},
           {"publish_threads", c.publish_threads},
           {"status_interval_ms", c.status_interval_ms},
@@ -124,6 +127,7 @@ void validate(const DaemonConfig& c) {
   if (c.continuity_seconds < 0) fail("continuity_seconds must be >= 0");
   if (c.hello_timeout_ms < 0) fail("hello_timeout_ms must be >= 0");
   if (c.subscriber_queue_frames < 1 || c.subscriber_queue_frames > 64) fail("subscriber_queue_frames must be 1-64");
+  if (c.compressed_key_interval < 1 || c.compressed_key_interval > 1200) fail("compressed_key_interval must be 1-1200");
   if (c.publish_threads < 0 || c.publish_threads > 16) fail("publish_threads must be 0-16");
   if (!c.subscriber_tcp_congestion.empty() && !is_tcp_congestion_name(c.subscriber_tcp_congestion))
     fail("subscriber_tcp_congestion must be empty (the system's) or a Linux congestion control name such as reno, not \"" +

@@ -37,6 +37,7 @@ struct DaemonConfig {
   int publish_threads = 2;        // threads writing to TCP subscribers; 0 = the io thread (server/publish/publish_threads.h)
   std::string subscriber_tcp_congestion = "reno";  // on subscriber and HTTP connections; empty = the system's (server/tcp_congestion.h)
   int subscriber_queue_frames = 32;  // per subscriber at most; max_frame_wait_ms bounds their age
+  int compressed_key_interval = 10;  // frames between key frames of the compressed encoding
   int status_interval_ms = 1000;
   double default_rate_hz = 120.0;  // until the source says its rate
 };

@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include "protocol/file_error.h"
+#include "protocol/subscriber_model.h"
 #include "server/http/http_server.h"
 #include "server/ingest/file_replay_source.h"
 #include "server/ingest/vicon_multicast_source.h"
@@ -28,8 +29,10 @@ SubjectFile load_subject(const DaemonConfig& config) {
   return read_subject_file(config.subject);
 }
 
-subscriber::MeshInfo mesh_info_of(const SubjectFile& subject) {
+subscriber::MeshInfo mesh_info_of(const SubjectFile& subject, const std::string& path) {
   subscriber::MeshInfo info;
+  // The subject's name: its file's stem until subjects are named on the command line.
+  info.subject = std::filesystem::path(path).stem().string();
   const SubjectModel& model = subject.model;
   info.marker_count = static_cast<uint32_t>(model.marker_count());
   info.marker_names = model.marker_names;
@@ -81,6 +84,7 @@ nlohmann::json latency_summaries(const Metrics& metrics) {
   add("deform", metrics.deform);
   add("normals", metrics.normals);
   add("encode", metrics.encode);
+  add("encode_compressed", metrics.encode_compressed);
   add("receive_to_publish", metrics.receive_to_publish);
   add("subscriber_queue_wait", metrics.subscriber_queue_wait);
   add("subscriber_write", metrics.subscriber_write);
@@ -103,7 +107,7 @@ Daemon::Daemon(const DaemonConfig& config)
   hub_options.queue_frames = config.subscriber_queue_frames;
   hub_options.frame_max_wait = std::chrono::milliseconds(config.max_frame_wait_ms);
   hub_options.hello_timeout = std::chrono::milliseconds(config.hello_timeout_ms);
-  hub_ = std::make_unique<SubscriberHub>(metrics_, hub_options, mesh_info_of(subject_), subject_.deformation.has_value());
+  hub_ = std::make_unique<SubscriberHub>(metrics_, hub_options, mesh_info_of(subject_, config.subject), subject_.deformation.has_value());
 
   PipelineOptions pipeline_options;
   pipeline_options.lookahead = config.lookahead;
@@ -123,6 +127,7 @@ Daemon::Daemon(const DaemonConfig& config)
   pipeline_options.default_rate_hz = config.default_rate_hz;
   pipeline_options.filler.continuity_seconds = config.continuity_seconds;
   pipeline_options.filler.use_pca = config.use_pca;
+  pipeline_options.compressed_key_interval = config.compressed_key_interval;
   try {
     pipeline_ = std::make_unique<Pipeline>(model, subject_.deformation ? &*subject_.deformation : nullptr, pipeline_options,
                                            mailbox_, *hub_, metrics_);
@@ -130,7 +135,13 @@ Daemon::Daemon(const DaemonConfig& config)
     throw FileError(config.subject, std::string("deformation model unusable: ") + e.what());
   }
 
-  hub_->set_encoding_preparer([pipeline = pipeline_.get()](uint32_t frame_flags) { pipeline->prepare_encoding(frame_flags); });
+  hub_->set_encoding_preparer([pipeline = pipeline_.get()](StreamKey key) { pipeline->prepare_encoding(key); });
+  hub_->set_compressed_order(pipeline_->compressed_order());
+  if (const EvaluationModel* evaluation = pipeline_->evaluation_model()) {
+    hub_->set_model_message(std::make_shared<const std::vector<unsigned char>>(subscriber::encode_model(*evaluation)));
+    spdlog::info("parameter encoding: Model message of {} bytes ({} parts, {} RBF centres, {} influences)",
+                 hub_->model_message()->size(), evaluation->part_count(), evaluation->member_count(), evaluation->influence_count());
+  }
 
   if (!config.replay.empty()) {
     source_ = std::make_unique<FileReplaySource>(io_, model, config.replay, static_cast<FrameSink&>(*this), ReplayOptions{config.loop, config.speed});
@@ -268,6 +279,7 @@ void Daemon::on_frame(const MarkerFrame& in) {
   out.source_time_ns = in.source_time_ns;
   out.receive_time_ns = in.receive_time_ns;
   out.source_rate_hz = in.source_rate_hz;
+  out.timecode = in.timecode;
   out.unknown_labels = in.unknown_labels;
   int non_finite = 0;
   for (size_t m = 0; m < in.labelled.size(); ++m) {
@@ -346,6 +358,7 @@ void Daemon::broadcast_status() {
     status.state = code_of(state_);
     status.source_rate_hz = static_cast<float>(source_rate_hz_);
     status.detail = state_detail_;
+    status.subject_present = state_ == SourceState::Streaming;
   }
   status.frames_received = metrics_.frames_received.load();
   status.frames_published = metrics_.frames_published.load();
