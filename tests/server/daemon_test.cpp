@@ -133,7 +133,7 @@ TEST(Daemon, PublishesTheOfflineFillFrameByFrameInOrder) {
   });
   // The replay starts only once the subscriber listens, so it sees the take from its first frame.
   daemon.start_serving();
-  wait_until([&] { return daemon.hub().wanted_encodings() != 0; });
+  wait_until([&] { return !daemon.hub().wanted_encodings().empty(); });
   daemon.start_source();
   reader.join();
   daemon.stop();
@@ -181,7 +181,7 @@ TEST(Daemon, StalledSubscriberDoesNotHoldBackTheOthers) {
   stalled.set_option(asio::socket_base::receive_buffer_size(1024));
   stalled.connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), static_cast<unsigned short>(daemon.sub_port())));
   asio::write(stalled, asio::buffer(subscriber::encode_hello({.wants = subscriber::kWantMarkers})));
-  wait_until([&] { return daemon.hub().wanted_encodings() != 0; });
+  wait_until([&] { return !daemon.hub().wanted_encodings().empty(); });
 
   daemon.start_source();
   long received = 0;
@@ -255,7 +255,7 @@ TEST_P(DaemonPublishThreads, EverySubscriberGetsEveryFrameInOrderAndStopClosesTh
         return numbers[s].size() < kFrames;
       });
     });
-  wait_until([&] { return daemon.hub().subscriber_count() == kSubscribers + 1 && daemon.hub().wanted_encodings() != 0; });
+  wait_until([&] { return daemon.hub().subscriber_count() == kSubscribers + 1 && !daemon.hub().wanted_encodings().empty(); });
   daemon.start_source();
   for (std::thread& t : readers) t.join();
   daemon.stop();
@@ -321,7 +321,7 @@ TEST(Daemon, PacedSubscriberHasAtMostTheWindowInFlightAndGetsTheNewestFrameOnAck
   tcp::socket paced(io);
   paced.connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), static_cast<unsigned short>(daemon.sub_port())));
   asio::write(paced, asio::buffer(subscriber::encode_hello({.wants = subscriber::kWantMarkers | subscriber::kWantPaced})));
-  wait_until([&] { return daemon.hub().wanted_encodings() != 0; });
+  wait_until([&] { return !daemon.hub().wanted_encodings().empty(); });
   daemon.start_source();
   subscriber::StreamDecoder decoder;
   using std::chrono::milliseconds;
