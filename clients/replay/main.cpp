@@ -5,7 +5,7 @@
 //
 //   skinstream-replay [--protocol vicon|qtm|natnet] RECORDING... --port P [--rate HZ] [--speed X]
 //                     [--loop | --hold] [--subject NAME] [--multicast GROUP[:PORT]] [--multicast-ttl N]
-//                     [--start-now] [--unicast] [--natnet-version 3.1|4.0|4.1]
+//                     [--start-now] [--unicast] [--multicast-interface ADDR] [--natnet-version 3.1|4.0|4.1]
 //
 // Prints one JSON line {"port": N} on stdout once listening (port 0 picks a free one); logs go to
 // stderr. Errors are one line on stderr and a non-zero exit code.
@@ -52,6 +52,7 @@ struct Arguments {
   int max_queued = 4;
   std::string tcp_congestion;  // the system's
   bool unicast = false;           // NatNet
+  std::string multicast_interface;  // NatNet: the interface multicast leaves by; empty: the system's
   std::string natnet_version = "4.1";
 };
 
@@ -168,6 +169,7 @@ int run_qtm_or_natnet(const Arguments& args) {
       if (colon != std::string::npos) options.data_port = static_cast<uint16_t>(std::stoi(args.multicast.substr(colon + 1)));
     }
     options.multicast_ttl = args.multicast_ttl;
+    options.multicast_interface = args.multicast_interface;
     options.version = {args.natnet_version[0] - '0', args.natnet_version[2] - '0'};
     options.rate_hz = recordings.rate_hz;
     options.speed = args.speed;
@@ -243,6 +245,8 @@ int main(int argc, char** argv) {
   app.add_option("--multicast", args.multicast,
                  "vicon: also send every frame as UDP datagrams to GROUP[:PORT]; natnet: the group and data port "
                  "(default 239.255.42.99:1511)");
+  app.add_option("--multicast-interface", args.multicast_interface,
+                 "natnet: address of the interface multicast frames leave by (default: the system's choice)");
   app.add_flag("--unicast", args.unicast, "natnet: send frames to each connected client instead of multicast");
   app.add_option("--natnet-version", args.natnet_version, "natnet: the NatNet layout streamed")
       ->check(CLI::IsMember({"3.0", "3.1", "4.0", "4.1"}))
