@@ -28,6 +28,9 @@ std::string number_text(double value) {
   return ec == std::errc() ? std::string(buffer, end) : "0";
 }
 
+constexpr size_t kMaxTextBytes = 1024;  // a label or a number; QTM's own are far shorter
+constexpr size_t kMaxLabels = 100'000;  // QTM tracks a few thousand at most
+
 // What the parser is inside of; only the elements read are tracked, by their depth.
 struct ParseState {
   Parameters* out = nullptr;
@@ -81,7 +84,12 @@ void XMLCALL on_end(void* user, const XML_Char* name) {
     }
     if (is(name, "Label")) s.in_label = false;
   }
-  if (s.in_label && s.depth == 4 && is(name, "Name")) s.out->labels.push_back(s.text);
+  if (s.in_label && s.depth == 4 && is(name, "Name")) {
+    if (s.out->labels.size() >= kMaxLabels && s.error.empty())
+      s.error = "The_3D names more than " + std::to_string(kMaxLabels) + " labels";
+    else
+      s.out->labels.push_back(s.text);
+  }
   if (s.depth == 2) s.general_depth = s.the_3d_depth = 0;
   s.text.clear();
   --s.depth;
@@ -89,7 +97,11 @@ void XMLCALL on_end(void* user, const XML_Char* name) {
 
 void XMLCALL on_text(void* user, const XML_Char* text, int length) {
   auto& s = *static_cast<ParseState*>(user);
-  if (s.text.size() < 4096) s.text.append(text, static_cast<size_t>(length));  // longer is no label or number
+  if (s.text.size() + static_cast<size_t>(length) > kMaxTextBytes) {
+    if (s.error.empty()) s.error = "an element's text is longer than " + std::to_string(kMaxTextBytes) + " bytes";
+    return;
+  }
+  s.text.append(text, static_cast<size_t>(length));
 }
 
 }  // namespace

@@ -11,8 +11,9 @@
 //   </QTM_Parameters_Ver_1.19>
 //
 // The Label elements give the order of the positions in every 3D component. Parsing is by a real
-// XML parser (expat); a document that is not well formed, or whose Labels count disagrees with
-// its Label elements, is refused with a one-line reason.
+// XML parser (expat); a document that is not well formed, whose Labels count disagrees with its
+// Label elements, with an element's text over 1 kB or more than 100,000 labels is refused with a
+// one-line reason.
 
 #include <string>
 #include <string_view>

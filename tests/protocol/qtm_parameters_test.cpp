@@ -83,6 +83,9 @@ TEST(QtmParameters, MalformedOrInconsistentIsRefused) {
             std::string::npos);
   EXPECT_FALSE(parse_error("<R><The_3D><Labels>two</Labels></The_3D></R>").empty());
   EXPECT_FALSE(parse_error("<R><General><Frequency>nan</Frequency></General></R>").empty());
+  EXPECT_NE(parse_error("<R><The_3D><Label><Name>" + std::string(2000, 'x') + "</Name></Label></The_3D></R>")
+                .find("longer than 1024"),
+            std::string::npos);
   // Entity expansion (10^9 "a"s from a few hundred bytes) is stopped by expat, not performed.
   std::string bomb = "<?xml version=\"1.0\"?><!DOCTYPE R [<!ENTITY e0 \"aaaaaaaaaa\">";
   for (int i = 1; i < 10; ++i) {
