@@ -7,6 +7,7 @@
 
 #include "protocol/natnet_reader.h"
 #include "protocol/natnet_writer.h"
+#include "server/ingest/source_reconnection.h"
 
 namespace skinstream::server {
 namespace {
@@ -37,10 +38,9 @@ struct NatNetSource::State : std::enable_shared_from_this<NatNetSource::State> {
         command_socket(io),
         data_socket(io),
         resolver(io),
-        backoff_timer(io),
         watchdog(io),
         keep_alive_timer(io),
-        backoff(options.initial_backoff_seconds) {
+        reconnection(io, sink, options.initial_backoff_seconds, options.max_backoff_seconds) {
     command_buffer.resize(natnet::kMaxMessageBytes);
     data_buffer.resize(natnet::kMaxMessageBytes);
   }
@@ -51,7 +51,8 @@ struct NatNetSource::State : std::enable_shared_from_this<NatNetSource::State> {
   udp::socket command_socket;  // requests out; answers, and unicast frames, in
   udp::socket data_socket;     // multicast frames
   udp::resolver resolver;
-  asio::steady_timer backoff_timer, watchdog, keep_alive_timer;
+  asio::steady_timer watchdog, keep_alive_timer;
+  SourceReconnection reconnection;
   udp::endpoint server;
   udp::endpoint command_sender, data_sender;
   std::vector<unsigned char> command_buffer, data_buffer;
@@ -63,13 +64,10 @@ struct NatNetSource::State : std::enable_shared_from_this<NatNetSource::State> {
   std::unordered_map<std::string, size_t> subject_of;  // marker set name -> subject index
   Phase phase = Phase::ServerInfo;
   Clock::time_point phase_start, last_heard, last_model_request;
-  bool streaming = false;
-  bool disconnected_reported = false;
   bool have_previous = false;
   int32_t previous_frame_number = 0;
   double previous_timestamp = 0.0;
   uint64_t generation = 0;
-  double backoff;
   std::atomic<bool> stopped{false};
 
   std::string where() const { return options.host + ":" + std::to_string(options.command_port); }
@@ -79,7 +77,6 @@ struct NatNetSource::State : std::enable_shared_from_this<NatNetSource::State> {
     const uint64_t gen = ++generation;
     phase = Phase::ServerInfo;
     phase_start = Clock::now();
-    streaming = false;
     have_previous = false;
     resolver.async_resolve(udp::v4(), options.host, std::to_string(options.command_port),
                            [self = shared_from_this(), gen](const boost::system::error_code& ec,
@@ -269,12 +266,7 @@ struct NatNetSource::State : std::enable_shared_from_this<NatNetSource::State> {
     frame.timecode.frames = static_cast<uint8_t>(tc.frames);
     frame.timecode.subframe = static_cast<uint16_t>(data.timecode_subframe);
     frame.receive_time_ns = system_now_ns();
-    if (!streaming) {
-      streaming = true;
-      disconnected_reported = false;
-      backoff = options.initial_backoff_seconds;
-      sink.on_source_state(SourceState::Streaming, where());
-    }
+    reconnection.frame_arrived(where());
     sink.on_frame(frame);
   }
 
@@ -322,15 +314,8 @@ struct NatNetSource::State : std::enable_shared_from_this<NatNetSource::State> {
     if (stopped || gen != generation) return;
     ++generation;
     close_sockets();
-    streaming = false;
-    if (!disconnected_reported) {
-      disconnected_reported = true;
-      sink.on_source_state(SourceState::Disconnected, reason);
-    }
-    backoff_timer.expires_after(std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(backoff)));
-    backoff = std::min(backoff * 2.0, options.max_backoff_seconds);
-    backoff_timer.async_wait([self = shared_from_this()](const boost::system::error_code& ec) {
-      if (!ec && !self->stopped) self->connect();
+    reconnection.failed(reason, [self = shared_from_this()] {
+      if (!self->stopped) self->connect();
     });
   }
 };
@@ -351,7 +336,7 @@ void NatNetSource::start() {
 void NatNetSource::stop() {
   if (state_->stopped.exchange(true)) return;
   asio::post(state_->io, [state = state_] {
-    state->backoff_timer.cancel();
+    state->reconnection.cancel();
     state->close_sockets();
   });
 }

@@ -11,6 +11,7 @@
 #include "protocol/qtm_packet_reader.h"
 #include "protocol/qtm_packet_writer.h"
 #include "protocol/qtm_parameters.h"
+#include "server/ingest/source_reconnection.h"
 
 namespace skinstream::server {
 namespace {
@@ -48,9 +49,8 @@ struct QtmSource::State : std::enable_shared_from_this<QtmSource::State> {
         socket(io),
         udp_socket(io),
         resolver(io),
-        timer(io),
         stall_timer(io),
-        backoff(options.initial_backoff_seconds) {
+        reconnection(io, sink, options.initial_backoff_seconds, options.max_backoff_seconds) {
     udp_buffer.resize(qtm::kMaxPacketBytes < 65536 ? qtm::kMaxPacketBytes : 65536);
   }
 
@@ -60,8 +60,8 @@ struct QtmSource::State : std::enable_shared_from_this<QtmSource::State> {
   tcp::socket socket;
   udp::socket udp_socket;
   tcp::resolver resolver;
-  asio::steady_timer timer;
   asio::steady_timer stall_timer;
+  SourceReconnection reconnection;
   qtm::PacketFramer framer;
   std::vector<unsigned char> udp_buffer;
   qtm::DataFrame data;
@@ -71,11 +71,8 @@ struct QtmSource::State : std::enable_shared_from_this<QtmSource::State> {
   Phase phase = Phase::Welcome;
   bool have_labels = false;
   bool parameters_pending = false;  // a GetParameters is on its way; mismatching frames wait for it
-  bool streaming = false;
-  bool disconnected_reported = false;
   uint64_t generation = 0;  // bumps with every connection: stale handlers see another one
   int64_t last_frame_ns = 0;
-  double backoff;
   std::atomic<bool> stopped{false};
 
   std::string where() const { return options.host + ":" + std::to_string(options.port); }
@@ -86,7 +83,6 @@ struct QtmSource::State : std::enable_shared_from_this<QtmSource::State> {
     framer.reset();
     framer.reserve(2 * kReadBytes);
     phase = Phase::Welcome;
-    streaming = false;
     parameters_pending = false;
     resolver.async_resolve(
         options.host, std::to_string(options.port),
@@ -173,7 +169,7 @@ struct QtmSource::State : std::enable_shared_from_this<QtmSource::State> {
       }
       case qtm::PacketType::NoMoreData:
         sink.on_source_state(SourceState::Finished, "QTM has no more frames (" + where() + ")");
-        streaming = false;
+        reconnection.frames_stopped();
         return true;
       default:
         sink.on_bad_input("unknown_packet", std::string("QTM: skipping a packet of type ") + std::to_string(type) +
@@ -339,12 +335,7 @@ struct QtmSource::State : std::enable_shared_from_this<QtmSource::State> {
     frame.frame_number = data.frame_number;
     frame.source_time_ns = data.timestamp_us * 1000;
     frame.receive_time_ns = last_frame_ns = system_now_ns();
-    if (!streaming) {
-      streaming = true;
-      disconnected_reported = false;
-      backoff = options.initial_backoff_seconds;
-      sink.on_source_state(SourceState::Streaming, where());
-    }
+    reconnection.frame_arrived(where());
     sink.on_frame(frame);
   }
 
@@ -354,7 +345,7 @@ struct QtmSource::State : std::enable_shared_from_this<QtmSource::State> {
     stall_timer.async_wait([self = shared_from_this(), gen](const boost::system::error_code& ec) {
       if (ec || self->stopped || gen != self->generation) return;
       const auto silent = std::chrono::nanoseconds(system_now_ns() - self->last_frame_ns);
-      if (self->streaming && silent > self->options.stall_timeout)
+      if (self->reconnection.streaming() && silent > self->options.stall_timeout)
         return self->fail(gen, "no frame from " + self->where() + " for " +
                                    std::to_string(std::chrono::duration_cast<std::chrono::milliseconds>(silent).count()) +
                                    " ms");
@@ -385,16 +376,8 @@ struct QtmSource::State : std::enable_shared_from_this<QtmSource::State> {
     if (stopped || gen != generation) return;
     ++generation;
     close_sockets();
-    streaming = false;
-    if (!disconnected_reported) {
-      disconnected_reported = true;
-      sink.on_source_state(SourceState::Disconnected, reason);
-    }
-    timer.expires_after(std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-        std::chrono::duration<double>(backoff)));
-    backoff = std::min(backoff * 2.0, options.max_backoff_seconds);
-    timer.async_wait([self = shared_from_this()](const boost::system::error_code& ec) {
-      if (!ec && !self->stopped) self->connect();
+    reconnection.failed(reason, [self = shared_from_this()] {
+      if (!self->stopped) self->connect();
     });
   }
 };
@@ -415,7 +398,7 @@ void QtmSource::start() {
 void QtmSource::stop() {
   if (state_->stopped.exchange(true)) return;
   asio::post(state_->io, [state = state_] {
-    state->timer.cancel();
+    state->reconnection.cancel();
     state->close_sockets();
   });
 }

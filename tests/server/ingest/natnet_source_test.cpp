@@ -12,6 +12,7 @@
 #include "protocol/natnet_writer.h"
 #include "server/ingest/natnet_source.h"
 #include "server/natnet/natnet_server.h"
+#include "support/replay_capture.h"
 #include "support/source_sink_recorder.h"
 
 namespace skinstream::server {
@@ -20,16 +21,6 @@ namespace {
 using namespace std::chrono_literals;
 using test::IoThread;
 using test::SourceSinkRecorder;
-
-Capture synthetic_capture(int frames, double offset) {
-  Capture c({"A", "B", "*3"}, frames, 120.0);
-  c.first_frame = 100;
-  for (int f = 0; f < frames; ++f)
-    for (int p = 0; p < c.point_count(); ++p)
-      c.at(f, p) = Vec3(std::sin(0.1 * f + p) * 1000.0 / 3.0 + offset, p * 17.25 + f / 7.0, std::cos(0.05 * f) * 1e3);
-  for (int f = 0; f < frames; f += 3) c.at(f, 1) = missing_point();  // B occluded every third frame
-  return c;
-}
 
 NatNetServerOptions unicast_server(natnet::Version version, uint16_t port = 0) {
   NatNetServerOptions o;
@@ -91,7 +82,7 @@ void expect_frames_match(SourceSinkRecorder& sink, const Capture& walker, const 
 class NatNetLayouts : public ::testing::TestWithParam<natnet::Version> {};
 
 TEST_P(NatNetLayouts, UnicastStreamsMarkerSetsInMillimetres) {
-  const Capture walker = synthetic_capture(60, 0.0), runner = synthetic_capture(60, 500.0);
+  const Capture walker = test::replay_capture(60, 0.0), runner = test::replay_capture(60, 500.0);
   IoThread server_io, client_io;
   NatNetServer server(server_io.io, {{"walker", &walker}, {"runner_2", &runner}}, unicast_server(GetParam()));
   server_io.call([&] { server.start(); });
@@ -112,7 +103,7 @@ INSTANTIATE_TEST_SUITE_P(Versions, NatNetLayouts,
                          });
 
 TEST(NatNetSource, Multicast) {
-  const Capture walker = synthetic_capture(60, 0.0), runner = synthetic_capture(60, 500.0);
+  const Capture walker = test::replay_capture(60, 0.0), runner = test::replay_capture(60, 500.0);
   IoThread server_io, client_io;
   NatNetServerOptions options = unicast_server({4, 1});
   options.multicast = true;
@@ -137,7 +128,7 @@ TEST(NatNetSource, Multicast) {
 }
 
 TEST(NatNetSource, AServerThatVanishesIsReportedAndFoundAgain) {
-  const Capture walker = synthetic_capture(60, 0.0);
+  const Capture walker = test::replay_capture(60, 0.0);
   IoThread server_io, client_io;
   auto server = std::make_unique<NatNetServer>(server_io.io, std::vector<ReplaySubject>{{"walker", &walker}},
                                                unicast_server({4, 1}));
@@ -205,7 +196,7 @@ natnet::ByteVector unicast_info() {
 }
 
 TEST(NatNetSource, MalformedTruncatedAndUnknownInputIsReportedAndSurvived) {
-  const Capture walker = synthetic_capture(10, 0.0);
+  const Capture walker = test::replay_capture(10, 0.0);
   natnet::CaptureEncoder encoder({{"walker", &walker}});
   natnet::CaptureEncoder stranger_encoder({{"stranger", &walker}});
   int answered_definitions = 0;
@@ -280,7 +271,7 @@ TEST(NatNetSource, NoAnswerAndOldServersDisconnect) {
 }
 
 TEST(NatNetServer, CountsMalformedDatagramsAndAnswersTheRest) {
-  const Capture walker = synthetic_capture(10, 0.0);
+  const Capture walker = test::replay_capture(10, 0.0);
   IoThread server_io;
   NatNetServer server(server_io.io, {{"walker", &walker}}, unicast_server({3, 1}));
   server_io.call([&] { server.start(); });

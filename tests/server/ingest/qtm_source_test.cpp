@@ -14,6 +14,7 @@
 #include "protocol/qtm_parameters.h"
 #include "server/ingest/qtm_source.h"
 #include "server/qtm/qtm_server.h"
+#include "support/replay_capture.h"
 #include "support/source_sink_recorder.h"
 
 namespace skinstream::server {
@@ -22,17 +23,6 @@ namespace {
 using namespace std::chrono_literals;
 using test::IoThread;
 using test::SourceSinkRecorder;
-
-// Labelled, occluded and unlabelled channels with non-round coordinates.
-Capture synthetic_capture(int frames, double offset) {
-  Capture c({"A", "B", "*3"}, frames, 120.0);
-  c.first_frame = 100;
-  for (int f = 0; f < frames; ++f)
-    for (int p = 0; p < c.point_count(); ++p)
-      c.at(f, p) = Vec3(std::sin(0.1 * f + p) * 1000.0 / 3.0 + offset, p * 17.25 + f / 7.0, std::cos(0.05 * f) * 1e3);
-  for (int f = 0; f < frames; f += 3) c.at(f, 1) = missing_point();  // B occluded every third frame
-  return c;
-}
 
 QtmServerOptions fast_server(uint16_t port = 0) {
   QtmServerOptions o;
@@ -57,7 +47,7 @@ void expect_near(const Vec3& got, const Vec3& want) {
 }
 
 TEST(QtmSource, StreamsSeveralSubjectsAsRecorded) {
-  const Capture walker = synthetic_capture(60, 0.0), runner = synthetic_capture(60, 500.0);
+  const Capture walker = test::replay_capture(60, 0.0), runner = test::replay_capture(60, 500.0);
   IoThread server_io, client_io;
   QtmServer server(server_io.io, {{"walker", &walker}, {"runner_2", &runner}}, fast_server());
   server_io.call([&] { server.start(); });
@@ -98,7 +88,7 @@ TEST(QtmSource, StreamsSeveralSubjectsAsRecorded) {
 }
 
 TEST(QtmSource, StreamsOverUdp) {
-  const Capture walker = synthetic_capture(60, 0.0);
+  const Capture walker = test::replay_capture(60, 0.0);
   IoThread server_io, client_io;
   QtmServer server(server_io.io, {{"walker", &walker}}, fast_server());
   server_io.call([&] { server.start(); });
@@ -119,7 +109,7 @@ TEST(QtmSource, StreamsOverUdp) {
 }
 
 TEST(QtmSource, AServerThatVanishesIsReportedAndFoundAgain) {
-  const Capture walker = synthetic_capture(60, 0.0);
+  const Capture walker = test::replay_capture(60, 0.0);
   IoThread server_io, client_io;
   auto server = std::make_unique<QtmServer>(server_io.io, std::vector<ReplaySubject>{{"walker", &walker}}, fast_server());
   server_io.call([&] { server->start(); });
@@ -290,7 +280,7 @@ TEST(QtmSource, WrongMarkerCountAsksForTheLabelsAgainAndInfinityIsMissing) {
 }
 
 TEST(QtmServer, RefusesWhatItCannotDoAndClosesOnGarbage) {
-  const Capture walker = synthetic_capture(10, 0.0);
+  const Capture walker = test::replay_capture(10, 0.0);
   IoThread server_io;
   QtmServer server(server_io.io, {{"walker", &walker}}, fast_server());
   server_io.call([&] { server.start(); });
