@@ -7,6 +7,7 @@
 
 #include "protocol/natnet_reader.h"
 #include "protocol/natnet_writer.h"
+#include "server/ingest/source_lifecycle.h"
 #include "server/ingest/source_reconnection.h"
 
 namespace skinstream::server {
@@ -310,14 +311,7 @@ struct NatNetSource::State : std::enable_shared_from_this<NatNetSource::State> {
     data_socket.close(ignored);
   }
 
-  void fail(uint64_t gen, const std::string& reason) {
-    if (stopped || gen != generation) return;
-    ++generation;
-    close_sockets();
-    reconnection.failed(reason, [self = shared_from_this()] {
-      if (!self->stopped) self->connect();
-    });
-  }
+  void fail(uint64_t gen, const std::string& reason) { fail_connection(shared_from_this(), gen, reason); }
 };
 
 NatNetSource::NatNetSource(asio::io_context& io, NatNetSourceOptions options, SourceSink& sink)
@@ -325,20 +319,7 @@ NatNetSource::NatNetSource(asio::io_context& io, NatNetSourceOptions options, So
 
 NatNetSource::~NatNetSource() { stop(); }
 
-void NatNetSource::start() {
-  asio::post(state_->io, [state = state_] {
-    if (state->stopped) return;
-    state->sink.on_source_state(SourceState::Connecting, state->where());
-    state->connect();
-  });
-}
-
-void NatNetSource::stop() {
-  if (state_->stopped.exchange(true)) return;
-  asio::post(state_->io, [state = state_] {
-    state->reconnection.cancel();
-    state->close_sockets();
-  });
-}
+void NatNetSource::start() { start_source(state_); }
+void NatNetSource::stop() { stop_source(state_); }
 
 }  // namespace skinstream::server

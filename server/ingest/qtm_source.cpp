@@ -11,6 +11,7 @@
 #include "protocol/qtm_packet_reader.h"
 #include "protocol/qtm_packet_writer.h"
 #include "protocol/qtm_parameters.h"
+#include "server/ingest/source_lifecycle.h"
 #include "server/ingest/source_reconnection.h"
 
 namespace skinstream::server {
@@ -372,14 +373,7 @@ struct QtmSource::State : std::enable_shared_from_this<QtmSource::State> {
     udp_socket.close(ignored);
   }
 
-  void fail(uint64_t gen, const std::string& reason) {
-    if (stopped || gen != generation) return;
-    ++generation;
-    close_sockets();
-    reconnection.failed(reason, [self = shared_from_this()] {
-      if (!self->stopped) self->connect();
-    });
-  }
+  void fail(uint64_t gen, const std::string& reason) { fail_connection(shared_from_this(), gen, reason); }
 };
 
 QtmSource::QtmSource(asio::io_context& io, QtmSourceOptions options, SourceSink& sink)
@@ -387,20 +381,7 @@ QtmSource::QtmSource(asio::io_context& io, QtmSourceOptions options, SourceSink&
 
 QtmSource::~QtmSource() { stop(); }
 
-void QtmSource::start() {
-  asio::post(state_->io, [state = state_] {
-    if (state->stopped) return;
-    state->sink.on_source_state(SourceState::Connecting, state->where());
-    state->connect();
-  });
-}
-
-void QtmSource::stop() {
-  if (state_->stopped.exchange(true)) return;
-  asio::post(state_->io, [state = state_] {
-    state->reconnection.cancel();
-    state->close_sockets();
-  });
-}
+void QtmSource::start() { start_source(state_); }
+void QtmSource::stop() { stop_source(state_); }
 
 }  // namespace skinstream::server
