@@ -164,9 +164,9 @@ int run_qtm_or_natnet(const Arguments& args) {
     options.command_port = static_cast<uint16_t>(args.port < 0 ? natnet::kCommandPort : args.port);
     options.multicast = !args.unicast;
     if (!args.multicast.empty()) {
-      const auto colon = args.multicast.rfind(':');
-      options.multicast_group = args.multicast.substr(0, colon);
-      if (colon != std::string::npos) options.data_port = static_cast<uint16_t>(std::stoi(args.multicast.substr(colon + 1)));
+      const auto [group, data_port] = split_address(args.multicast);
+      options.multicast_group = group;
+      if (args.multicast.find(':') != std::string::npos) options.data_port = data_port;
     }
     options.multicast_ttl = args.multicast_ttl;
     options.multicast_interface = args.multicast_interface;
