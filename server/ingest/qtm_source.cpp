@@ -52,7 +52,7 @@ struct QtmSource::State : std::enable_shared_from_this<QtmSource::State> {
         resolver(io),
         stall_timer(io),
         reconnection(io, sink, options.initial_backoff_seconds, options.max_backoff_seconds) {
-    udp_buffer.resize(qtm::kMaxPacketBytes < 65536 ? qtm::kMaxPacketBytes : 65536);
+    udp_buffer.resize(65536);  // one datagram at most
   }
 
   asio::io_context& io;
