@@ -145,8 +145,10 @@ struct NatNetServer::State : std::enable_shared_from_this<NatNetServer::State> {
         clients.erase(std::remove_if(clients.begin(), clients.end(), [&](const Client& c) { return c.endpoint == from; }),
                       clients.end());
         break;
-      default:
+      case natnet::message::Request:  // text commands (TimelinePlay, Bitstream, ...): a replay takes none
         reply(natnet::encode_empty(natnet::message::UnrecognizedRequest), from);
+        break;
+      default:  // answers and frames from another server: never answered, so two servers cannot ping-pong
         break;
     }
   }

@@ -10,6 +10,7 @@
 //   KEEPALIVE             keeps a unicast client (one silent for client_timeout is dropped)
 //   DISCONNECT            drops the client
 //   REQUEST (text)        UNRECOGNIZED_REQUEST: a replay takes no text commands
+//   anything else         ignored (never answered)
 // Frames go to group:data_port (multicast), or to every connected client's command socket
 // (unicast), on the replay clock (server/replay/replay_timeline.h). The timeline starts with the
 // first CONNECT unless start_on_first_request is false. Malformed datagrams are counted, logged at

@@ -92,6 +92,7 @@ TEST_P(NatNetLayouts, UnicastStreamsMarkerSetsInMillimetres) {
   ASSERT_TRUE(sink.wait_frames(30));
   source.stop();
   client_io.call([] {});
+  server_io.call([&] { server.stop(); });  // on its own thread, before it is destroyed
   expect_frames_match(sink, walker, runner);
   EXPECT_EQ(server.stats().clients_connected.load(), 1u);
 }
@@ -121,6 +122,7 @@ TEST(NatNetSource, Multicast) {
                                           sink.count_state(SourceState::Disconnected) > 0; });
   source.stop();
   client_io.call([] {});
+  server_io.call([&] { server.stop(); });  // on its own thread, before it is destroyed
   if (!got || sink.frames.size() < 20)
     GTEST_SKIP() << "multicast is not looped back here: " << sink.last_detail(SourceState::Disconnected);
   expect_frames_match(sink, walker, runner);
@@ -297,6 +299,7 @@ TEST(NatNetServer, CountsMalformedDatagramsAndAnswersTheRest) {
   ASSERT_TRUE(natnet::read_message({buffer.data(), n2}, id, payload, error)) << error;
   EXPECT_EQ(id, natnet::message::UnrecognizedRequest);
   EXPECT_EQ(server.stats().bad_datagrams.load(), 2u);
+  server_io.call([&] { server.stop(); });
 }
 
 }  // namespace

@@ -57,6 +57,7 @@ TEST(QtmSource, StreamsSeveralSubjectsAsRecorded) {
   ASSERT_TRUE(sink.wait_frames(30));
   source.stop();
   client_io.call([] {});
+  server_io.call([&] { server.stop(); });  // on its own thread, before it is destroyed
 
   std::lock_guard lock(sink.mutex);
   ASSERT_TRUE(sink.count_state(SourceState::Streaming) == 1);
@@ -104,6 +105,8 @@ TEST(QtmSource, StreamsOverUdp) {
   source.start();
   ASSERT_TRUE(sink.wait_frames(10));
   source.stop();
+  client_io.call([] {});  // no handler of the source runs after this: the sink may go
+  server_io.call([&] { server.stop(); });  // on its own thread, before it is destroyed
   EXPECT_GE(server.stats().datagrams_sent.load(), 10u);
   EXPECT_EQ(server.stats().frame_packets_sent.load(), 0u);  // no frame came over TCP
 }
@@ -317,6 +320,7 @@ TEST(QtmServer, RefusesWhatItCannotDoAndClosesOnGarbage) {
   EXPECT_EQ(ec, asio::error::eof);
   EXPECT_EQ(server.stats().bad_clients.load(), 1u);
   EXPECT_EQ(server.stats().commands_refused.load(), 3u);
+  server_io.call([&] { server.stop(); });
 }
 
 }  // namespace
