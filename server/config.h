@@ -20,6 +20,9 @@ struct DaemonConfig {
   std::string vicon;              // HOST:PORT of a Vicon DataStream server; empty = none
   bool vicon_pull = false;        // Vicon: ask for each frame instead of server push
   std::string vicon_multicast;    // GROUP:PORT (or this host's address:PORT) of Vicon UDP datagrams; empty = none
+  std::string qtm;                // HOST[:PORT] of a QTM RT server (its little-endian port, 22223); empty = none
+  std::string natnet;             // HOST[:PORT] of a NatNet server's command port (1510); empty = none
+  std::string natnet_interface = "0.0.0.0";  // NatNet: this host's address to join the multicast group on
   std::string bind_address = "0.0.0.0";
   int http_port = 8480;           // 0 = ephemeral
   int sub_port = 8481;            // 0 = ephemeral
@@ -63,6 +66,8 @@ struct HostPort {
   uint16_t port = 0;
 };
 std::optional<HostPort> parse_host_port(const std::string& text);
+// "HOST" (with `default_port`) or "HOST:PORT" as parse_host_port: the form of the qtm and natnet keys.
+std::optional<HostPort> parse_host_with_port(const std::string& text, uint16_t default_port);
 
 struct CommandLine {
   DaemonConfig config;

@@ -1,7 +1,8 @@
 #pragma once
-// One frame of markers as a source (Vicon DataStream client, multicast receiver, file replay)
-// hands it to the pipeline, already in the subject's marker order. Sized once for the subject
-// (labelled = marker count, unlabelled capacity fixed) and reused: filling it allocates nothing.
+// One frame of one subject's markers as the pipeline takes it, in the subject's marker order: a
+// source's SourceFrame after SubjectRouter matched its labels to the subject's markers. Sized
+// once for the subject (labelled = marker count, unlabelled capacity fixed) and reused: filling
+// it allocates nothing.
 
 #include <cstdint>
 #include <vector>
@@ -26,7 +27,7 @@ struct MarkerFrame {
   int unlabelled_count = 0;
 
   int unknown_labels = 0;            // labelled points whose name the subject does not have
-  int rejected_points = 0;           // non-finite or beyond capacity
+  int rejected_points = 0;           // neither a position nor NaN, or beyond the unlabelled capacity
 
   explicit MarkerFrame(int marker_count = 0) { resize(marker_count); }
   void resize(int marker_count) {

@@ -11,7 +11,6 @@
 
 #include <memory>
 #include <string>
-#include <vector>
 
 #include "protocol/vicon_datastream.h"
 #include "server/asio.h"
@@ -28,8 +27,7 @@ struct ViconMulticastSourceOptions {
 
 class ViconMulticastSource : public FrameSource {
  public:
-  ViconMulticastSource(asio::io_context& io, ViconMulticastSourceOptions options,
-                       std::vector<std::string> marker_names, FrameSink& sink);
+  ViconMulticastSource(asio::io_context& io, ViconMulticastSourceOptions options, SourceSink& sink);
   ~ViconMulticastSource() override;
 
   void start() override;  // binds the port (reporting Disconnected with the reason on failure)

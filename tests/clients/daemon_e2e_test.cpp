@@ -369,10 +369,11 @@ TEST_F(DaemonProgram, SigtermStopsCleanlyWithMarkersOnly) {
   EXPECT_NE(daemon.log().find("no deformation model"), std::string::npos) << daemon.log();
 }
 
-// skinstream-replay -> skinstreamd --vicon -> skinstream-sub, in both Vicon modes: frames arrive
-// in order, and a measured marker is the recording's sample of the same frame number (so the
-// numbering and the marker mapping survive the DataStream round trip).
-enum class ViconMode { Push, Pull, Multicast };
+// skinstream-replay -> skinstreamd --vicon -> skinstream-sub, in both Vicon modes (and the same
+// with --qtm and --natnet): frames arrive in order, and a measured marker is the recording's
+// sample of the same frame number (so the numbering and the marker mapping survive the round trip
+// through each capture system's protocol).
+enum class ViconMode { Push, Pull, Multicast, Qtm, NatNet };
 
 // A UDP port free on loopback right now: bound, noted, closed.
 int free_udp_port() {
@@ -400,6 +401,14 @@ void expect_vicon_stream_in_order(const std::string& subject, const std::string&
     daemon_process = std::make_unique<DaemonProcess>("--subject " + subject + " --vicon-multicast 127.0.0.1:" + std::to_string(udp_port));
     replay = std::make_unique<ReplayProcess>(take, 0, "--multicast 127.0.0.1:" + std::to_string(udp_port) + " --start-now");
     expected_log = "multicast";
+  } else if (mode == ViconMode::Qtm) {
+    replay = std::make_unique<ReplayProcess>(take, 0, "--protocol qtm");
+    daemon_process = std::make_unique<DaemonProcess>("--subject " + subject + " --qtm 127.0.0.1:" + std::to_string(replay->port));
+    expected_log = "source: QTM RT";
+  } else if (mode == ViconMode::NatNet) {
+    replay = std::make_unique<ReplayProcess>(take, 0, "--protocol natnet --unicast");
+    daemon_process = std::make_unique<DaemonProcess>("--subject " + subject + " --natnet 127.0.0.1:" + std::to_string(replay->port));
+    expected_log = "source: NatNet";
   } else {
     replay = std::make_unique<ReplayProcess>(take, 0);
     daemon_process = std::make_unique<DaemonProcess>("--subject " + subject + " --vicon 127.0.0.1:" + std::to_string(replay->port) +
@@ -439,7 +448,8 @@ void expect_vicon_stream_in_order(const std::string& subject, const std::string&
       const Vec3 sample = recording.at(index, m);
       if (!is_present(sample)) continue;
       ++measured;
-      // Measured samples pass through unchanged (C3D float -> Vicon double -> published float).
+      // Measured samples pass through unchanged (C3D float -> Vicon double / QTM float / NatNet
+      // float metres -> published float), NatNet's metres within 0.2 um.
       const Vec3 got(live[3 * m], live[3 * m + 1], live[3 * m + 2]);
       if ((got - sample).norm() < 1e-3) ++measured_equal;
     }
@@ -454,6 +464,10 @@ TEST_F(DaemonProgram, ViconServerPushReachesTheSubscriberInOrder) { expect_vicon
 TEST_F(DaemonProgram, ViconClientPullReachesTheSubscriberInOrder) { expect_vicon_stream_in_order(subject_, take_, ViconMode::Pull); }
 
 TEST_F(DaemonProgram, ViconUdpDatagramsReachTheSubscriberInOrder) { expect_vicon_stream_in_order(subject_, take_, ViconMode::Multicast); }
+
+TEST_F(DaemonProgram, QtmReachesTheSubscriberInOrder) { expect_vicon_stream_in_order(subject_, take_, ViconMode::Qtm); }
+
+TEST_F(DaemonProgram, NatNetReachesTheSubscriberInOrder) { expect_vicon_stream_in_order(subject_, take_, ViconMode::NatNet); }
 
 TEST_F(DaemonProgram, ViconUnreachableIsReportedAndServingGoesOn) {
   // A port nobody listens on: bind one, note it, close it.
