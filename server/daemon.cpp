@@ -176,15 +176,16 @@ Daemon::Daemon(const DaemonConfig& config)
     auto subscriber = std::make_shared<TcpSubscriber>(placed.io, *hub_, std::move(socket), remote, std::move(placed.token));
     hub_->add(subscriber);
     asio::post(placed.io, [subscriber] { subscriber->start(); });
-  }, config.subscriber_tcp_congestion);
+  }, ListenerOptions{config.subscriber_tcp_congestion, &metrics_, &descriptor_reserve_, false});
   HttpRoutes routes;
   routes.health_json = [this] { return health_json(); };
   routes.metrics_text = [this] { return metrics_.render_prometheus(hub_->subscriber_metrics()); };
   routes.web_root = config.web_root;
   if (!config.web_root.empty() && !std::filesystem::is_directory(config.web_root))
     throw FileError(config.web_root, "web root is not a directory");
+  // Out of descriptors, the HTTP port spends the reserve: /health answers while subscribers hold the rest.
   http_ = std::make_unique<HttpServer>(io_, config.bind_address, config.http_port, *hub_, std::move(routes),
-                                       config.subscriber_tcp_congestion);
+                                       ListenerOptions{config.subscriber_tcp_congestion, &metrics_, &descriptor_reserve_, true});
 }
 
 Daemon::~Daemon() { stop(); }
