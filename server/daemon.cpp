@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include "protocol/file_error.h"
+#include "protocol/printable_text.h"
 #include "server/http/http_server.h"
 #include "server/ingest/file_replay_source.h"
 #include "server/ingest/vicon_multicast_source.h"
@@ -64,6 +65,14 @@ ViconSourceOptions vicon_options_of(const DaemonConfig& config) {
   options.port = address.port;
   options.mode = config.vicon_pull ? ViconSourceOptions::Mode::ClientPull : ViconSourceOptions::Mode::ServerPush;
   return options;
+}
+
+vicon::DescriptionLimits description_limits_of(const DaemonConfig& config) {
+  vicon::DescriptionLimits limits;
+  limits.max_subjects = static_cast<uint32_t>(config.source_max_subjects);
+  limits.max_markers_per_subject = static_cast<uint32_t>(config.source_max_markers_per_subject);
+  limits.max_name_bytes = static_cast<uint32_t>(config.source_max_name_bytes);
+  return limits;
 }
 
 subscriber::SourceStateCode code_of(SourceState s) { return static_cast<subscriber::SourceStateCode>(static_cast<uint32_t>(s)); }
@@ -139,6 +148,7 @@ Daemon::Daemon(const DaemonConfig& config)
     ViconMulticastSourceOptions options;
     options.group = address.host;
     options.port = address.port;
+    options.limits = description_limits_of(config);
     spdlog::info("source: Vicon DataStream multicast {}:{} (receive only)", options.group, options.port);
     source_ = std::make_unique<ViconMulticastSource>(io_, std::move(options), model.marker_names, static_cast<FrameSink&>(*this));
   } else if (!config.vicon.empty()) {
@@ -337,7 +347,8 @@ void Daemon::on_bad_input(std::string_view what, std::string_view detail) {
 
 void Daemon::on_unknown_label(std::string_view name) {
   metrics_.count_bad_input("unknown_label");
-  spdlog::info("source: label \"{}\" is not a marker of the subject: used as an unlabelled point", name);
+  // Rate-limited and made printable: the names come from the source, which may send thousands.
+  bad_input_log_.warn("unknown_label", "source label " + quoted_text(name) + " is not a marker of the subject: used as an unlabelled point");
 }
 
 void Daemon::broadcast_status() {
@@ -386,6 +397,10 @@ std::string Daemon::health_json() const {
       {"publish_threads", publish_.count()},
       {"subscriber_tcp_congestion", config_.subscriber_tcp_congestion},  // empty: the system's
       {"subject", {{"markers", subject_.model.marker_count()}, {"vertices", pipeline_->vertex_count()}}},
+      {"source_limits",
+       {{"max_subjects", config_.source_max_subjects},
+        {"max_markers_per_subject", config_.source_max_markers_per_subject},
+        {"max_name_bytes", config_.source_max_name_bytes}}},
       {"latency_ms", latency_summaries(metrics_)}};
   return health.dump();
 }

@@ -418,6 +418,9 @@ TEST(Daemon, ServesHealthMetricsWebSocketAndSubscribersWithoutHello) {
   EXPECT_GT(health["frames"]["received"].get<long>(), 0);
   EXPECT_LE(health["frames"]["dropped_mailbox_full"].get<uint64_t>(), health["frames"]["dropped"].get<uint64_t>());
   EXPECT_GE(health["subscribers"].get<int>(), 2);
+  EXPECT_EQ(health["source_limits"]["max_subjects"].get<int>(), DaemonConfig{}.source_max_subjects);
+  EXPECT_EQ(health["source_limits"]["max_markers_per_subject"].get<int>(), DaemonConfig{}.source_max_markers_per_subject);
+  EXPECT_EQ(health["source_limits"]["max_name_bytes"].get<int>(), DaemonConfig{}.source_max_name_bytes);
   // Frames went out, so encoded buffers exist (the counter only grows, and frames keep coming).
   EXPECT_GE(health["frame_buffers_allocated"].get<long>(), 1);
   EXPECT_LE(health["frame_buffers_allocated"].get<uint64_t>(), daemon.metrics().frame_buffers_allocated.load());
