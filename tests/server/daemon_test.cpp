@@ -453,6 +453,29 @@ TEST(Daemon, ServesHealthMetricsWebSocketAndSubscribersWithoutHello) {
   daemon.stop();
 }
 
+// The subscriber protocol is binary (docs/subscriber-protocol.md): a Hello sent as a text message
+// is refused with a close frame saying so (1003), and counted as a bad message.
+TEST(Daemon, WebSocketTextMessageIsRefusedWithACloseAndCounted) {
+  Daemon daemon(test_config());
+  daemon.start();
+  asio::io_context io;
+  websocket::stream<beast::tcp_stream> ws(io);
+  beast::get_lowest_layer(ws).connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), static_cast<unsigned short>(daemon.http_port())));
+  ws.handshake("127.0.0.1", "/stream");
+  ws.text(true);
+  ws.write(asio::buffer(subscriber::encode_hello({subscriber::kWantMarkers})));
+  boost::system::error_code ec;
+  for (int i = 0; i < 100 && !ec; ++i) {  // whatever was under way before the close, then the close
+    beast::flat_buffer message;
+    ws.read(message, ec);
+  }
+  EXPECT_EQ(ec, websocket::error::closed) << ec.message();
+  EXPECT_EQ(ws.reason().code, websocket::close_code::unknown_data);
+  EXPECT_EQ(std::string(ws.reason().reason.c_str()), "binary messages only");
+  EXPECT_EQ(daemon.metrics().bad_subscriber_messages.load(), 1u);
+  daemon.stop();
+}
+
 // The congestion control the daemon gave a TCP subscriber and a WebSocket subscriber, each
 // read once the daemon has sent it something (so it was accepted and set up).
 std::pair<std::string, std::string> subscriber_congestion(const Daemon& daemon) {
