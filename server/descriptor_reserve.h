@@ -14,7 +14,6 @@ class DescriptorReserve {
   DescriptorReserve(const DescriptorReserve&) = delete;
   DescriptorReserve& operator=(const DescriptorReserve&) = delete;
 
-  bool held() const { return fd_ >= 0; }
   // Closes the reserve; false when none was held.
   bool release();
   // Takes one descriptor again if none is held and one is free.
