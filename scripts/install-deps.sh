@@ -8,6 +8,7 @@ packages=(
   libeigen3-dev libboost-dev libboost-system-dev nlohmann-json3-dev libspdlog-dev libfmt-dev
   libopenmesh-dev libmeshoptimizer-dev libgtest-dev libgmock-dev libbenchmark-dev libcli11-dev zlib1g-dev libexpat1-dev
   chromium
+  clang libclang-rt-14-dev  # scripts/fuzz.sh: libFuzzer and clang's sanitizer runtimes
 )
 # The web viewer's build (npm) and its browser test (node + playwright-core + chromium). A
 # machine with Node.js from elsewhere (e.g. NodeSource, which bundles npm) keeps it.

@@ -11,6 +11,7 @@
 
 #include "protocol/file_error.h"
 #include "protocol/subscriber_model.h"
+#include "protocol/printable_text.h"
 #include "server/http/http_server.h"
 #include "server/ingest/file_replay_source.h"
 #include "server/ingest/natnet_source.h"
@@ -76,6 +77,14 @@ ViconSourceOptions vicon_options_of(const DaemonConfig& config) {
   options.port = address.port;
   options.mode = config.vicon_pull ? ViconSourceOptions::Mode::ClientPull : ViconSourceOptions::Mode::ServerPush;
   return options;
+}
+
+vicon::DescriptionLimits description_limits_of(const DaemonConfig& config) {
+  vicon::DescriptionLimits limits;
+  limits.max_subjects = static_cast<uint32_t>(config.source_max_subjects);
+  limits.max_markers_per_subject = static_cast<uint32_t>(config.source_max_markers_per_subject);
+  limits.max_name_bytes = static_cast<uint32_t>(config.source_max_name_bytes);
+  return limits;
 }
 
 subscriber::SourceStateCode code_of(SourceState s) { return static_cast<subscriber::SourceStateCode>(static_cast<uint32_t>(s)); }
@@ -165,6 +174,7 @@ Daemon::Daemon(const DaemonConfig& config)
     ViconMulticastSourceOptions options;
     options.group = address.host;
     options.port = address.port;
+    options.limits = description_limits_of(config);
     spdlog::info("source: Vicon DataStream multicast {}:{} (receive only)", options.group, options.port);
     source_ = std::make_unique<ViconMulticastSource>(io_, std::move(options), static_cast<SourceSink&>(*this));
   } else if (!config.vicon.empty()) {
@@ -218,15 +228,16 @@ Daemon::Daemon(const DaemonConfig& config)
     auto subscriber = std::make_shared<TcpSubscriber>(placed.io, *hub_, std::move(socket), remote, std::move(placed.token));
     hub_->add(subscriber);
     asio::post(placed.io, [subscriber] { subscriber->start(); });
-  }, config.subscriber_tcp_congestion);
+  }, ListenerOptions{config.subscriber_tcp_congestion, &metrics_, &descriptor_reserve_, false});
   HttpRoutes routes;
   routes.health_json = [this] { return health_json(); };
   routes.metrics_text = [this] { return metrics_.render_prometheus(hub_->subscriber_metrics()); };
   routes.web_root = config.web_root;
   if (!config.web_root.empty() && !std::filesystem::is_directory(config.web_root))
     throw FileError(config.web_root, "web root is not a directory");
+  // Out of descriptors, the HTTP port spends the reserve: /health answers while subscribers hold the rest.
   http_ = std::make_unique<HttpServer>(io_, config.bind_address, config.http_port, *hub_, std::move(routes),
-                                       config.subscriber_tcp_congestion);
+                                       ListenerOptions{config.subscriber_tcp_congestion, &metrics_, &descriptor_reserve_, true});
 }
 
 Daemon::~Daemon() { stop(); }
@@ -365,7 +376,7 @@ void Daemon::on_match(int, bool present, std::string_view detail) {
 }
 
 void Daemon::on_unknown_subjects(std::span<const std::string> names, size_t not_listed) {
-  for (const std::string& name : names) spdlog::info("source: subject \"{}\" is none of ours: ignored", name);
+  for (const std::string& name : names) bad_input_log_.warn("unknown_subject", "source subject " + quoted_text(name) + " is none of ours: ignored");
   if (not_listed > 0)
     bad_input_log_.warn("unknown_subjects", std::to_string(not_listed) + " more source subjects that are none of ours (no longer listed)");
 }
@@ -373,7 +384,8 @@ void Daemon::on_unknown_subjects(std::span<const std::string> names, size_t not_
 void Daemon::on_unknown_labels(int, std::span<const std::string> names, size_t not_listed) {
   for (const std::string& name : names) {
     metrics_.count_bad_input("unknown_label");
-    spdlog::info("source: label \"{}\" is not a marker of the subject: used as an unlabelled point", name);
+    // Rate-limited and made printable: the names come from the source, which may send thousands.
+    bad_input_log_.warn("unknown_label", "source label " + quoted_text(name) + " is not a marker of the subject: used as an unlabelled point");
   }
   if (not_listed > 0)
     bad_input_log_.warn("unknown_labels", std::to_string(not_listed) + " more labels that are not markers of the subject (no longer listed)");
@@ -426,6 +438,10 @@ std::string Daemon::health_json() const {
       {"publish_threads", publish_.count()},
       {"subscriber_tcp_congestion", config_.subscriber_tcp_congestion},  // empty: the system's
       {"subject", {{"markers", subject_.model.marker_count()}, {"vertices", pipeline_->vertex_count()}}},
+      {"source_limits",
+       {{"max_subjects", config_.source_max_subjects},
+        {"max_markers_per_subject", config_.source_max_markers_per_subject},
+        {"max_name_bytes", config_.source_max_name_bytes}}},
       {"latency_ms", latency_summaries(metrics_)}};
   return health.dump();
 }

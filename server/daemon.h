@@ -16,6 +16,7 @@
 #include "protocol/subject_file.h"
 #include "server/asio.h"
 #include "server/config.h"
+#include "server/descriptor_reserve.h"
 #include "server/ingest/frame_source.h"
 #include "server/ingest/subject_router.h"
 #include "server/logging.h"
@@ -83,6 +84,7 @@ class Daemon : private SourceSink, private SubjectRouter::Observer {
   // The TCP subscribers' threads: destroyed before io_ and after the listeners (declared
   // between), once every session was closed on its own thread.
   PublishThreads publish_;
+  DescriptorReserve descriptor_reserve_;  // the HTTP port's, for when subscribers hold every other descriptor
   std::unique_ptr<Listener> sub_listener_;
   std::unique_ptr<HttpServer> http_;
   std::unique_ptr<FrameSource> source_;

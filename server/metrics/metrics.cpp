@@ -107,6 +107,9 @@ std::string Metrics::render_prometheus(const std::vector<SubscriberMetrics>& sub
   counter(out, "bad_subscriber_messages_total", "Subscriber messages that broke the protocol.", bad_subscriber_messages);
   counter(out, "subscribers_accepted_total", "Subscriber connections accepted.", subscribers_connected);
   counter(out, "subscribers_refused_total", "Subscribers refused after their Hello (unknown subject, ...).", subscribers_refused);
+  counter(out, "accepts_failed_no_descriptor_total",
+          "Accepts (HTTP and subscriber ports) that failed for lack of file descriptors; each pauses that port's accepts, 10 ms doubling to 1 s.",
+          accepts_failed_no_descriptor);
   counter(out, "frame_buffers_allocated_total", "Encoded frame buffers created (steady state: constant).", frame_buffers_allocated);
   counter(out, "frame_buffers_allocated_by_pipeline_total",
           "Of those, created on the pipeline thread because none was prepared when the subscriber asked (expected: 0).",
