@@ -39,10 +39,12 @@ class Receiver:
         self._thread.start()
 
     def stop(self, timeout=5.0):
-        """Stops the thread (it notices within a quarter of a second) and any recording."""
+        """Stops the thread and any recording. The thread notices within a quarter of a second
+        (or when a connection attempt gives up); timeout=0 does not wait for it."""
         self._stop.set()
         if self._thread is not None:
-            self._thread.join(timeout)
+            if timeout:
+                self._thread.join(timeout)
             self._thread = None
         self.stop_recording()
         self._state = 'stopped'
