@@ -35,8 +35,10 @@ _connection = None
 def connect(scene, host, port, encoding, subject='', token=''):
     global _connection
     disconnect()
+    # Paced: at most two frames in flight, so a reader slower than the stream (the numpy
+    # decoders, docs/connect-a-renderer.md) shows frames late by two at most, not by a socket's fill.
     receiver = skinstream.Receiver(host, port, encoding=encoding, subject=subject, token=token, normals=False, markers=True,
-                                   connect_timeout=2.0)
+                                   paced=True, connect_timeout=2.0)
     receiver.start()
     _connection = _Connection(receiver, scene.name)
     if not bpy.app.timers.is_registered(apply_newest_frame):
