@@ -22,13 +22,16 @@ class DaemonProcess:
         with open(self.log_path, 'wb') as log:
             self.process = subprocess.Popen(command, stdout=log, stderr=subprocess.STDOUT)
         deadline = time.monotonic() + 60
-        while not os.path.exists(self.ports_path):
+        ports = None
+        while ports is None:
             if self.process.poll() is not None or time.monotonic() > deadline:
                 raise RuntimeError(f'skinstreamd did not start: {self.log()}')
             time.sleep(0.02)
-        time.sleep(0.05)  # the file is written whole, but give a slow disk its moment
-        with open(self.ports_path) as f:
-            ports = json.load(f)
+            try:
+                with open(self.ports_path) as f:
+                    ports = json.load(f)
+            except (FileNotFoundError, json.JSONDecodeError):  # not there yet, or not written whole yet
+                pass
         self.sub_port, self.http_port = ports['sub'], ports['http']
 
     def log(self):

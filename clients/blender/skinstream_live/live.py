@@ -101,9 +101,9 @@ def apply_newest_frame():
                 _build_body(scene, info, reference if reference is not None else frame.vertices)
         if frame is not None and info is c.mesh_info:
             _apply(scene, frame)
-    except (ReferenceError, RuntimeError, KeyError, ValueError) as e:  # objects deleted or renamed by the user
+    except Exception as e:  # e.g. objects deleted by the user; a timer that raised would be dropped by Blender
         c.problem = f'{type(e).__name__}: {e}'
-        c.mesh_info = None
+        c.mesh_info = None  # built again from the next frame
     _redraw()
     return TICK_SECONDS
 
@@ -112,7 +112,7 @@ def _apply(scene, frame):
     c = _connection
     body = bpy.data.objects.get(c.body)
     if body is None:
-        c.mesh_info = None  # deleted: built again from the next frame
+        c.mesh_info = None  # deleted by the user: built again from the next frame
         return
     if frame.vertices is not None:
         body.data.vertices.foreach_set('co', frame.vertices.ravel())

@@ -1,6 +1,7 @@
 """One subscription to a skinstreamd over TCP: Hello, then MeshInfo (and the Model for the
 parameter encoding), then Frames decoded into numpy arrays, read on the calling thread."""
 import socket
+import struct
 import time
 
 import numpy as np
@@ -122,9 +123,9 @@ class Subscriber:
                     raise Refused(f'the daemon refused this subscriber: {self.status.detail}')
             elif kind == wire.FRAME:
                 frame = self._on_frame(payload)
+                if self.paced:  # every Frame taken, a skipped one too: the daemon waits while two are unacknowledged
+                    self._send(wire.encode_ack(self.version, struct.unpack_from('<I', payload)[0]))
                 if frame is not None:
-                    if self.paced:
-                        self._send(wire.encode_ack(self.version, frame.frame_number))
                     return frame
             else:
                 raise ProtocolError(f'unexpected {wire.MESSAGE_NAMES[kind]} message from the daemon')

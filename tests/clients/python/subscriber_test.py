@@ -154,5 +154,35 @@ class BadDaemons(unittest.TestCase):
                 self.assertNotIn('\n', error)
 
 
+class Paced(unittest.TestCase):
+    def test_skipped_compressed_deltas_are_acknowledged_too(self):
+        # A delta of a key the subscriber never saw (it gave way in the daemon's queue) is
+        # skipped, and acknowledged like the frames shown: the daemon waits while two are not.
+        delta = bytearray(fixture('frame_v2_compressed.bin'))
+        delta[16] &= ~0x40  # the flags after the header and the frame number: no longer a key
+        delta[44:48] = struct.pack('<I', 4)  # the vertex count: the MeshInfo's 4 (the coded bytes are never read)
+        listener = socket.create_server(('127.0.0.1', 0))
+        received = bytearray()
+
+        def serve():
+            peer, _ = listener.accept()
+            with peer:
+                peer.recv(1024)  # the Hello
+                peer.sendall(fixture('mesh_info_v2.bin') + bytes(delta) * 3)
+                while chunk := peer.recv(1024):
+                    received.extend(chunk)
+
+        thread = threading.Thread(target=serve)
+        thread.start()
+        with skinstream.Subscriber(port=listener.getsockname()[1], encoding='compressed', paced=True) as sub:
+            self.assertIsNone(sub.next_frame(1.5))
+            self.assertEqual(sub.frames_skipped, 3)
+        thread.join()
+        listener.close()
+        acks = [struct.unpack_from('<IHHII', received, 16 * i) for i in range(len(received) // 16)]
+        self.assertEqual(len(received), 3 * 16)
+        self.assertEqual(acks, [(0x46534B53, 2, 5, 4, 1234)] * 3)
+
+
 if __name__ == '__main__':
     unittest.main(verbosity=2)
