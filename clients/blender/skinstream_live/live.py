@@ -72,7 +72,7 @@ def status_lines():
     c = _connection
     lines = [c.receiver.describe()]
     if c.frame_number is not None:
-        lines.append(f'Frame {c.frame_number}, {c.frames_applied} shown, {c.receiver.frames_replaced} skipped')
+        lines.append(f'Frame {c.frame_number}: {c.frames_applied} shown, {c.receiver.frames_replaced} replaced by newer ones first')
     recording = c.receiver.recording()
     if recording is not None:
         path, samples, error = recording

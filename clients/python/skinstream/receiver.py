@@ -125,11 +125,11 @@ class Receiver:
             wait = min(2 * wait, self.longest_retry)
 
     def _arrived(self, frame):
-        self.frames_received += 1
         with self._slot:
             if self._newest is not None:
                 self.frames_replaced += 1
             self._newest = frame
+            self.frames_received += 1  # after the slot: a count that moved means a frame to take
         with self._record:
             if self._writer is None or self._record_error is not None or frame.vertices is None:
                 return
