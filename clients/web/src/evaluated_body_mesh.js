@@ -2,7 +2,7 @@
 // shader takes each vertex's position and normal from the evaluator's float render targets
 // (texel = vertex index) instead of attributes, so no vertex data crosses from the CPU per frame.
 import * as THREE from 'three';
-import { fillPartColours } from './part_palette.js';
+import { BodySurface } from './body_mesh.js';
 import { TABLE_WIDTH } from './gpu_evaluator.js';
 
 const FETCH_DECLARATIONS = /* glsl */ `#include <common>
@@ -20,19 +20,13 @@ const FETCH_POSITION = /* glsl */ `vec3 transformed = texelFetch(evaluatedPositi
   vPosition = transformed;
 #endif`;
 
-export class EvaluatedBodyMesh {
+export class EvaluatedBodyMesh extends BodySurface {
   // evaluator: a GpuMeshEvaluator; meshInfo: its MeshInfo (faces and dominant parts).
   constructor(meshInfo, evaluator) {
-    const V = meshInfo.vertexCount;
-    const colours = new Float32Array(3 * V);
-    fillPartColours(meshInfo.dominantPart, colours);
-    this.geometry = new THREE.BufferGeometry();
+    const geometry = new THREE.BufferGeometry();
     // The reference pose: unused by the shader, but three.js sizes and bounds geometry by it.
-    this.geometry.setAttribute('position', new THREE.BufferAttribute(evaluator.model.referenceVertices, 3));
-    this.geometry.setAttribute('color', new THREE.BufferAttribute(colours, 3));
-    this.geometry.setIndex(new THREE.BufferAttribute(meshInfo.faces, 1));
-
-    this.material = new THREE.MeshStandardMaterial({ color: 0xd8c3b0, roughness: 0.65, metalness: 0.0, side: THREE.DoubleSide });
+    geometry.setAttribute('position', new THREE.BufferAttribute(evaluator.model.referenceVertices, 3));
+    super(meshInfo, geometry);
     this.material.onBeforeCompile = (shader) => {
       shader.uniforms.evaluatedPositions = { value: evaluator.positionsTexture };
       shader.uniforms.evaluatedNormals = { value: evaluator.normalsTexture };
@@ -42,22 +36,5 @@ export class EvaluatedBodyMesh {
         .replace('#include <begin_vertex>', FETCH_POSITION);
     };
     this.material.customProgramCacheKey = () => 'skinstream-evaluated-body';
-    this.object = new THREE.Mesh(this.geometry, this.material);
-    this.object.frustumCulled = false; // the body moves away from its reference pose
-  }
-
-  setPartColours(on) {
-    this.material.vertexColors = on;
-    this.material.color.set(on ? 0xffffff : 0xd8c3b0);
-    this.material.needsUpdate = true;
-  }
-
-  setVisible(on) {
-    this.object.visible = on;
-  }
-
-  dispose() {
-    this.geometry.dispose();
-    this.material.dispose();
   }
 }
