@@ -3,6 +3,8 @@
 #include "server/pipeline/deform_cpus.h"
 #include "server/tcp_congestion.h"
 
+#include <arpa/inet.h>
+
 #include <CLI/CLI.hpp>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -26,11 +28,13 @@ void take(const nlohmann::json& json, const char* key, T& out, const std::string
 
 void apply_json(const nlohmann::json& json, DaemonConfig& c, const std::string& origin) {
   if (!json.is_object()) throw ConfigError(origin + ": the configuration must be a JSON object");
-  static const char* const kKeys[] = {"subject", "replay", "loop", "speed", "vicon", "vicon_pull", "vicon_multicast", "bind_address",
+  static const char* const kKeys[] = {"subject", "replay", "loop", "speed", "vicon", "vicon_pull", "vicon_multicast", "qtm", "natnet", "natnet_interface", "bind_address",
                                       "http_port", "sub_port", "web_root", "lookahead", "max_frame_wait_ms", "deform_threads",
                                       "deform_cpus", "deform_spin_lead_us",
                                       "continuity_seconds", "use_pca", "ports_file", "log_level", "hello_timeout_ms",
-                                      "subscriber_queue_frames", "subscriber_tcp_congestion", "publish_threads", "status_interval_ms", "default_rate_hz"};
+                                      "subscriber_queue_frames", "subscriber_tcp_congestion", "publish_threads", "status_interval_ms", "default_rate_hz",
+                                      "compressed_key_interval", "source_max_subjects", "source_max_markers_per_subject",
+                                      "source_max_name_bytes"};
   for (const auto& [key, value] : json.items()) {
     bool known = false;
     for (const char* k : kKeys) known = known || key == k;
@@ -43,6 +47,9 @@ void apply_json(const nlohmann::json& json, DaemonConfig& c, const std::string& 
   take(json, "vicon", c.vicon, origin);
   take(json, "vicon_pull", c.vicon_pull, origin);
   take(json, "vicon_multicast", c.vicon_multicast, origin);
+  take(json, "qtm", c.qtm, origin);
+  take(json, "natnet", c.natnet, origin);
+  take(json, "natnet_interface", c.natnet_interface, origin);
   take(json, "bind_address", c.bind_address, origin);
   take(json, "http_port", c.http_port, origin);
   take(json, "sub_port", c.sub_port, origin);
@@ -58,10 +65,14 @@ void apply_json(const nlohmann::json& json, DaemonConfig& c, const std::string& 
   take(json, "log_level", c.log_level, origin);
   take(json, "hello_timeout_ms", c.hello_timeout_ms, origin);
   take(json, "subscriber_queue_frames", c.subscriber_queue_frames, origin);
+  take(json, "compressed_key_interval", c.compressed_key_interval, origin);
   take(json, "subscriber_tcp_congestion", c.subscriber_tcp_congestion, origin);
   take(json, "publish_threads", c.publish_threads, origin);
   take(json, "status_interval_ms", c.status_interval_ms, origin);
   take(json, "default_rate_hz", c.default_rate_hz, origin);
+  take(json, "source_max_subjects", c.source_max_subjects, origin);
+  take(json, "source_max_markers_per_subject", c.source_max_markers_per_subject, origin);
+  take(json, "source_max_name_bytes", c.source_max_name_bytes, origin);
 }
 
 DaemonConfig load_config_file(const std::string& path) {
@@ -88,6 +99,9 @@ nlohmann::json to_json(const DaemonConfig& c) {
           {"vicon", c.vicon},
           {"vicon_pull", c.vicon_pull},
           {"vicon_multicast", c.vicon_multicast},
+          {"qtm", c.qtm},
+          {"natnet", c.natnet},
+          {"natnet_interface", c.natnet_interface},
           {"bind_address", c.bind_address},
           {"http_port", c.http_port},
           {"sub_port", c.sub_port},
@@ -103,16 +117,20 @@ nlohmann::json to_json(const DaemonConfig& c) {
           {"log_level", c.log_level},
           {"hello_timeout_ms", c.hello_timeout_ms},
           {"subscriber_queue_frames", c.subscriber_queue_frames},
+          {"compressed_key_interval", c.compressed_key_interval},
           {"subscriber_tcp_congestion", c.subscriber_tcp_congestion},
           {"publish_threads", c.publish_threads},
           {"status_interval_ms", c.status_interval_ms},
-          {"default_rate_hz", c.default_rate_hz}};
+          {"default_rate_hz", c.default_rate_hz},
+          {"source_max_subjects", c.source_max_subjects},
+          {"source_max_markers_per_subject", c.source_max_markers_per_subject},
+          {"source_max_name_bytes", c.source_max_name_bytes}};
 }
 
 void validate(const DaemonConfig& c) {
   auto fail = [](const std::string& what) { throw ConfigError("configuration: " + what); };
-  if (!c.replay.empty() + !c.vicon.empty() + !c.vicon_multicast.empty() > 1)
-    fail("give one source: a replay file, a Vicon server or a Vicon multicast address");
+  if (!c.replay.empty() + !c.vicon.empty() + !c.vicon_multicast.empty() + !c.qtm.empty() + !c.natnet.empty() > 1)
+    fail("give one source: a replay file, a Vicon server, a Vicon multicast address, a QTM or a NatNet server");
   if (!(c.speed > 0 && c.speed <= 100)) fail("speed must be in (0, 100]");
   if (c.http_port < 0 || c.http_port > 65535) fail("http_port must be 0-65535");
   if (c.sub_port < 0 || c.sub_port > 65535) fail("sub_port must be 0-65535");
@@ -124,12 +142,17 @@ void validate(const DaemonConfig& c) {
   if (c.continuity_seconds < 0) fail("continuity_seconds must be >= 0");
   if (c.hello_timeout_ms < 0) fail("hello_timeout_ms must be >= 0");
   if (c.subscriber_queue_frames < 1 || c.subscriber_queue_frames > 64) fail("subscriber_queue_frames must be 1-64");
+  if (c.compressed_key_interval < 1 || c.compressed_key_interval > 1200) fail("compressed_key_interval must be 1-1200");
   if (c.publish_threads < 0 || c.publish_threads > 16) fail("publish_threads must be 0-16");
   if (!c.subscriber_tcp_congestion.empty() && !is_tcp_congestion_name(c.subscriber_tcp_congestion))
     fail("subscriber_tcp_congestion must be empty (the system's) or a Linux congestion control name such as reno, not \"" +
          c.subscriber_tcp_congestion + "\"");
   if (c.status_interval_ms < 10) fail("status_interval_ms must be >= 10");
   if (!(c.default_rate_hz > 0)) fail("default_rate_hz must be > 0");
+  if (c.source_max_subjects < 1 || c.source_max_subjects > 4096) fail("source_max_subjects must be 1-4096");
+  if (c.source_max_markers_per_subject < 1 || c.source_max_markers_per_subject > 65536)
+    fail("source_max_markers_per_subject must be 1-65536");
+  if (c.source_max_name_bytes < 1 || c.source_max_name_bytes > 4096) fail("source_max_name_bytes must be 1-4096");
   static const char* const kLevels[] = {"trace", "debug", "info", "warn", "error", "critical", "off"};
   bool level_ok = false;
   for (const char* l : kLevels) level_ok = level_ok || c.log_level == l;
@@ -138,6 +161,12 @@ void validate(const DaemonConfig& c) {
     fail("vicon must be HOST:PORT with a port of 1-65535 (Vicon's default is 801), not \"" + c.vicon + "\"");
   if (!c.vicon_multicast.empty() && !parse_host_port(c.vicon_multicast))
     fail("vicon_multicast must be GROUP:PORT with a port of 1-65535 (Vicon's default is 44801), not \"" + c.vicon_multicast + "\"");
+  if (!c.qtm.empty() && !parse_host_with_port(c.qtm, 22223))
+    fail("qtm must be HOST or HOST:PORT with a port of 1-65535 (QTM's little-endian port is 22223), not \"" + c.qtm + "\"");
+  if (!c.natnet.empty() && !parse_host_with_port(c.natnet, 1510))
+    fail("natnet must be HOST or HOST:PORT with a port of 1-65535 (the command port is 1510), not \"" + c.natnet + "\"");
+  in_addr address{};
+  if (inet_pton(AF_INET, c.natnet_interface.c_str(), &address) != 1) fail("natnet_interface must be an IPv4 address of this host, not \"" + c.natnet_interface + "\"");
 }
 
 std::optional<HostPort> parse_host_port(const std::string& text) {
@@ -148,6 +177,12 @@ std::optional<HostPort> parse_host_port(const std::string& text) {
   const int number = std::stoi(port);
   if (number < 1 || number > 65535) return std::nullopt;
   return HostPort{text.substr(0, colon), static_cast<uint16_t>(number)};
+}
+
+std::optional<HostPort> parse_host_with_port(const std::string& text, uint16_t default_port) {
+  if (text.empty()) return std::nullopt;
+  if (text.find(':') == std::string::npos) return HostPort{text, default_port};
+  return parse_host_port(text);
 }
 
 std::optional<CommandLine> parse_command_line(int argc, const char* const* argv, int& out_exit_code) {
@@ -164,6 +199,10 @@ std::optional<CommandLine> parse_command_line(int argc, const char* const* argv,
   auto* vicon_pull = app.add_flag("--vicon-pull", flags.vicon_pull, "Vicon: ask for each frame (ClientPull) instead of the server pushing them");
   auto* vicon_multicast = app.add_option("--vicon-multicast", flags.vicon_multicast,
                                          "receive Vicon DataStream UDP datagrams sent to GROUP:PORT as the source");
+  auto* qtm = app.add_option("--qtm", flags.qtm, "Qualisys QTM RT server HOST[:PORT] as the source (little-endian port, 22223)");
+  auto* natnet = app.add_option("--natnet", flags.natnet, "OptiTrack NatNet server HOST[:PORT] as the source (command port, 1510)");
+  auto* natnet_interface = app.add_option("--natnet-interface", flags.natnet_interface,
+                                          "NatNet: this host's IPv4 address to join the multicast group on");
   auto* bind = app.add_option("--bind", flags.bind_address, "address to listen on");
   auto* http_port = app.add_option("--http-port", flags.http_port, "HTTP/WebSocket port (0 = ephemeral)");
   auto* sub_port = app.add_option("--sub-port", flags.sub_port, "TCP subscriber port (0 = ephemeral)");
@@ -194,11 +233,14 @@ std::optional<CommandLine> parse_command_line(int argc, const char* const* argv,
   auto given = [](const CLI::Option* o) { return o->count() > 0; };
   if (given(subject)) c.subject = flags.subject;
   // A source given on the command line replaces the file's (several on the command line: validate() refuses).
-  if (given(replay) || given(vicon) || given(vicon_multicast)) {
+  if (given(replay) || given(vicon) || given(vicon_multicast) || given(qtm) || given(natnet)) {
     c.replay = given(replay) ? flags.replay : std::string();
     c.vicon = given(vicon) ? flags.vicon : std::string();
     c.vicon_multicast = given(vicon_multicast) ? flags.vicon_multicast : std::string();
+    c.qtm = given(qtm) ? flags.qtm : std::string();
+    c.natnet = given(natnet) ? flags.natnet : std::string();
   }
+  if (given(natnet_interface)) c.natnet_interface = flags.natnet_interface;
   if (given(loop)) c.loop = flags.loop;
   if (given(speed)) c.speed = flags.speed;
   if (given(vicon_pull)) c.vicon_pull = flags.vicon_pull;

@@ -10,8 +10,12 @@
 #include <unistd.h>
 
 #include "protocol/file_error.h"
+#include "protocol/subscriber_model.h"
+#include "protocol/printable_text.h"
 #include "server/http/http_server.h"
 #include "server/ingest/file_replay_source.h"
+#include "server/ingest/natnet_source.h"
+#include "server/ingest/qtm_source.h"
 #include "server/ingest/vicon_multicast_source.h"
 #include "server/ingest/vicon_source.h"
 #include "server/listener.h"
@@ -28,8 +32,10 @@ SubjectFile load_subject(const DaemonConfig& config) {
   return read_subject_file(config.subject);
 }
 
-subscriber::MeshInfo mesh_info_of(const SubjectFile& subject) {
+subscriber::MeshInfo mesh_info_of(const SubjectFile& subject, const std::string& path) {
   subscriber::MeshInfo info;
+  // The subject's name: its file's stem until subjects are named on the command line.
+  info.subject = std::filesystem::path(path).stem().string();
   const SubjectModel& model = subject.model;
   info.marker_count = static_cast<uint32_t>(model.marker_count());
   info.marker_names = model.marker_names;
@@ -57,6 +63,13 @@ HostPort host_port_of(const std::string& flag, const std::string& text) {
   return *parsed;
 }
 
+// A "HOST[:PORT]" key (qtm, natnet), likewise.
+HostPort host_port_of(const std::string& flag, const std::string& text, uint16_t default_port) {
+  const std::optional<HostPort> parsed = parse_host_with_port(text, default_port);
+  if (!parsed) throw ConfigError(flag + " " + text + ": expected HOST or HOST:PORT with a port of 1-65535");
+  return *parsed;
+}
+
 ViconSourceOptions vicon_options_of(const DaemonConfig& config) {
   const HostPort address = host_port_of("--vicon", config.vicon);
   ViconSourceOptions options;
@@ -64,6 +77,14 @@ ViconSourceOptions vicon_options_of(const DaemonConfig& config) {
   options.port = address.port;
   options.mode = config.vicon_pull ? ViconSourceOptions::Mode::ClientPull : ViconSourceOptions::Mode::ServerPush;
   return options;
+}
+
+vicon::DescriptionLimits description_limits_of(const DaemonConfig& config) {
+  vicon::DescriptionLimits limits;
+  limits.max_subjects = static_cast<uint32_t>(config.source_max_subjects);
+  limits.max_markers_per_subject = static_cast<uint32_t>(config.source_max_markers_per_subject);
+  limits.max_name_bytes = static_cast<uint32_t>(config.source_max_name_bytes);
+  return limits;
 }
 
 subscriber::SourceStateCode code_of(SourceState s) { return static_cast<subscriber::SourceStateCode>(static_cast<uint32_t>(s)); }
@@ -81,6 +102,7 @@ nlohmann::json latency_summaries(const Metrics& metrics) {
   add("deform", metrics.deform);
   add("normals", metrics.normals);
   add("encode", metrics.encode);
+  add("encode_compressed", metrics.encode_compressed);
   add("receive_to_publish", metrics.receive_to_publish);
   add("subscriber_queue_wait", metrics.subscriber_queue_wait);
   add("subscriber_write", metrics.subscriber_write);
@@ -93,6 +115,7 @@ Daemon::Daemon(const DaemonConfig& config)
     : config_(config),
       subject_(load_subject(config)),
       mailbox_(subject_.model.marker_count(), std::chrono::milliseconds(config.max_frame_wait_ms)),
+      router_({SubjectTarget{"", subject_.model.marker_names}}, static_cast<SubjectRouter::Observer&>(*this)),
       publish_(config.publish_threads),
       status_timer_(io_) {
   const SubjectModel& model = subject_.model;
@@ -103,7 +126,7 @@ Daemon::Daemon(const DaemonConfig& config)
   hub_options.queue_frames = config.subscriber_queue_frames;
   hub_options.frame_max_wait = std::chrono::milliseconds(config.max_frame_wait_ms);
   hub_options.hello_timeout = std::chrono::milliseconds(config.hello_timeout_ms);
-  hub_ = std::make_unique<SubscriberHub>(metrics_, hub_options, mesh_info_of(subject_), subject_.deformation.has_value());
+  hub_ = std::make_unique<SubscriberHub>(metrics_, hub_options, mesh_info_of(subject_, config.subject), subject_.deformation.has_value());
 
   PipelineOptions pipeline_options;
   pipeline_options.lookahead = config.lookahead;
@@ -123,6 +146,7 @@ Daemon::Daemon(const DaemonConfig& config)
   pipeline_options.default_rate_hz = config.default_rate_hz;
   pipeline_options.filler.continuity_seconds = config.continuity_seconds;
   pipeline_options.filler.use_pca = config.use_pca;
+  pipeline_options.compressed_key_interval = config.compressed_key_interval;
   try {
     pipeline_ = std::make_unique<Pipeline>(model, subject_.deformation ? &*subject_.deformation : nullptr, pipeline_options,
                                            mailbox_, *hub_, metrics_);
@@ -130,24 +154,52 @@ Daemon::Daemon(const DaemonConfig& config)
     throw FileError(config.subject, std::string("deformation model unusable: ") + e.what());
   }
 
-  hub_->set_encoding_preparer([pipeline = pipeline_.get()](uint32_t frame_flags) { pipeline->prepare_encoding(frame_flags); });
+  hub_->set_encoding_preparer([pipeline = pipeline_.get()](StreamKey key) { pipeline->prepare_encoding(key); });
+  hub_->set_compressed_order(pipeline_->compressed_order());
+  if (const EvaluationModel* evaluation = pipeline_->evaluation_model()) {
+    hub_->set_model_message(std::make_shared<const std::vector<unsigned char>>(subscriber::encode_model(*evaluation)));
+    spdlog::info("parameter encoding: Model message of {} bytes ({} parts, {} RBF centres, {} influences)",
+                 hub_->model_message()->size(), evaluation->part_count(), evaluation->member_count(), evaluation->influence_count());
+  }
 
   if (!config.replay.empty()) {
-    source_ = std::make_unique<FileReplaySource>(io_, model, config.replay, static_cast<FrameSink&>(*this), ReplayOptions{config.loop, config.speed});
+    auto replay = std::make_unique<FileReplaySource>(io_, config.replay, static_cast<SourceSink&>(*this),
+                                                     ReplayOptions{config.loop, config.speed, {}});
+    if (router_.markers_labelled_by(0, replay->subject()) == 0)
+      throw FileError(config.replay, "none of the subject's " + std::to_string(model.marker_count()) +
+                                         " marker labels is in this capture (wrong subject file?)");
+    source_ = std::move(replay);
   } else if (!config.vicon_multicast.empty()) {
     const HostPort address = host_port_of("--vicon-multicast", config.vicon_multicast);
     ViconMulticastSourceOptions options;
     options.group = address.host;
     options.port = address.port;
+    options.limits = description_limits_of(config);
     spdlog::info("source: Vicon DataStream multicast {}:{} (receive only)", options.group, options.port);
-    source_ = std::make_unique<ViconMulticastSource>(io_, std::move(options), model.marker_names, static_cast<FrameSink&>(*this));
+    source_ = std::make_unique<ViconMulticastSource>(io_, std::move(options), static_cast<SourceSink&>(*this));
   } else if (!config.vicon.empty()) {
     ViconSourceOptions options = vicon_options_of(config);
     spdlog::info("source: Vicon DataStream {}:{} ({})", options.host, options.port,
                  options.mode == ViconSourceOptions::Mode::ClientPull ? "client pull" : "server push");
-    source_ = std::make_unique<ViconSource>(io_, std::move(options), model.marker_names, static_cast<FrameSink&>(*this));
+    source_ = std::make_unique<ViconSource>(io_, std::move(options), static_cast<SourceSink&>(*this));
+  } else if (!config.qtm.empty()) {
+    const HostPort address = host_port_of("--qtm", config.qtm, qtm::kLittleEndianPort);
+    QtmSourceOptions options;
+    options.host = address.host;
+    options.port = address.port;
+    spdlog::info("source: QTM RT {}:{}", options.host, options.port);
+    source_ = std::make_unique<QtmSource>(io_, std::move(options), static_cast<SourceSink&>(*this));
+  } else if (!config.natnet.empty()) {
+    const HostPort address = host_port_of("--natnet", config.natnet, natnet::kCommandPort);
+    NatNetSourceOptions options;
+    options.host = address.host;
+    options.command_port = address.port;
+    options.interface_address = config.natnet_interface;
+    spdlog::info("source: NatNet {}:{}", options.host, options.command_port);
+    source_ = std::make_unique<NatNetSource>(io_, std::move(options), static_cast<SourceSink&>(*this));
   } else {
-    spdlog::warn("no source configured (--replay FILE, --vicon HOST:PORT or --vicon-multicast GROUP:PORT): serving subscribers without frames");
+    spdlog::warn("no source configured (--replay FILE, --vicon HOST:PORT, --vicon-multicast GROUP:PORT, --qtm HOST[:PORT] "
+                 "or --natnet HOST[:PORT]): serving subscribers without frames");
   }
 
   sub_listener_ = std::make_unique<Listener>(io_, config.bind_address, config.sub_port, "subscriber port", [this](tcp::socket socket) {
@@ -176,15 +228,16 @@ Daemon::Daemon(const DaemonConfig& config)
     auto subscriber = std::make_shared<TcpSubscriber>(placed.io, *hub_, std::move(socket), remote, std::move(placed.token));
     hub_->add(subscriber);
     asio::post(placed.io, [subscriber] { subscriber->start(); });
-  }, config.subscriber_tcp_congestion);
+  }, ListenerOptions{config.subscriber_tcp_congestion, &metrics_, &descriptor_reserve_, false});
   HttpRoutes routes;
   routes.health_json = [this] { return health_json(); };
   routes.metrics_text = [this] { return metrics_.render_prometheus(hub_->subscriber_metrics()); };
   routes.web_root = config.web_root;
   if (!config.web_root.empty() && !std::filesystem::is_directory(config.web_root))
     throw FileError(config.web_root, "web root is not a directory");
+  // Out of descriptors, the HTTP port spends the reserve: /health answers while subscribers hold the rest.
   http_ = std::make_unique<HttpServer>(io_, config.bind_address, config.http_port, *hub_, std::move(routes),
-                                       config.subscriber_tcp_congestion);
+                                       ListenerOptions{config.subscriber_tcp_congestion, &metrics_, &descriptor_reserve_, true});
 }
 
 Daemon::~Daemon() { stop(); }
@@ -253,43 +306,14 @@ void Daemon::stop() {
   wait();
 }
 
-void Daemon::on_frame(const MarkerFrame& in) {
+void Daemon::on_frame(const SourceFrame& frame) {
   metrics_.frames_received.fetch_add(1, std::memory_order_relaxed);
-  MarkerFrame& out = mailbox_.writable();
-  if (in.labelled.size() != out.labelled.size()) {
-    metrics_.count_bad_input("wrong_marker_count");
-    bad_input_log_.warn("wrong_marker_count", "frame " + std::to_string(in.frame_number) + " has " +
-                                                  std::to_string(in.labelled.size()) + " labelled markers, the subject " +
-                                                  std::to_string(out.labelled.size()));
-    return;
-  }
-  out.clear();
-  out.frame_number = in.frame_number;
-  out.source_time_ns = in.source_time_ns;
-  out.receive_time_ns = in.receive_time_ns;
-  out.source_rate_hz = in.source_rate_hz;
-  out.unknown_labels = in.unknown_labels;
-  int non_finite = 0;
-  for (size_t m = 0; m < in.labelled.size(); ++m) {
-    const Vec3& p = in.labelled[m];
-    if (is_present(p)) out.labelled[m] = p;
-    else if (!p.array().isNaN().all()) ++non_finite;  // NaN is "missing"; anything else is broken
-  }
-  const int count = std::clamp(in.unlabelled_count, 0, static_cast<int>(std::min(in.unlabelled.size(), in.unlabelled_ids.size())));
-  for (int i = 0; i < count; ++i) {
-    if (!is_present(in.unlabelled[i])) {
-      ++non_finite;
-      continue;
-    }
-    out.unlabelled[out.unlabelled_count] = in.unlabelled[i];
-    out.unlabelled_ids[out.unlabelled_count] = in.unlabelled_ids[i];
-    ++out.unlabelled_count;
-  }
-  if (non_finite > 0) {
-    metrics_.count_bad_input("non_finite_point");
-    bad_input_log_.warn("non_finite_point", "frame " + std::to_string(in.frame_number) + ": " + std::to_string(non_finite) +
-                                                " non-finite points ignored");
-  }
+  MarkerFrame* const out[] = {&mailbox_.writable()};
+  const SubjectRouter::Stats routed = router_.route(frame, out);
+  if (routed.rejected_points > 0) on_rejected_points(frame.frame_number, routed.rejected_points);
+  if (!router_.present(0)) return;
+  const MarkerFrame& in = *out[0];
+  if (in.rejected_points > 0) on_rejected_points(in.frame_number, in.rejected_points);
   if (in.source_rate_hz > 0 && in.source_rate_hz != source_rate_hz_) {
     {
       std::lock_guard lock(state_mutex_);
@@ -334,9 +358,37 @@ void Daemon::on_bad_input(std::string_view what, std::string_view detail) {
   bad_input_log_.warn(what, detail);
 }
 
-void Daemon::on_unknown_label(std::string_view name) {
-  metrics_.count_bad_input("unknown_label");
-  spdlog::info("source: label \"{}\" is not a marker of the subject: used as an unlabelled point", name);
+void Daemon::on_rejected_points(uint32_t frame_number, int count) {
+  metrics_.count_bad_input("rejected_point");
+  bad_input_log_.warn("rejected_point", "frame " + std::to_string(frame_number) + ": " + std::to_string(count) +
+                                            " points ignored (not finite, or beyond " +
+                                            std::to_string(MarkerFrame::kMaxUnlabelled) + " unlabelled)");
+}
+
+void Daemon::on_match(int, bool present, std::string_view detail) {
+  if (present) {
+    // Back in the stream: a new take for its filler.
+    std::lock_guard lock(state_mutex_);
+    ++generation_;
+  }
+  if (present) spdlog::info("subject {}: {}", config_.subject, detail);
+  else spdlog::warn("subject {}: absent, waiting for it: {}", config_.subject, detail);
+}
+
+void Daemon::on_unknown_subjects(std::span<const std::string> names, size_t not_listed) {
+  for (const std::string& name : names) bad_input_log_.warn("unknown_subject", "source subject " + quoted_text(name) + " is none of ours: ignored");
+  if (not_listed > 0)
+    bad_input_log_.warn("unknown_subjects", std::to_string(not_listed) + " more source subjects that are none of ours (no longer listed)");
+}
+
+void Daemon::on_unknown_labels(int, std::span<const std::string> names, size_t not_listed) {
+  for (const std::string& name : names) {
+    metrics_.count_bad_input("unknown_label");
+    // Rate-limited and made printable: the names come from the source, which may send thousands.
+    bad_input_log_.warn("unknown_label", "source label " + quoted_text(name) + " is not a marker of the subject: used as an unlabelled point");
+  }
+  if (not_listed > 0)
+    bad_input_log_.warn("unknown_labels", std::to_string(not_listed) + " more labels that are not markers of the subject (no longer listed)");
 }
 
 void Daemon::broadcast_status() {
@@ -346,6 +398,7 @@ void Daemon::broadcast_status() {
     status.state = code_of(state_);
     status.source_rate_hz = static_cast<float>(source_rate_hz_);
     status.detail = state_detail_;
+    status.subject_present = state_ == SourceState::Streaming;
   }
   status.frames_received = metrics_.frames_received.load();
   status.frames_published = metrics_.frames_published.load();
@@ -385,6 +438,10 @@ std::string Daemon::health_json() const {
       {"publish_threads", publish_.count()},
       {"subscriber_tcp_congestion", config_.subscriber_tcp_congestion},  // empty: the system's
       {"subject", {{"markers", subject_.model.marker_count()}, {"vertices", pipeline_->vertex_count()}}},
+      {"source_limits",
+       {{"max_subjects", config_.source_max_subjects},
+        {"max_markers_per_subject", config_.source_max_markers_per_subject},
+        {"max_name_bytes", config_.source_max_name_bytes}}},
       {"latency_ms", latency_summaries(metrics_)}};
   return health.dump();
 }

@@ -16,7 +16,9 @@
 #include "protocol/subject_file.h"
 #include "server/asio.h"
 #include "server/config.h"
+#include "server/descriptor_reserve.h"
 #include "server/ingest/frame_source.h"
+#include "server/ingest/subject_router.h"
 #include "server/logging.h"
 #include "server/metrics/metrics.h"
 #include "server/pipeline/frame_mailbox.h"
@@ -29,7 +31,7 @@ class SubscriberHub;
 class HttpServer;
 class Listener;
 
-class Daemon : private FrameSink {
+class Daemon : private SourceSink, private SubjectRouter::Observer {
  public:
   // Loads the subject, opens the source file, binds both ports. Throws with a one-line message
   // (FileError, ConfigError, std::runtime_error) when any of it fails.
@@ -52,11 +54,15 @@ class Daemon : private FrameSink {
   std::string health_json() const;
 
  private:
-  // FrameSink (called on the io thread by the source).
-  void on_frame(const MarkerFrame& frame) override;
+  // SourceSink (called on the io thread by the source).
+  void on_frame(const SourceFrame& frame) override;
   void on_source_state(SourceState state, std::string_view detail) override;
   void on_bad_input(std::string_view what, std::string_view detail) override;
-  void on_unknown_label(std::string_view name) override;
+  // SubjectRouter::Observer (io thread, from on_frame).
+  void on_match(int target, bool present, std::string_view detail) override;
+  void on_unknown_subjects(std::span<const std::string> names, size_t not_listed) override;
+  void on_unknown_labels(int target, std::span<const std::string> names, size_t not_listed) override;
+  void on_rejected_points(uint32_t frame_number, int count);
 
   void broadcast_status();
   void schedule_status();
@@ -69,6 +75,7 @@ class Daemon : private FrameSink {
   RateLimitedLog bad_input_log_;
   RateLimitedLog drop_log_;  // frames that gave way in the mailbox, with the reason
   FrameMailbox mailbox_;
+  SubjectRouter router_;
   std::unique_ptr<SubscriberHub> hub_;
   std::unique_ptr<Pipeline> pipeline_;
   // After the pipeline and the hub: the io_context is destroyed first, and with it the handlers
@@ -77,6 +84,7 @@ class Daemon : private FrameSink {
   // The TCP subscribers' threads: destroyed before io_ and after the listeners (declared
   // between), once every session was closed on its own thread.
   PublishThreads publish_;
+  DescriptorReserve descriptor_reserve_;  // the HTTP port's, for when subscribers hold every other descriptor
   std::unique_ptr<Listener> sub_listener_;
   std::unique_ptr<HttpServer> http_;
   std::unique_ptr<FrameSource> source_;

@@ -1,34 +1,32 @@
 #include "server/ingest/file_replay_source.h"
 
-#include "core/capture_filler.h"
+#include <filesystem>
+
 #include "protocol/capture_file.h"
 #include "protocol/file_error.h"
 
 namespace skinstream::server {
 
-FileReplaySource::FileReplaySource(asio::io_context& io, const SubjectModel& model, const std::string& path,
-                                   FrameSink& sink, const ReplayOptions& options)
-    : io_(io), path_(path), capture_(read_capture(path)), sink_(sink), options_(options), frame_(model.marker_count()),
-      timer_(io) {
-  CaptureFillReport report;
-  channel_of_ = map_channels_to_markers(model, capture_, &report);
+FileReplaySource::FileReplaySource(asio::io_context& io, const std::string& path, SourceSink& sink,
+                                   const ReplayOptions& options)
+    : io_(io), path_(path), capture_(read_capture(path)), sink_(sink), options_(options), timer_(io) {
   if (capture_.frame_count == 0) throw FileError(path, "the capture has no frames");
-  if (channel_of_ == std::vector<int>(model.marker_count(), -1))
-    throw FileError(path, "none of the subject's " + std::to_string(model.marker_count()) +
-                              " marker labels is in this capture (wrong subject file?)");
-  std::vector<char> is_marker_channel(capture_.point_count(), 0);
-  for (int c : channel_of_)
-    if (c >= 0) is_marker_channel[c] = 1;
-  for (int c = 0; c < capture_.point_count(); ++c)
-    if (!is_marker_channel[c]) free_channels_.push_back(c);
-  unknown_labels_ = report.unknown_labels;
+  labelled_channels_ = capture_.labelled_points();
+  unlabelled_channels_ = capture_.unlabelled_points();
+  SourceSubject& subject = frame_.subjects.emplace_back();
+  subject.name = options.subject_name.empty() ? std::filesystem::path(path).stem().string() : options.subject_name;
+  for (int c : labelled_channels_) subject.labels.push_back(capture_.labels[c]);
+  frame_.labelled.assign(1, std::vector<Vec3>(labelled_channels_.size(), missing_point()));
+  frame_.unlabelled.reserve(unlabelled_channels_.size());
+  frame_.unlabelled_ids.reserve(unlabelled_channels_.size());
+  frame_.structure_version = 1;
+  frame_.rate_hz = capture_.rate_hz;
   const double rate = capture_.rate_hz > 0 ? capture_.rate_hz : 120.0;
   period_ = std::chrono::nanoseconds(static_cast<long long>(1e9 / (rate * options_.speed)));
 }
 
 void FileReplaySource::start() {
   running_ = true;
-  for (const std::string& name : unknown_labels_) sink_.on_unknown_label(name);
   sink_.on_source_state(SourceState::Streaming, "replay " + path_);
   start_ = std::chrono::steady_clock::now();
   ticks_ = 0;
@@ -62,24 +60,19 @@ void FileReplaySource::schedule() {
 }
 
 void FileReplaySource::emit(int index) {
-  frame_.clear();
   frame_.frame_number = static_cast<uint32_t>(capture_.first_frame + index);
   const double rate = capture_.rate_hz > 0 ? capture_.rate_hz : 120.0;
   frame_.source_time_ns = static_cast<int64_t>(1e9 * index / rate);
-  frame_.source_rate_hz = capture_.rate_hz;
   frame_.receive_time_ns =
       std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch()).count();
-  for (size_t m = 0; m < channel_of_.size(); ++m)
-    frame_.labelled[m] = channel_of_[m] >= 0 ? capture_.at(index, channel_of_[m]) : missing_point();
-  for (int c : free_channels_) {
+  std::vector<Vec3>& labelled = frame_.labelled.front();
+  for (size_t l = 0; l < labelled_channels_.size(); ++l) labelled[l] = capture_.at(index, labelled_channels_[l]);
+  frame_.unlabelled.clear();
+  frame_.unlabelled_ids.clear();
+  for (int c : unlabelled_channels_) {
     if (!capture_.present(index, c)) continue;
-    if (frame_.unlabelled_count == MarkerFrame::kMaxUnlabelled) {
-      ++frame_.rejected_points;
-      continue;
-    }
-    frame_.unlabelled[frame_.unlabelled_count] = capture_.at(index, c);
-    frame_.unlabelled_ids[frame_.unlabelled_count] = c;  // a channel is one trajectory fragment
-    ++frame_.unlabelled_count;
+    frame_.unlabelled.push_back(capture_.at(index, c));
+    frame_.unlabelled_ids.push_back(c);  // a channel is one trajectory fragment
   }
   sink_.on_frame(frame_);
 }

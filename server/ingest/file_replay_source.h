@@ -1,15 +1,15 @@
 #pragma once
 // Replays a capture file (C3D/TRC) as a live source: one frame per period / speed, on absolute
-// steady-clock deadlines (no drift), channels mapped to the subject's markers exactly as
-// fill_capture does (labelled channels the subject does not know become unlabelled points),
-// frame_number = first_frame + index. Loops if asked; otherwise ends in the Finished state.
+// steady-clock deadlines (no drift), frame_number = first_frame + index. The file is one subject
+// (named by the caller; by default the file's stem): its labelled channels are the subject's
+// labels, its unlabelled ones ("" or "*N") the frame's unlabelled points with the channel as
+// their trajectory id. Loops if asked; otherwise ends in the Finished state.
 
 #include <chrono>
 #include <string>
 #include <vector>
 
 #include "core/capture.h"
-#include "core/subject_model.h"
 #include "server/asio.h"
 #include "server/ingest/frame_source.h"
 
@@ -18,18 +18,19 @@ namespace skinstream::server {
 struct ReplayOptions {
   bool loop = false;
   double speed = 1.0;
+  std::string subject_name;  // empty: the file's stem
 };
 
 class FileReplaySource : public FrameSource {
  public:
-  // Reads the file now; throws FileError when it cannot, or when no channel names a marker.
-  FileReplaySource(asio::io_context& io, const SubjectModel& model, const std::string& path, FrameSink& sink,
-                   const ReplayOptions& options);
+  // Reads the file now; throws FileError when it cannot, or when it has no frames.
+  FileReplaySource(asio::io_context& io, const std::string& path, SourceSink& sink, const ReplayOptions& options);
   void start() override;
   void stop() override;
 
   double rate_hz() const { return capture_.rate_hz; }
   int frame_count() const { return capture_.frame_count; }
+  const SourceSubject& subject() const { return frame_.subjects.front(); }
 
  private:
   void schedule();
@@ -38,12 +39,10 @@ class FileReplaySource : public FrameSource {
   asio::io_context& io_;
   std::string path_;
   Capture capture_;
-  FrameSink& sink_;
+  SourceSink& sink_;
   ReplayOptions options_;
-  std::vector<int> channel_of_;     // per subject marker
-  std::vector<int> free_channels_;  // channels that are not a subject marker
-  std::vector<std::string> unknown_labels_;
-  MarkerFrame frame_;
+  std::vector<int> labelled_channels_, unlabelled_channels_;
+  SourceFrame frame_;
   asio::steady_timer timer_;
   std::chrono::steady_clock::time_point start_;
   std::chrono::nanoseconds period_{};

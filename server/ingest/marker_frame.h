@@ -1,12 +1,14 @@
 #pragma once
-// One frame of markers as a source (Vicon DataStream client, multicast receiver, file replay)
-// hands it to the pipeline, already in the subject's marker order. Sized once for the subject
-// (labelled = marker count, unlabelled capacity fixed) and reused: filling it allocates nothing.
+// One frame of one subject's markers as the pipeline takes it, in the subject's marker order: a
+// source's SourceFrame after SubjectRouter matched its labels to the subject's markers. Sized
+// once for the subject (labelled = marker count, unlabelled capacity fixed) and reused: filling
+// it allocates nothing.
 
 #include <cstdint>
 #include <vector>
 
 #include "core/capture.h"
+#include "server/ingest/source_frame.h"
 
 namespace skinstream::server {
 
@@ -17,6 +19,7 @@ struct MarkerFrame {
   int64_t source_time_ns = 0;        // capture time: the source's timecode or frame * period
   int64_t receive_time_ns = 0;       // wall clock (system_clock, ns since epoch) when complete
   double source_rate_hz = 0.0;       // from the source (StreamInfo frame period, file rate)
+  SourceTimecode timecode;           // the source's SMPTE timecode, when it sends one
 
   std::vector<Vec3> labelled;        // one per subject marker, NaN = missing
   std::vector<Vec3> unlabelled;      // capacity kMaxUnlabelled; the first unlabelled_count used
@@ -24,7 +27,7 @@ struct MarkerFrame {
   int unlabelled_count = 0;
 
   int unknown_labels = 0;            // labelled points whose name the subject does not have
-  int rejected_points = 0;           // non-finite or beyond capacity
+  int rejected_points = 0;           // neither a position nor NaN, or beyond the unlabelled capacity
 
   explicit MarkerFrame(int marker_count = 0) { resize(marker_count); }
   void resize(int marker_count) {
@@ -39,6 +42,7 @@ struct MarkerFrame {
     unlabelled_count = 0;
     unknown_labels = 0;
     rejected_points = 0;
+    timecode = SourceTimecode{};
   }
 };
 

@@ -17,12 +17,11 @@ int64_t system_now_ns() {
 }  // namespace
 
 struct ViconMulticastSource::State : std::enable_shared_from_this<ViconMulticastSource::State> {
-  State(asio::io_context& io_context, ViconMulticastSourceOptions opts, std::vector<std::string> marker_names,
-        FrameSink& frame_sink)
+  State(asio::io_context& io_context, ViconMulticastSourceOptions opts, SourceSink& frame_sink)
       : io(io_context),
         options(std::move(opts)),
         sink(frame_sink),
-        assembler(std::move(marker_names), frame_sink),
+        assembler(frame_sink),
         socket(io),
         silence_timer(io),
         datagram(64 * 1024) {
@@ -31,7 +30,7 @@ struct ViconMulticastSource::State : std::enable_shared_from_this<ViconMulticast
 
   asio::io_context& io;
   ViconMulticastSourceOptions options;
-  FrameSink& sink;
+  SourceSink& sink;
   ViconFrameAssembler assembler;
   udp::socket socket;
   asio::steady_timer silence_timer;
@@ -88,7 +87,7 @@ struct ViconMulticastSource::State : std::enable_shared_from_this<ViconMulticast
     std::string error;
     const vicon::Bytes packet(datagram.data(), n);
     auto result = ViconFrameAssembler::Result::Malformed;
-    if (vicon::split_objects(packet, objects, error)) result = assembler.handle(objects, now, error);
+    if (vicon::split_objects(packet, objects, error, options.limits)) result = assembler.handle(objects, now, error);
     if (stopped) return;
     if (result == ViconFrameAssembler::Result::Malformed) {
       sink.on_bad_input("malformed_packet", "datagram of " + std::to_string(n) + " bytes: " + error);
@@ -116,9 +115,8 @@ struct ViconMulticastSource::State : std::enable_shared_from_this<ViconMulticast
   }
 };
 
-ViconMulticastSource::ViconMulticastSource(asio::io_context& io, ViconMulticastSourceOptions options,
-                                           std::vector<std::string> marker_names, FrameSink& sink)
-    : state_(std::make_shared<State>(io, std::move(options), std::move(marker_names), sink)) {}
+ViconMulticastSource::ViconMulticastSource(asio::io_context& io, ViconMulticastSourceOptions options, SourceSink& sink)
+    : state_(std::make_shared<State>(io, std::move(options), sink)) {}
 
 ViconMulticastSource::~ViconMulticastSource() { stop(); }
 

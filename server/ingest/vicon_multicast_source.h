@@ -11,7 +11,6 @@
 
 #include <memory>
 #include <string>
-#include <vector>
 
 #include "protocol/vicon_datastream.h"
 #include "server/asio.h"
@@ -24,12 +23,12 @@ struct ViconMulticastSourceOptions {
   uint16_t port = vicon::kDefaultMulticastPort;
   std::string interface_address = "0.0.0.0";
   double silence_timeout_seconds = 1.0;
+  vicon::DescriptionLimits limits{};  // the subjects a datagram may carry
 };
 
 class ViconMulticastSource : public FrameSource {
  public:
-  ViconMulticastSource(asio::io_context& io, ViconMulticastSourceOptions options,
-                       std::vector<std::string> marker_names, FrameSink& sink);
+  ViconMulticastSource(asio::io_context& io, ViconMulticastSourceOptions options, SourceSink& sink);
   ~ViconMulticastSource() override;
 
   void start() override;  // binds the port (reporting Disconnected with the reason on failure)

@@ -5,7 +5,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
-#include <unordered_map>
+#include <iterator>
+#include <utility>
 
 #include "protocol/vicon_packet_framer.h"
 #include "protocol/vicon_packet_writer.h"
@@ -31,60 +32,97 @@ constexpr uint32_t kWantedTypes[] = {type::StreamInfo,      type::SubjectInfo, t
 // Bytes asked of the socket per read: several frames of 350 markers, so a backlog drains in few reads.
 constexpr size_t kReadBytes = 64 * 1024;
 
+// Unknown object types reported by name, at most.
+constexpr size_t kRememberedTypes = 64;
+
+// The SDK's timecode standards: PAL 0, NTSC 1, NTSCDrop 2, Film 3, NTSCFilm 4, ATSC 5.
+SourceTimecode timecode_of(const vicon::Timecode& in) {
+  struct Standard {
+    float rate;
+    bool drop;
+  };
+  static constexpr Standard kStandards[] = {{25.0f, false}, {30000.0f / 1001.0f, false}, {30000.0f / 1001.0f, true},
+                                            {24.0f, false}, {24000.0f / 1001.0f, false}, {30.0f, false}};
+  SourceTimecode out;
+  if (in.standard >= std::size(kStandards)) return out;  // none: not valid
+  out.valid = true;
+  out.hours = in.hours;
+  out.minutes = in.minutes;
+  out.seconds = in.seconds;
+  out.frames = in.frames;
+  out.subframe = in.subframes;
+  out.subframes_per_frame = in.subframes_per_frame;
+  out.rate_hz = kStandards[in.standard].rate;
+  out.drop_frame = kStandards[in.standard].drop;
+  out.field = in.field_flag != 0;
+  return out;
+}
+
 }  // namespace
 
 // ---------------------------------------------------------------- ViconFrameAssembler
 
-ViconFrameAssembler::ViconFrameAssembler(std::vector<std::string> marker_names, FrameSink& sink)
-    : marker_names_(std::move(marker_names)), sink_(sink), frame_(static_cast<int>(marker_names_.size())) {
-  labeled_.reserve(marker_names_.size() + 64);
+ViconFrameAssembler::ViconFrameAssembler(SourceSink& sink) : sink_(sink) {
+  labeled_.reserve(512);
   unlabeled_.reserve(256);
+  frame_.unlabelled.reserve(256);
+  frame_.unlabelled_ids.reserve(256);
 }
 
 void ViconFrameAssembler::reset() {
   frame_period_ticks_ = 0;
   saw_object_enums_ = false;
   offered_.types.clear();
-  marker_map_.clear();
+  // Until the new connection lists its subjects, there are none.
   subject_bytes_.clear();
+  label_slots_.clear();
+  frame_.subjects.clear();
+  frame_.labelled.clear();
+  ++frame_.structure_version;
+  reported_unknown_marker_ = false;
 }
 
 bool ViconFrameAssembler::update_subjects(const std::vector<vicon::ObjectView>& objects, std::string& out_error) {
   subject_bytes_scratch_.clear();
-  bool any = false;
+  bool listed = false;  // this packet says which subjects there are
   for (const vicon::ObjectView& o : objects) {
+    if (o.type == type::StreamInfo) listed = true;
     if (o.type != type::SubjectInfo) continue;
-    any = true;
+    listed = true;
     const auto length = static_cast<uint32_t>(o.payload.size());
     const auto* raw = reinterpret_cast<const unsigned char*>(&length);
     subject_bytes_scratch_.insert(subject_bytes_scratch_.end(), raw, raw + 4);
     subject_bytes_scratch_.insert(subject_bytes_scratch_.end(), o.payload.begin(), o.payload.end());
   }
-  if (!any || subject_bytes_scratch_ == subject_bytes_) return true;  // unchanged: nothing to redo
+  // Unchanged (the same bytes, or a packet that does not list the subjects): nothing to redo.
+  if (!listed || subject_bytes_scratch_ == subject_bytes_) return true;
 
-  std::unordered_map<std::string, int> index_of;
-  for (size_t i = 0; i < marker_names_.size(); ++i) index_of.emplace(marker_names_[i], static_cast<int>(i));
-  std::vector<std::pair<uint64_t, int>> map;
+  std::vector<SourceSubject> subjects;
+  std::vector<std::pair<uint64_t, uint64_t>> slots;
   for (const vicon::ObjectView& o : objects) {
     if (o.type != type::SubjectInfo) continue;
-    vicon::SubjectInfo subject;
-    if (!vicon::decode(o.payload, subject, out_error)) return false;
-    const bool matches = std::any_of(subject.markers.begin(), subject.markers.end(),
-                                     [&](const vicon::SubjectMarker& m) { return index_of.count(m.name) > 0; });
-    for (const vicon::SubjectMarker& m : subject.markers) {
-      int index = kIgnored;
-      if (matches) {
-        const auto it = index_of.find(m.name);
-        index = it != index_of.end() ? it->second : kUnknownLabel;
-        if (index == kUnknownLabel && reported_labels_.insert(m.name).second) sink_.on_unknown_label(m.name);
-      }
-      map.emplace_back(marker_key(subject.subject_id, m.marker_id), index);
+    vicon::SubjectInfo info;
+    if (!vicon::decode(o.payload, info, out_error)) return false;
+    SourceSubject& subject = subjects.emplace_back();
+    subject.name = std::move(info.name);
+    for (const vicon::SubjectMarker& m : info.markers) {
+      slots.emplace_back(marker_key(info.subject_id, m.marker_id), (static_cast<uint64_t>(subjects.size() - 1) << 32) | subject.labels.size());
+      subject.labels.push_back(m.name);
     }
   }
-  std::sort(map.begin(), map.end());
-  marker_map_ = std::move(map);
+  std::sort(slots.begin(), slots.end());
+  label_slots_ = std::move(slots);
+  frame_.subjects = std::move(subjects);
+  frame_.labelled.resize(frame_.subjects.size());
+  for (size_t s = 0; s < frame_.subjects.size(); ++s) frame_.labelled[s].assign(frame_.subjects[s].labels.size(), missing_point());
+  ++frame_.structure_version;
   subject_bytes_.swap(subject_bytes_scratch_);
   return true;
+}
+
+void ViconFrameAssembler::add_unlabelled(const std::array<double, 3>& position, uint32_t trajectory_id) {
+  frame_.unlabelled.emplace_back(position[0], position[1], position[2]);
+  frame_.unlabelled_ids.push_back(trajectory_id <= static_cast<uint32_t>(INT32_MAX) ? static_cast<int>(trajectory_id) : -1);
 }
 
 ViconFrameAssembler::Result ViconFrameAssembler::handle(const std::vector<vicon::ObjectView>& objects,
@@ -101,20 +139,12 @@ ViconFrameAssembler::Result ViconFrameAssembler::handle(const std::vector<vicon:
   }
   if (!update_subjects(objects, out_error)) return Result::Malformed;
 
-  frame_.clear();
+  for (std::vector<Vec3>& labels : frame_.labelled) std::fill(labels.begin(), labels.end(), missing_point());
+  frame_.unlabelled.clear();
+  frame_.unlabelled_ids.clear();
+  frame_.timecode = {};
   bool has_frame = false;
   uint32_t frame_id = 0;
-  auto add_unlabelled = [this](const std::array<double, 3>& p, uint32_t id) {
-    const Vec3 point(p[0], p[1], p[2]);
-    if (!is_present(point) || frame_.unlabelled_count >= MarkerFrame::kMaxUnlabelled) {
-      ++frame_.rejected_points;
-      return;
-    }
-    frame_.unlabelled[static_cast<size_t>(frame_.unlabelled_count)] = point;
-    frame_.unlabelled_ids[static_cast<size_t>(frame_.unlabelled_count)] =
-        id <= static_cast<uint32_t>(INT32_MAX) ? static_cast<int>(id) : -1;
-    ++frame_.unlabelled_count;
-  };
   for (const vicon::ObjectView& o : objects) {
     switch (o.type) {
       case type::FrameInfo: {
@@ -128,19 +158,16 @@ ViconFrameAssembler::Result ViconFrameAssembler::handle(const std::vector<vicon:
         if (!vicon::decode(o.payload, labeled_, out_error)) return Result::Malformed;
         for (const vicon::LabeledRecon& r : labeled_) {
           const uint64_t key = marker_key(r.subject_id, r.marker_id);
-          const auto it = std::lower_bound(marker_map_.begin(), marker_map_.end(), std::make_pair(key, INT32_MIN));
-          const int index = (it != marker_map_.end() && it->first == key) ? it->second : kUnknownLabel;
-          if (index == kIgnored) continue;
-          if (index == kUnknownLabel) {
-            ++frame_.unknown_labels;
+          const auto it = std::lower_bound(label_slots_.begin(), label_slots_.end(), std::make_pair(key, uint64_t{0}));
+          if (it == label_slots_.end() || it->first != key) {
+            if (!std::exchange(reported_unknown_marker_, true))
+              sink_.on_bad_input("unknown_marker_id", "a labelled marker (subject id " + std::to_string(r.subject_id) + ", marker id " +
+                                                          std::to_string(r.marker_id) +
+                                                          ") that SubjectInfo does not list: passed on as unlabelled (reported once)");
             add_unlabelled(r.position, r.trajectory_id);
             continue;
           }
-          const Vec3 point(r.position[0], r.position[1], r.position[2]);
-          if (is_present(point))
-            frame_.labelled[static_cast<size_t>(index)] = point;
-          else
-            ++frame_.rejected_points;
+          frame_.labelled[it->second >> 32][it->second & 0xFFFFFFFFu] = Vec3(r.position[0], r.position[1], r.position[2]);
         }
         break;
       }
@@ -149,9 +176,10 @@ ViconFrameAssembler::Result ViconFrameAssembler::handle(const std::vector<vicon:
         for (const vicon::UnlabeledRecon& r : unlabeled_) add_unlabelled(r.position, r.trajectory_id);
         break;
       }
-      case type::Timecode: {  // validated; the capture time comes from the frame number
+      case type::Timecode: {
         vicon::Timecode timecode;
         if (!vicon::decode(o.payload, timecode, out_error)) return Result::Malformed;
+        frame_.timecode = timecode_of(timecode);
         break;
       }
       case type::ObjectEnums:
@@ -161,15 +189,15 @@ ViconFrameAssembler::Result ViconFrameAssembler::handle(const std::vector<vicon:
       case type::Ping:
         break;
       default:
-        if (reported_types_.insert(o.type).second)
-          sink_.on_bad_input("unknown_object", "skipping Vicon object type " + std::to_string(o.type) +
-                                                   " (reported once)");
+        // Each unknown type once, remembering a few: a source sending many kinds is only counted.
+        if (reported_types_.size() < kRememberedTypes && reported_types_.insert(o.type).second)
+          sink_.on_bad_input("unknown_object", "skipping Vicon object type " + std::to_string(o.type) + " (reported once)");
         break;
     }
   }
   if (!has_frame) return Result::NoFrame;
   frame_.frame_number = frame_id + 1;  // as the Vicon SDK numbers frames
-  frame_.source_rate_hz = vicon::rate_from_period(frame_period_ticks_);
+  frame_.rate_hz = vicon::rate_from_period(frame_period_ticks_);
   // ticks / 135 MHz in ns = ticks * 200 / 27, split so that a long take cannot overflow.
   const int64_t ticks = static_cast<int64_t>(frame_id) * frame_period_ticks_;
   frame_.source_time_ns = ticks / 27 * 200 + ticks % 27 * 200 / 27;
@@ -180,12 +208,11 @@ ViconFrameAssembler::Result ViconFrameAssembler::handle(const std::vector<vicon:
 // ---------------------------------------------------------------- ViconSource
 
 struct ViconSource::State : std::enable_shared_from_this<ViconSource::State> {
-  State(asio::io_context& io_context, ViconSourceOptions opts, std::vector<std::string> marker_names,
-        FrameSink& frame_sink)
+  State(asio::io_context& io_context, ViconSourceOptions opts, SourceSink& frame_sink)
       : io(io_context),
         options(std::move(opts)),
         sink(frame_sink),
-        assembler(std::move(marker_names), frame_sink),
+        assembler(frame_sink),
         socket(io),
         resolver(io),
         timer(io),
@@ -197,7 +224,7 @@ struct ViconSource::State : std::enable_shared_from_this<ViconSource::State> {
 
   asio::io_context& io;
   ViconSourceOptions options;
-  FrameSink& sink;
+  SourceSink& sink;
   ViconFrameAssembler assembler;
   tcp::socket socket;
   tcp::resolver resolver;
@@ -367,9 +394,8 @@ struct ViconSource::State : std::enable_shared_from_this<ViconSource::State> {
   }
 };
 
-ViconSource::ViconSource(asio::io_context& io, ViconSourceOptions options, std::vector<std::string> marker_names,
-                         FrameSink& sink)
-    : state_(std::make_shared<State>(io, std::move(options), std::move(marker_names), sink)) {}
+ViconSource::ViconSource(asio::io_context& io, ViconSourceOptions options, SourceSink& sink)
+    : state_(std::make_shared<State>(io, std::move(options), sink)) {}
 
 ViconSource::~ViconSource() { stop(); }
 

@@ -1,7 +1,7 @@
 #pragma once
 // The daemon's Vicon DataStream client: connects to Vicon Nexus / Tracker / Shogun (or
-// skinstream-replay) on TCP port 801, asks for frames and hands each one to a FrameSink in the
-// subject's marker order.
+// skinstream-replay) on TCP port 801, asks for frames and hands each one on as a SourceFrame
+// (every subject with its labels; SubjectRouter then matches them to ours).
 //
 // Handshake: the server sends ObjectEnums; we answer with the types we read (StreamInfo,
 // SubjectInfo, FrameInfo, LabeledRecons, UnlabeledRecons, Timecode, Contents) and RequestFrame
@@ -10,15 +10,17 @@
 // Disconnected with the reason and retries after a backoff of 0.25 s doubling to 5 s; the backoff
 // returns to 0.25 s once frames flow again (Streaming).
 //
-// Marker mapping: SubjectInfo marker names are matched to the subject's marker names. Every
-// subject with at least one matching name is used (several Vicon subjects may split one body);
-// its markers whose names the subject does not have are reported once each (on_unknown_label)
-// and then passed on as unlabelled points. Subjects with no matching name (another performer)
-// are ignored. SubjectInfo is decoded only when its bytes change.
+// Subjects: SourceFrame::subjects are the SubjectInfo objects (name, marker names in the order
+// SubjectInfo lists them), decoded only when their bytes change (structure_version then bumps).
+// A packet with SubjectInfo lists every subject; one with StreamInfo and no SubjectInfo says
+// there are none (the last subject left). A LabeledRecon whose subject or marker id SubjectInfo
+// does not list is passed on as an unlabelled point (reported once per connection).
 //
-// Frame numbers are those the SDK reports (FrameInfo + 1); source_time_ns = FrameInfo x period.
+// Frame numbers are those the SDK reports (FrameInfo + 1); source_time_ns = FrameInfo x period;
+// the Timecode object is valid when its standard is one of the SDK's (the rate follows from it).
 // After the first frames, receiving a frame allocates nothing.
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -30,20 +32,20 @@
 #include "protocol/vicon_packet_reader.h"
 #include "server/asio.h"
 #include "server/ingest/frame_source.h"
-#include "server/ingest/marker_frame.h"
+#include "server/ingest/source_frame.h"
 
 namespace skinstream::server {
 
-// Packet objects -> MarkerFrame, shared by the TCP and the multicast sources.
+// Packet objects -> SourceFrame, shared by the TCP and the multicast sources.
 class ViconFrameAssembler {
  public:
-  ViconFrameAssembler(std::vector<std::string> marker_names, FrameSink& sink);
+  explicit ViconFrameAssembler(SourceSink& sink);
 
   enum class Result { NoFrame, Frame, Malformed };
   // One packet's objects. On Frame, frame() holds it (receive_time_ns as given). Unknown object
   // types are reported to the sink once per type.
   Result handle(const std::vector<vicon::ObjectView>& objects, int64_t receive_time_ns, std::string& out_error);
-  const MarkerFrame& frame() const { return frame_; }
+  const SourceFrame& frame() const { return frame_; }
 
   bool saw_object_enums() const { return saw_object_enums_; }
   const vicon::ObjectEnums& offered() const { return offered_; }
@@ -51,20 +53,18 @@ class ViconFrameAssembler {
 
  private:
   bool update_subjects(const std::vector<vicon::ObjectView>& objects, std::string& out_error);
+  void add_unlabelled(const std::array<double, 3>& position, uint32_t trajectory_id);
 
-  std::vector<std::string> marker_names_;
-  FrameSink& sink_;
-  MarkerFrame frame_;
+  SourceSink& sink_;
+  SourceFrame frame_;
   int64_t frame_period_ticks_ = 0;
   bool saw_object_enums_ = false;
   vicon::ObjectEnums offered_;
-  // (subject id << 32 | marker id) -> subject marker index, kUnknownLabel or kIgnored; sorted.
-  static constexpr int kUnknownLabel = -1;
-  static constexpr int kIgnored = -2;
-  std::vector<std::pair<uint64_t, int>> marker_map_;
+  // (subject id << 32 | marker id) -> (subject index << 32 | label index) in frame_; sorted.
+  std::vector<std::pair<uint64_t, uint64_t>> label_slots_;
   std::vector<unsigned char> subject_bytes_;          // the SubjectInfo payloads last decoded
   std::vector<unsigned char> subject_bytes_scratch_;  // this packet's, to compare
-  std::unordered_set<std::string> reported_labels_;
+  bool reported_unknown_marker_ = false;  // this connection
   std::unordered_set<uint32_t> reported_types_;
   std::vector<vicon::LabeledRecon> labeled_;
   std::vector<vicon::UnlabeledRecon> unlabeled_;
@@ -81,9 +81,7 @@ struct ViconSourceOptions {
 
 class ViconSource : public FrameSource {
  public:
-  // marker_names: the subject's markers, in the order MarkerFrame::labelled uses.
-  ViconSource(asio::io_context& io, ViconSourceOptions options, std::vector<std::string> marker_names,
-              FrameSink& sink);
+  ViconSource(asio::io_context& io, ViconSourceOptions options, SourceSink& sink);
   ~ViconSource() override;
 
   void start() override;

@@ -106,6 +106,10 @@ std::string Metrics::render_prometheus(const std::vector<SubscriberMetrics>& sub
   counter(out, "markers_held_total", "Marker samples held relative to their anchors.", markers_held);
   counter(out, "bad_subscriber_messages_total", "Subscriber messages that broke the protocol.", bad_subscriber_messages);
   counter(out, "subscribers_accepted_total", "Subscriber connections accepted.", subscribers_connected);
+  counter(out, "subscribers_refused_total", "Subscribers refused after their Hello (unknown subject, ...).", subscribers_refused);
+  counter(out, "accepts_failed_no_descriptor_total",
+          "Accepts (HTTP and subscriber ports) that failed for lack of file descriptors; each pauses that port's accepts, 10 ms doubling to 1 s.",
+          accepts_failed_no_descriptor);
   counter(out, "frame_buffers_allocated_total", "Encoded frame buffers created (steady state: constant).", frame_buffers_allocated);
   counter(out, "frame_buffers_allocated_by_pipeline_total",
           "Of those, created on the pipeline thread because none was prepared when the subscriber asked (expected: 0).",
@@ -121,7 +125,8 @@ std::string Metrics::render_prometheus(const std::vector<SubscriberMetrics>& sub
   fill.render(out, "fill_seconds", "Gap filler time per frame.");
   deform.render(out, "deform_seconds", "Mesh deformation time per frame (parts and vertices).");
   normals.render(out, "normals_seconds", "Normal computation time per frame.");
-  encode.render(out, "encode_seconds", "Frame encoding time per frame.");
+  encode.render(out, "encode_seconds", "Frame encoding time per frame (every encoding but the compressed one).");
+  encode_compressed.render(out, "encode_compressed_seconds", "The compressed encoding's time per frame (vertex codec, after the other encodings were handed over).");
   receive_to_publish.render(out, "receive_to_publish_seconds", "From frame received to handed to the publishers.");
   subscriber_queue_wait.render(out, "subscriber_queue_wait_seconds",
                                "Per frame and subscriber: from published to its write starting (the subscriber's queue and its io thread's turn).");

@@ -6,9 +6,32 @@
 
 namespace skinstream::server {
 
+namespace {
+
+// The encoding a stream key's frames are in.
+subscriber::Encoding encoding_of(StreamKey key) {
+  const uint32_t flags = stream_flags(key);
+  if (flags & subscriber::kFrameParameters) return subscriber::Encoding::Parameters;
+  if (flags & subscriber::kFrameCompressed) return subscriber::Encoding::Compressed;
+  if (flags & subscriber::kFrameQuantised) return subscriber::Encoding::Quantised;
+  return subscriber::Encoding::Float;
+}
+
+size_t status_index(StreamKey key) {
+  return stream_version(key) >= subscriber::kVersion2 ? 1 + static_cast<size_t>(encoding_of(key)) : 0;
+}
+
+ControlMessage encode_status_for(subscriber::Status status, StreamKey key) {
+  status.encoding = encoding_of(key);
+  return std::make_shared<const std::vector<unsigned char>>(subscriber::encode_status(status, stream_version(key)));
+}
+
+}  // namespace
+
 SubscriberHub::SubscriberHub(Metrics& metrics, const HubOptions& options, subscriber::MeshInfo mesh_info, bool has_mesh)
     : metrics_(metrics), options_(options), has_mesh_(has_mesh), mesh_info_(std::move(mesh_info)) {
-  status_ = std::make_shared<const std::vector<unsigned char>>(subscriber::encode_status({}));
+  status_.subject = mesh_info_.subject;
+  broadcast_status(status_);
 }
 
 void SubscriberHub::add(const std::shared_ptr<SubscriberSession>& session) {
@@ -17,8 +40,8 @@ void SubscriberHub::add(const std::shared_ptr<SubscriberSession>& session) {
   metrics_.subscribers_connected.fetch_add(1, std::memory_order_relaxed);
 }
 
-void SubscriberHub::activate(SubscriberSession& session, uint32_t frame_flags) {
-  if (prepare_encoding_) prepare_encoding_(frame_flags);  // does nothing once the encoding is prepared
+void SubscriberHub::activate(SubscriberSession& session, StreamKey key) {
+  if (prepare_encoding_) prepare_encoding_(key);  // makes nothing once the key's buffers are made
   std::lock_guard lock(mutex_);
   if (std::find(active_.begin(), active_.end(), &session) == active_.end()) active_.push_back(&session);
   update_wanted_locked();
@@ -46,22 +69,25 @@ void SubscriberHub::close_all() {
 }
 
 void SubscriberHub::update_wanted_locked() {
-  uint32_t mask = 0;
-  for (const SubscriberSession* s : active_) mask |= 1u << s->frame_flags();
-  wanted_.store(mask);
+  StreamKeySet set;
+  for (const SubscriberSession* s : active_) set.add(s->stream_key());
+  wanted_[0].store(set.bits[0]);
+  wanted_[1].store(set.bits[1]);
 }
 
-ControlMessage SubscriberHub::mesh_info_message(uint32_t frame_flags) {
+ControlMessage SubscriberHub::mesh_info_message(StreamKey key) {
   std::lock_guard lock(mesh_info_mutex_);
-  ControlMessage& cached = mesh_info_messages_[frame_flags & 15u];
+  ControlMessage& cached = mesh_info_messages_[key % kStreamKeys];
   if (!cached) {
     subscriber::MeshInfo info = mesh_info_;
-    if (frame_flags & subscriber::kFrameNoPositions) {
+    if (stream_flags(key) & subscriber::kFrameNoPositions) {
       info.vertex_count = 0;
       info.faces.clear();
       info.dominant_part.clear();
     }
-    cached = std::make_shared<const std::vector<unsigned char>>(subscriber::encode_mesh_info(info));
+    info.encoding = encoding_of(key);
+    if (info.encoding == subscriber::Encoding::Compressed) info.compressed_order = compressed_order_;
+    cached = std::make_shared<const std::vector<unsigned char>>(subscriber::encode_mesh_info(info, stream_version(key)));
   }
   return cached;
 }
@@ -73,16 +99,35 @@ void SubscriberHub::set_source_rate(float rate_hz) {
   for (ControlMessage& m : mesh_info_messages_) m.reset();
 }
 
-ControlMessage SubscriberHub::status_message() const {
+ControlMessage SubscriberHub::status_message(StreamKey key) const {
   std::lock_guard lock(mutex_);
-  return status_;
+  return status_messages_[status_index(key)];
 }
 
-void SubscriberHub::broadcast_status(const subscriber::Status& status) {
-  const ControlMessage message = std::make_shared<const std::vector<unsigned char>>(subscriber::encode_status(status));
+ControlMessage SubscriberHub::status_message(StreamKey key, const std::string& detail, subscriber::SourceStateCode state) const {
+  subscriber::Status status;
+  {
+    std::lock_guard lock(mutex_);
+    status = status_;
+  }
+  status.detail = detail;
+  status.state = state;
+  return encode_status_for(status, key);
+}
+
+void SubscriberHub::broadcast_status(const subscriber::Status& in) {
+  subscriber::Status status = in;
+  if (status.subject.empty()) status.subject = mesh_info_.subject;
+  std::array<ControlMessage, 1 + subscriber::kEncodingCount> messages;
+  messages[0] = encode_status_for(status, stream_key(0, subscriber::kVersion1));
+  const uint32_t encoding_flags[subscriber::kEncodingCount] = {0, subscriber::kFrameQuantised, subscriber::kFrameCompressed,
+                                                              subscriber::kFrameParameters};
+  for (uint32_t e = 0; e < subscriber::kEncodingCount; ++e)
+    messages[1 + e] = encode_status_for(status, stream_key(encoding_flags[e], subscriber::kVersion2));
   std::lock_guard lock(mutex_);
-  status_ = message;
-  for (SubscriberSession* s : active_) s->offer_control(message);
+  status_ = status;
+  status_messages_ = messages;
+  for (SubscriberSession* s : active_) s->offer_control(status_messages_[status_index(s->stream_key())]);
 }
 
 void SubscriberHub::publish(const FrameRef& frame) {

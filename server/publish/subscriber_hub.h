@@ -1,7 +1,8 @@
 #pragma once
 // Every connected subscriber (TCP and WebSocket): fans each published frame out to their queues
-// without waiting for any of them, keeps the MeshInfo for each encoding and the latest Status,
-// and says which frame encodings are wanted so the pipeline encodes only those.
+// without waiting for any of them, keeps the MeshInfo for each stream key, the Model message and
+// the latest Status in each version, and says which stream keys are wanted so the pipeline
+// encodes only those.
 
 #include <array>
 #include <atomic>
@@ -29,30 +30,46 @@ struct HubOptions {
 
 class SubscriberHub : public FrameConsumer {
  public:
-  // `mesh_info` describes the full mesh; subscribers without positions get it with V = F = 0.
+  // `mesh_info` describes the full mesh (its subject field names the subject); subscribers
+  // without positions get it with V = F = 0.
   SubscriberHub(Metrics& metrics, const HubOptions& options, subscriber::MeshInfo mesh_info, bool has_mesh);
 
   const HubOptions& options() const { return options_; }
   Metrics& metrics() { return metrics_; }
   bool has_mesh() const { return has_mesh_; }
+  const std::string& subject_name() const { return mesh_info_.subject; }
 
   void add(const std::shared_ptr<SubscriberSession>& session);
-  // Called by activate() on the subscriber's thread before its encoding becomes wanted, so the
-  // pipeline can make that encoding's buffers there (Pipeline::prepare_encoding). Set before
-  // any subscriber connects.
-  void set_encoding_preparer(std::function<void(uint32_t frame_flags)> prepare) { prepare_encoding_ = std::move(prepare); }
-  // After Hello (or its timeout): the session starts receiving frames with these flags.
-  void activate(SubscriberSession& session, uint32_t frame_flags);
+  // Called by activate() on the subscriber's thread before its stream key becomes wanted, so
+  // the pipeline can make that key's buffers there (Pipeline::prepare_encoding). Set before any
+  // subscriber connects.
+  void set_encoding_preparer(std::function<void(StreamKey key)> prepare) { prepare_encoding_ = std::move(prepare); }
+  // After Hello (or its timeout): the session starts receiving frames of this stream key.
+  void activate(SubscriberSession& session, StreamKey key);
   void remove(SubscriberSession& session);
   void close_all();
 
-  ControlMessage mesh_info_message(uint32_t frame_flags);
-  ControlMessage status_message() const;
+  ControlMessage mesh_info_message(StreamKey key);
+  // The compressed encoding's vertex order, sent in its MeshInfo. Set before any subscriber connects.
+  void set_compressed_order(std::vector<uint32_t> order) { compressed_order_ = std::move(order); }
+  // The Model message of the parameter encoding (null without a mesh). Set before any
+  // subscriber connects.
+  void set_model_message(ControlMessage model) { model_message_ = std::move(model); }
+  const ControlMessage& model_message() const { return model_message_; }
+  // The latest Status, in the key's version (and with the encoding it serves).
+  ControlMessage status_message(StreamKey key) const;
+  // The latest Status with another detail (a notice to one subscriber, e.g. an encoding it
+  // asked for and does not get), in the key's version.
+  ControlMessage status_message(StreamKey key, const std::string& detail, subscriber::SourceStateCode state) const;
   void set_source_rate(float rate_hz);
-  // Encodes and sends a Status to every greeted subscriber.
+  // Encodes and sends a Status to every greeted subscriber, each in its version.
   void broadcast_status(const subscriber::Status& status);
 
-  uint32_t wanted_encodings() const override { return wanted_.load(); }
+  StreamKeySet wanted_encodings() const override {
+    StreamKeySet set;
+    set.bits = {wanted_[0].load(std::memory_order_relaxed), wanted_[1].load(std::memory_order_relaxed)};
+    return set;
+  }
   void publish(const FrameRef& frame) override;
 
   std::vector<SubscriberMetrics> subscriber_metrics() const;
@@ -68,13 +85,17 @@ class SubscriberHub : public FrameConsumer {
   // subscriber's Hello) under mutex_ held the pipeline's publish() for 14 ms at start-up.
   std::mutex mesh_info_mutex_;
   subscriber::MeshInfo mesh_info_;
-  std::array<ControlMessage, 16> mesh_info_messages_;
+  std::array<ControlMessage, kStreamKeys> mesh_info_messages_;
+  ControlMessage model_message_;
+  std::vector<uint32_t> compressed_order_;
   mutable std::mutex mutex_;  // the sessions and the status
   std::vector<std::shared_ptr<SubscriberSession>> sessions_;
   std::vector<SubscriberSession*> active_;
-  ControlMessage status_;
-  std::atomic<uint32_t> wanted_{0};
-  std::function<void(uint32_t)> prepare_encoding_;
+  subscriber::Status status_;
+  // The status encoded: version 1, then version 2 per encoding served.
+  std::array<ControlMessage, 1 + subscriber::kEncodingCount> status_messages_;
+  std::array<std::atomic<uint64_t>, 2> wanted_{};  // StreamKeySet::bits
+  std::function<void(StreamKey)> prepare_encoding_;
 };
 
 }  // namespace skinstream::server

@@ -24,7 +24,7 @@ SubscriberSession::SubscriberSession(asio::io_context& io, SubscriberHub& hub, s
       pump_slot_(std::make_shared<HandlerSlot>()) {}
 
 void SubscriberSession::offer(const FrameRef& frame) {
-  if (!frame->has(flags_.load())) return;  // encoding not ready in this frame (wants just changed)
+  if (!frame->has(key_.load())) return;  // encoding not ready in this frame (wants just changed)
   queue_.push_frame(frame);
   kick();
 }
@@ -49,14 +49,18 @@ void SubscriberSession::start_hello_timer(std::chrono::milliseconds timeout) {
     if (ec || self->greeted_ || self->closed_) return;
     spdlog::info("subscriber {} ({} {}): no Hello within the timeout, sending positions only", self->id_, self->transport_,
                  self->remote_);
-    self->on_hello(0);
+    self->on_hello(subscriber::Hello{});
   });
 }
 
-void SubscriberSession::on_subscriber_message(subscriber::MessageType type, std::span<const unsigned char> payload) {
+void SubscriberSession::on_subscriber_message(subscriber::MessageType type, std::span<const unsigned char> payload,
+                                              uint16_t version) {
+  if (version_ != 0 && version != version_)
+    throw subscriber::DecodeError("a version " + std::to_string(version) + " message after a version " + std::to_string(version_) +
+                                  " Hello");
   switch (type) {
     case subscriber::MessageType::Hello:
-      on_hello(subscriber::decode_hello(payload).wants);
+      on_hello(subscriber::decode_hello(payload, version));
       return;
     case subscriber::MessageType::Ack:
       subscriber::decode_ack(payload);  // checks the length
@@ -74,19 +78,55 @@ void SubscriberSession::on_ack() {
   if (!writing_) pump();
 }
 
-void SubscriberSession::on_hello(uint32_t wants) {
+void SubscriberSession::on_hello(const subscriber::Hello& hello) {
   if (closed_) return;
-  paced_ = (wants & subscriber::kWantPaced) != 0;
-  const uint32_t flags = subscriber::frame_flags_for(wants, hub_.has_mesh());
-  const bool changed = !greeted_ || flags != flags_.load();
+  version_ = hello.version;
+  paced_ = (hello.wants & subscriber::kWantPaced) != 0;
+  // Version 2: the encoding asked for, or what can be served instead, and why.
+  std::string notice;
+  uint32_t flags = subscriber::frame_flags_for(hello.wants, hub_.has_mesh());
+  if (hello.version >= subscriber::kVersion2) {
+    if (!hello.subject.empty() && hello.subject != hub_.subject_name()) {
+      refuse("no subject \"" + hello.subject + "\" here (this daemon serves \"" + hub_.subject_name() + "\")");
+      return;
+    }
+    subscriber::Encoding served = subscriber::Encoding::Float;
+    if (hello.encoding < subscriber::kEncodingCount) {
+      served = static_cast<subscriber::Encoding>(hello.encoding);
+    } else {
+      notice = "encoding " + std::to_string(hello.encoding) + " is not one this daemon serves: positions in float";
+    }
+    const bool needs_mesh = served == subscriber::Encoding::Parameters || served == subscriber::Encoding::Compressed;
+    if (needs_mesh && !hub_.has_mesh())
+      notice = std::string("no ") + subscriber::to_string(served) + " encoding for a subject without a mesh: markers only";
+    flags = subscriber::frame_flags_for(hello.wants, served, hub_.has_mesh());
+  }
+  const StreamKey key = server::stream_key(flags, hello.version);
+  const bool changed = !greeted_ || key != key_.load();
   greeted_ = true;
   hello_timer_.cancel();
   if (!changed) return;
-  flags_.store(flags);
-  offer_control(hub_.mesh_info_message(flags));
-  offer_control(hub_.status_message());
-  hub_.activate(*this, flags);
-  spdlog::info("subscriber {} ({} {}): wants {:#x}, frame flags {:#x}", id_, transport_, remote_, wants, flags);
+  key_.store(key);
+  offer_control(hub_.mesh_info_message(key));
+  if ((flags & subscriber::kFrameParameters) && hub_.model_message()) offer_control(hub_.model_message());
+  offer_control(hub_.status_message(key));
+  if (!notice.empty()) {
+    offer_control(hub_.status_message(key, notice, subscriber::SourceStateCode::Streaming));
+    spdlog::info("subscriber {} ({} {}): {}", id_, transport_, remote_, notice);
+  }
+  hub_.activate(*this, key);
+  spdlog::info("subscriber {} ({} {}): protocol {}, wants {:#x}, frame flags {:#x}", id_, transport_, remote_, hello.version,
+               hello.wants, flags);
+}
+
+void SubscriberSession::refuse(const std::string& reason) {
+  hub_.metrics().subscribers_refused.fetch_add(1, std::memory_order_relaxed);
+  spdlog::warn("subscriber {} ({} {}): refused: {}", id_, transport_, remote_, reason);
+  greeted_ = true;
+  hello_timer_.cancel();
+  // The Status goes out first; the session closes once its queue has been written.
+  close_after_write_ = true;
+  offer_control(hub_.status_message(server::stream_key(0, version_), reason, subscriber::SourceStateCode::Refused));
 }
 
 void SubscriberSession::on_protocol_error(const std::string& reason) {
@@ -125,7 +165,7 @@ void SubscriberSession::pump() {
     const auto take = window_full ? SubscriberQueue::Take::ControlOnly
                                   : (paced_ ? SubscriberQueue::Take::NewestFrame : SubscriberQueue::Take::OldestFrame);
     if (!queue_.pop(in_flight_, take)) return;
-    if (in_flight_.control || in_flight_.frame->has(flags_.load())) break;
+    if (in_flight_.control || in_flight_.frame->has(key_.load())) break;
     in_flight_.frame.reset();  // encoded for this subscriber's previous wants
   }
   writing_ = true;
@@ -137,7 +177,7 @@ void SubscriberSession::pump() {
   write_started_ = std::chrono::steady_clock::now();
   hub_.metrics().subscriber_queue_wait.observe_ns(
       std::chrono::duration_cast<std::chrono::nanoseconds>(write_started_ - in_flight_.frame->published).count());
-  const std::span<const unsigned char> message = in_flight_.frame->message(flags_.load());
+  const std::span<const unsigned char> message = in_flight_.frame->message(key_.load());
   const size_t prefix = std::min(frame_prefix_.size(), message.size());
   std::memcpy(frame_prefix_.data(), message.data(), prefix);
   subscriber::patch_subscriber_dropped(std::span(frame_prefix_).first(prefix), static_cast<uint32_t>(queue_.frames_dropped()));
@@ -159,6 +199,7 @@ void SubscriberSession::write_done(const boost::system::error_code& ec) {
         std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - write_started_).count());
   }
   pump();
+  if (close_after_write_ && !writing_) close();  // a refused subscriber: its Status is written
 }
 
 }  // namespace skinstream::server

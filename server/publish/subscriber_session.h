@@ -16,6 +16,7 @@
 #include "server/metrics/metrics.h"
 #include "protocol/subscriber_stream.h"
 #include "server/publish/handler_slot.h"
+#include "server/pipeline/stream_key.h"
 #include "server/publish/subscriber_queue.h"
 
 namespace skinstream::server {
@@ -31,7 +32,7 @@ class SubscriberSession : public std::enable_shared_from_this<SubscriberSession>
   void offer(const FrameRef& frame);
   void offer_control(ControlMessage message);
 
-  uint32_t frame_flags() const { return flags_.load(); }
+  StreamKey stream_key() const { return key_.load(); }
   SubscriberMetrics stats() const;
   uint64_t id() const { return id_; }
   virtual void close() = 0;  // the session's io thread; idempotent
@@ -42,10 +43,13 @@ class SubscriberSession : public std::enable_shared_from_this<SubscriberSession>
  protected:
   // For the transports (io thread).
   void start_hello_timer(std::chrono::milliseconds timeout);
-  void on_hello(uint32_t wants);
-  // A message from the subscriber (Hello or Ack); DecodeError for anything else.
-  void on_subscriber_message(subscriber::MessageType type, std::span<const unsigned char> payload);
+  void on_hello(const subscriber::Hello& hello);
+  // A message from the subscriber (Hello or Ack) in protocol `version`; DecodeError for
+  // anything else.
+  void on_subscriber_message(subscriber::MessageType type, std::span<const unsigned char> payload, uint16_t version);
   void on_ack();
+  // Sends a Status "refused" with the reason, then closes.
+  void refuse(const std::string& reason);
   void on_protocol_error(const std::string& reason);
   void on_disconnected(const std::string& reason);
   // Writes the buffers as one protocol message, then calls write_done().
@@ -66,11 +70,13 @@ class SubscriberSession : public std::enable_shared_from_this<SubscriberSession>
   bool greeted_ = false;  // Hello received or timed out
   bool closed_ = false;
   bool writing_ = false;
+  bool close_after_write_ = false;  // refused: close once the Status is written
   bool paced_ = false;  // Hello asked for kWantPaced
+  uint16_t version_ = 0;  // of the first Hello; 0 before it
   int unacked_ = 0;     // Frames sent (or being sent) and not acknowledged yet
   std::atomic<bool> pump_scheduled_{false};
   std::shared_ptr<HandlerSlot> pump_slot_;  // the posted pump's memory: the pipeline thread posts it
-  std::atomic<uint32_t> flags_{0};
+  std::atomic<StreamKey> key_{0};
   std::atomic<uint64_t> sent_{0};
   SubscriberQueue::Item in_flight_;
   std::chrono::steady_clock::time_point write_started_;  // of the frame in flight

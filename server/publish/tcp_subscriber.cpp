@@ -31,7 +31,7 @@ void TcpSubscriber::read_next() {
                             try {
                               self->decoder_.feed(std::span(self->read_buffer_).first(n));
                               while (auto message = self->decoder_.next())
-                                self->on_subscriber_message(message->type, message->payload);
+                                self->on_subscriber_message(message->type, message->payload, message->version);
                             } catch (const subscriber::DecodeError& e) {
                               self->on_protocol_error(e.what());
                               return;

@@ -5,6 +5,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "protocol/vicon_datastream.h"
 #include "support/test_data.h"
 
 namespace skinstream::server {
@@ -114,6 +115,25 @@ TEST(Config, SubscriberTcpCongestionComesFromFileAndFlags) {
         << bad;
 }
 
+TEST(Config, SourceLimitsDefaultToTheDecodersAndComeFromTheFile) {
+  const DaemonConfig defaults;
+  const vicon::DescriptionLimits decoder;
+  EXPECT_EQ(defaults.source_max_subjects, static_cast<int>(decoder.max_subjects));
+  EXPECT_EQ(defaults.source_max_markers_per_subject, static_cast<int>(decoder.max_markers_per_subject));
+  EXPECT_EQ(defaults.source_max_name_bytes, static_cast<int>(decoder.max_name_bytes));
+  const std::string path = write_file("limits.json", R"({"source_max_subjects": 4, "source_max_markers_per_subject": 400,
+                                                         "source_max_name_bytes": 32})");
+  const auto parsed = parse({"--config", path});
+  ASSERT_TRUE(parsed);
+  EXPECT_EQ(parsed->config.source_max_subjects, 4);
+  EXPECT_EQ(parsed->config.source_max_markers_per_subject, 400);
+  EXPECT_EQ(parsed->config.source_max_name_bytes, 32);
+  for (const char* bad : {R"({"source_max_subjects": 0})", R"({"source_max_markers_per_subject": 65537})", R"({"source_max_name_bytes": -1})"}) {
+    const std::string bad_path = write_file("bad_limits.json", bad);
+    EXPECT_NE(error_of([&] { parse({"--config", bad_path}); }).find("source_max_"), std::string::npos) << bad;
+  }
+}
+
 TEST(Config, OutOfRangeValuesAndConflictsAreErrors) {
   EXPECT_NE(error_of([] { parse({"--deform-threads", "0"}); }).find("deform_threads"), std::string::npos);
   EXPECT_NE(error_of([] { parse({"--deform-cpus", "1;2"}); }).find("deform_cpus must be"), std::string::npos);
@@ -126,6 +146,24 @@ TEST(Config, OutOfRangeValuesAndConflictsAreErrors) {
   EXPECT_NE(error_of([] { parse({"--vicon-multicast", "239.1.1.1"}); }).find("GROUP:PORT"), std::string::npos);
   EXPECT_NE(error_of([] { parse({"--log-level", "loud"}); }).find("log_level"), std::string::npos);
   EXPECT_NE(error_of([] { parse({"--vicon", "nohost"}); }).find("HOST:PORT"), std::string::npos);
+  EXPECT_NE(error_of([] { parse({"--qtm", "h", "--natnet", "h"}); }).find("one source"), std::string::npos);
+  EXPECT_NE(error_of([] { parse({"--vicon", "h:1", "--qtm", "h"}); }).find("one source"), std::string::npos);
+  EXPECT_NE(error_of([] { parse({"--qtm", "h:99999"}); }).find("qtm must be HOST or HOST:PORT"), std::string::npos);
+  EXPECT_NE(error_of([] { parse({"--natnet", "h:x"}); }).find("natnet must be HOST or HOST:PORT"), std::string::npos);
+  EXPECT_NE(error_of([] { parse({"--natnet", "h", "--natnet-interface", "eth0"}); }).find("natnet_interface"),
+            std::string::npos);
+}
+
+TEST(Config, QtmAndNatNetTakeAHostWithOrWithoutItsPort) {
+  const auto qtm = parse({"--qtm", "qtm-pc"});
+  ASSERT_TRUE(qtm);
+  EXPECT_EQ(qtm->config.qtm, "qtm-pc");
+  EXPECT_EQ(parse_host_with_port(qtm->config.qtm, 22223)->port, 22223);
+  const auto natnet = parse({"--natnet", "10.0.0.5:1600", "--natnet-interface", "10.0.0.9"});
+  ASSERT_TRUE(natnet);
+  EXPECT_EQ(parse_host_with_port(natnet->config.natnet, 1510)->port, 1600);
+  EXPECT_EQ(natnet->config.natnet_interface, "10.0.0.9");
+  EXPECT_FALSE(parse_host_with_port("", 1510));
 }
 
 TEST(Config, PrintConfigIsAFlag) {

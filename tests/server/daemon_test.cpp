@@ -133,7 +133,7 @@ TEST(Daemon, PublishesTheOfflineFillFrameByFrameInOrder) {
   });
   // The replay starts only once the subscriber listens, so it sees the take from its first frame.
   daemon.start_serving();
-  wait_until([&] { return daemon.hub().wanted_encodings() != 0; });
+  wait_until([&] { return !daemon.hub().wanted_encodings().empty(); });
   daemon.start_source();
   reader.join();
   daemon.stop();
@@ -180,8 +180,8 @@ TEST(Daemon, StalledSubscriberDoesNotHoldBackTheOthers) {
   stalled.open(tcp::v4());
   stalled.set_option(asio::socket_base::receive_buffer_size(1024));
   stalled.connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), static_cast<unsigned short>(daemon.sub_port())));
-  asio::write(stalled, asio::buffer(subscriber::encode_hello({subscriber::kWantMarkers})));
-  wait_until([&] { return daemon.hub().wanted_encodings() != 0; });
+  asio::write(stalled, asio::buffer(subscriber::encode_hello({.wants = subscriber::kWantMarkers})));
+  wait_until([&] { return !daemon.hub().wanted_encodings().empty(); });
 
   daemon.start_source();
   long received = 0;
@@ -237,7 +237,7 @@ TEST_P(DaemonPublishThreads, EverySubscriberGetsEveryFrameInOrderAndStopClosesTh
   asio::io_context io;  // the subscriber that never reads: still connected at stop()
   tcp::socket idle(io);
   idle.connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), static_cast<unsigned short>(daemon.sub_port())));
-  asio::write(idle, asio::buffer(subscriber::encode_hello({subscriber::kWantMarkers})));
+  asio::write(idle, asio::buffer(subscriber::encode_hello({.wants = subscriber::kWantMarkers})));
 
   constexpr int kSubscribers = 4;
   constexpr size_t kFrames = 120;
@@ -255,7 +255,7 @@ TEST_P(DaemonPublishThreads, EverySubscriberGetsEveryFrameInOrderAndStopClosesTh
         return numbers[s].size() < kFrames;
       });
     });
-  wait_until([&] { return daemon.hub().subscriber_count() == kSubscribers + 1 && daemon.hub().wanted_encodings() != 0; });
+  wait_until([&] { return daemon.hub().subscriber_count() == kSubscribers + 1 && !daemon.hub().wanted_encodings().empty(); });
   daemon.start_source();
   for (std::thread& t : readers) t.join();
   daemon.stop();
@@ -320,8 +320,8 @@ TEST(Daemon, PacedSubscriberHasAtMostTheWindowInFlightAndGetsTheNewestFrameOnAck
   asio::io_context io;
   tcp::socket paced(io);
   paced.connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), static_cast<unsigned short>(daemon.sub_port())));
-  asio::write(paced, asio::buffer(subscriber::encode_hello({subscriber::kWantMarkers | subscriber::kWantPaced})));
-  wait_until([&] { return daemon.hub().wanted_encodings() != 0; });
+  asio::write(paced, asio::buffer(subscriber::encode_hello({.wants = subscriber::kWantMarkers | subscriber::kWantPaced})));
+  wait_until([&] { return !daemon.hub().wanted_encodings().empty(); });
   daemon.start_source();
   subscriber::StreamDecoder decoder;
   using std::chrono::milliseconds;
@@ -391,7 +391,7 @@ TEST(Daemon, ServesHealthMetricsWebSocketAndSubscribersWithoutHello) {
   beast::get_lowest_layer(ws).connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), static_cast<unsigned short>(daemon.http_port())));
   ws.handshake("127.0.0.1", "/stream");
   ws.binary(true);
-  ws.write(asio::buffer(subscriber::encode_hello({subscriber::kWantMarkers})));
+  ws.write(asio::buffer(subscriber::encode_hello({.wants = subscriber::kWantMarkers})));
   bool ws_frame = false;
   for (int i = 0; i < 20 && !ws_frame; ++i) {
     beast::flat_buffer message;
@@ -418,6 +418,9 @@ TEST(Daemon, ServesHealthMetricsWebSocketAndSubscribersWithoutHello) {
   EXPECT_GT(health["frames"]["received"].get<long>(), 0);
   EXPECT_LE(health["frames"]["dropped_mailbox_full"].get<uint64_t>(), health["frames"]["dropped"].get<uint64_t>());
   EXPECT_GE(health["subscribers"].get<int>(), 2);
+  EXPECT_EQ(health["source_limits"]["max_subjects"].get<int>(), DaemonConfig{}.source_max_subjects);
+  EXPECT_EQ(health["source_limits"]["max_markers_per_subject"].get<int>(), DaemonConfig{}.source_max_markers_per_subject);
+  EXPECT_EQ(health["source_limits"]["max_name_bytes"].get<int>(), DaemonConfig{}.source_max_name_bytes);
   // Frames went out, so encoded buffers exist (the counter only grows, and frames keep coming).
   EXPECT_GE(health["frame_buffers_allocated"].get<long>(), 1);
   EXPECT_LE(health["frame_buffers_allocated"].get<uint64_t>(), daemon.metrics().frame_buffers_allocated.load());
@@ -450,13 +453,36 @@ TEST(Daemon, ServesHealthMetricsWebSocketAndSubscribersWithoutHello) {
   daemon.stop();
 }
 
+// The subscriber protocol is binary (docs/subscriber-protocol.md): a Hello sent as a text message
+// is refused with a close frame saying so (1003), and counted as a bad message.
+TEST(Daemon, WebSocketTextMessageIsRefusedWithACloseAndCounted) {
+  Daemon daemon(test_config());
+  daemon.start();
+  asio::io_context io;
+  websocket::stream<beast::tcp_stream> ws(io);
+  beast::get_lowest_layer(ws).connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), static_cast<unsigned short>(daemon.http_port())));
+  ws.handshake("127.0.0.1", "/stream");
+  ws.text(true);
+  ws.write(asio::buffer(subscriber::encode_hello({subscriber::kWantMarkers})));
+  boost::system::error_code ec;
+  for (int i = 0; i < 100 && !ec; ++i) {  // whatever was under way before the close, then the close
+    beast::flat_buffer message;
+    ws.read(message, ec);
+  }
+  EXPECT_EQ(ec, websocket::error::closed) << ec.message();
+  EXPECT_EQ(ws.reason().code, websocket::close_code::unknown_data);
+  EXPECT_EQ(std::string(ws.reason().reason.c_str()), "binary messages only");
+  EXPECT_EQ(daemon.metrics().bad_subscriber_messages.load(), 1u);
+  daemon.stop();
+}
+
 // The congestion control the daemon gave a TCP subscriber and a WebSocket subscriber, each
 // read once the daemon has sent it something (so it was accepted and set up).
 std::pair<std::string, std::string> subscriber_congestion(const Daemon& daemon) {
   asio::io_context io;
   tcp::socket sub(io);
   sub.connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), static_cast<unsigned short>(daemon.sub_port())));
-  asio::write(sub, asio::buffer(subscriber::encode_hello({subscriber::kWantMarkers})));
+  asio::write(sub, asio::buffer(subscriber::encode_hello({.wants = subscriber::kWantMarkers})));
   subscriber::StreamDecoder decoder;
   std::array<unsigned char, 4096> buffer;
   bool got_frame = false;

@@ -1,6 +1,7 @@
 // The Vicon DataStream server engine and the daemon's ViconSource / ViconMulticastSource over real
-// loopback sockets: push and pull, exact positions, occlusion, unlabelled points, reconnection,
-// garbage, stalled and malformed clients, multicast datagrams, and no allocation per frame.
+// loopback sockets, their SourceFrames matched to a subject by the SubjectRouter as in the daemon:
+// push and pull, exact positions, occlusion, unlabelled points, timecode, reconnection, garbage,
+// stalled and malformed clients, multicast datagrams, and no allocation per frame.
 #include <gtest/gtest.h>
 
 #include <atomic>
@@ -12,10 +13,13 @@
 #include <mutex>
 #include <optional>
 #include <thread>
+#include <tuple>
 
 #include "protocol/capture_file.h"
 #include "protocol/vicon_packet_writer.h"
 #include "server/asio.h"
+#include "protocol/vicon_capture_encoder.h"
+#include "server/ingest/subject_router.h"
 #include "server/ingest/vicon_multicast_source.h"
 #include "server/ingest/vicon_source.h"
 #include "server/tcp_congestion.h"
@@ -61,11 +65,21 @@ struct ReceivedFrame {
   std::vector<Vec3> labelled;
   std::vector<std::pair<int, Vec3>> unlabelled;  // id, position
   int unknown_labels = 0;
+  std::vector<std::string> subjects;  // as the source listed them
+  SourceTimecode timecode;
 };
 
-class RecordingSink : public FrameSink {
+// Records what a source hands on, as one subject of `markers` (matched by the SubjectRouter, as
+// the daemon does) sees it.
+class RecordingSink : public SourceSink, private SubjectRouter::Observer {
  public:
-  void on_frame(const MarkerFrame& frame) override {
+  explicit RecordingSink(std::vector<std::string> markers)
+      : out_(static_cast<int>(markers.size())), router_({SubjectTarget{"", std::move(markers)}}, *this) {}
+
+  void on_frame(const SourceFrame& source) override {
+    MarkerFrame* const out[] = {&out_};
+    router_.route(source, out);
+    const MarkerFrame& frame = out_;
     ReceivedFrame r;
     r.number = frame.frame_number;
     r.source_time_ns = frame.source_time_ns;
@@ -75,6 +89,8 @@ class RecordingSink : public FrameSink {
     for (int i = 0; i < frame.unlabelled_count; ++i)
       r.unlabelled.emplace_back(frame.unlabelled_ids[static_cast<size_t>(i)], frame.unlabelled[static_cast<size_t>(i)]);
     r.unknown_labels = frame.unknown_labels;
+    r.timecode = frame.timecode;
+    for (const SourceSubject& subject : source.subjects) r.subjects.push_back(subject.name);
     std::lock_guard lock(mutex_);
     frames_.push_back(std::move(r));
     changed_.notify_all();
@@ -89,9 +105,11 @@ class RecordingSink : public FrameSink {
     bad_inputs_.emplace_back(what);
     changed_.notify_all();
   }
-  void on_unknown_label(std::string_view name) override {
+  void on_match(int, bool, std::string_view) override {}
+  void on_unknown_subjects(std::span<const std::string>, size_t) override {}
+  void on_unknown_labels(int, std::span<const std::string> names, size_t) override {
     std::lock_guard lock(mutex_);
-    unknown_labels_.emplace_back(name);
+    unknown_labels_.insert(unknown_labels_.end(), names.begin(), names.end());
   }
 
   bool wait(const std::function<bool()>& done) {
@@ -118,6 +136,10 @@ class RecordingSink : public FrameSink {
   std::vector<std::pair<SourceState, std::string>> states_;
   std::vector<std::string> bad_inputs_;
   std::vector<std::string> unknown_labels_;
+
+ private:
+  MarkerFrame out_;
+  SubjectRouter router_;
 };
 
 // A small capture with labelled, occluded, "*N" and "" channels and non-round coordinates.
@@ -196,8 +218,8 @@ TEST(ViconStream, PushDeliversEveryFrameInOrderWithExactPositions) {
       hooked.emplace_back(number, ns);
     });
   });
-  RecordingSink sink;
-  ViconSource source(net.client_io.io, {.host = "127.0.0.1", .port = net.port}, markers, sink);
+  RecordingSink sink(markers);
+  ViconSource source(net.client_io.io, {.host = "127.0.0.1", .port = net.port}, sink);
   source.start();
   ASSERT_TRUE(sink.wait_frames(static_cast<size_t>(capture.frame_count))) << sink.frames_.size() << " frames";
   source.stop();
@@ -209,6 +231,15 @@ TEST(ViconStream, PushDeliversEveryFrameInOrderWithExactPositions) {
       ASSERT_EQ(r.number, static_cast<uint32_t>(capture.first_frame) + i);
       EXPECT_DOUBLE_EQ(r.rate, capture.rate_hz);
       expect_frame_matches(capture, markers, r);
+      EXPECT_EQ(r.subjects, std::vector<std::string>{"test"});
+      // The timecode as sent: 120 Hz is 24 fps film with 5 subframes.
+      const vicon::Timecode sent = vicon::CaptureFrameEncoder::timecode_for(r.number, capture.rate_hz);
+      ASSERT_TRUE(r.timecode.valid);
+      EXPECT_EQ(r.timecode.rate_hz, 24.0f);
+      EXPECT_FALSE(r.timecode.drop_frame);
+      EXPECT_EQ(r.timecode.subframes_per_frame, 5);
+      EXPECT_EQ(std::make_tuple(r.timecode.hours, r.timecode.minutes, r.timecode.seconds, r.timecode.frames, r.timecode.subframe),
+                std::make_tuple(sent.hours, sent.minutes, sent.seconds, sent.frames, sent.subframes));
     }
     EXPECT_EQ(sink.count_state(SourceState::Streaming), 1u);
     EXPECT_TRUE(sink.bad_inputs_.empty());
@@ -233,10 +264,9 @@ TEST(ViconStream, PullDeliversOneFramePerRequestInOrder) {
   const std::vector<std::string> markers = {"A", "B", "C"};
   Loopback net;
   net.start_server(capture, fast_options(1.0));
-  RecordingSink sink;
+  RecordingSink sink(markers);
   ViconSource source(net.client_io.io,
-                     {.host = "127.0.0.1", .port = net.port, .mode = ViconSourceOptions::Mode::ClientPull}, markers,
-                     sink);
+                     {.host = "127.0.0.1", .port = net.port, .mode = ViconSourceOptions::Mode::ClientPull}, sink);
   source.start();
   ASSERT_TRUE(sink.wait([&] { return !sink.frames_.empty() && sink.frames_.back().number >= 189; }));
   source.stop();
@@ -265,8 +295,8 @@ TEST(ViconStream, UnknownLabelsAreReportedOnceAndPassedAsUnlabelled) {
   const std::vector<std::string> markers = {"A", "B", "Z"};  // C unknown to the subject, Z never streamed
   Loopback net;
   net.start_server(capture, fast_options(4.0));
-  RecordingSink sink;
-  ViconSource source(net.client_io.io, {.host = "127.0.0.1", .port = net.port}, markers, sink);
+  RecordingSink sink(markers);
+  ViconSource source(net.client_io.io, {.host = "127.0.0.1", .port = net.port}, sink);
   source.start();
   ASSERT_TRUE(sink.wait_frames(30));
   source.stop();
@@ -278,7 +308,7 @@ TEST(ViconStream, UnknownLabelsAreReportedOnceAndPassedAsUnlabelled) {
       EXPECT_EQ(r.unknown_labels, 1);
       ASSERT_FALSE(r.unlabelled.empty());
       EXPECT_EQ(r.unlabelled[0].second, capture.at(index, 2));  // C, as an unlabelled point
-      EXPECT_EQ(r.unlabelled[0].first, 2);                        // with its trajectory id
+      EXPECT_EQ(r.unlabelled[0].first, SubjectRouter::kUnknownLabelIds - 2);  // with the id of the subject's label 2
     }
   });
 }
@@ -289,8 +319,8 @@ TEST(ViconStream, ServerGoneThenBackGivesDisconnectedThenStreaming) {
   options.loop = true;
   Loopback net;
   net.start_server(capture, options);
-  RecordingSink sink;
-  ViconSource source(net.client_io.io, {.host = "127.0.0.1", .port = net.port}, {"A", "B", "C"}, sink);
+  RecordingSink sink({"A", "B", "C"});
+  ViconSource source(net.client_io.io, {.host = "127.0.0.1", .port = net.port}, sink);
   source.start();
   ASSERT_TRUE(sink.wait_frames(5));
   net.stop_server();
@@ -324,10 +354,10 @@ TEST(ViconStream, GarbageFromTheServerIsCountedNotFatal) {
     });
   };
   server_io.call([&] { serve_garbage(); });
-  RecordingSink sink;
+  RecordingSink sink({"A"});
   ViconSourceOptions options{.host = "127.0.0.1", .port = port};
   options.initial_backoff_seconds = 0.01;
-  ViconSource source(client_io.io, options, {"A"}, sink);
+  ViconSource source(client_io.io, options, sink);
   source.start();
   ASSERT_TRUE(sink.wait([&] { return sink.bad_inputs_.size() >= 2; }));  // and it kept retrying
   source.stop();
@@ -388,8 +418,8 @@ TEST(ViconStream, StalledClientDoesNotStopAnother) {
   net.start_server(capture, options);
   asio::io_context raw_io;
   tcp::socket stalled = stalled_client(raw_io, net.port);
-  RecordingSink sink;
-  ViconSource source(net.client_io.io, {.host = "127.0.0.1", .port = net.port}, {"A", "B", "C"}, sink);
+  RecordingSink sink({"A", "B", "C"});
+  ViconSource source(net.client_io.io, {.host = "127.0.0.1", .port = net.port}, sink);
   source.start();
   ASSERT_TRUE(sink.wait_frames(300));
   source.stop();
@@ -405,8 +435,8 @@ TEST(ViconStream, MalformedClientIsClosedAndCountedOthersGoOn) {
   options.loop = true;
   Loopback net;
   net.start_server(capture, options);
-  RecordingSink sink;
-  ViconSource source(net.client_io.io, {.host = "127.0.0.1", .port = net.port}, {"A", "B", "C"}, sink);
+  RecordingSink sink({"A", "B", "C"});
+  ViconSource source(net.client_io.io, {.host = "127.0.0.1", .port = net.port}, sink);
   source.start();
   ASSERT_TRUE(sink.wait_frames(3));
 
@@ -429,9 +459,9 @@ TEST(ViconStream, MulticastRequestSendsWholePacketsAsDatagrams) {
   const Capture capture = synthetic_capture();
   Loopback net;
   net.start_server(capture, fast_options(2.0));
-  RecordingSink sink;
+  RecordingSink sink({"A", "B", "C"});
   // 127.0.0.1 unicast: always available in a sandbox (a group is tried in the next test).
-  ViconMulticastSource receiver(net.client_io.io, {.group = "127.0.0.1", .port = 0}, {"A", "B", "C"}, sink);
+  ViconMulticastSource receiver(net.client_io.io, {.group = "127.0.0.1", .port = 0}, sink);
   receiver.start();
   ASSERT_TRUE(sink.wait([&] { return receiver.bound_port() != 0; }));
 
@@ -468,9 +498,9 @@ TEST(ViconStream, MulticastGroupOnLoopback) {
   options.start_on_first_request = false;
   options.loop = true;
   Loopback net;
-  RecordingSink sink;
+  RecordingSink sink({"A", "B", "C"});
   ViconMulticastSource receiver(net.client_io.io, {.group = "239.255.42.77", .port = 0, .interface_address = "127.0.0.1"},
-                                {"A", "B", "C"}, sink);
+                                sink);
   receiver.start();
   ASSERT_TRUE(sink.wait([&] { return receiver.bound_port() != 0 || !sink.states_.empty(); }));
   if (receiver.bound_port() == 0) GTEST_SKIP() << "cannot join a multicast group here: " << sink.states_[0].second;
@@ -485,9 +515,9 @@ TEST(ViconStream, MulticastGroupOnLoopback) {
 }
 
 // Counts heap allocations on the client's io thread between frames 40 and 160.
-class AllocationCheckingSink : public FrameSink {
+class AllocationCheckingSink : public SourceSink {
  public:
-  void on_frame(const MarkerFrame&) override {
+  void on_frame(const SourceFrame&) override {
     ++frames;
     if (frames == 40) counter.emplace();
     if (frames == 160) {
@@ -498,7 +528,6 @@ class AllocationCheckingSink : public FrameSink {
   }
   void on_source_state(SourceState, std::string_view) override {}
   void on_bad_input(std::string_view, std::string_view) override {}
-  void on_unknown_label(std::string_view) override {}
   int frames = 0;
   std::optional<test::CountAllocations> counter;
   size_t allocations = 0;
@@ -514,8 +543,7 @@ TEST(ViconStream, ReceivingFramesAllocatesNothingAfterTheFirst) {
     net.start_server(capture, options);
     AllocationCheckingSink sink;
     auto done = sink.done.get_future();
-    ViconSource source(net.client_io.io, {.host = "127.0.0.1", .port = net.port, .mode = mode}, {"A", "B", "C"},
-                       sink);
+    ViconSource source(net.client_io.io, {.host = "127.0.0.1", .port = net.port, .mode = mode}, sink);
     source.start();
     ASSERT_EQ(done.wait_for(kPatience), std::future_status::ready);
     source.stop();

@@ -1,0 +1,37 @@
+#include "server/replay/replay_recordings.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <stdexcept>
+
+#include "protocol/capture_file.h"
+#include "protocol/file_error.h"
+
+namespace skinstream::server {
+
+ReplayRecordings load_replay_recordings(const std::vector<std::string>& paths, const std::string& subject_name,
+                                        double rate) {
+  if (paths.empty()) throw std::invalid_argument("no recording given");
+  ReplayRecordings out;
+  for (const std::string& path : paths) {
+    auto capture = std::make_unique<Capture>(read_capture(path));
+    if (capture->frame_count <= 0) throw FileError(path, "holds no frames");
+    if (!(capture->rate_hz > 0.0) && !(rate > 0.0)) throw FileError(path, "has no frame rate; pass --rate");
+    if (!(rate > 0.0) && !out.captures.empty() && std::abs(capture->rate_hz - out.captures[0]->rate_hz) > 1e-9)
+      throw std::invalid_argument(path + " is at " + std::to_string(capture->rate_hz) + " Hz, " + paths[0] + " at " +
+                                  std::to_string(out.captures[0]->rate_hz) + " Hz; pass --rate to stream both");
+    std::string name = paths.size() == 1 && !subject_name.empty() ? subject_name
+                                                                  : std::filesystem::path(path).stem().string();
+    const std::string base = name;
+    for (int n = 2; std::any_of(out.subjects.begin(), out.subjects.end(), [&](const auto& s) { return s.name == name; });
+         ++n)
+      name = base + "_" + std::to_string(n);
+    out.subjects.push_back({name, capture.get()});
+    out.captures.push_back(std::move(capture));
+  }
+  out.rate_hz = rate > 0.0 ? rate : out.captures[0]->rate_hz;
+  return out;
+}
+
+}  // namespace skinstream::server
