@@ -283,7 +283,8 @@ void GapFiller::estimate_rigid() {
   }
 }
 
-// Eq. 2 for marker i from the ring members known (observed or estimated) now.
+// Eq. 2 for marker i from the ring members known (observed or estimated) now, at least three
+// (estimate_rigid picks only such a marker).
 void GapFiller::fit_rigid_estimate(int i) {
   int count = 0, observed_support = 0;
   for (int k = model_.ring_offsets[i]; k < model_.ring_offsets[i + 1]; ++k) {
@@ -294,7 +295,6 @@ void GapFiller::fit_rigid_estimate(int i) {
     scratch_target_[count] = estimate_[j];
     ++count;
   }
-  if (count < 3) return;
   rigid_support_[i] = observed_support;
   RigidTransform t;
   fit_rigid({scratch_source_.data(), static_cast<size_t>(count)}, {scratch_target_.data(), static_cast<size_t>(count)}, t);

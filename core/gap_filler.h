@@ -132,7 +132,7 @@ class GapFiller {
   static constexpr double kPrefilterReach = 3.0;  // in eps1, around the rigid estimate
   bool has_previous_ = false;
   long frame_ = 0;
-  long solve_stamp_ = 0;  // PCA solves are valid while the observed set is unchanged
+  long solve_stamp_ = 0;  // this frame's: a PCA solve made in it stands until its ring changes (refresh_estimates)
   std::vector<Vec3> previous_;
   std::vector<MarkerStatus> previous_status_;
   std::vector<int> assigned_id_;      // free-point trajectory currently standing for marker i
