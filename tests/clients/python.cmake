@@ -1,5 +1,6 @@
 # The Python package (clients/python) with Debian's python3 and python3-numpy: its codecs against
-# the golden fixtures and the real meshoptimizer library, pip install without the network, and
+# the golden fixtures and the real meshoptimizer library, its numpy evaluation of the parameters
+# against the spec's in float64, pip install without the network, and
 # end to end against the real skinstreamd on the demo subject (tests/clients/python/).
 find_program(SKINSTREAM_PYTHON NAMES python3 PATHS /usr/bin NO_DEFAULT_PATH)
 if(NOT SKINSTREAM_PYTHON)
@@ -10,7 +11,7 @@ elseif(TARGET skinstreamd)
     SKINSTREAM_CLI=$<TARGET_FILE:skinstream>
     SKINSTREAM_DEMO_DIR=${CMAKE_BINARY_DIR}/demo
     SKINSTREAM_TEST_TMP_DIR=${CMAKE_BINARY_DIR}/test_tmp/python)
-  foreach(name vertex_codec protocol install subscriber receiver)
+  foreach(name vertex_codec protocol evaluation normals install subscriber receiver)
     add_test(NAME python.${name} COMMAND ${SKINSTREAM_PYTHON} ${CMAKE_CURRENT_LIST_DIR}/python/${name}_test.py)
     set_tests_properties(python.${name} PROPERTIES ENVIRONMENT "${python_test_environment}" LABELS clients TIMEOUT 300)
   endforeach()

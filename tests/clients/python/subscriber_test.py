@@ -14,7 +14,7 @@ sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), '..'
 from support.python_clients import demo_daemon, fixture  # noqa: E402
 import numpy as np  # noqa: E402
 import skinstream  # noqa: E402
-from skinstream.evaluation import vertex_normals  # noqa: E402
+from skinstream.normals import vertex_normals  # noqa: E402
 
 
 def receive(port, encoding, count, results):
