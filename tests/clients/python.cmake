@@ -11,7 +11,7 @@ elseif(TARGET skinstreamd)
     SKINSTREAM_CLI=$<TARGET_FILE:skinstream>
     SKINSTREAM_DEMO_DIR=${CMAKE_BINARY_DIR}/demo
     SKINSTREAM_TEST_TMP_DIR=${CMAKE_BINARY_DIR}/test_tmp/python)
-  foreach(name vertex_codec protocol evaluation normals install subscriber receiver)
+  foreach(name vertex_codec meshoptimizer_library protocol evaluation normals install subscriber receiver)
     add_test(NAME python.${name} COMMAND ${SKINSTREAM_PYTHON} ${CMAKE_CURRENT_LIST_DIR}/python/${name}_test.py)
     set_tests_properties(python.${name} PROPERTIES ENVIRONMENT "${python_test_environment}" LABELS clients TIMEOUT 300)
   endforeach()
