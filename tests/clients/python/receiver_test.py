@@ -46,6 +46,8 @@ class Receiver(unittest.TestCase):
                 for _ in range(100):
                     self.assertIsNone(receiver.take())
                 self.assertEqual(receiver.state(), 'streaming')
+                self.assertIn(receiver.decoder, ('libmeshoptimizer', 'numpy'))
+                self.assertIn(f'(decoded by {receiver.decoder})', receiver.describe())
                 daemon.resume()
                 self.assertTrue(wait_until(lambda: receiver.take() is not None))
             finally:
