@@ -41,7 +41,8 @@ class Frame:
 class Subscriber:
     """A subscription. Connects and sends Hello on construction (ConnectionLost when the daemon
     cannot be reached); next_frame() and frames() read. Every error is an Error subclass with a
-    one-line message; after one, make a new Subscriber (Receiver does that with backoff)."""
+    one-line message; after one, make a new Subscriber (Receiver does that with backoff).
+    libraries=False decodes in numpy even where libmeshoptimizer or libskinstream_client load."""
 
     def __init__(self, host='127.0.0.1', port=8481, encoding='parameters', normals=True, markers=False, mesh=True,
                  paced=False, evaluate=True, subject='', token='', protocol_version=2, connect_timeout=5.0, libraries=True):

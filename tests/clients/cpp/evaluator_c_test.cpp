@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "skinstream/client.h"
+#include "support/client_frames.h"
 #include "support/daemon_process.h"
 #include "support/test_data.h"
 
@@ -191,16 +192,11 @@ std::map<uint32_t, Received> receive(uint16_t port, client::Encoding encoding, i
   options.encoding = encoding;
   options.evaluate = false;
   client::Subscriber sub(options);
-  std::map<uint32_t, Received> frames;
-  client::Frame frame;
-  const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(120);
-  while (static_cast<int>(frames.size()) < count && std::chrono::steady_clock::now() < give_up) {
-    if (!sub.next(frame, std::chrono::seconds(1))) continue;
-    Received& r = frames[frame.frame_number];
+  auto frames = test::receive_frames<Received>(sub, count, [&sub](const client::Frame& frame, Received& r) {
     r.positions.assign(frame.positions.begin(), frame.positions.end());
     r.normals.assign(frame.normals.begin(), frame.normals.end());
     r.block.assign(sub.parameter_block().begin(), sub.parameter_block().end());
-  }
+  });
   if (model) model->assign(sub.model_payload().begin(), sub.model_payload().end());
   if (faces) *faces = sub.mesh().indices;
   return frames;
