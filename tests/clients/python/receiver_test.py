@@ -57,8 +57,9 @@ class Receiver(unittest.TestCase):
     def test_the_daemon_going_away_and_coming_back(self):
         daemon = demo_daemon()
         port = daemon.sub_port
-        # Paced: a reader slower than the stream (parameters are evaluated in numpy) has two frames
-        # in flight, not a socket's fill to read before it sees the daemon gone.
+        # Paced: a reader slower than the stream (parameters evaluated in numpy, where the client
+        # library is not found) has two frames in flight, not a socket's fill to read before it
+        # sees the daemon gone.
         receiver = skinstream.Receiver(port=port, encoding='parameters', markers=True, paced=True, first_retry=0.1,
                                        longest_retry=0.8)
         receiver.start()
