@@ -1,9 +1,11 @@
 """Which decoder the package picks (skinstream/decoder_choice.py): the system's libraries when asked
 for and they load, numpy otherwise, which always works; and decoders() saying so, with how to
 get a library numpy stands in for."""
+import ctypes.util
 import os
 import sys
 import unittest
+from unittest import mock
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', '..'))
 from support.python_clients import CLIENT_LIBRARY  # noqa: E402
@@ -44,6 +46,16 @@ class ChoosingADecoder(unittest.TestCase):
         name, line = with_client_library('/nonexistent/libskinstream_client.so.0', choose)
         self.assertEqual(name, 'numpy')
         self.assertRegex(line, '^numpy; /nonexistent/libskinstream_client.so.0 does not load: ')
+
+    def test_numpy_when_there_is_no_meshoptimizer_and_which_package_has_it(self):
+        find_meshoptimizer.cache_clear()
+        try:
+            with mock.patch.object(ctypes.util, 'find_library', return_value=None):
+                name, line = decoder_choice.compressed_decoder(100).name, skinstream.decoders()['compressed']
+        finally:
+            find_meshoptimizer.cache_clear()
+        self.assertEqual(name, 'numpy')
+        self.assertEqual(line, 'numpy; libmeshoptimizer not found (Debian: apt-get install libmeshoptimizer2d)')
 
     def test_the_libraries_when_they_load(self):
         if os.path.exists(CLIENT_LIBRARY):
