@@ -23,9 +23,16 @@
 namespace skinstream::server {
 namespace {
 
-SubjectFile load_subject(const DaemonConfig& config) {
-  if (config.subject.empty()) throw ConfigError("no subject file given (--subject FILE or \"subject\" in the config)");
-  return read_subject_file(config.subject);
+const SubjectConfig& subject_config(const DaemonConfig& config) {
+  if (config.subjects.empty())
+    throw ConfigError("no subject file given (--subject FILE or NAME=FILE, or \"subject\" in the config)");
+  if (config.subjects.size() > 1) throw ConfigError("one daemon serves one subject");
+  return config.subjects.front();
+}
+
+// What the log, /health and Status call a subject: its source subject's name, else its file's stem.
+std::string display_name(const SubjectConfig& subject) {
+  return subject.name.empty() ? std::filesystem::path(subject.file).stem().string() : subject.name;
 }
 
 subscriber::MeshInfo mesh_info_of(const SubjectFile& subject) {
@@ -91,15 +98,17 @@ nlohmann::json latency_summaries(const Metrics& metrics) {
 
 Daemon::Daemon(const DaemonConfig& config)
     : config_(config),
-      subject_(load_subject(config)),
+      subject_config_(subject_config(config)),
+      subject_name_(display_name(subject_config_)),
+      subject_(read_subject_file(subject_config_.file)),
       mailbox_(subject_.model.marker_count(), std::chrono::milliseconds(config.max_frame_wait_ms)),
-      router_({SubjectTarget{"", subject_.model.marker_names}}, static_cast<SubjectRouter::Observer&>(*this)),
+      router_({SubjectTarget{subject_config_.name, subject_.model.marker_names}}, static_cast<SubjectRouter::Observer&>(*this)),
       publish_(config.publish_threads),
       status_timer_(io_) {
   const SubjectModel& model = subject_.model;
   if (!subject_.deformation)
     spdlog::warn("{}: no deformation model (built without --mesh): publishing markers only (MeshInfo with V = 0)",
-                 config.subject);
+                 subject_config_.file);
   HubOptions hub_options;
   hub_options.queue_frames = config.subscriber_queue_frames;
   hub_options.frame_max_wait = std::chrono::milliseconds(config.max_frame_wait_ms);
@@ -128,14 +137,18 @@ Daemon::Daemon(const DaemonConfig& config)
     pipeline_ = std::make_unique<Pipeline>(model, subject_.deformation ? &*subject_.deformation : nullptr, pipeline_options,
                                            mailbox_, *hub_, metrics_);
   } catch (const std::invalid_argument& e) {
-    throw FileError(config.subject, std::string("deformation model unusable: ") + e.what());
+    throw FileError(subject_config_.file, std::string("deformation model unusable: ") + e.what());
   }
 
   hub_->set_encoding_preparer([pipeline = pipeline_.get()](uint32_t frame_flags) { pipeline->prepare_encoding(frame_flags); });
 
   if (!config.replay.empty()) {
     auto replay = std::make_unique<FileReplaySource>(io_, config.replay, static_cast<SourceSink&>(*this),
-                                                     ReplayOptions{config.loop, config.speed, {}});
+                                                     ReplayOptions{config.loop, config.speed, config.replay_subject});
+    // A replay's one subject never changes: a subject that cannot follow it is an error now.
+    if (!subject_config_.name.empty() && subject_config_.name != replay->subject().name)
+      throw ConfigError("subject \"" + subject_config_.name + "\" is not in the replay " + config.replay + ", whose subject is \"" +
+                        replay->subject().name + "\" (name it with --replay-subject)");
     if (router_.markers_labelled_by(0, replay->subject()) == 0)
       throw FileError(config.replay, "none of the subject's " + std::to_string(model.marker_count()) +
                                          " marker labels is in this capture (wrong subject file?)");
@@ -220,7 +233,7 @@ void Daemon::start_serving() {
   http_->start();
   schedule_status();
   write_ports_file();
-  spdlog::info("skinstreamd: subject {} ({} markers, {} vertices), HTTP port {}, subscriber port {}", config_.subject,
+  spdlog::info("skinstreamd: subject {} ({} markers, {} vertices), HTTP port {}, subscriber port {}", subject_name_,
                subject_.model.marker_count(), pipeline_->vertex_count(), http_port(), sub_port());
   io_thread_ = std::thread([this] {
     name_this_thread("io");
@@ -319,13 +332,15 @@ void Daemon::on_rejected_points(uint32_t frame_number, int count) {
 }
 
 void Daemon::on_match(int, bool present, std::string_view detail) {
-  if (present) {
-    // Back in the stream: a new take for its filler.
+  {
     std::lock_guard lock(state_mutex_);
-    ++generation_;
+    if (present) ++generation_;  // back in the stream: a new take for its filler
+    present_ = present;
+    presence_detail_ = std::string(detail);
   }
-  if (present) spdlog::info("subject {}: {}", config_.subject, detail);
-  else spdlog::warn("subject {}: absent, waiting for it: {}", config_.subject, detail);
+  if (present) spdlog::info("subject {}: {}", subject_name_, detail);
+  else spdlog::warn("subject {}: absent, waiting for it: {}", subject_name_, detail);
+  broadcast_status();
 }
 
 void Daemon::on_unknown_subjects(std::span<const std::string> names, size_t not_listed) {
@@ -349,7 +364,9 @@ void Daemon::broadcast_status() {
     std::lock_guard lock(state_mutex_);
     status.state = code_of(state_);
     status.source_rate_hz = static_cast<float>(source_rate_hz_);
-    status.detail = state_detail_;
+    status.detail = present_ || state_ != SourceState::Streaming
+                        ? state_detail_
+                        : "subject " + subject_name_ + " absent, waiting for it: " + presence_detail_;
   }
   status.frames_received = metrics_.frames_received.load();
   status.frames_published = metrics_.frames_published.load();
@@ -366,10 +383,13 @@ void Daemon::schedule_status() {
 }
 
 std::string Daemon::health_json() const {
-  nlohmann::json source;
+  nlohmann::json source, subject;
   {
     std::lock_guard lock(state_mutex_);
     source = {{"state", to_string(state_)}, {"detail", state_detail_}, {"rate_hz", source_rate_hz_}};
+    // present: in the source's latest frames (the daemon waits for an absent one).
+    subject = {{"name", subject_name_}, {"file", subject_config_.file}, {"present", present_}, {"detail", presence_detail_},
+               {"markers", subject_.model.marker_count()}, {"vertices", pipeline_->vertex_count()}};
   }
   const nlohmann::json health = {
       {"status", "ok"},
@@ -388,7 +408,7 @@ std::string Daemon::health_json() const {
       {"deform", {{"threads", config_.deform_threads}, {"cpus", deform_cpus_}, {"spin_lead_us", config_.deform_spin_lead_us}}},
       {"publish_threads", publish_.count()},
       {"subscriber_tcp_congestion", config_.subscriber_tcp_congestion},  // empty: the system's
-      {"subject", {{"markers", subject_.model.marker_count()}, {"vertices", pipeline_->vertex_count()}}},
+      {"subject", subject},
       {"latency_ms", latency_summaries(metrics_)}};
   return health.dump();
 }

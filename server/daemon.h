@@ -69,6 +69,8 @@ class Daemon : private SourceSink, private SubjectRouter::Observer {
 
   DaemonConfig config_;
   std::vector<int> deform_cpus_;  // one per deform thread, or none (not pinned)
+  SubjectConfig subject_config_;
+  std::string subject_name_;
   SubjectFile subject_;
   Metrics metrics_;
   RateLimitedLog bad_input_log_;
@@ -91,6 +93,8 @@ class Daemon : private SourceSink, private SubjectRouter::Observer {
   mutable std::mutex state_mutex_;
   SourceState state_ = SourceState::Connecting;
   std::string state_detail_;
+  bool present_ = false;  // the subject is in the source's latest frames
+  std::string presence_detail_ = "no frame from the source yet";
   double source_rate_hz_ = 0.0;
   uint64_t generation_ = 0;  // bumped when the source (re)starts streaming
 

@@ -193,6 +193,10 @@ class BackgroundSubscriber {
     std::lock_guard lock(mutex_);
     return statuses_.size();
   }
+  std::string last_status_detail() const {
+    std::lock_guard lock(mutex_);
+    return statuses_.empty() ? std::string() : statuses_.back().detail;
+  }
   bool closed() const { return closed_.load(); }
   std::string error() const {
     std::lock_guard lock(mutex_);
@@ -478,6 +482,32 @@ TEST_F(DaemonProgram, BadViconAddressFailsNamingIt) {
   const ProgramRun r = run(std::string(SKINSTREAMD) + " --subject " + subject_ + " --vicon localhost:eighty --http-port 0 --sub-port 0");
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.output.find("localhost:eighty"), std::string::npos) << r.output;
+}
+
+// A subject named after a Vicon subject the stream does not have is reported absent (/health,
+// Status, the log) and waited for; named after the one it has, it streams.
+TEST_F(DaemonProgram, NamedSubjectAbsentFromTheStreamIsReportedAndWaitedFor) {
+  ReplayProcess replay(take_, 0, "--subject Actor1");
+  DaemonProcess absent("--subject Actor2=" + subject_ + " --vicon 127.0.0.1:" + std::to_string(replay.port));
+  BackgroundSubscriber waiting(absent.sub_port, subscriber::kWantMarkers | subscriber::kWantNoMesh);
+  ASSERT_TRUE(eventually([&] { return server::fetch_health(absent.http_port)["source"]["state"] == "streaming"; })) << absent.log();
+  const nlohmann::json subject = server::fetch_health(absent.http_port)["subject"];
+  EXPECT_EQ(subject["name"], "Actor2");
+  EXPECT_FALSE(subject["present"].get<bool>()) << subject.dump();
+  EXPECT_EQ(subject["detail"], "the stream has no subject \"Actor2\" (it has \"Actor1\")");
+  EXPECT_TRUE(eventually([&] { return waiting.last_status_detail().find("subject Actor2 absent, waiting for it") == 0; }))
+      << waiting.last_status_detail();
+  EXPECT_EQ(waiting.frames(), 0);
+  EXPECT_NE(absent.log().find("subject Actor2: absent, waiting for it: the stream has no subject \"Actor2\""), std::string::npos)
+      << absent.log();
+
+  DaemonProcess present("--subject Actor1=" + subject_ + " --vicon 127.0.0.1:" + std::to_string(replay.port));
+  BackgroundSubscriber streaming(present.sub_port, subscriber::kWantMarkers | subscriber::kWantNoMesh);
+  EXPECT_TRUE(eventually([&] { return streaming.frames() >= 20; })) << streaming.error() << present.log();
+  EXPECT_TRUE(server::fetch_health(present.http_port)["subject"]["present"].get<bool>());
+  EXPECT_EQ(waiting.frames(), 0);
+  EXPECT_EQ(present.stop(), 0) << present.log();
+  EXPECT_EQ(absent.stop(), 0) << absent.log();
 }
 
 // The source goes away (skinstream-replay killed) and comes back on the same port: the daemon

@@ -56,7 +56,7 @@ const Fixture& fixture() {
 
 DaemonConfig test_config() {
   DaemonConfig config;
-  config.subject = fixture().subject_path;
+  config.subjects = {{"", fixture().subject_path}};
   config.replay = fixture().take_path;
   config.bind_address = "127.0.0.1";
   config.http_port = 0;
@@ -94,13 +94,34 @@ std::string http_get(int port, const std::string& target, int* out_status = null
 
 TEST(Daemon, MissingSubjectFailsClearly) {
   DaemonConfig config = test_config();
-  config.subject = test::scratch_path("absent.sks");
+  config.subjects = {{"", test::scratch_path("absent.sks")}};
   try {
     Daemon daemon(config);
     FAIL() << "started without a subject";
   } catch (const std::exception& e) {
     EXPECT_NE(std::string(e.what()).find("absent.sks"), std::string::npos) << e.what();
   }
+}
+
+TEST(Daemon, NamedSubjectIsTheReplaysOneSubject) {
+  DaemonConfig config = test_config();
+  config.subjects = {{"Actor1", fixture().subject_path}};
+  try {
+    Daemon daemon(config);
+    FAIL() << "followed a subject the replay does not have";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("subject \"Actor1\" is not in the replay"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("--replay-subject"), std::string::npos) << e.what();
+  }
+  config.replay_subject = "Actor1";
+  Daemon daemon(config);
+  daemon.start();
+  wait_until([&] { return nlohmann::json::parse(daemon.health_json())["frames"]["published"].get<int>() > 0; });
+  const nlohmann::json subject = nlohmann::json::parse(daemon.health_json())["subject"];
+  daemon.stop();
+  EXPECT_EQ(subject["name"], "Actor1");
+  EXPECT_TRUE(subject["present"].get<bool>());
+  EXPECT_EQ(subject["detail"], "follows \"Actor1\": 41 of the subject's 41 markers labelled");
 }
 
 TEST(Daemon, PortInUseFailsClearly) {
