@@ -48,7 +48,7 @@ Pipeline::Pipeline(const SubjectModel& model, const DeformationModel* deformatio
     positions_.resize(3 * static_cast<size_t>(deformer_->vertex_count()));
     normals_.resize(positions_.size());
     workers_ = std::make_unique<DeformWorkers>(
-        *deformer_, DeformWorkerOptions{options.deform_threads, options.deform_spin_lead, options.deform_cpus});
+        *deformer_, DeformWorkerOptions{options.deform_threads, options.deform_spin_lead, options.deform_cpus, options.deform_thread_name});
     if (workers_->unpinned_workers() > 0)
       spdlog::warn("pipeline: {} deform worker(s) could not be pinned to their CPU; they run where the OS puts them",
                    workers_->unpinned_workers());
@@ -60,7 +60,7 @@ Pipeline::~Pipeline() { stop(); }
 void Pipeline::start() {
   if (running_.exchange(true)) return;
   thread_ = std::thread([this] {
-    name_this_thread("pipeline");
+    name_this_thread(options_.thread_name);
     run();
   });
 }

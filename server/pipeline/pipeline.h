@@ -8,6 +8,7 @@
 #include <atomic>
 #include <memory>
 #include <optional>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -40,6 +41,8 @@ struct PipelineOptions {
   std::vector<int> deform_cpus;                   // DeformWorkerOptions; index 0 the pipeline thread's
   double default_rate_hz = 120.0;
   GapFillerOptions filler;
+  std::string thread_name = "pipeline";  // its deform workers: DeformWorkerOptions::thread_name
+  std::string deform_thread_name = "deform";
 };
 
 class Pipeline {

@@ -154,7 +154,7 @@ TEST(Daemon, PublishesTheOfflineFillFrameByFrameInOrder) {
   });
   // The replay starts only once the subscriber listens, so it sees the take from its first frame.
   daemon.start_serving();
-  wait_until([&] { return daemon.hub().wanted_encodings() != 0; });
+  wait_until([&] { return daemon.subject(0).hub().wanted_encodings() != 0; });
   daemon.start_source();
   reader.join();
   daemon.stop();
@@ -202,7 +202,7 @@ TEST(Daemon, StalledSubscriberDoesNotHoldBackTheOthers) {
   stalled.set_option(asio::socket_base::receive_buffer_size(1024));
   stalled.connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), static_cast<unsigned short>(daemon.sub_port())));
   asio::write(stalled, asio::buffer(subscriber::encode_hello({subscriber::kWantMarkers})));
-  wait_until([&] { return daemon.hub().wanted_encodings() != 0; });
+  wait_until([&] { return daemon.subject(0).hub().wanted_encodings() != 0; });
 
   daemon.start_source();
   long received = 0;
@@ -212,7 +212,7 @@ TEST(Daemon, StalledSubscriberDoesNotHoldBackTheOthers) {
   uint32_t own_drops = 0;
   auto stalled_dropped = [&] {
     uint64_t most = 0;
-    for (const SubscriberMetrics& s : daemon.hub().subscriber_metrics()) most = std::max(most, s.dropped);
+    for (const SubscriberMetrics& s : daemon.subject(0).hub().subscriber_metrics()) most = std::max(most, s.dropped);
     return most;
   };
   sub::SubscriberClient client("127.0.0.1", std::to_string(daemon.sub_port()), subscriber::kWantMarkers);
@@ -276,7 +276,7 @@ TEST_P(DaemonPublishThreads, EverySubscriberGetsEveryFrameInOrderAndStopClosesTh
         return numbers[s].size() < kFrames;
       });
     });
-  wait_until([&] { return daemon.hub().subscriber_count() == kSubscribers + 1 && daemon.hub().wanted_encodings() != 0; });
+  wait_until([&] { return daemon.subject(0).hub().subscriber_count() == kSubscribers + 1 && daemon.subject(0).hub().wanted_encodings() != 0; });
   daemon.start_source();
   for (std::thread& t : readers) t.join();
   daemon.stop();
@@ -342,7 +342,7 @@ TEST(Daemon, PacedSubscriberHasAtMostTheWindowInFlightAndGetsTheNewestFrameOnAck
   tcp::socket paced(io);
   paced.connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), static_cast<unsigned short>(daemon.sub_port())));
   asio::write(paced, asio::buffer(subscriber::encode_hello({subscriber::kWantMarkers | subscriber::kWantPaced})));
-  wait_until([&] { return daemon.hub().wanted_encodings() != 0; });
+  wait_until([&] { return daemon.subject(0).hub().wanted_encodings() != 0; });
   daemon.start_source();
   subscriber::StreamDecoder decoder;
   using std::chrono::milliseconds;
@@ -431,7 +431,7 @@ TEST(Daemon, ServesHealthMetricsWebSocketAndSubscribersWithoutHello) {
   asio::write(rude, asio::buffer(subscriber::encode_status({})));
   boost::system::error_code ec;
   while (!ec) rude.read_some(asio::buffer(buffer), ec);  // until the daemon closes it
-  EXPECT_EQ(daemon.metrics().bad_subscriber_messages.load(), 1u);
+  EXPECT_EQ(daemon.subject(0).metrics().bad_subscriber_messages.load(), 1u);
 
   int status = 0;
   const nlohmann::json health = nlohmann::json::parse(http_get(daemon.http_port(), "/health", &status));
@@ -441,7 +441,7 @@ TEST(Daemon, ServesHealthMetricsWebSocketAndSubscribersWithoutHello) {
   EXPECT_GE(health["subscribers"].get<int>(), 2);
   // Frames went out, so encoded buffers exist (the counter only grows, and frames keep coming).
   EXPECT_GE(health["frame_buffers_allocated"].get<long>(), 1);
-  EXPECT_LE(health["frame_buffers_allocated"].get<uint64_t>(), daemon.metrics().frame_buffers_allocated.load());
+  EXPECT_LE(health["frame_buffers_allocated"].get<uint64_t>(), daemon.subject(0).metrics().frame_buffers_allocated.load());
   // Every stage summarised for scripts, each summary ordered. Frames were filled, encoded and
   // written to subscribers; this subject has no mesh, so nothing was deformed.
   for (const char* stage : {"receive_to_take", "fill", "deform", "normals", "encode", "receive_to_publish",
@@ -459,11 +459,16 @@ TEST(Daemon, ServesHealthMetricsWebSocketAndSubscribersWithoutHello) {
   }
   const std::string metrics = http_get(daemon.http_port(), "/metrics", &status);
   EXPECT_EQ(status, 200);
-  for (const char* name : {"skinstream_frames_received_total ", "skinstream_frames_published_total ", "skinstream_frames_dropped_total ",
-                           "skinstream_frames_dropped_mailbox_full_total ", "skinstream_markers_filled_total ", "skinstream_fill_seconds_bucket{le=\"+Inf\"}",
-                           "skinstream_encode_seconds_count", "skinstream_receive_to_take_seconds_count",
-                           "skinstream_subscriber_queue_wait_seconds_count", "skinstream_subscriber_write_seconds_count", "skinstream_bad_subscriber_messages_total 1"})
-    EXPECT_NE(metrics.find(name), std::string::npos) << name;
+  // The source's frames unlabelled, the subject's series labelled with its name.
+  const std::string subject = "{subject=\"" + daemon.subject(0).name() + "\"";
+  EXPECT_NE(metrics.find("skinstream_source_frames_total "), std::string::npos);
+  for (const char* name : {"skinstream_frames_received_total", "skinstream_frames_published_total", "skinstream_frames_dropped_total",
+                           "skinstream_frames_dropped_mailbox_full_total", "skinstream_markers_filled_total", "skinstream_encode_seconds_count",
+                           "skinstream_receive_to_take_seconds_count", "skinstream_subscriber_queue_wait_seconds_count",
+                           "skinstream_subscriber_write_seconds_count"})
+    EXPECT_NE(metrics.find(name + subject + "} "), std::string::npos) << name;
+  EXPECT_NE(metrics.find("skinstream_fill_seconds_bucket" + subject + ",le=\"+Inf\"}"), std::string::npos);
+  EXPECT_NE(metrics.find("skinstream_bad_subscriber_messages_total" + subject + "} 1"), std::string::npos);
   http_get(daemon.http_port(), "/nothing-here", &status);
   EXPECT_EQ(status, 404);
   http_get(daemon.http_port(), "/", &status);
