@@ -1,8 +1,10 @@
-// skinstream-replay: streams a recorded capture (C3D or TRC) as a Vicon DataStream server, so that
-// skinstreamd, benchmarks and unmodified Vicon SDK clients can run without a capture stage.
+// skinstream-replay: streams recorded captures (C3D or TRC) as a Vicon DataStream server, so that
+// skinstreamd, benchmarks and unmodified Vicon SDK clients can run without a capture stage. Several
+// recordings stream as several subjects of one stream (a stage with several actors), each frame
+// holding one frame of each.
 //
-//   skinstream-replay RECORDING --port P [--rate HZ] [--speed X] [--loop | --hold] [--subject NAME]
-//                     [--multicast GROUP[:PORT]] [--multicast-ttl N] [--start-now]
+//   skinstream-replay RECORDING... --port P [--rate HZ] [--speed X] [--loop | --hold]
+//                     [--subject NAME]... [--multicast GROUP[:PORT]] [--multicast-ttl N] [--start-now]
 //
 // Prints one JSON line {"port": N} on stdout once listening (port 0 picks a free one); logs go to
 // stderr. Errors are one line on stderr and a non-zero exit code.
@@ -12,6 +14,7 @@
 #include <iostream>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 #include <spdlog/sinks/stdout_color_sinks.h>
@@ -28,7 +31,7 @@ namespace {
 using namespace skinstream;
 
 struct Arguments {
-  std::string recording;
+  std::vector<std::string> recordings;
   int port = vicon::kDefaultPort;
   std::string bind = "0.0.0.0";
   double rate = 0.0;
@@ -36,7 +39,7 @@ struct Arguments {
   bool loop = false;
   bool hold = false;
   bool start_now = false;
-  std::string subject;
+  std::vector<std::string> subjects;  // one per recording, or none (the files' stems)
   std::string multicast;
   int multicast_ttl = 1;
   int max_queued = 4;
@@ -52,15 +55,36 @@ std::pair<std::string, uint16_t> split_address(const std::string& text) {
   return {text.substr(0, colon), static_cast<uint16_t>(port)};
 }
 
-int run(const Arguments& args) {
-  const Capture capture = read_capture(args.recording);
-  if (capture.frame_count <= 0) throw FileError(args.recording, "holds no frames");
-  if (!(capture.rate_hz > 0.0) && !(args.rate > 0.0)) throw FileError(args.recording, "has no frame rate; pass --rate");
+// The recordings, read, each with the name of the subject it streams as.
+struct Recordings {
+  std::vector<Capture> captures;
+  std::vector<vicon::CaptureSubject> subjects;
+};
 
+Recordings read_recordings(const Arguments& args) {
+  if (!args.subjects.empty() && args.subjects.size() != args.recordings.size())
+    throw std::invalid_argument("--subject is given " + std::to_string(args.subjects.size()) + " times for " +
+                                std::to_string(args.recordings.size()) + " recordings: once per recording, or not at all");
+  Recordings out;
+  out.captures.reserve(args.recordings.size());  // the subjects point into it
+  for (size_t r = 0; r < args.recordings.size(); ++r) {
+    const std::string& path = args.recordings[r];
+    const Capture& capture = out.captures.emplace_back(read_capture(path));
+    if (capture.frame_count <= 0) throw FileError(path, "holds no frames");
+    if (!(capture.rate_hz > 0.0) && !(args.rate > 0.0)) throw FileError(path, "has no frame rate; pass --rate");
+    const std::string name = args.subjects.empty() ? std::filesystem::path(path).stem().string() : args.subjects[r];
+    for (const vicon::CaptureSubject& other : out.subjects)
+      if (other.name == name) throw std::invalid_argument("two recordings stream as subject \"" + name + "\": name each with --subject");
+    out.subjects.push_back({&capture, name});
+  }
+  return out;
+}
+
+int run(const Arguments& args) {
+  const Recordings recordings = read_recordings(args);
   server::ViconServerOptions options;
   options.bind_address = args.bind;
   options.port = static_cast<uint16_t>(args.port);
-  options.subject_name = args.subject.empty() ? std::filesystem::path(args.recording).stem().string() : args.subject;
   options.rate_hz = args.rate;
   options.speed = args.speed;
   options.loop = args.loop;
@@ -70,7 +94,7 @@ int run(const Arguments& args) {
   options.tcp_congestion = args.tcp_congestion;
 
   server::asio::io_context io;
-  server::ViconServer vicon_server(io, capture, options);
+  server::ViconServer vicon_server(io, recordings.subjects, options);
   vicon_server.start();  // throws with the address on failure
 
   // Without --loop or --hold: once the last frame is out, wait (up to 2 s) for the clients'
@@ -107,9 +131,12 @@ int run(const Arguments& args) {
   }
 
   std::cout << "{\"port\": " << vicon_server.port() << "}" << std::endl;
-  spdlog::info("streaming {} ({} markers, {} frames at {} Hz, speed {}) as subject '{}' on {}:{}", args.recording,
-               capture.point_count(), capture.frame_count, args.rate > 0.0 ? args.rate : capture.rate_hz, args.speed,
-               options.subject_name, args.bind, vicon_server.port());
+  for (size_t r = 0; r < args.recordings.size(); ++r) {
+    const Capture& capture = recordings.captures[r];
+    spdlog::info("streaming {} ({} markers, {} frames at {} Hz, speed {}) as subject '{}' on {}:{}", args.recordings[r],
+                 capture.point_count(), capture.frame_count, args.rate > 0.0 ? args.rate : capture.rate_hz, args.speed,
+                 recordings.subjects[r].name, args.bind, vicon_server.port());
+  }
   io.run();
   return 0;
 }
@@ -119,8 +146,8 @@ int run(const Arguments& args) {
 int main(int argc, char** argv) {
   spdlog::set_default_logger(spdlog::stderr_color_mt("replay"));
   Arguments args;
-  CLI::App app{"skinstream-replay: stream a recorded capture (C3D/TRC) as a Vicon DataStream server"};
-  app.add_option("RECORDING", args.recording, "capture file (.c3d or .trc)")->required();
+  CLI::App app{"skinstream-replay: stream recorded captures (C3D/TRC) as a Vicon DataStream server"};
+  app.add_option("RECORDING", args.recordings, "capture files (.c3d or .trc), each streamed as one subject")->required();
   app.add_option("--port", args.port, "TCP port to listen on (0: pick a free one; printed as {\"port\": N})")
       ->check(CLI::Range(0, 65535))
       ->capture_default_str();
@@ -135,7 +162,9 @@ int main(int argc, char** argv) {
       ->excludes(loop);
   app.add_flag("--start-now", args.start_now,
                "start the recording at once instead of when the first client asks for a frame");
-  app.add_option("--subject", args.subject, "subject name (default: the recording's file stem)");
+  app.add_option("--subject", args.subjects, "subject name, once per recording in their order (default: each file's stem)")
+      ->expected(1)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   app.add_option("--multicast", args.multicast, "also send every frame as UDP datagrams to GROUP[:PORT]");
   app.add_option("--multicast-ttl", args.multicast_ttl, "multicast TTL (hops)")
       ->check(CLI::Range(0, 255))
@@ -152,6 +181,8 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.footer(
       "The recording starts when the first client asks for a frame (RequestFrame), unless --start-now.\n"
+      "Several recordings stream as several subjects, frame k of each in frame k of the stream; a subject\n"
+      "is listed only in frames where its recording has a marker (it leaves the stage, and comes back).\n"
       "Without --loop or --hold the program exits 0 once the last frame has been sent to the connected\n"
       "clients. SIGINT/SIGTERM stop it cleanly (exit 0).");
   CLI11_PARSE(app, argc, argv);
