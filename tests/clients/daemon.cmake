@@ -3,7 +3,8 @@
 # `skinstream fill`; a Vicon DataStream source (skinstream-replay) going away and coming back;
 # the demo subject's vertex buffers against `skinstream fill` + `deform`; bad paths fail clearly.
 if(TARGET skinstreamd AND TARGET skinstream-sub AND TARGET skinstream-replay)
-  add_executable(daemon_tests ${CMAKE_CURRENT_LIST_DIR}/daemon_e2e_test.cpp ${PROJECT_SOURCE_DIR}/tests/support/test_data.cpp
+  add_executable(daemon_tests ${CMAKE_CURRENT_LIST_DIR}/daemon_e2e_test.cpp ${CMAKE_CURRENT_LIST_DIR}/daemon_subjects_e2e_test.cpp
+  ${PROJECT_SOURCE_DIR}/tests/support/test_data.cpp
   ${PROJECT_SOURCE_DIR}/tests/support/program_run.cpp)
   target_include_directories(daemon_tests PRIVATE ${PROJECT_SOURCE_DIR}/tests)
   # skinstream_server for the blocking subscriber client (server/client/) the tests subscribe with.

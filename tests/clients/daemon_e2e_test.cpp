@@ -24,194 +24,20 @@
 #include "protocol/capture_file.h"
 #include "protocol/point_cache.h"
 #include "server/client/subscriber_client.h"
+#include "support/program_processes.h"
 #include "support/program_run.h"
+#include "support/recording_match.h"
 #include "support/test_data.h"
 
 namespace skinstream {
 namespace {
 
+using test::BackgroundSubscriber;
+using test::DaemonProcess;
+using test::eventually;
 using test::ProgramRun;
+using test::ReplayProcess;
 ProgramRun run(const std::string& command_line) { return test::run_program(command_line); }
-
-// A daemon in the background; stopped with SIGTERM.
-class DaemonProcess {
- public:
-  explicit DaemonProcess(const std::string& arguments) {
-    // The process id too: ctest runs each test as its own process, several at once.
-    ports_path_ = test::scratch_path("ports_" + std::to_string(getpid()) + "_" + std::to_string(counter_++) + ".json");
-    std::remove(ports_path_.c_str());
-    log_path_ = ports_path_ + ".log";
-    pid_ = fork();
-    if (pid_ == 0) {
-      const std::string command = "exec " + std::string(SKINSTREAMD) + " --bind 127.0.0.1 --http-port 0 --sub-port 0 --ports-file " +
-                                  ports_path_ + " " + arguments + " > " + log_path_ + " 2>&1";
-      execl("/bin/sh", "sh", "-c", command.c_str(), static_cast<char*>(nullptr));
-      _exit(127);
-    }
-    for (;;) {
-      std::ifstream in(ports_path_);
-      if (in) {
-        const nlohmann::json ports = nlohmann::json::parse(in);
-        http_port = ports["http"];
-        sub_port = ports["sub"];
-        return;
-      }
-      int status = 0;
-      if (waitpid(pid_, &status, WNOHANG) == pid_) {
-        pid_ = -1;
-        ADD_FAILURE() << "skinstreamd exited at startup: " << log();
-        return;
-      }
-      std::this_thread::sleep_for(std::chrono::milliseconds(20));
-    }
-  }
-  ~DaemonProcess() { stop(); }
-  int stop() {
-    if (pid_ <= 0) return exit_code_;
-    kill(pid_, SIGTERM);
-    int status = 0;
-    waitpid(pid_, &status, 0);
-    pid_ = -1;
-    exit_code_ = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    return exit_code_;
-  }
-  std::string log() const {
-    std::ifstream in(log_path_);
-    std::stringstream text;
-    text << in.rdbuf();
-    return text.str();
-  }
-  int http_port = 0, sub_port = 0;
-
- private:
-  static inline int counter_ = 0;
-  pid_t pid_ = -1;
-  int exit_code_ = -1;
-  std::string ports_path_, log_path_;
-};
-
-
-// skinstream-replay in the background: a Vicon DataStream server looping a recording.
-class ReplayProcess {
- public:
-  // port 0: any free port (see port). `extra` goes on the command line as it is.
-  ReplayProcess(const std::string& recording, int port, const std::string& extra = "") {
-    out_path_ = test::scratch_path("replay_" + std::to_string(getpid()) + "_" + std::to_string(counter_++) + ".out");
-    std::remove(out_path_.c_str());
-    pid_ = fork();
-    if (pid_ == 0) {
-      const std::string command = "exec " + std::string(SKINSTREAM_REPLAY) + " " + recording + " --bind 127.0.0.1 --port " +
-                                  std::to_string(port) + " --loop " + extra + " > " + out_path_ + " 2> " + out_path_ + ".log";
-      execl("/bin/sh", "sh", "-c", command.c_str(), static_cast<char*>(nullptr));
-      _exit(127);
-    }
-    for (;;) {
-      std::ifstream in(out_path_);
-      std::string line;
-      if (in && std::getline(in, line) && line.find('}') != std::string::npos) {
-        this->port = nlohmann::json::parse(line)["port"];
-        return;
-      }
-      if (waitpid(pid_, nullptr, WNOHANG) == pid_) {
-        pid_ = -1;
-        ADD_FAILURE() << "skinstream-replay exited at startup";
-        return;
-      }
-      std::this_thread::sleep_for(std::chrono::milliseconds(20));
-    }
-  }
-  ~ReplayProcess() { kill_now(); }
-  // SIGKILL: the source vanishes as a crashed or unplugged server would, without a goodbye.
-  void kill_now() {
-    if (pid_ <= 0) return;
-    kill(pid_, SIGKILL);
-    waitpid(pid_, nullptr, 0);
-    pid_ = -1;
-  }
-  int port = 0;
-
- private:
-  static inline int counter_ = 0;
-  pid_t pid_ = -1;
-  std::string out_path_;
-};
-
-
-// Polls `condition` every 20 ms for up to `limit`: a bound on a hang, not a timing assertion.
-bool eventually(const std::function<bool()>& condition, std::chrono::seconds limit = std::chrono::seconds(20)) {
-  const auto end = std::chrono::steady_clock::now() + limit;
-  while (std::chrono::steady_clock::now() < end) {
-    if (condition()) return true;
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
-  }
-  return condition();
-}
-
-// A subscriber on its own thread that keeps every Status and counts frames, until stopped.
-class BackgroundSubscriber {
- public:
-  BackgroundSubscriber(int port, uint32_t wants) {
-    thread_ = std::thread([this, port, wants] {
-      try {
-        sub::SubscriberClient client("127.0.0.1", std::to_string(port), wants);
-        client.run([this](subscriber::MessageType type, std::span<const unsigned char> payload, int64_t) {
-          std::lock_guard lock(mutex_);
-          if (type == subscriber::MessageType::Status) statuses_.push_back(subscriber::decode_status(payload));
-          if (type == subscriber::MessageType::Frame) {
-            last_frame_number_ = subscriber::decode_frame(payload).info.frame_number;
-            ++frames_;
-          }
-          return !stop_.load();
-        });
-      } catch (const std::exception& e) {
-        std::lock_guard lock(mutex_);
-        error_ = e.what();
-      }
-      closed_ = true;
-    });
-  }
-  ~BackgroundSubscriber() {
-    stop_ = true;
-    thread_.join();  // a Status arrives at least every status interval, so run() returns
-  }
-  long frames() const {
-    std::lock_guard lock(mutex_);
-    return frames_;
-  }
-  uint32_t last_frame_number() const {
-    std::lock_guard lock(mutex_);
-    return last_frame_number_;
-  }
-  // Statuses received from index `from` on with this state.
-  bool saw_status(subscriber::SourceStateCode state, size_t from = 0) const {
-    std::lock_guard lock(mutex_);
-    for (size_t i = from; i < statuses_.size(); ++i)
-      if (statuses_[i].state == state) return true;
-    return false;
-  }
-  size_t status_count() const {
-    std::lock_guard lock(mutex_);
-    return statuses_.size();
-  }
-  std::string last_status_detail() const {
-    std::lock_guard lock(mutex_);
-    return statuses_.empty() ? std::string() : statuses_.back().detail;
-  }
-  bool closed() const { return closed_.load(); }
-  std::string error() const {
-    std::lock_guard lock(mutex_);
-    return error_;
-  }
-
- private:
-  mutable std::mutex mutex_;
-  std::vector<subscriber::Status> statuses_;
-  long frames_ = 0;
-  uint32_t last_frame_number_ = 0;
-  std::string error_;
-  std::atomic<bool> stop_{false}, closed_{false};
-  std::thread thread_;
-};
 
 class DaemonProgram : public ::testing::Test {
  protected:
@@ -378,18 +204,6 @@ TEST_F(DaemonProgram, SigtermStopsCleanlyWithMarkersOnly) {
 // numbering and the marker mapping survive the DataStream round trip).
 enum class ViconMode { Push, Pull, Multicast };
 
-// A UDP port free on loopback right now: bound, noted, closed.
-int free_udp_port() {
-  const int holder = socket(AF_INET, SOCK_DGRAM, 0);
-  sockaddr_in address{};
-  address.sin_family = AF_INET;
-  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  if (bind(holder, reinterpret_cast<sockaddr*>(&address), sizeof address) != 0) return 0;
-  socklen_t length = sizeof address;
-  getsockname(holder, reinterpret_cast<sockaddr*>(&address), &length);
-  close(holder);
-  return ntohs(address.sin_port);
-}
 
 void expect_vicon_stream_in_order(const std::string& subject, const std::string& take, ViconMode mode) {
   const Capture recording = read_capture(take);
@@ -399,7 +213,7 @@ void expect_vicon_stream_in_order(const std::string& subject, const std::string&
   if (mode == ViconMode::Multicast) {
     // Datagrams to this host's loopback address (a 239.x group does not loop back in every
     // sandbox); the daemon listens first, then the replay streams with nobody on TCP.
-    const int udp_port = free_udp_port();
+    const int udp_port = test::free_loopback_port(SOCK_DGRAM);
     ASSERT_GT(udp_port, 0);
     daemon_process = std::make_unique<DaemonProcess>("--subject " + subject + " --vicon-multicast 127.0.0.1:" + std::to_string(udp_port));
     replay = std::make_unique<ReplayProcess>(take, 0, "--multicast 127.0.0.1:" + std::to_string(udp_port) + " --start-now");
@@ -420,37 +234,9 @@ void expect_vicon_stream_in_order(const std::string& subject, const std::string&
   EXPECT_EQ(health["source"]["state"], "streaming") << health.dump();
   EXPECT_NE(daemon.log().find(expected_log), std::string::npos) << daemon.log();
 
-  const int markers = recording.point_count();
-  std::vector<nlohmann::json> frames;
-  std::istringstream lines(sub.output);
-  for (std::string line; std::getline(lines, line);) {
-    const nlohmann::json j = nlohmann::json::parse(line);
-    if (j.contains("frame")) frames.push_back(j);
-  }
+  const std::vector<nlohmann::json> frames = test::frames_of(sub.output);
   ASSERT_EQ(frames.size(), static_cast<size_t>(kFrames));
-  long measured = 0, measured_equal = 0;
-  for (size_t i = 0; i < frames.size(); ++i) {
-    const int number = frames[i]["frame"];
-    if (i > 0) {  // numbers never go back, even across loops
-      EXPECT_GT(number, frames[i - 1]["frame"].get<int>()) << "frame " << i;
-    }
-    ASSERT_GE(number, recording.first_frame);
-    const int index = (number - recording.first_frame) % recording.frame_count;
-    const std::vector<float> live = frames[i]["markers"];
-    ASSERT_EQ(live.size(), static_cast<size_t>(3 * markers));
-    for (int m = 0; m < markers; ++m) {
-      for (int a = 0; a < 3; ++a) ASSERT_TRUE(std::isfinite(live[3 * m + a])) << "frame " << number << " marker " << m;
-      const Vec3 sample = recording.at(index, m);
-      if (!is_present(sample)) continue;
-      ++measured;
-      // Measured samples pass through unchanged (C3D float -> Vicon double -> published float).
-      const Vec3 got(live[3 * m], live[3 * m + 1], live[3 * m + 2]);
-      if ((got - sample).norm() < 1e-3) ++measured_equal;
-    }
-  }
-  ASSERT_GT(measured, 0);
-  // The relabeller may refuse a label now and then; the mapping is wrong if many differ.
-  EXPECT_GE(measured_equal, measured * 99 / 100) << measured_equal << " of " << measured << " measured samples equal the recording";
+  test::expect_frames_follow_recording(recording, frames);
 }
 
 TEST_F(DaemonProgram, ViconServerPushReachesTheSubscriberInOrder) { expect_vicon_stream_in_order(subject_, take_, ViconMode::Push); }
@@ -460,16 +246,9 @@ TEST_F(DaemonProgram, ViconClientPullReachesTheSubscriberInOrder) { expect_vicon
 TEST_F(DaemonProgram, ViconUdpDatagramsReachTheSubscriberInOrder) { expect_vicon_stream_in_order(subject_, take_, ViconMode::Multicast); }
 
 TEST_F(DaemonProgram, ViconUnreachableIsReportedAndServingGoesOn) {
-  // A port nobody listens on: bind one, note it, close it.
-  const int holder = socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in address{};
-  address.sin_family = AF_INET;
-  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  ASSERT_EQ(bind(holder, reinterpret_cast<sockaddr*>(&address), sizeof address), 0);
-  socklen_t length = sizeof address;
-  getsockname(holder, reinterpret_cast<sockaddr*>(&address), &length);
-  close(holder);
-  DaemonProcess daemon("--subject " + subject_ + " --vicon 127.0.0.1:" + std::to_string(ntohs(address.sin_port)));
+  const int port = test::free_loopback_port(SOCK_STREAM);  // nobody listens on it
+  ASSERT_GT(port, 0);
+  DaemonProcess daemon("--subject " + subject_ + " --vicon 127.0.0.1:" + std::to_string(port));
   EXPECT_TRUE(eventually([&] { return server::fetch_health(daemon.http_port)["source"]["state"] == "disconnected"; })) << daemon.log();
   BackgroundSubscriber subscriber(daemon.sub_port, subscriber::kWantMarkers | subscriber::kWantNoMesh);
   EXPECT_TRUE(eventually([&] { return subscriber.saw_status(subscriber::SourceStateCode::Disconnected); })) << subscriber.error();

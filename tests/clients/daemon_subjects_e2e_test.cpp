@@ -1,0 +1,110 @@
+// Several actors on one stage, with the real programs on loopback: skinstream-replay streams two
+// recordings of one marker template as the Vicon subjects Actor1 and Actor2, and skinstreamd
+// follows them by name. A stage grows past one machine by running one daemon per group of
+// subjects, each a separate client of the same Vicon stream.
+#include <gtest/gtest.h>
+
+#include <thread>
+
+#include "protocol/capture_file.h"
+#include "server/client/health_probe.h"
+#include "support/program_processes.h"
+#include "support/program_run.h"
+#include "support/recording_match.h"
+#include "support/test_data.h"
+
+namespace skinstream {
+namespace {
+
+using test::DaemonProcess;
+using test::ProgramRun;
+using test::ReplayProcess;
+
+constexpr double kApartMm = 4000.0;  // Actor2 stands this far from Actor1 along x
+
+class DaemonSubjects : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    // Per process: ctest runs each test as its own process, several at once.
+    const std::string own = std::to_string(getpid());
+    subject_ = test::scratch_path("subjects_subject_" + own + ".sks");
+    const ProgramRun built = test::run_program(std::string(SKINSTREAM_CLI) + " build-subject --capture " +
+                                               test::source_path("replay_data/cmu/85_02.c3d") + " --out " + subject_);
+    ASSERT_EQ(built.exit_code, 0) << built.output;
+    // Two takes of the same performer's template: 85_12 where it was, 85_02 moved 4 m away.
+    std::vector<int> channels;
+    for (int c = 0; c < 41; ++c) channels.push_back(c);
+    const Capture first = read_capture(test::source_path("replay_data/cmu/85_12.c3d")).select(channels, 0, kTakeFrames);
+    Capture second = read_capture(test::source_path("replay_data/cmu/85_02.c3d")).select(channels, 0, kTakeFrames);
+    second.first_frame = first.first_frame;  // one stream, one numbering
+    for (int f = 0; f < second.frame_count; ++f)
+      for (int c = 0; c < second.point_count(); ++c)
+        if (second.present(f, c)) second.at(f, c) += Vec3(kApartMm, 0.0, 0.0);
+    take_a_ = test::scratch_path("subjects_a_" + own + ".c3d");
+    take_b_ = test::scratch_path("subjects_b_" + own + ".c3d");
+    write_capture(first, take_a_);
+    write_capture(second, take_b_);
+  }
+  static void TearDownTestSuite() {
+    for (const std::string& path : {subject_, take_a_, take_b_}) std::remove(path.c_str());
+  }
+  static std::string replay_arguments() { return take_a_ + " " + take_b_; }
+
+  static constexpr int kTakeFrames = 240;
+  static inline std::string subject_, take_a_, take_b_;
+};
+
+// `frames` (skinstream-sub --markers --json) follow `own`, and no marker, measured or filled,
+// lies nearer the other actor: a marker of the other subject would be 4 m off.
+void expect_own_actor_only(const Capture& own, const std::vector<nlohmann::json>& frames, double other_x_offset) {
+  test::expect_frames_follow_recording(own, frames);
+  for (const nlohmann::json& frame : frames) {
+    const int index = (frame["frame"].get<int>() - own.first_frame) % own.frame_count;
+    Vec3 centre = Vec3::Zero();
+    int measured = 0;
+    for (int m = 0; m < own.point_count(); ++m)
+      if (own.present(index, m)) centre += own.at(index, m), ++measured;
+    ASSERT_GT(measured, 0);
+    centre /= measured;
+    const std::vector<float> live = frame["markers"];
+    for (int m = 0; m < own.point_count(); ++m) {
+      const Vec3 p(live[3 * m], live[3 * m + 1], live[3 * m + 2]);
+      ASSERT_LT((p - centre).norm(), (p - centre - Vec3(other_x_offset, 0, 0)).norm())
+          << "frame " << frame["frame"] << " marker " << m << " is nearer the other actor";
+    }
+  }
+}
+
+// Two daemons, each following one actor, read one replay server at once: each gets its own
+// actor's frames, and the server serves both.
+TEST_F(DaemonSubjects, TwoDaemonsReadOneReplayServerEachFollowingItsOwnActor) {
+  ReplayProcess replay(replay_arguments(), 0, "--subject Actor1 --subject Actor2");
+  const std::string vicon = " --vicon 127.0.0.1:" + std::to_string(replay.port);
+  DaemonProcess first("--subject Actor1=" + subject_ + vicon);
+  DaemonProcess second("--subject Actor2=" + subject_ + vicon);
+  constexpr int kFrames = 120;
+  auto subscribe = [&](const DaemonProcess& daemon) {
+    return test::run_program(std::string(SKINSTREAM_SUB) + " 127.0.0.1:" + std::to_string(daemon.sub_port) +
+                             " --markers --json --frames " + std::to_string(kFrames));
+  };
+  ProgramRun from_second;
+  std::thread other([&] { from_second = subscribe(second); });
+  const ProgramRun from_first = subscribe(first);
+  other.join();
+  const nlohmann::json health_first = server::fetch_health(first.http_port), health_second = server::fetch_health(second.http_port);
+  EXPECT_EQ(first.stop(), 0) << first.log();
+  EXPECT_EQ(second.stop(), 0) << second.log();
+  ASSERT_EQ(from_first.exit_code, 0) << from_first.output << first.log();
+  ASSERT_EQ(from_second.exit_code, 0) << from_second.output << second.log();
+  EXPECT_EQ(health_first["subject"]["detail"], "follows \"Actor1\": 41 of the subject's 41 markers labelled");
+  EXPECT_EQ(health_second["subject"]["detail"], "follows \"Actor2\": 41 of the subject's 41 markers labelled");
+
+  const std::vector<nlohmann::json> actor1 = test::frames_of(from_first.output), actor2 = test::frames_of(from_second.output);
+  ASSERT_EQ(actor1.size(), static_cast<size_t>(kFrames));
+  ASSERT_EQ(actor2.size(), static_cast<size_t>(kFrames));
+  expect_own_actor_only(read_capture(take_a_), actor1, kApartMm);
+  expect_own_actor_only(read_capture(take_b_), actor2, -kApartMm);
+}
+
+}  // namespace
+}  // namespace skinstream
