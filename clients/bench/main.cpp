@@ -32,6 +32,7 @@
 #include <unistd.h>
 
 #include "clients/bench/stall_log.h"
+#include "clients/bench/subjects.h"
 #include "server/client/health_probe.h"
 #include "protocol/capture_file.h"
 #include "protocol/file_error.h"
@@ -181,22 +182,7 @@ long resident_kb(pid_t pid) {
 
 std::pair<double, long> process_usage(pid_t pid) {
   std::ifstream stat("/proc/" + std::to_string(pid) + "/stat");
-  std::string text((std::istreambuf_iterator<char>(stat)), std::istreambuf_iterator<char>());
-  double cpu = 0;
-  const size_t close = text.rfind(')');
-  if (close != std::string::npos) {
-    std::istringstream fields(text.substr(close + 2));
-    std::string field;
-    long utime = 0, stime = 0;
-    for (int i = 3; fields >> field; ++i) {  // field 3 is the state
-      if (i == 14) utime = std::stol(field);
-      if (i == 15) {
-        stime = std::stol(field);
-        break;
-      }
-    }
-    cpu = static_cast<double>(utime + stime) / static_cast<double>(sysconf(_SC_CLK_TCK));
-  }
+  const double cpu = bench::cpu_seconds_of_stat(std::string((std::istreambuf_iterator<char>(stat)), std::istreambuf_iterator<char>()));
   long hwm = 0;
   std::ifstream status("/proc/" + std::to_string(pid) + "/status");
   for (std::string line; std::getline(status, line);)
@@ -227,6 +213,8 @@ int main(int argc, char** argv) {
   std::optional<std::string> tcp_congestion;  // unset: the daemon's default
   std::string replay_tcp_congestion = server::ViconServerOptions{}.tcp_congestion;
   bool json = false, normals = false, quantised = false;
+  int subjects = 1;
+  double subject_spacing_mm = 3000.0;
   app.add_option("--seconds", seconds, "how long to measure")->check(CLI::Range(0.5, 3600.0))->capture_default_str();
   app.add_option("--subscribers", subscriber_count, "subscribers connected in-process, one thread each")->check(CLI::Range(1, 256))->capture_default_str();
   app.add_option("--recording", recording, "capture the Vicon replay server streams, looped")->capture_default_str();
@@ -242,6 +230,11 @@ int main(int argc, char** argv) {
                  "TCP congestion control of the replay server's connection to the daemon (\"\" = the system's)")
       ->capture_default_str();
   app.add_option("--vicon-subject-name", vicon_subject_name, "subject name the replay announces (default: the recording's file name)");
+  app.add_option("--subjects", subjects, "actors on the stage: the recording streamed this many times, moved apart, as Actor1..ActorN")
+      ->check(CLI::Range(1, 16))
+      ->capture_default_str();
+  app.add_option("--subject-spacing-mm", subject_spacing_mm, "with --subjects: how far apart the actors stand along x")
+      ->capture_default_str();
   app.add_flag("--normals", normals, "subscribers ask for normals too");
   app.add_flag("--quantised", quantised, "subscribers ask for the quantised encoding (half the bytes)");
   app.add_flag("--json", json, "print the report as JSON");
@@ -270,8 +263,9 @@ int main(int argc, char** argv) {
     replay_options.port = 0;
     replay_options.loop = true;
     replay_options.tcp_congestion = replay_tcp_congestion;
-    replay_options.subject_name = vicon_subject_name.empty() ? fs::path(recording).stem().string() : vicon_subject_name;
-    server::ViconServer replay(replay_io, capture, replay_options);
+    const bench::ReplayStage stage = bench::replay_stage(capture, subjects, subject_spacing_mm,
+                                                         vicon_subject_name.empty() ? fs::path(recording).stem().string() : vicon_subject_name);
+    server::ViconServer replay(replay_io, stage.subjects, replay_options);
     bench::StallLog stalls;  // before send_times, which writes to it until the replay stops
     SendTimes send_times;
     replay.set_frame_hook([&send_times](uint32_t frame_number, int64_t send_ns) { send_times.record(frame_number, send_ns); });
@@ -286,9 +280,11 @@ int main(int argc, char** argv) {
       ~ReplayThreadStop() { stop(); }
     } replay_thread_stop{stop_replay};
 
-    std::vector<std::string> daemon_args = {daemon_path.string(), "--subject", subject, "--vicon", "127.0.0.1:" + std::to_string(replay.port()),
+    std::vector<std::string> daemon_args = {daemon_path.string(), "--vicon", "127.0.0.1:" + std::to_string(replay.port()),
                                             "--deform-threads", std::to_string(deform_threads), "--http-port", "0", "--sub-port", "0",
                                             "--bind", "127.0.0.1", "--ports-file", ports_path, "--log-level", "warn"};
+    const std::vector<std::string> subject_args = bench::daemon_subject_arguments(subject, subjects);
+    daemon_args.insert(daemon_args.end(), subject_args.begin(), subject_args.end());
     if (!deform_cpus.empty()) daemon_args.insert(daemon_args.end(), {"--deform-cpus", deform_cpus});
     if (deform_spin_lead_us >= 0) daemon_args.insert(daemon_args.end(), {"--deform-spin-lead-us", std::to_string(deform_spin_lead_us)});
     if (publish_threads >= 0) daemon_args.insert(daemon_args.end(), {"--publish-threads", std::to_string(publish_threads)});
@@ -305,6 +301,7 @@ int main(int argc, char** argv) {
     const uint64_t sent_before = replay.stats().frame_packets_sent.load();
     const uint64_t replay_dropped_before = replay.stats().frames_dropped.load();
     const double cpu_before = process_usage(pid).first;  // startup (loading the subject) is not counted
+    const std::map<std::string, double> thread_cpu_before = bench::thread_cpu_seconds(pid);
     const double own_cpu_before = process_usage(getpid()).first;
 
     std::vector<SubscriberTally> tallies(subscriber_count);
@@ -380,6 +377,8 @@ int main(int argc, char** argv) {
     const uint64_t sent = replay.stats().frame_packets_sent.load() - sent_before;
     const uint64_t replay_dropped = replay.stats().frames_dropped.load() - replay_dropped_before;
     const auto [cpu_total, peak_rss_kb] = process_usage(pid);
+    const nlohmann::json per_subject =
+        bench::per_subject_report(subjects, thread_cpu_before, bench::thread_cpu_seconds(pid), health_before, health, seconds);
     const double own_cpu_seconds = process_usage(getpid()).first - own_cpu_before;
     const double cpu_seconds = cpu_total - cpu_before;
     kill(pid, SIGTERM);
@@ -412,6 +411,7 @@ int main(int argc, char** argv) {
         {"mode", "Vicon DataStream replay (in-process, loopback) -> skinstreamd --vicon -> subscribers"},
         {"seconds", seconds},
         {"subscribers", subscriber_count},
+        {"subjects", subjects},
         {"subscribers_want", {{"normals", normals}, {"quantised", quantised}}},
         {"deform_threads", deform_threads},
         {"deform", health["deform"]},  // as the daemon applied it: threads, CPUs pinned to, spin lead
@@ -444,6 +444,8 @@ int main(int argc, char** argv) {
                     {"out_of_order", all.out_of_order},
                     {"without_send_time", all.unmatched}}},
         {"per_subscriber", per_subscriber},
+        // Each actor's own threads' CPU and the daemon's figures for it; the threads they share.
+        {"per_subject", per_subject},
         // Gaps over 3 frame periods (the replay's sends, each subscriber's arrivals), drops for a
         // subscriber and drops in the pipeline, in time order: a pause of the whole machine shows
         // at one moment in all.
@@ -481,6 +483,10 @@ int main(int argc, char** argv) {
                     h["p50_le"].get<double>(), h["p99_le"].get<double>(), h["max"].get<double>(), h["count"].get<unsigned long>());
       }
       std::printf("frames: %s\n", report["frames"].dump().c_str());
+      for (const auto& row : per_subject["subjects"])
+        std::printf("subject %s: %.0f%% of one core, receive to publish p99 <= %.3f ms, frames %s\n",
+                    row["name"].get<std::string>().c_str(), 100 * row["cpu_share_of_one_core"].get<double>(),
+                    row["daemon_stages_ms"]["receive_to_publish"]["p99_le"].get<double>(), row["frames"].dump().c_str());
       std::printf("daemon: %.2f s CPU (%.0f%% of one core), peak RSS %ld kB, RSS %ld kB after 1 s and %ld kB at the end\n",
                   cpu_seconds, 100 * cpu_seconds / seconds, peak_rss_kb, rss_samples.empty() ? 0L : rss_samples.front(),
                   rss_samples.empty() ? 0L : rss_samples.back());

@@ -92,6 +92,32 @@ TEST(BenchProgram, ShortRunReportsEveryFrameItCounted) {
   EXPECT_EQ(j["daemon"]["exit_status"], 0);  // SIGTERM stops it cleanly
 }
 
+// --subjects 2: two actors (the recording twice, apart), each followed by the daemon and
+// reported with its own threads' CPU and frames; the io and publish threads are nobody's.
+TEST(BenchProgram, SeveralSubjectsAreEachReportedWithTheirOwnThreads) {
+  const test::ProgramRun r = test::run_program(
+      bench("--subject " + kDemo + "/subject.sksubj --recording " + kDemo + "/live.c3d --seconds 2 --subjects 2 --json"),
+      /*stderr_too=*/false);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto j = nlohmann::json::parse(r.output);
+  EXPECT_EQ(j["subjects"], 2);
+  const auto& rows = j["per_subject"]["subjects"];
+  ASSERT_EQ(rows.size(), 2u);
+  double total = 0.0;
+  for (int k = 0; k < 2; ++k) {
+    SCOPED_TRACE(k);
+    EXPECT_EQ(rows[k]["name"], "Actor" + std::to_string(k + 1));
+    EXPECT_GT(rows[k]["frames"]["received"].get<long>(), 0);
+    EXPECT_GT(rows[k]["cpu_share_of_one_core"].get<double>(), 0.0);
+    EXPECT_EQ(rows[k]["deform"]["threads"], 2);
+    total += rows[k]["cpu_share_of_one_core"].get<double>();
+  }
+  EXPECT_DOUBLE_EQ(j["per_subject"]["mean_cpu_share_per_subject"].get<double>(), total / 2);
+  EXPECT_TRUE(j["per_subject"]["shared_threads_cpu_share"].contains("io")) << j["per_subject"].dump();
+  EXPECT_FALSE(j["per_subject"]["shared_threads_cpu_share"].contains("pipeline-0"));
+  EXPECT_EQ(j["daemon"]["exit_status"], 0);
+}
+
 TEST(BenchProgram, MissingRecordingFailsNamingIt) {
   const std::string absent = test::scratch_path("absent.c3d");
   const test::ProgramRun r = test::run_program(bench("--subject " + kDemo + "/subject.sksubj --recording " + absent + " --seconds 1"));

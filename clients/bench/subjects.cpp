@@ -1,0 +1,109 @@
+#include "clients/bench/subjects.h"
+
+#include <unistd.h>
+
+#include <cctype>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace skinstream::bench {
+namespace {
+
+// The subject a daemon thread works for (-1: none, e.g. io or publish-N).
+int subject_of_thread(const std::string& name, int subjects) {
+  if (subjects == 1) return name == "pipeline" || name.rfind("deform-", 0) == 0 ? 0 : -1;
+  for (const char* prefix : {"pipeline-", "deform-"}) {
+    if (name.rfind(prefix, 0) != 0) continue;
+    const std::string rest = name.substr(std::string(prefix).size());
+    const int k = std::atoi(rest.c_str());
+    if (!rest.empty() && std::isdigit(static_cast<unsigned char>(rest[0])) && k < subjects) return k;
+  }
+  return -1;
+}
+
+}  // namespace
+
+ReplayStage replay_stage(const Capture& recording, int subjects, double spacing_mm, const std::string& single_name) {
+  ReplayStage stage;
+  stage.captures.reserve(static_cast<size_t>(subjects));  // the subjects point into it
+  for (int k = 0; k < subjects; ++k) {
+    Capture& copy = stage.captures.emplace_back(recording);
+    const Vec3 offset(k * spacing_mm, 0.0, 0.0);
+    for (int f = 0; f < copy.frame_count; ++f)
+      for (int c = 0; c < copy.point_count(); ++c)
+        if (copy.present(f, c)) copy.at(f, c) += offset;
+    stage.subjects.push_back({&copy, subjects == 1 ? single_name : "Actor" + std::to_string(k + 1)});
+  }
+  return stage;
+}
+
+std::vector<std::string> daemon_subject_arguments(const std::string& subject_file, int subjects) {
+  std::vector<std::string> out;
+  for (int k = 0; k < subjects; ++k)
+    out.insert(out.end(), {"--subject", subjects == 1 ? subject_file : "Actor" + std::to_string(k + 1) + "=" + subject_file});
+  return out;
+}
+
+double cpu_seconds_of_stat(const std::string& text) {
+  const size_t close = text.rfind(')');
+  if (close == std::string::npos || close + 2 > text.size()) return 0.0;
+  std::istringstream fields(text.substr(close + 2));
+  std::string field;
+  long utime = 0, stime = 0;
+  for (int i = 3; fields >> field; ++i) {  // field 3 is the state; 14 and 15 user and system time
+    if (i == 14) utime = std::stol(field);
+    if (i == 15) {
+      stime = std::stol(field);
+      break;
+    }
+  }
+  return static_cast<double>(utime + stime) / static_cast<double>(sysconf(_SC_CLK_TCK));
+}
+
+std::map<std::string, double> thread_cpu_seconds(pid_t pid) {
+  std::map<std::string, double> out;
+  std::error_code ec;
+  for (const auto& task : std::filesystem::directory_iterator("/proc/" + std::to_string(pid) + "/task", ec)) {
+    std::ifstream stat(task.path() / "stat");
+    const std::string text((std::istreambuf_iterator<char>(stat)), std::istreambuf_iterator<char>());
+    const size_t open = text.find('('), close = text.rfind(')');
+    if (open == std::string::npos || close == std::string::npos) continue;  // the thread just ended
+    out[text.substr(open + 1, close - open - 1)] += cpu_seconds_of_stat(text);
+  }
+  return out;
+}
+
+nlohmann::json per_subject_report(int subjects, const std::map<std::string, double>& cpu_before,
+                                  const std::map<std::string, double>& cpu_after, const nlohmann::json& health_before,
+                                  const nlohmann::json& health_after, double seconds) {
+  std::vector<double> subject_cpu(static_cast<size_t>(subjects), 0.0);
+  nlohmann::json shared = nlohmann::json::object();
+  for (const auto& [name, after] : cpu_after) {
+    const auto before = cpu_before.find(name);
+    const double used = after - (before == cpu_before.end() ? 0.0 : before->second);
+    const int k = subject_of_thread(name, subjects);
+    if (k >= 0) subject_cpu[static_cast<size_t>(k)] += used;
+    else shared[name] = used / seconds;
+  }
+  nlohmann::json rows = nlohmann::json::array();
+  double total = 0.0;
+  for (int k = 0; k < subjects; ++k) {
+    const nlohmann::json& now = health_after["subjects"][k];
+    const nlohmann::json& then = health_before["subjects"][k];
+    auto delta = [&](const char* key) { return now["frames"][key].get<uint64_t>() - then["frames"][key].get<uint64_t>(); };
+    total += subject_cpu[static_cast<size_t>(k)];
+    rows.push_back({{"name", now["name"]},
+                    {"cpu_share_of_one_core", subject_cpu[static_cast<size_t>(k)] / seconds},
+                    {"frames", {{"received", delta("received")}, {"published", delta("published")}, {"dropped", delta("dropped")}}},
+                    {"deform", now["deform"]},
+                    // The daemon's histograms over its whole life (warm-up included): upper bounds.
+                    {"daemon_stages_ms", now["latency_ms"]}});
+  }
+  return {{"subjects", rows},
+          {"mean_cpu_share_per_subject", subjects > 0 ? total / seconds / subjects : 0.0},
+          {"shared_threads_cpu_share", shared}};
+}
+
+}  // namespace skinstream::bench
