@@ -46,19 +46,44 @@ class SpanWriter {
   size_t pos_ = 0;
 };
 
-void put_header(ByteWriter& w, MessageType type, size_t payload) {
+void put_header(ByteWriter& w, MessageType type, size_t payload, uint16_t version) {
   w.put<uint32_t>(kMagic);
-  w.put<uint16_t>(kProtocolVersion);
+  w.put<uint16_t>(version);
   w.put<uint16_t>(static_cast<uint16_t>(type));
   w.put<uint32_t>(static_cast<uint32_t>(payload));
 }
 
 // Messages other than Frame: payload built first, then the header in front.
-std::vector<unsigned char> with_header(MessageType type, const ByteWriter& payload) {
+std::vector<unsigned char> with_header(MessageType type, const ByteWriter& payload, uint16_t version) {
   ByteWriter w;
-  put_header(w, type, payload.bytes().size());
+  put_header(w, type, payload.bytes().size(), version);
   w.put_bytes(payload.bytes().data(), payload.bytes().size());
   return std::move(w.bytes());
+}
+
+// A string as u16 length + bytes, cut at `limit` bytes.
+void put_short_string(ByteWriter& w, const std::string& s, size_t limit = std::numeric_limits<uint16_t>::max()) {
+  const size_t n = std::min(s.size(), limit);
+  w.put<uint16_t>(static_cast<uint16_t>(n));
+  w.put_bytes(s.data(), n);
+}
+
+std::string get_short_string(ByteReader& r, const char* what, size_t limit = std::numeric_limits<uint16_t>::max()) {
+  const uint16_t n = r.get<uint16_t>();
+  if (n > limit) throw DecodeError(std::string(what) + " of " + std::to_string(n) + " bytes exceeds " + std::to_string(limit));
+  if (n > r.remaining()) throw std::out_of_range(std::string(what) + " truncated");
+  std::string s(n, '\0');
+  r.get_array(s.data(), n);
+  return s;
+}
+
+Encoding encoding_of(uint32_t value, const char* what) {
+  if (value >= kEncodingCount) throw DecodeError(std::string(what) + ": unknown encoding " + std::to_string(value));
+  return static_cast<Encoding>(value);
+}
+
+void check_version(uint16_t version) {
+  if (version != kVersion1 && version != kVersion2) throw std::invalid_argument("subscriber protocol version " + std::to_string(version));
 }
 
 size_t padding_to_4(size_t n) { return (4 - n % 4) % 4; }
@@ -93,6 +118,17 @@ const char* to_string(MessageType type) {
     case MessageType::MeshInfo: return "MeshInfo";
     case MessageType::Frame: return "Frame";
     case MessageType::Status: return "Status";
+    case MessageType::Model: return "Model";
+  }
+  return "unknown";
+}
+
+const char* to_string(Encoding encoding) {
+  switch (encoding) {
+    case Encoding::Float: return "float";
+    case Encoding::Quantised: return "quantised";
+    case Encoding::Compressed: return "compressed";
+    case Encoding::Parameters: return "parameters";
   }
   return "unknown";
 }
@@ -107,19 +143,46 @@ uint32_t frame_flags_for(uint32_t wants, bool has_mesh) {
   return flags;
 }
 
+uint32_t frame_flags_for(uint32_t wants, Encoding served, bool has_mesh) {
+  const bool positions = has_mesh && !(wants & kWantNoMesh);
+  uint32_t flags = 0;
+  if (!positions) flags |= kFrameNoPositions;
+  if (positions && served == Encoding::Parameters) flags |= kFrameParameters;  // normals: the subscriber's
+  if (positions && served != Encoding::Parameters && (wants & kWantNormals)) flags |= kFrameNormals;
+  if (positions && served == Encoding::Quantised) flags |= kFrameQuantised;
+  if (positions && served == Encoding::Compressed) flags |= kFrameCompressed;
+  if (wants & kWantMarkers) flags |= kFrameMarkers;
+  return flags;
+}
+
 std::vector<unsigned char> encode_hello(const Hello& hello) {
+  check_version(hello.version);
   ByteWriter p;
   p.put<uint32_t>(hello.wants);
-  return with_header(MessageType::Hello, p);
+  if (hello.version >= kVersion2) {
+    p.put<uint32_t>(hello.encoding);
+    put_short_string(p, hello.subject, kMaxHelloString);
+    put_short_string(p, hello.token, kMaxHelloString);
+  }
+  return with_header(MessageType::Hello, p, hello.version);
 }
 
-std::vector<unsigned char> encode_ack(const Ack& ack) {
+std::vector<unsigned char> encode_ack(const Ack& ack, uint16_t version) {
+  check_version(version);
   ByteWriter p;
   p.put<uint32_t>(ack.frame_number);
-  return with_header(MessageType::Ack, p);
+  return with_header(MessageType::Ack, p, version);
 }
 
-std::vector<unsigned char> encode_mesh_info(const MeshInfo& info) {
+void write_header(MessageType type, uint16_t version, size_t payload_bytes, std::span<unsigned char, kHeaderBytes> out) {
+  check_version(version);
+  ByteWriter w;
+  put_header(w, type, payload_bytes, version);
+  std::memcpy(out.data(), w.bytes().data(), kHeaderBytes);
+}
+
+std::vector<unsigned char> encode_mesh_info(const MeshInfo& info, uint16_t version) {
+  check_version(version);
   ByteWriter p;
   p.put<uint32_t>(info.vertex_count);
   p.put<uint32_t>(static_cast<uint32_t>(info.faces.size()));
@@ -133,28 +196,34 @@ std::vector<unsigned char> encode_mesh_info(const MeshInfo& info) {
   p.put<uint32_t>(static_cast<uint32_t>(info.marker_triangles.size()));
   for (const auto& t : info.marker_triangles)
     for (uint32_t m : t) p.put<uint32_t>(m);
-  for (const std::string& name : info.marker_names) {
-    const size_t n = std::min<size_t>(name.size(), std::numeric_limits<uint16_t>::max());
-    p.put<uint16_t>(static_cast<uint16_t>(n));
-    p.put_bytes(name.data(), n);
+  for (const std::string& name : info.marker_names) put_short_string(p, name);
+  if (version >= kVersion2) {
+    put_short_string(p, info.subject);
+    p.put<uint32_t>(static_cast<uint32_t>(info.encoding));
   }
-  return with_header(MessageType::MeshInfo, p);
+  return with_header(MessageType::MeshInfo, p, version);
 }
 
-std::vector<unsigned char> encode_status(const Status& status) {
+std::vector<unsigned char> encode_status(const Status& status, uint16_t version) {
+  check_version(version);
   ByteWriter p;
-  p.put<uint32_t>(static_cast<uint32_t>(status.state));
+  // Version 1 has no "refused": its subscriber is told the source is disconnected, and why.
+  const bool refused_in_v1 = version < kVersion2 && status.state == SourceStateCode::Refused;
+  p.put<uint32_t>(static_cast<uint32_t>(refused_in_v1 ? SourceStateCode::Disconnected : status.state));
   p.put<float>(status.source_rate_hz);
   p.put<uint64_t>(status.frames_received);
   p.put<uint64_t>(status.frames_published);
-  const size_t n = std::min<size_t>(status.detail.size(), std::numeric_limits<uint16_t>::max());
-  p.put<uint16_t>(static_cast<uint16_t>(n));
-  p.put_bytes(status.detail.data(), n);
-  return with_header(MessageType::Status, p);
+  put_short_string(p, status.detail);
+  if (version >= kVersion2) {
+    put_short_string(p, status.subject);
+    p.put<uint32_t>(status.subject_present ? 1u : 0u);
+    p.put<uint32_t>(static_cast<uint32_t>(status.encoding));
+  }
+  return with_header(MessageType::Status, p, version);
 }
 
-size_t frame_message_bytes(uint32_t flags, uint32_t vertex_count, uint32_t marker_count) {
-  size_t bytes = kHeaderBytes + kFrameInfoBytes;
+size_t frame_message_bytes(uint32_t flags, uint32_t vertex_count, uint32_t marker_count, uint16_t version) {
+  size_t bytes = kHeaderBytes + frame_info_bytes(version);
   const size_t v3 = 3 * static_cast<size_t>(vertex_count);
   const bool quantised = flags & kFrameQuantised;
   // Quantised blocks are padded to 4 bytes so the floats after them stay aligned (JS typed arrays).
@@ -164,24 +233,12 @@ size_t frame_message_bytes(uint32_t flags, uint32_t vertex_count, uint32_t marke
   return bytes;
 }
 
-void encode_frame(const FrameInfo& in, std::span<const float> positions, std::span<const float> normals,
-                  std::span<const float> markers, std::span<const uint8_t> marker_status, std::span<unsigned char> out) {
-  FrameInfo info = in;
-  const bool has_positions = !(info.flags & kFrameNoPositions);
-  const bool has_normals = info.flags & kFrameNormals;
-  const bool has_markers = info.flags & kFrameMarkers;
-  const bool quantised = info.flags & kFrameQuantised;
-  if (!has_positions) info.vertex_count = 0;
-  if (!has_markers) info.marker_count = 0;
-  const size_t v3 = 3 * static_cast<size_t>(info.vertex_count);
-  const size_t total = frame_message_bytes(info.flags, info.vertex_count, info.marker_count);
-  if (out.size() != total || (has_positions && positions.size() < v3) || (has_normals && normals.size() < v3) ||
-      (has_markers && (markers.size() < 3 * size_t{info.marker_count} || marker_status.size() < info.marker_count)))
-    throw std::invalid_argument("encode_frame: buffer sizes do not match the frame's counts");
+namespace {
 
-  SpanWriter w(out);
+// The header, the fixed part and (version 2) the timecode.
+void write_frame_start(SpanWriter& w, const FrameInfo& info, size_t total, uint16_t version) {
   w.put<uint32_t>(kMagic);
-  w.put<uint16_t>(kProtocolVersion);
+  w.put<uint16_t>(version);
   w.put<uint16_t>(static_cast<uint16_t>(MessageType::Frame));
   w.put<uint32_t>(static_cast<uint32_t>(total - kHeaderBytes));
   w.put<uint32_t>(info.frame_number);
@@ -195,6 +252,50 @@ void encode_frame(const FrameInfo& in, std::span<const float> positions, std::sp
   w.put<uint16_t>(info.markers_relabelled);
   w.put<uint32_t>(info.pipeline_dropped);
   w.put<uint32_t>(info.subscriber_dropped);
+  if (version < kVersion2) return;
+  const FrameTimecode& t = info.timecode;
+  w.put<uint8_t>(t.hours);
+  w.put<uint8_t>(t.minutes);
+  w.put<uint8_t>(t.seconds);
+  w.put<uint8_t>(t.frames);
+  w.put<uint16_t>(t.subframe);
+  w.put<uint16_t>(t.subframes_per_frame);
+  w.put<float>(t.rate_hz);
+  w.put<uint32_t>(t.flags);
+}
+
+void write_markers(SpanWriter& w, const FrameInfo& info, std::span<const float> markers, std::span<const uint8_t> marker_status) {
+  w.put_floats(markers.first(3 * size_t{info.marker_count}));
+  std::memcpy(w.reserve(info.marker_count), marker_status.data(), info.marker_count);
+  w.zeros(padding_to_4(info.marker_count));
+}
+
+size_t marker_block_bytes(uint32_t marker_count) { return 12 * size_t{marker_count} + marker_count + padding_to_4(marker_count); }
+
+}  // namespace
+
+void encode_frame(const FrameInfo& in, std::span<const float> positions, std::span<const float> normals,
+                  std::span<const float> markers, std::span<const uint8_t> marker_status, std::span<unsigned char> out,
+                  uint16_t version) {
+  check_version(version);
+  FrameInfo info = in;
+  if (info.flags & ~(version >= kVersion2 ? kFrameFlagsVersion2 : kFrameFlagsVersion1) ||
+      (info.flags & (kFrameParameters | kFrameCompressed | kFrameKey)))
+    throw std::invalid_argument("encode_frame: flags " + std::to_string(info.flags) + " are not a float or quantised frame of this version");
+  const bool has_positions = !(info.flags & kFrameNoPositions);
+  const bool has_normals = info.flags & kFrameNormals;
+  const bool has_markers = info.flags & kFrameMarkers;
+  const bool quantised = info.flags & kFrameQuantised;
+  if (!has_positions) info.vertex_count = 0;
+  if (!has_markers) info.marker_count = 0;
+  const size_t v3 = 3 * static_cast<size_t>(info.vertex_count);
+  const size_t total = frame_message_bytes(info.flags, info.vertex_count, info.marker_count, version);
+  if (out.size() != total || (has_positions && positions.size() < v3) || (has_normals && normals.size() < v3) ||
+      (has_markers && (markers.size() < 3 * size_t{info.marker_count} || marker_status.size() < info.marker_count)))
+    throw std::invalid_argument("encode_frame: buffer sizes do not match the frame's counts");
+
+  SpanWriter w(out);
+  write_frame_start(w, info, total, version);
 
   if (has_positions && !quantised) {
     w.put_floats(positions.first(v3));
@@ -211,11 +312,32 @@ void encode_frame(const FrameInfo& in, std::span<const float> positions, std::sp
     quantise_normals(normals.first(v3), w.reserve(2 * v3));
     w.zeros(padding_to_4(2 * v3));
   }
-  if (has_markers) {
-    w.put_floats(markers.first(3 * size_t{info.marker_count}));
-    for (uint32_t m = 0; m < info.marker_count; ++m) w.put<uint8_t>(marker_status[m]);
-    w.zeros(padding_to_4(info.marker_count));
-  }
+  if (has_markers) write_markers(w, info, markers, marker_status);
+}
+
+size_t frame_message_bytes_with_block(size_t block_bytes, uint32_t flags, uint32_t marker_count) {
+  return kHeaderBytes + frame_info_bytes(kVersion2) + block_bytes + ((flags & kFrameMarkers) ? marker_block_bytes(marker_count) : 0);
+}
+
+void encode_frame_with_block(const FrameInfo& in, std::span<const unsigned char> blocks, std::span<const float> markers,
+                             std::span<const uint8_t> marker_status, std::span<unsigned char> out) {
+  FrameInfo info = in;
+  const bool coded = (info.flags & kFrameParameters) || (info.flags & kFrameCompressed);
+  if ((info.flags & ~kFrameFlagsVersion2) || !coded || (info.flags & (kFrameQuantised | kFrameNoPositions)) ||
+      ((info.flags & kFrameParameters) && (info.flags & (kFrameCompressed | kFrameNormals | kFrameKey))) || blocks.size() % 4 != 0)
+    throw std::invalid_argument("encode_frame_with_block: flags " + std::to_string(info.flags) +
+                                " are not a compressed or parameter frame, or the block is not padded");
+  if (info.flags & kFrameParameters) info.vertex_count = 0;
+  const bool has_markers = info.flags & kFrameMarkers;
+  if (!has_markers) info.marker_count = 0;
+  const size_t total = frame_message_bytes_with_block(blocks.size(), info.flags, info.marker_count);
+  if (out.size() != total ||
+      (has_markers && (markers.size() < 3 * size_t{info.marker_count} || marker_status.size() < info.marker_count)))
+    throw std::invalid_argument("encode_frame_with_block: buffer sizes do not match the frame's counts");
+  SpanWriter w(out);
+  write_frame_start(w, info, total, kVersion2);
+  std::memcpy(w.reserve(blocks.size()), blocks.data(), blocks.size());
+  if (has_markers) write_markers(w, info, markers, marker_status);
 }
 
 void patch_subscriber_dropped(std::span<unsigned char> frame_message, uint32_t dropped) {
@@ -237,18 +359,28 @@ MessageHeader decode_header(std::span<const unsigned char> bytes, uint32_t max_p
   const uint16_t type = r.get<uint16_t>();
   const uint32_t payload = r.get<uint32_t>();
   if (magic != kMagic) throw DecodeError("bad magic (not a skinstream subscriber stream)");
-  if (version != kProtocolVersion)
-    throw DecodeError("unsupported protocol version " + std::to_string(version) + " (this side speaks 1)");
-  if (type < 1 || type > 5) throw DecodeError("unknown message type " + std::to_string(type));
+  if (version != kVersion1 && version != kVersion2)
+    throw DecodeError("unsupported protocol version " + std::to_string(version) + " (this side speaks 1 and 2)");
+  const uint16_t last_type = version >= kVersion2 ? 6 : 5;
+  if (type < 1 || type > last_type)
+    throw DecodeError("unknown message type " + std::to_string(type) + " in version " + std::to_string(version));
   if (payload > max_payload)
     throw DecodeError("payload of " + std::to_string(payload) + " bytes exceeds the limit of " + std::to_string(max_payload));
-  return {static_cast<MessageType>(type), payload};
+  return {static_cast<MessageType>(type), payload, version};
 }
 
-Hello decode_hello(std::span<const unsigned char> payload) {
-  return decode_payload("Hello", payload, [](ByteReader& r) {
-    Hello hello{r.get<uint32_t>()};
-    if (hello.wants & ~kWantAll) throw DecodeError("Hello: reserved wants bits set (" + std::to_string(hello.wants) + ")");
+Hello decode_hello(std::span<const unsigned char> payload, uint16_t version) {
+  return decode_payload("Hello", payload, [version](ByteReader& r) {
+    Hello hello;
+    hello.version = version;
+    hello.wants = r.get<uint32_t>();
+    const uint32_t allowed = version >= kVersion2 ? kWantAllVersion2 : kWantAll;
+    if (hello.wants & ~allowed) throw DecodeError("Hello: reserved wants bits set (" + std::to_string(hello.wants) + ")");
+    if (version >= kVersion2) {
+      hello.encoding = r.get<uint32_t>();  // an unknown one is the daemon's to answer, not an error
+      hello.subject = get_short_string(r, "Hello: subject name", kMaxHelloString);
+      hello.token = get_short_string(r, "Hello: token", kMaxHelloString);
+    }
     return hello;
   });
 }
@@ -257,8 +389,8 @@ Ack decode_ack(std::span<const unsigned char> payload) {
   return decode_payload("Ack", payload, [](ByteReader& r) { return Ack{r.get<uint32_t>()}; });
 }
 
-MeshInfo decode_mesh_info(std::span<const unsigned char> payload) {
-  return decode_payload("MeshInfo", payload, [](ByteReader& r) {
+MeshInfo decode_mesh_info(std::span<const unsigned char> payload, uint16_t version) {
+  return decode_payload("MeshInfo", payload, [version](ByteReader& r) {
     MeshInfo info;
     info.vertex_count = r.get<uint32_t>();
     const uint32_t face_count = r.get<uint32_t>();
@@ -283,11 +415,10 @@ MeshInfo decode_mesh_info(std::span<const unsigned char> payload) {
       }
     if (info.marker_count > r.remaining() / 2) throw std::out_of_range("marker count exceeds the data left");
     info.marker_names.resize(info.marker_count);
-    for (std::string& name : info.marker_names) {
-      const uint16_t n = r.get<uint16_t>();
-      if (n > r.remaining()) throw std::out_of_range("marker name truncated");
-      name.resize(n);
-      for (char& c : name) c = r.get<char>();
+    for (std::string& name : info.marker_names) name = get_short_string(r, "marker name");
+    if (version >= kVersion2) {
+      info.subject = get_short_string(r, "MeshInfo: subject name");
+      info.encoding = encoding_of(r.get<uint32_t>(), "MeshInfo");
     }
     return info;
   });
@@ -295,9 +426,9 @@ MeshInfo decode_mesh_info(std::span<const unsigned char> payload) {
 
 namespace {
 
-// The fixed part of a Frame payload, checked against the sizes of what follows it; the reader is
-// left at the first array.
-FrameInfo read_frame_info(ByteReader& r) {
+// The fixed part of a Frame payload (and the version 2 timecode), its flags checked; the reader
+// is left at the first block.
+FrameInfo read_frame_info(ByteReader& r, uint16_t version) {
   FrameInfo info;
   info.frame_number = r.get<uint32_t>();
   info.flags = r.get<uint32_t>();
@@ -310,75 +441,155 @@ FrameInfo read_frame_info(ByteReader& r) {
   info.markers_relabelled = r.get<uint16_t>();
   info.pipeline_dropped = r.get<uint32_t>();
   info.subscriber_dropped = r.get<uint32_t>();
-  if (info.flags & ~uint32_t{0xF}) throw DecodeError("Frame: reserved flag bits set (" + std::to_string(info.flags) + ")");
+  if (version >= kVersion2) {
+    FrameTimecode& t = info.timecode;
+    t.hours = r.get<uint8_t>();
+    t.minutes = r.get<uint8_t>();
+    t.seconds = r.get<uint8_t>();
+    t.frames = r.get<uint8_t>();
+    t.subframe = r.get<uint16_t>();
+    t.subframes_per_frame = r.get<uint16_t>();
+    t.rate_hz = r.get<float>();
+    t.flags = r.get<uint32_t>();
+  }
+  const uint32_t allowed = version >= kVersion2 ? kFrameFlagsVersion2 : kFrameFlagsVersion1;
+  if (info.flags & ~allowed) throw DecodeError("Frame: reserved flag bits set (" + std::to_string(info.flags) + ")");
   const bool has_positions = !(info.flags & kFrameNoPositions);
-  if (!has_positions && info.vertex_count != 0) throw DecodeError("Frame: vertex count with \"no positions\"");
+  const int encodings = ((info.flags & kFrameQuantised) != 0) + ((info.flags & kFrameCompressed) != 0) + ((info.flags & kFrameParameters) != 0);
+  if (encodings > 1) throw DecodeError("Frame: more than one encoding of the positions");
+  if (!has_positions && (info.vertex_count != 0 || encodings != 0)) throw DecodeError("Frame: positions encoded with \"no positions\"");
   if (!has_positions && (info.flags & kFrameNormals)) throw DecodeError("Frame: normals without positions");
+  if ((info.flags & kFrameParameters) && (info.flags & kFrameNormals)) throw DecodeError("Frame: normals with parameters");
+  if ((info.flags & kFrameParameters) && info.vertex_count != 0) throw DecodeError("Frame: vertex count with parameters");
+  if ((info.flags & kFrameKey) && !(info.flags & kFrameCompressed)) throw DecodeError("Frame: key frame flag without compression");
   if (!(info.flags & kFrameMarkers) && info.marker_count != 0) throw DecodeError("Frame: marker count without markers");
-  // Sizes first, so a corrupt count is refused before anything is allocated for it.
-  const size_t expected = frame_message_bytes(info.flags, info.vertex_count, info.marker_count) - kHeaderBytes - kFrameInfoBytes;
-  if (expected != r.remaining())
-    throw DecodeError("Frame: counts say " + std::to_string(expected) + " bytes of data, the payload holds " +
-                      std::to_string(r.remaining()));
   return info;
+}
+
+// The next `bytes` of the payload as a block, or a DecodeError naming it.
+std::span<const unsigned char> take_block(std::span<const unsigned char> payload, ByteReader& r, size_t bytes, const char* what) {
+  if (bytes > r.remaining())
+    throw DecodeError(std::string("Frame: ") + what + " of " + std::to_string(bytes) + " bytes, the payload holds " +
+                      std::to_string(r.remaining()));
+  const std::span<const unsigned char> block = payload.subspan(r.position(), bytes);
+  r.skip(bytes);
+  return block;
+}
+
+// A block whose first u32 (at `offset`) counts the coded bytes that follow: its whole size.
+size_t counted_block_bytes(ByteReader& r, size_t offset, const char* what) {
+  if (r.remaining() < offset + 4) throw DecodeError(std::string("Frame: ") + what + " truncated");
+  uint32_t coded = 0;
+  ByteReader peek = r;
+  peek.skip(offset);
+  coded = peek.get<uint32_t>();
+  if (coded > r.remaining()) throw DecodeError(std::string("Frame: ") + what + " says " + std::to_string(coded) + " bytes, more than the payload holds");
+  return offset + 4 + coded + padding_to_4(coded);
+}
+
+FrameView view_payload(std::span<const unsigned char> payload, ByteReader& r, uint16_t version) {
+  FrameView view;
+  view.info = read_frame_info(r, version);
+  const FrameInfo& info = view.info;
+  const size_t v3 = 3 * size_t{info.vertex_count};
+  const bool has_positions = !(info.flags & kFrameNoPositions);
+  if (info.flags & kFrameParameters) {
+    if (r.remaining() < 8) throw DecodeError("Frame: parameters truncated");
+    ByteReader peek = r;
+    const uint64_t parts = peek.get<uint32_t>(), members = peek.get<uint32_t>();
+    view.positions = take_block(payload, r, 8 + 160 * parts + 12 * members, "parameters");
+  } else if (info.flags & kFrameCompressed) {
+    view.positions = take_block(payload, r, counted_block_bytes(r, 28, "compressed positions"), "compressed positions");
+    if (info.flags & kFrameNormals)
+      view.normals = take_block(payload, r, counted_block_bytes(r, 0, "compressed normals"), "compressed normals");
+  } else if (has_positions) {
+    const bool quantised = info.flags & kFrameQuantised;
+    // Checked against the payload before anything is cut, so a corrupt count is named as such.
+    const size_t expected = frame_message_bytes(info.flags, info.vertex_count, info.marker_count, version) -
+                            kHeaderBytes - frame_info_bytes(version);
+    if (expected != r.remaining())
+      throw DecodeError("Frame: counts say " + std::to_string(expected) + " bytes of data, the payload holds " +
+                        std::to_string(r.remaining()));
+    view.positions = take_block(payload, r, quantised ? 24 + 2 * v3 + padding_to_4(2 * v3) : 4 * v3, "positions");
+    if (info.flags & kFrameNormals)
+      view.normals = take_block(payload, r, quantised ? 2 * v3 + padding_to_4(2 * v3) : 4 * v3, "normals");
+  }
+  if (info.flags & kFrameMarkers) {
+    const size_t m = info.marker_count;
+    if (marker_block_bytes(info.marker_count) != r.remaining())
+      throw DecodeError("Frame: counts say " + std::to_string(marker_block_bytes(info.marker_count)) +
+                        " bytes of markers, the payload holds " + std::to_string(r.remaining()));
+    view.markers = take_block(payload, r, 12 * m, "markers");
+    view.marker_status = take_block(payload, r, m, "marker status");
+    r.skip(padding_to_4(m));
+  }
+  if (r.remaining() != 0)
+    throw DecodeError("Frame: counts say " + std::to_string(r.position()) + " bytes, the payload holds " + std::to_string(payload.size()));
+  return view;
 }
 
 }  // namespace
 
-FrameInfo decode_frame_info(std::span<const unsigned char> payload) {
-  return decode_payload("Frame", payload, [](ByteReader& r) {
-    const FrameInfo info = read_frame_info(r);
-    r.skip(r.remaining());
-    return info;
-  });
+FrameView view_frame(std::span<const unsigned char> payload, uint16_t version) {
+  return decode_payload("Frame", payload, [&](ByteReader& r) { return view_payload(payload, r, version); });
 }
 
-Frame decode_frame(std::span<const unsigned char> payload) {
-  return decode_payload("Frame", payload, [](ByteReader& r) {
-    Frame frame;
-    frame.info = read_frame_info(r);
-    const FrameInfo& info = frame.info;
-    const bool has_positions = !(info.flags & kFrameNoPositions);
-    const size_t v3 = 3 * size_t{info.vertex_count};
-    const bool quantised = info.flags & kFrameQuantised;
-    if (has_positions && !quantised) get_floats(r, frame.positions, v3);
-    if (has_positions && quantised) {
-      for (float& o : frame.origin) o = r.get<float>();
-      for (float& s : frame.step) s = r.get<float>();
-      frame.positions.resize(v3);
-      for (size_t i = 0; i < v3; ++i) frame.positions[i] = frame.origin[i % 3] + r.get<uint16_t>() * frame.step[i % 3];
-      for (size_t i = 0; i < padding_to_4(2 * v3); ++i) r.get<uint8_t>();
-    }
-    if ((info.flags & kFrameNormals) && !quantised) get_floats(r, frame.normals, v3);
-    if ((info.flags & kFrameNormals) && quantised) {
+FrameInfo decode_frame_info(std::span<const unsigned char> payload, uint16_t version) { return view_frame(payload, version).info; }
+
+Frame decode_frame(std::span<const unsigned char> payload, uint16_t version) {
+  const FrameView view = view_frame(payload, version);
+  Frame frame;
+  frame.info = view.info;
+  const FrameInfo& info = frame.info;
+  const size_t v3 = 3 * size_t{info.vertex_count};
+  const bool quantised = info.flags & kFrameQuantised;
+  if ((info.flags & kFrameCompressed) || (info.flags & kFrameParameters)) {
+    frame.coded_positions.assign(view.positions.begin(), view.positions.end());
+    frame.coded_normals.assign(view.normals.begin(), view.normals.end());
+  } else if (quantised) {
+    ByteReader r(view.positions.data(), view.positions.size());
+    for (float& o : frame.origin) o = r.get<float>();
+    for (float& s : frame.step) s = r.get<float>();
+    frame.positions.resize(v3);
+    for (size_t i = 0; i < v3; ++i) frame.positions[i] = frame.origin[i % 3] + r.get<uint16_t>() * frame.step[i % 3];
+    if (!view.normals.empty()) {
+      ByteReader n(view.normals.data(), view.normals.size());
       frame.normals.resize(v3);
-      for (float& n : frame.normals) n = r.get<int16_t>() / 32767.0f;
-      for (size_t i = 0; i < padding_to_4(2 * v3); ++i) r.get<uint8_t>();
+      for (float& c : frame.normals) c = n.get<int16_t>() / 32767.0f;
     }
-    if (info.flags & kFrameMarkers) {
-      get_floats(r, frame.markers, 3 * size_t{info.marker_count});
-      frame.marker_status.resize(info.marker_count);
-      for (uint8_t& s : frame.marker_status) {
-        s = r.get<uint8_t>();
-        if (s > 4) throw DecodeError("Frame: marker status " + std::to_string(s) + " is not one of 0-4");
-      }
-      for (size_t i = 0; i < padding_to_4(info.marker_count); ++i) r.get<uint8_t>();
-    }
-    return frame;
-  });
+  } else {
+    ByteReader p(view.positions.data(), view.positions.size());
+    get_floats(p, frame.positions, view.positions.size() / 4);
+    ByteReader n(view.normals.data(), view.normals.size());
+    get_floats(n, frame.normals, view.normals.size() / 4);
+    if (frame.positions.size() != v3 || (!frame.normals.empty() && frame.normals.size() != v3))
+      throw DecodeError("Frame: block sizes do not match the vertex count");
+  }
+  ByteReader m(view.markers.data(), view.markers.size());
+  get_floats(m, frame.markers, view.markers.size() / 4);
+  frame.marker_status.assign(view.marker_status.begin(), view.marker_status.end());
+  for (uint8_t s : frame.marker_status)
+    if (s > 4) throw DecodeError("Frame: marker status " + std::to_string(s) + " is not one of 0-4");
+  return frame;
 }
 
-Status decode_status(std::span<const unsigned char> payload) {
-  return decode_payload("Status", payload, [](ByteReader& r) {
+Status decode_status(std::span<const unsigned char> payload, uint16_t version) {
+  return decode_payload("Status", payload, [version](ByteReader& r) {
     Status status;
     const uint32_t state = r.get<uint32_t>();
-    if (state > 3) throw DecodeError("Status: unknown source state " + std::to_string(state));
+    if (state > (version >= kVersion2 ? 4u : 3u)) throw DecodeError("Status: unknown source state " + std::to_string(state));
     status.state = static_cast<SourceStateCode>(state);
     status.source_rate_hz = r.get<float>();
     status.frames_received = r.get<uint64_t>();
     status.frames_published = r.get<uint64_t>();
-    status.detail.resize(r.get<uint16_t>());
-    for (char& c : status.detail) c = r.get<char>();
+    status.detail = get_short_string(r, "Status: detail");
+    if (version >= kVersion2) {
+      status.subject = get_short_string(r, "Status: subject name");
+      const uint32_t present = r.get<uint32_t>();
+      if (present > 1) throw DecodeError("Status: subject presence " + std::to_string(present) + " is not 0 or 1");
+      status.subject_present = present == 1;
+      status.encoding = encoding_of(r.get<uint32_t>(), "Status");
+    }
     return status;
   });
 }
@@ -410,7 +621,7 @@ std::optional<RawMessage> StreamDecoder::next() {
   const MessageHeader header = decode_header(pending, max_payload_);
   if (pending.size() - kHeaderBytes < header.payload_bytes) return std::nullopt;
   consumed_ += kHeaderBytes + header.payload_bytes;
-  return RawMessage{header.type, pending.subspan(kHeaderBytes, header.payload_bytes)};
+  return RawMessage{header.type, pending.subspan(kHeaderBytes, header.payload_bytes), header.version};
 }
 
 }  // namespace skinstream::subscriber

@@ -1,5 +1,5 @@
 #pragma once
-// The vector lanes MeshDeformer computes in (GCC vector extensions, so one source serves the
+// The vector lanes MeshEvaluator computes in (GCC vector extensions, so one source serves the
 // AVX-512, AVX2 and baseline clones of its loops), and how the normals load points into them:
 // four points as x y z _ in the four 128-bit segments of one register. Internal to
 // core/deform; in a header so the tests can run the helpers at every ISA level.

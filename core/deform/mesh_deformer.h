@@ -1,15 +1,15 @@
 #pragma once
 // The per-frame job of section 5.3 over the whole detailed mesh: fits every part to the filled
-// markers (rigid by Horn, quadratic by eq. 6, RBF residual by eq. 7), then moves each vertex by
-// eq. 8 in every part that influences it and blends them by eq. 9, and computes vertex normals.
+// markers (rigid by Horn, quadratic by eq. 6, RBF residual by eq. 7) into the frame's part
+// parameters, then moves each vertex by eq. 8 in every part that influences it and blends them
+// by eq. 9, and computes vertex normals (the MeshEvaluator, from the parameters alone: what a
+// renderer receiving the parameters evaluates too).
 //
 // Split in stages so a caller with threads can share the work out by ranges (core/ has no
-// threads itself): solve_parts() once, then deform_clusters() over disjoint cluster ranges, then
-// blend_vertices() over vertex ranges, then vertex_normals() over vertex ranges; each stage
-// reads what the one before wrote. Vertex ranges count in the deformer's own vertex sequence
-// (sequence_vertex): a permutation of the mesh's vertices whose two halves are spatially
-// compact, so that threads given one half each mostly read what they wrote themselves. The
-// buffers are always in the mesh's own vertex order.
+// threads itself): solve_part() for every part, then deform_clusters() over disjoint cluster
+// ranges, then blend_vertices() over vertex ranges, then vertex_normals() over vertex ranges;
+// each stage reads what the one before wrote (see MeshEvaluator for the vertex sequence). A
+// caller that only wants the parameters stops after the fits.
 // Buffers are sized at construction; no stage allocates.
 
 #include <memory>
@@ -18,10 +18,20 @@
 
 #include "core/capture.h"
 #include "core/deform/deformation_model.h"
+#include "core/deform/evaluation_model.h"
+#include "core/deform/mesh_evaluator.h"
 #include "core/deform/part_deformation.h"
+#include "core/deform/part_parameters.h"
 #include "core/subject_model.h"
 
 namespace skinstream {
+
+struct PartModel;
+
+// From the subject's deformation model and its parts' offline data (in part order), rounded to
+// float once here: what MeshDeformer evaluates with, and what the daemon sends parameter
+// subscribers in the Model message.
+EvaluationModel make_evaluation_model(const DeformationModel& model, const std::vector<PartModel>& parts);
 
 class MeshDeformer {
  public:
@@ -36,6 +46,10 @@ class MeshDeformer {
   // Fits every part to the markers (subject order, all present). Returns false, keeping the
   // previous fit, when the count is wrong or a marker is not finite.
   bool solve_parts(std::span<const Vec3> markers);
+  // The fit of the last solved frame, in float, as the evaluator uses it and the subscriber
+  // protocol sends it; and the static data it is evaluated with.
+  const FrameParameters& parameters() const;
+  const EvaluationModel& evaluation_model() const;
   // The same in pieces, for callers that share the parts out over threads: whether the
   // markers can be used, then each part's fit (different parts may be solved concurrently;
   // the clusters of a part need that part's fit).
@@ -81,7 +95,7 @@ class MeshDeformer {
   // One part's fit at the solved frame (for tools that ask how a single part would move a
   // point, e.g. eval-deform's worst vertices).
   const PartDeformer& part(int part) const;
-  // Heap bytes held by the runtime state (precomputed per-vertex data and fans, parts).
+  // Heap bytes held by the runtime state (the evaluator's per-vertex data and fans, the parts).
   size_t memory_bytes() const;
 
  private:

@@ -23,7 +23,7 @@ SubscriberClient::SubscriberClient(const std::string& host, const std::string& p
   server::asio::connect(socket_, endpoints, ec);
   if (ec) throw std::runtime_error(host + ":" + port + ": " + ec.message());
   socket_.set_option(server::tcp::no_delay(true));
-  const std::vector<unsigned char> hello = subscriber::encode_hello({wants});
+  const std::vector<unsigned char> hello = subscriber::encode_hello({.wants = wants});
   server::asio::write(socket_, server::asio::buffer(hello));
 }
 

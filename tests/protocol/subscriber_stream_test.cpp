@@ -80,18 +80,19 @@ TEST(SubscriberStream, HeaderRejectsBadMagicVersionTypeAndSize) {
     }
   };
   expect_reject(0, 'X', "bad magic");
-  expect_reject(4, 2, "version 2");
+  expect_reject(4, 3, "version 3");
   expect_reject(6, 9, "unknown message type 9");
+  expect_reject(6, 6, "unknown message type 6 in version 1");  // Model is version 2's
   expect_reject(11, 0x10, "exceeds the limit");
   EXPECT_THROW(decode_header(std::span(good).first(11)), DecodeError);
 }
 
 TEST(SubscriberStream, HelloMatchesGoldenBytes) {
-  EXPECT_EQ(encode_hello({kWantNormals | kWantMarkers}), fixture("hello.bin"));
+  EXPECT_EQ(encode_hello({.wants = kWantNormals | kWantMarkers}), fixture("hello.bin"));
   EXPECT_EQ(decode_hello(payload_of(fixture("hello.bin"))).wants, kWantNormals | kWantMarkers);
-  const std::vector<unsigned char> reserved = encode_hello({0x20});
+  const std::vector<unsigned char> reserved = encode_hello({.wants = 0x20});
   EXPECT_THROW(decode_hello(payload_of(reserved)), DecodeError);
-  EXPECT_EQ(decode_hello(payload_of(encode_hello({kWantPaced}))).wants, kWantPaced);
+  EXPECT_EQ(decode_hello(payload_of(encode_hello({.wants = kWantPaced}))).wants, kWantPaced);
 }
 
 // ack.bin was written with Python's struct: b'SKSF' + pack('<HHI', 1, 5, 4) + pack('<I', 123456).
@@ -165,7 +166,8 @@ TEST(SubscriberStream, EveryFrameBlockStaysFourByteAligned) {
 }
 
 TEST(SubscriberStream, StatusMatchesGoldenBytes) {
-  Status status{SourceStateCode::Disconnected, 119.88f, 1000, 990, "vicon 127.0.0.1:801: connection refused"};
+  const Status status{.state = SourceStateCode::Disconnected, .source_rate_hz = 119.88f, .frames_received = 1000, .frames_published = 990,
+                      .detail = "vicon 127.0.0.1:801: connection refused"};
   const std::vector<unsigned char> golden = fixture("status.bin");
   EXPECT_EQ(encode_status(status), golden);
   const Status decoded = decode_status(payload_of(golden));
@@ -206,34 +208,213 @@ TEST(SubscriberStream, FlagsFollowWants) {
 }
 
 TEST(SubscriberStream, EveryTruncationOfEveryMessageIsRejected) {
-  for (const char* name : {"hello.bin", "ack.bin", "mesh_info.bin", "frame_float.bin", "frame_quantised.bin", "frame_markers_only.bin", "status.bin"}) {
+  for (const char* name : {"hello.bin", "ack.bin", "mesh_info.bin", "frame_float.bin", "frame_quantised.bin", "frame_markers_only.bin",
+                           "status.bin", "hello_v2.bin", "mesh_info_v2.bin", "status_v2.bin", "frame_v2_float.bin",
+                           "frame_v2_parameters.bin", "frame_v2_compressed.bin"}) {
     const std::vector<unsigned char> message = fixture(name);
     const MessageHeader header = decode_header(message);
+    const uint16_t v = header.version;
     for (size_t n = kHeaderBytes; n < message.size(); ++n) {
       const std::span<const unsigned char> cut = std::span(message).subspan(kHeaderBytes, n - kHeaderBytes);
       auto decode = [&] {
         switch (header.type) {
-          case MessageType::Hello: decode_hello(cut); break;
+          case MessageType::Hello: decode_hello(cut, v); break;
           case MessageType::Ack: decode_ack(cut); break;
-          case MessageType::MeshInfo: decode_mesh_info(cut); break;
-          case MessageType::Frame: decode_frame(cut); break;
-          case MessageType::Status: decode_status(cut); break;
+          case MessageType::MeshInfo: decode_mesh_info(cut, v); break;
+          case MessageType::Frame: decode_frame(cut, v); break;
+          case MessageType::Status: decode_status(cut, v); break;
+          case MessageType::Model: FAIL() << "no Model decoder here"; break;
         }
       };
       EXPECT_THROW(decode(), DecodeError) << name << " cut at " << n;
       if (header.type == MessageType::Frame) {
-        EXPECT_THROW(decode_frame_info(cut), DecodeError) << name << " cut at " << n;
+        EXPECT_THROW(decode_frame_info(cut, v), DecodeError) << name << " cut at " << n;
       }
     }
     // A byte too many is refused as well.
     std::vector<unsigned char> longer(message.begin() + kHeaderBytes, message.end());
     longer.push_back(0);
     if (header.type == MessageType::Frame) {
-      EXPECT_THROW(decode_frame(longer), DecodeError) << name;
-      EXPECT_THROW(decode_frame_info(longer), DecodeError) << name;
+      EXPECT_THROW(decode_frame(longer, v), DecodeError) << name;
+      EXPECT_THROW(decode_frame_info(longer, v), DecodeError) << name;
     }
-    if (header.type == MessageType::Hello) { EXPECT_THROW(decode_hello(longer), DecodeError) << name; }
+    if (header.type == MessageType::Hello) { EXPECT_THROW(decode_hello(longer, v), DecodeError) << name; }
+    if (header.type == MessageType::Status) { EXPECT_THROW(decode_status(longer, v), DecodeError) << name; }
+    if (header.type == MessageType::MeshInfo) { EXPECT_THROW(decode_mesh_info(longer, v), DecodeError) << name; }
   }
+}
+
+// ---- version 2 (the golden files come from make_v2_fixtures.py, written from the spec) ----
+
+TEST(SubscriberStreamV2, HelloMatchesGoldenBytes) {
+  Hello hello;
+  hello.version = kVersion2;
+  hello.wants = kWantNormals | kWantMarkers | kWantPaced;
+  hello.encoding = static_cast<uint32_t>(Encoding::Parameters);
+  hello.subject = "Actor2";
+  hello.token = "stage-token";
+  const std::vector<unsigned char> golden = fixture("hello_v2.bin");
+  EXPECT_EQ(encode_hello(hello), golden);
+  const MessageHeader header = decode_header(golden);
+  EXPECT_EQ(header.version, kVersion2);
+  const Hello decoded = decode_hello(payload_of(golden), header.version);
+  EXPECT_EQ(decoded.wants, hello.wants);
+  EXPECT_EQ(decoded.encoding, hello.encoding);
+  EXPECT_EQ(decoded.subject, "Actor2");
+  EXPECT_EQ(decoded.token, "stage-token");
+  // The version 1 payload is not a version 2 Hello, nor the other way round.
+  EXPECT_THROW(decode_hello(payload_of(golden), kVersion1), DecodeError);
+  EXPECT_THROW(decode_hello(payload_of(fixture("hello.bin")), kVersion2), DecodeError);
+}
+
+TEST(SubscriberStreamV2, HelloKeepsAnUnknownEncodingAndRefusesTheQuantisedBitAndLongNames) {
+  Hello hello;
+  hello.version = kVersion2;
+  hello.encoding = 7;
+  EXPECT_EQ(decode_hello(payload_of(encode_hello(hello)), kVersion2).encoding, 7u);  // the daemon answers it
+  hello.wants = kWantQuantised;  // version 2 says the encoding apart
+  EXPECT_THROW(decode_hello(payload_of(encode_hello(hello)), kVersion2), DecodeError);
+  // A longer subject is cut by the encoder; a decoder refuses one over the limit.
+  std::vector<unsigned char> payload = {0, 0, 0, 0, 0, 0, 0, 0};
+  const uint16_t n = kMaxHelloString + 1;
+  payload.push_back(static_cast<unsigned char>(n & 0xFF));
+  payload.push_back(static_cast<unsigned char>(n >> 8));
+  payload.resize(payload.size() + n + 2, 'a');
+  try {
+    decode_hello(payload, kVersion2);
+    FAIL() << "accepted a subject of " << n << " bytes";
+  } catch (const DecodeError& e) {
+    EXPECT_NE(std::string(e.what()).find("subject name of 257 bytes exceeds 256"), std::string::npos) << e.what();
+  }
+}
+
+TEST(SubscriberStreamV2, MeshInfoMatchesGoldenBytes) {
+  MeshInfo info = fixture_mesh_info();
+  info.subject = "Actor2";
+  info.encoding = Encoding::Compressed;
+  const std::vector<unsigned char> golden = fixture("mesh_info_v2.bin");
+  EXPECT_EQ(encode_mesh_info(info, kVersion2), golden);
+  const MeshInfo decoded = decode_mesh_info(payload_of(golden), kVersion2);
+  EXPECT_EQ(decoded.faces, info.faces);
+  EXPECT_EQ(decoded.marker_names, info.marker_names);
+  EXPECT_EQ(decoded.subject, "Actor2");
+  EXPECT_EQ(decoded.encoding, Encoding::Compressed);
+  // Version 1's MeshInfo is the same bytes without the two version 2 fields.
+  const std::vector<unsigned char> v1 = fixture("mesh_info.bin");
+  EXPECT_TRUE(std::equal(v1.begin() + kHeaderBytes, v1.end(), golden.begin() + kHeaderBytes));
+  std::vector<unsigned char> bad = golden;
+  bad.back() = 4;  // encoding 4 does not exist
+  EXPECT_THROW(decode_mesh_info(payload_of(bad), kVersion2), DecodeError);
+}
+
+TEST(SubscriberStreamV2, StatusMatchesGoldenBytesAndRefusalReadsAsDisconnectedInVersion1) {
+  Status status{.state = SourceStateCode::Refused, .frames_received = 10, .frames_published = 9,
+                .detail = "no subject \"Actor3\" (subjects: Actor1, Actor2)"};
+  status.subject = "Actor3";
+  status.subject_present = false;
+  const std::vector<unsigned char> golden = fixture("status_v2.bin");
+  EXPECT_EQ(encode_status(status, kVersion2), golden);
+  const Status decoded = decode_status(payload_of(golden), kVersion2);
+  EXPECT_EQ(decoded.state, SourceStateCode::Refused);
+  EXPECT_EQ(decoded.detail, status.detail);
+  EXPECT_EQ(decoded.subject, "Actor3");
+  EXPECT_FALSE(decoded.subject_present);
+  const Status v1 = decode_status(payload_of(encode_status(status, kVersion1)), kVersion1);
+  EXPECT_EQ(v1.state, SourceStateCode::Disconnected);
+  EXPECT_EQ(v1.detail, status.detail);
+  EXPECT_THROW(decode_status(payload_of(golden), kVersion1), DecodeError);  // state 4 and trailing fields
+}
+
+FrameInfo fixture_info_v2(uint32_t flags, uint32_t vertex_count) {
+  FrameInfo info = fixture_info(flags, vertex_count);
+  if (flags & kFrameTimecode) info.timecode = {10, 20, 30, 12, 1, 5, 29.97f, kTimecodeDropFrame};
+  return info;
+}
+
+TEST(SubscriberStreamV2, FloatFrameWithTimecodeMatchesGoldenBytes) {
+  const FrameInfo info = fixture_info_v2(kFrameMarkers | kFrameTimecode, 3);
+  std::vector<unsigned char> out(frame_message_bytes(info.flags, info.vertex_count, info.marker_count, kVersion2));
+  encode_frame(info, kPositions, {}, kMarkers, kStatus, out, kVersion2);
+  const std::vector<unsigned char> golden = fixture("frame_v2_float.bin");
+  EXPECT_EQ(out, golden);
+  const Frame frame = decode_frame(payload_of(golden), kVersion2);
+  EXPECT_EQ(frame.positions, kPositions);
+  EXPECT_EQ(frame.markers, kMarkers);
+  EXPECT_EQ(frame.marker_status, kStatus);
+  EXPECT_EQ(frame.info.timecode.hours, 10);
+  EXPECT_EQ(frame.info.timecode.frames, 12);
+  EXPECT_EQ(frame.info.timecode.subframes_per_frame, 5);
+  EXPECT_EQ(frame.info.timecode.rate_hz, 29.97f);
+  EXPECT_EQ(frame.info.timecode.flags, kTimecodeDropFrame);
+  // Both versions keep the fields the daemon patches per subscriber at the same offsets.
+  std::vector<unsigned char> patched = golden;
+  patch_subscriber_dropped(patched, 41);
+  patch_publish_time(patched, 5);
+  const FrameInfo read = decode_frame_info(payload_of(patched), kVersion2);
+  EXPECT_EQ(read.subscriber_dropped, 41u);
+  EXPECT_EQ(read.publish_time_ns, 5);
+  EXPECT_THROW(decode_frame(payload_of(golden), kVersion1), DecodeError);
+}
+
+// The framing of blocks coded elsewhere: the bytes after the fixed part are passed through.
+void expect_block_frame_matches(const char* name, uint32_t flags, uint32_t vertex_count, size_t block_bytes) {
+  const std::vector<unsigned char> golden = fixture(name);
+  FrameInfo info = fixture_info_v2(flags, vertex_count);
+  if (!(flags & kFrameMarkers)) info.marker_count = 0;
+  const size_t block_at = kHeaderBytes + frame_info_bytes(kVersion2);
+  const std::span<const unsigned char> block = std::span(golden).subspan(block_at, block_bytes);
+  std::vector<unsigned char> out(frame_message_bytes_with_block(block.size(), flags, info.marker_count));
+  encode_frame_with_block(info, block, kMarkers, kStatus, out);
+  EXPECT_EQ(out, golden) << name;
+  const FrameView view = view_frame(payload_of(golden), kVersion2);
+  EXPECT_EQ(view.info.flags, flags) << name;
+  EXPECT_EQ(view.positions.size() + view.normals.size(), block_bytes) << name;
+  EXPECT_EQ(view.positions.data(), golden.data() + block_at) << name;
+  const Frame frame = decode_frame(payload_of(golden), kVersion2);
+  EXPECT_TRUE(frame.positions.empty()) << name;
+  EXPECT_EQ(frame.coded_positions.size(), view.positions.size()) << name;
+  EXPECT_EQ(frame.coded_normals.size(), view.normals.size()) << name;
+}
+
+TEST(SubscriberStreamV2, ParameterFrameFraming) {
+  expect_block_frame_matches("frame_v2_parameters.bin", kFrameMarkers | kFrameParameters, 0, 8 + 160 + 24);
+  const Frame frame = decode_frame(payload_of(fixture("frame_v2_parameters.bin")), kVersion2);
+  EXPECT_EQ(frame.markers, kMarkers);
+}
+
+TEST(SubscriberStreamV2, CompressedFrameFraming) {
+  expect_block_frame_matches("frame_v2_compressed.bin", kFrameNormals | kFrameCompressed | kFrameKey, 3, 40 + 12);
+  const FrameView view = view_frame(payload_of(fixture("frame_v2_compressed.bin")), kVersion2);
+  EXPECT_EQ(view.positions.size(), 40u);  // key, origin, step, count, 7 bytes padded to 8
+  EXPECT_EQ(view.normals.size(), 12u);    // count, 5 bytes padded to 8
+}
+
+TEST(SubscriberStreamV2, InconsistentFlagsAreRejected) {
+  const std::vector<unsigned char> golden = fixture("frame_v2_parameters.bin");
+  auto with_flags = [&](uint32_t flags) {
+    std::vector<unsigned char> bad(golden.begin() + kHeaderBytes, golden.end());
+    std::memcpy(bad.data() + 4, &flags, 4);
+    return bad;
+  };
+  EXPECT_THROW(view_frame(with_flags(kFrameMarkers | kFrameParameters | kFrameQuantised), kVersion2), DecodeError);
+  EXPECT_THROW(view_frame(with_flags(kFrameMarkers | kFrameParameters | kFrameNormals), kVersion2), DecodeError);
+  EXPECT_THROW(view_frame(with_flags(kFrameMarkers | kFrameParameters | kFrameKey), kVersion2), DecodeError);
+  EXPECT_THROW(view_frame(with_flags(kFrameMarkers | kFrameParameters | kFrameNoPositions), kVersion2), DecodeError);
+  EXPECT_THROW(view_frame(with_flags(kFrameMarkers | kFrameParameters | 0x100), kVersion2), DecodeError);
+  // A part count that claims more than the payload holds.
+  std::vector<unsigned char> bad(golden.begin() + kHeaderBytes, golden.end());
+  const uint32_t parts = 1'000'000;
+  std::memcpy(bad.data() + frame_info_bytes(kVersion2), &parts, 4);
+  EXPECT_THROW(view_frame(bad, kVersion2), DecodeError);
+}
+
+TEST(SubscriberStreamV2, FlagsFollowWantsAndEncoding) {
+  EXPECT_EQ(frame_flags_for(kWantNormals, Encoding::Float, true), kFrameNormals);
+  EXPECT_EQ(frame_flags_for(kWantNormals | kWantMarkers, Encoding::Parameters, true), kFrameParameters | kFrameMarkers);
+  EXPECT_EQ(frame_flags_for(kWantNormals, Encoding::Compressed, true), kFrameNormals | kFrameCompressed);
+  EXPECT_EQ(frame_flags_for(kWantNormals, Encoding::Quantised, true), kFrameNormals | kFrameQuantised);
+  EXPECT_EQ(frame_flags_for(kWantNormals, Encoding::Parameters, false), kFrameNoPositions);
+  EXPECT_EQ(frame_flags_for(kWantNoMesh | kWantMarkers, Encoding::Compressed, true), kFrameNoPositions | kFrameMarkers);
 }
 
 TEST(SubscriberStream, CorruptFrameCountsAndFlagsAreRejected) {

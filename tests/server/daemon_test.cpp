@@ -201,7 +201,7 @@ TEST(Daemon, StalledSubscriberDoesNotHoldBackTheOthers) {
   stalled.open(tcp::v4());
   stalled.set_option(asio::socket_base::receive_buffer_size(1024));
   stalled.connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), static_cast<unsigned short>(daemon.sub_port())));
-  asio::write(stalled, asio::buffer(subscriber::encode_hello({subscriber::kWantMarkers})));
+  asio::write(stalled, asio::buffer(subscriber::encode_hello({.wants = subscriber::kWantMarkers})));
   wait_until([&] { return daemon.subject(0).hub().wanted_encodings() != 0; });
 
   daemon.start_source();
@@ -258,7 +258,7 @@ TEST_P(DaemonPublishThreads, EverySubscriberGetsEveryFrameInOrderAndStopClosesTh
   asio::io_context io;  // the subscriber that never reads: still connected at stop()
   tcp::socket idle(io);
   idle.connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), static_cast<unsigned short>(daemon.sub_port())));
-  asio::write(idle, asio::buffer(subscriber::encode_hello({subscriber::kWantMarkers})));
+  asio::write(idle, asio::buffer(subscriber::encode_hello({.wants = subscriber::kWantMarkers})));
 
   constexpr int kSubscribers = 4;
   constexpr size_t kFrames = 120;
@@ -341,7 +341,7 @@ TEST(Daemon, PacedSubscriberHasAtMostTheWindowInFlightAndGetsTheNewestFrameOnAck
   asio::io_context io;
   tcp::socket paced(io);
   paced.connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), static_cast<unsigned short>(daemon.sub_port())));
-  asio::write(paced, asio::buffer(subscriber::encode_hello({subscriber::kWantMarkers | subscriber::kWantPaced})));
+  asio::write(paced, asio::buffer(subscriber::encode_hello({.wants = subscriber::kWantMarkers | subscriber::kWantPaced})));
   wait_until([&] { return daemon.subject(0).hub().wanted_encodings() != 0; });
   daemon.start_source();
   subscriber::StreamDecoder decoder;
@@ -412,7 +412,7 @@ TEST(Daemon, ServesHealthMetricsWebSocketAndSubscribersWithoutHello) {
   beast::get_lowest_layer(ws).connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), static_cast<unsigned short>(daemon.http_port())));
   ws.handshake("127.0.0.1", "/stream");
   ws.binary(true);
-  ws.write(asio::buffer(subscriber::encode_hello({subscriber::kWantMarkers})));
+  ws.write(asio::buffer(subscriber::encode_hello({.wants = subscriber::kWantMarkers})));
   bool ws_frame = false;
   for (int i = 0; i < 20 && !ws_frame; ++i) {
     beast::flat_buffer message;
@@ -482,7 +482,7 @@ std::pair<std::string, std::string> subscriber_congestion(const Daemon& daemon) 
   asio::io_context io;
   tcp::socket sub(io);
   sub.connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), static_cast<unsigned short>(daemon.sub_port())));
-  asio::write(sub, asio::buffer(subscriber::encode_hello({subscriber::kWantMarkers})));
+  asio::write(sub, asio::buffer(subscriber::encode_hello({.wants = subscriber::kWantMarkers})));
   subscriber::StreamDecoder decoder;
   std::array<unsigned char, 4096> buffer;
   bool got_frame = false;

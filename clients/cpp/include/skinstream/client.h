@@ -1,0 +1,141 @@
+#pragma once
+// skinstream's C++ client library: subscribe to a skinstreamd and receive each frame of a
+// subject's deforming mesh as vertex positions and normals, however the daemon sends them
+// (float, quantised, compressed, or as the frame's deformation parameters, which the library
+// evaluates here with the daemon's own code and numbers). One Subscriber is one TCP
+// connection, read on the thread that calls next(). Protocol: docs/subscriber-protocol.md.
+//
+//   skinstream::client::Subscriber sub({.host = "stage-pc", .encoding = skinstream::client::Encoding::Parameters});
+//   skinstream::client::Frame frame;
+//   while (sub.next(frame, std::chrono::seconds(1)))
+//     upload(frame.positions, frame.normals);  // 3 floats per vertex, mm; sub.mesh().indices
+//
+// Errors (no daemon, refused, a daemon that goes away, bytes that break the protocol) throw
+// skinstream::client::Error with a one-line reason; make a new Subscriber to try again.
+
+#include <chrono>
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace skinstream::client {
+
+// How the daemon sends positions (the subscriber protocol's encodings).
+enum class Encoding : uint32_t { Float = 0, Quantised = 1, Compressed = 2, Parameters = 3 };
+const char* to_string(Encoding encoding);
+// "float", "quantised", "compressed", "parameters"; throws std::invalid_argument otherwise.
+Encoding encoding_from_string(const std::string& name);
+
+struct Options {
+  std::string host = "127.0.0.1";
+  uint16_t port = 8481;
+  Encoding encoding = Encoding::Parameters;
+  bool normals = true;       // vertex normals (with parameters: computed here from the positions)
+  bool markers = false;      // the filled markers and their status
+  bool mesh = true;          // false: markers only, no vertices
+  bool paced = false;        // acknowledge each frame: at most 2 in flight (for slow readers)
+  bool evaluate = true;      // parameters: evaluate them into vertices (false: parameters only)
+  std::string subject;       // the capture system's subject name; empty: the daemon's first
+  std::string token;         // the daemon's shared token, when it has one
+  int protocol_version = 2;  // 1 speaks to a daemon older than version 2 (float or quantised)
+  std::chrono::milliseconds connect_timeout{5000};
+};
+
+class Error : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// What MeshInfo says of the subject (valid once has_mesh()).
+struct Mesh {
+  std::string subject;
+  Encoding encoding = Encoding::Float;  // what the daemon serves (it says why in Status when not what was asked)
+  uint32_t vertex_count = 0;
+  std::vector<uint32_t> indices;         // 3 per triangle, counter-clockwise from outside
+  std::vector<uint8_t> dominant_part;    // per vertex, 255 = none (for colouring the segmentation)
+  uint32_t part_count = 0;
+  std::vector<std::string> marker_names;
+  std::vector<uint32_t> marker_triangles;  // 3 per triangle of the marker surface
+  float source_rate_hz = 0.0f;
+};
+
+struct Timecode {
+  bool valid = false;
+  int hours = 0, minutes = 0, seconds = 0, frames = 0;
+  int subframe = 0, subframes_per_frame = 0;
+  float rate_hz = 0.0f;
+  bool drop_frame = false;
+};
+
+// Marker status values (Frame::marker_status).
+enum class MarkerStatus : uint8_t { Measured = 0, Relabelled = 1, FilledByPca = 2, FilledRigidly = 3, Held = 4 };
+
+// One frame. The spans point into the Subscriber and stay valid until its next call to next().
+struct Frame {
+  uint32_t frame_number = 0;
+  int64_t source_time_ns = 0;   // capture time, from the source
+  int64_t receive_time_ns = 0;  // the daemon received it (system clock, ns since the epoch)
+  int64_t publish_time_ns = 0;  // the daemon handed it to the publishers
+  int64_t arrival_time_ns = 0;  // its last byte arrived here
+  int64_t ready_time_ns = 0;    // decoded (and evaluated) here: when the renderer can use it
+  Timecode timecode;
+  uint16_t markers_filled = 0, markers_relabelled = 0;
+  uint32_t pipeline_dropped = 0;    // frames the daemon's pipeline dropped so far
+  uint32_t subscriber_dropped = 0;  // frames dropped for this subscriber so far
+  size_t message_bytes = 0;         // the Frame message's size on the wire
+  bool key_frame = false;           // compressed: a key frame
+  std::span<const float> positions;  // 3 per vertex, mm (empty: markers only, or parameters not evaluated)
+  std::span<const float> normals;    // 3 per vertex, unit (empty when not asked for)
+  std::span<const float> markers;    // 3 per marker, mm, subject order
+  std::span<const uint8_t> marker_status;  // MarkerStatus per marker
+};
+
+// What the daemon last said of its source (Status messages).
+struct SourceStatus {
+  enum class State { Connecting = 0, Streaming = 1, Disconnected = 2, Finished = 3, Refused = 4 };
+  State state = State::Connecting;
+  float source_rate_hz = 0.0f;
+  uint64_t frames_received = 0, frames_published = 0;
+  std::string detail;
+  std::string subject;
+  bool subject_present = false;
+};
+
+class Subscriber {
+ public:
+  // Connects and sends Hello; throws Error when the daemon cannot be reached.
+  explicit Subscriber(Options options);
+  ~Subscriber();
+  Subscriber(const Subscriber&) = delete;
+  Subscriber& operator=(const Subscriber&) = delete;
+
+  // Reads until the next frame is ready and fills `frame`; false when none came within
+  // `timeout`. Delta frames of a compressed stream that joined between key frames are skipped
+  // (counted in frames_skipped()). Throws Error when the daemon refuses this subscriber, closes
+  // the connection, or sends bytes that break the protocol.
+  bool next(Frame& frame, std::chrono::milliseconds timeout);
+
+  bool has_mesh() const;
+  const Mesh& mesh() const;
+  const SourceStatus& status() const;
+  const Options& options() const;
+  uint64_t frames_skipped() const;  // compressed deltas without their key
+  uint64_t bytes_received() const;
+  // Parameters: the size of the Model message (bytes, header included; 0 before it came).
+  size_t model_bytes() const;
+  // Parameters: the last frame's raw parameters (floats as sent: per part A 3x9, R 3x3, d, flag;
+  // then 3 RBF weights per member), for renderers that evaluate on their GPU (Options::evaluate
+  // false). Empty for other encodings.
+  std::span<const unsigned char> parameter_block() const;
+  // Parameters: the Model message's payload, for the same renderers.
+  std::span<const unsigned char> model_payload() const;
+
+ private:
+  struct State;
+  std::unique_ptr<State> state_;
+};
+
+}  // namespace skinstream::client

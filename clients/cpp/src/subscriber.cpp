@@ -1,0 +1,269 @@
+#include <algorithm>
+#include <cstring>
+#include <optional>
+
+#include "core/deform/mesh_evaluator.h"
+#include "protocol/compressed_vertices.h"
+#include "protocol/frame_parameters.h"
+#include "protocol/subscriber_model.h"
+#include "protocol/subscriber_stream.h"
+#include "skinstream/client.h"
+#include "tcp_connection.h"
+
+namespace skinstream::client {
+namespace wire = skinstream::subscriber;
+
+namespace {
+
+int64_t wall_clock_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch()).count();
+}
+
+// Up to 1 MiB a read: a 53,500-vertex float frame (640 kB) in one or two reads.
+constexpr size_t kReadBytes = 1 << 20;
+
+}  // namespace
+
+const char* to_string(Encoding encoding) { return wire::to_string(static_cast<wire::Encoding>(encoding)); }
+
+Encoding encoding_from_string(const std::string& name) {
+  for (uint32_t e = 0; e < wire::kEncodingCount; ++e)
+    if (name == wire::to_string(static_cast<wire::Encoding>(e))) return static_cast<Encoding>(e);
+  throw std::invalid_argument("unknown encoding \"" + name + "\" (float, quantised, compressed or parameters)");
+}
+
+struct Subscriber::State {
+  Options options;
+  uint16_t version = wire::kVersion2;
+  std::optional<TcpConnection> connection;
+  wire::StreamDecoder decoder;
+  Mesh mesh;
+  bool has_mesh = false;
+  SourceStatus status;
+  uint64_t skipped = 0;
+  uint64_t bytes = 0;
+  int64_t arrival_ns = 0;  // of the last bytes read
+
+  // Parameters.
+  std::vector<unsigned char> model_payload;
+  std::unique_ptr<MeshEvaluator> evaluator;
+  FrameParameters parameters;
+  std::vector<unsigned char> parameter_block;
+  // Compressed.
+  std::unique_ptr<wire::CompressedVertexDecoder> compressed;
+
+  std::vector<float> positions, normals, markers;
+  std::vector<uint8_t> marker_status;
+
+  void on_mesh_info(std::span<const unsigned char> payload);
+  void on_model(std::span<const unsigned char> payload);
+  void on_status(std::span<const unsigned char> payload);
+  // False when the frame cannot be shown (a compressed delta without its key).
+  bool on_frame(std::span<const unsigned char> payload, Frame& frame);
+};
+
+Subscriber::Subscriber(Options options) : state_(std::make_unique<State>()) {
+  State& s = *state_;
+  s.options = std::move(options);
+  const Options& o = s.options;
+  if (o.protocol_version != 1 && o.protocol_version != 2)
+    throw std::invalid_argument("protocol version " + std::to_string(o.protocol_version) + " (this library speaks 1 and 2)");
+  s.version = static_cast<uint16_t>(o.protocol_version);
+  if (s.version == wire::kVersion1 && (o.encoding == Encoding::Compressed || o.encoding == Encoding::Parameters))
+    throw std::invalid_argument(std::string("the ") + to_string(o.encoding) + " encoding needs protocol version 2");
+  if (s.version == wire::kVersion1 && (!o.subject.empty() || !o.token.empty()))
+    throw std::invalid_argument("a subject or a token needs protocol version 2");
+  wire::Hello hello;
+  hello.version = s.version;
+  hello.wants = (o.normals ? wire::kWantNormals : 0) | (o.markers ? wire::kWantMarkers : 0) | (o.mesh ? 0 : wire::kWantNoMesh) |
+                (o.paced ? wire::kWantPaced : 0);
+  if (s.version == wire::kVersion1 && o.encoding == Encoding::Quantised) hello.wants |= wire::kWantQuantised;
+  hello.encoding = static_cast<uint32_t>(o.encoding);
+  hello.subject = o.subject;
+  hello.token = o.token;
+  s.connection.emplace(o.host, o.port, o.connect_timeout);
+  s.connection->send_all(wire::encode_hello(hello));
+}
+
+Subscriber::~Subscriber() = default;
+
+bool Subscriber::next(Frame& frame, std::chrono::milliseconds timeout) {
+  State& s = *state_;
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  for (;;) {
+    try {
+      while (const std::optional<wire::RawMessage> message = s.decoder.next()) {
+        if (message->version != s.version)
+          throw Error("the daemon answered in protocol version " + std::to_string(message->version) + ", not " + std::to_string(s.version));
+        switch (message->type) {
+          case wire::MessageType::MeshInfo: s.on_mesh_info(message->payload); break;
+          case wire::MessageType::Model: s.on_model(message->payload); break;
+          case wire::MessageType::Status: s.on_status(message->payload); break;
+          case wire::MessageType::Frame:
+            if (s.on_frame(message->payload, frame)) {
+              if (s.options.paced) s.connection->send_all(wire::encode_ack({frame.frame_number}, s.version));
+              return true;
+            }
+            break;
+          default: throw Error(std::string("unexpected ") + wire::to_string(message->type) + " message from the daemon");
+        }
+      }
+    } catch (const wire::DecodeError& e) {
+      throw Error(std::string("bad message from the daemon: ") + e.what());
+    }
+    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
+    if (left.count() < 0) return false;
+    const std::span<unsigned char> room = s.decoder.prepare(kReadBytes);
+    const size_t n = s.connection->receive(room, left);
+    s.decoder.commit(n);
+    if (n == 0 && std::chrono::steady_clock::now() >= deadline) return false;
+    s.bytes += n;
+    s.arrival_ns = wall_clock_ns();
+  }
+}
+
+void Subscriber::State::on_mesh_info(std::span<const unsigned char> payload) {
+  const wire::MeshInfo info = wire::decode_mesh_info(payload, version);
+  mesh.subject = info.subject;
+  mesh.encoding = version >= wire::kVersion2 ? static_cast<Encoding>(info.encoding)
+                                             : (options.encoding == Encoding::Quantised ? Encoding::Quantised : Encoding::Float);
+  mesh.vertex_count = info.vertex_count;
+  mesh.indices.clear();
+  for (const auto& f : info.faces) mesh.indices.insert(mesh.indices.end(), f.begin(), f.end());
+  mesh.dominant_part = info.dominant_part;
+  mesh.part_count = info.part_count;
+  mesh.marker_names = info.marker_names;
+  mesh.marker_triangles.clear();
+  for (const auto& t : info.marker_triangles) mesh.marker_triangles.insert(mesh.marker_triangles.end(), t.begin(), t.end());
+  mesh.source_rate_hz = info.source_rate_hz;
+  has_mesh = true;
+  const size_t v3 = 3 * static_cast<size_t>(mesh.vertex_count);
+  positions.assign(v3, 0.0f);
+  normals.assign(v3, 0.0f);
+  markers.assign(3 * info.marker_names.size(), 0.0f);
+  marker_status.assign(info.marker_names.size(), 0);
+  evaluator.reset();
+  compressed.reset();
+  if (mesh.encoding == Encoding::Compressed) compressed = std::make_unique<wire::CompressedVertexDecoder>(static_cast<int>(mesh.vertex_count));
+}
+
+void Subscriber::State::on_model(std::span<const unsigned char> payload) {
+  if (!has_mesh) throw Error("a Model message before MeshInfo");
+  EvaluationModel model = wire::decode_model(payload);
+  if (model.vertex_count() != static_cast<int>(mesh.vertex_count))
+    throw Error("the Model has " + std::to_string(model.vertex_count()) + " vertices, MeshInfo " + std::to_string(mesh.vertex_count));
+  for (size_t i = 0; i + 2 < mesh.indices.size(); i += 3)
+    model.faces.push_back({static_cast<int>(mesh.indices[i]), static_cast<int>(mesh.indices[i + 1]), static_cast<int>(mesh.indices[i + 2])});
+  model_payload.assign(payload.begin(), payload.end());
+  parameters.resize(model.part_count(), model.member_count());
+  parameter_block.reserve(wire::parameter_block_bytes(model.part_count(), model.member_count()));
+  try {
+    evaluator = std::make_unique<MeshEvaluator>(model);
+  } catch (const std::invalid_argument& e) {
+    throw Error(std::string("the Model does not evaluate: ") + e.what());
+  }
+}
+
+void Subscriber::State::on_status(std::span<const unsigned char> payload) {
+  const wire::Status in = wire::decode_status(payload, version);
+  status.state = static_cast<SourceStatus::State>(in.state);
+  status.source_rate_hz = in.source_rate_hz;
+  status.frames_received = in.frames_received;
+  status.frames_published = in.frames_published;
+  status.detail = in.detail;
+  status.subject = in.subject;
+  status.subject_present = in.subject_present;
+  if (in.state == wire::SourceStateCode::Refused) throw Error("the daemon refused this subscriber: " + in.detail);
+}
+
+bool Subscriber::State::on_frame(std::span<const unsigned char> payload, Frame& frame) {
+  if (!has_mesh) throw Error("a Frame before MeshInfo");
+  const wire::FrameView view = wire::view_frame(payload, version);
+  const wire::FrameInfo& info = view.info;
+  const size_t v3 = 3 * static_cast<size_t>(mesh.vertex_count);
+  bool have_positions = false, have_normals = false;
+  if (info.flags & wire::kFrameParameters) {
+    if (!evaluator) throw Error("a parameter Frame before the Model");
+    wire::decode_parameter_block(view.positions, parameters);
+    parameter_block.assign(view.positions.begin(), view.positions.end());
+    if (options.evaluate) {
+      const bool want_normals = options.normals;
+      if (!evaluator->evaluate(parameters, positions, want_normals ? std::span<float>(normals) : std::span<float>()))
+        throw Error("parameters do not fit the Model");
+      have_positions = true;
+      have_normals = want_normals;
+    }
+  } else if (info.flags & wire::kFrameCompressed) {
+    if (!compressed || info.vertex_count != mesh.vertex_count) throw Error("a compressed Frame that does not fit MeshInfo");
+    const bool with_normals = !view.normals.empty();
+    const auto result = compressed->decode(view.positions, view.normals, (info.flags & wire::kFrameKey) != 0, positions,
+                                           with_normals ? std::span<float>(normals) : std::span<float>());
+    if (result == wire::CompressedVertexDecoder::Result::NeedsKey) {
+      ++skipped;
+      return false;
+    }
+    have_positions = true;
+    have_normals = with_normals;
+  } else if (!(info.flags & wire::kFrameNoPositions)) {
+    if (info.vertex_count != mesh.vertex_count) throw Error("a Frame of " + std::to_string(info.vertex_count) + " vertices, MeshInfo says " +
+                                                            std::to_string(mesh.vertex_count));
+    if (info.flags & wire::kFrameQuantised) {
+      float origin[3], step[3];
+      std::memcpy(origin, view.positions.data(), 12);
+      std::memcpy(step, view.positions.data() + 12, 12);
+      const unsigned char* q = view.positions.data() + 24;
+      for (size_t i = 0; i < v3; ++i) {
+        uint16_t value;
+        std::memcpy(&value, q + 2 * i, 2);
+        positions[i] = origin[i % 3] + value * step[i % 3];
+      }
+      for (size_t i = 0; !view.normals.empty() && i < v3; ++i) {
+        int16_t value;
+        std::memcpy(&value, view.normals.data() + 2 * i, 2);
+        normals[i] = value / 32767.0f;
+      }
+    } else {
+      std::memcpy(positions.data(), view.positions.data(), 4 * v3);
+      if (!view.normals.empty()) std::memcpy(normals.data(), view.normals.data(), 4 * v3);
+    }
+    have_positions = true;
+    have_normals = !view.normals.empty();
+  }
+  const size_t m = view.marker_status.size();
+  if (m > marker_status.size()) throw Error("a Frame with more markers than MeshInfo names");
+  std::memcpy(markers.data(), view.markers.data(), 12 * m);
+  std::memcpy(marker_status.data(), view.marker_status.data(), m);
+
+  frame.frame_number = info.frame_number;
+  frame.source_time_ns = info.source_time_ns;
+  frame.receive_time_ns = info.receive_time_ns;
+  frame.publish_time_ns = info.publish_time_ns;
+  frame.arrival_time_ns = arrival_ns;
+  const wire::FrameTimecode& t = info.timecode;
+  frame.timecode = {(info.flags & wire::kFrameTimecode) != 0, t.hours, t.minutes, t.seconds, t.frames, t.subframe,
+                    t.subframes_per_frame, t.rate_hz, (t.flags & wire::kTimecodeDropFrame) != 0};
+  frame.markers_filled = info.markers_filled;
+  frame.markers_relabelled = info.markers_relabelled;
+  frame.pipeline_dropped = info.pipeline_dropped;
+  frame.subscriber_dropped = info.subscriber_dropped;
+  frame.message_bytes = wire::kHeaderBytes + payload.size();
+  frame.key_frame = (info.flags & wire::kFrameKey) != 0;
+  frame.positions = have_positions ? std::span<const float>(positions) : std::span<const float>();
+  frame.normals = have_normals ? std::span<const float>(normals) : std::span<const float>();
+  frame.markers = std::span<const float>(markers).first(3 * m);
+  frame.marker_status = std::span<const uint8_t>(marker_status).first(m);
+  frame.ready_time_ns = wall_clock_ns();
+  return true;
+}
+
+bool Subscriber::has_mesh() const { return state_->has_mesh; }
+const Mesh& Subscriber::mesh() const { return state_->mesh; }
+const SourceStatus& Subscriber::status() const { return state_->status; }
+const Options& Subscriber::options() const { return state_->options; }
+uint64_t Subscriber::frames_skipped() const { return state_->skipped; }
+uint64_t Subscriber::bytes_received() const { return state_->bytes; }
+size_t Subscriber::model_bytes() const { return state_->model_payload.empty() ? 0 : wire::kHeaderBytes + state_->model_payload.size(); }
+std::span<const unsigned char> Subscriber::parameter_block() const { return state_->parameter_block; }
+std::span<const unsigned char> Subscriber::model_payload() const { return state_->model_payload; }
+
+}  // namespace skinstream::client
