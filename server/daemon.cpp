@@ -104,6 +104,10 @@ Daemon::Daemon(const DaemonConfig& config)
       routed_(subjects_.size(), nullptr),
       publish_(config.publish_threads),
       status_timer_(io_) {
+  for (auto& s : subjects_) {
+    directory_.add(s->name(), s->hub());
+    s->hub().set_directory(&directory_);
+  }
   if (!config.replay.empty()) {
     auto replay = std::make_unique<FileReplaySource>(io_, config.replay, static_cast<SourceSink&>(*this),
                                                      ReplayOptions{config.loop, config.speed, config.replay_subject});
@@ -157,7 +161,7 @@ Daemon::Daemon(const DaemonConfig& config)
       }
       socket = std::move(own);
     }
-    SubscriberHub& hub = subject(0).hub();  // version 1 subscribers get the first subject
+    SubscriberHub& hub = subject(0).hub();  // until a version 2 Hello names another
     auto subscriber = std::make_shared<TcpSubscriber>(placed.io, hub, std::move(socket), remote, std::move(placed.token));
     hub.add(subscriber);
     asio::post(placed.io, [subscriber] { subscriber->start(); });

@@ -23,6 +23,7 @@
 #include "server/logging.h"
 #include "server/metrics/metrics.h"
 #include "server/publish/publish_threads.h"
+#include "server/publish/subject_directory.h"
 #include "server/subject_stream.h"
 
 namespace skinstream::server {
@@ -74,6 +75,7 @@ class Daemon : private SourceSink, private SubjectRouter::Observer {
   std::vector<int> deform_cpus_;  // deform_threads per subject, subject after subject, or none (not pinned)
   Metrics source_metrics_;
   RateLimitedLog bad_input_log_;
+  SubjectDirectory directory_;  // the subjects' hubs by name; outlives them
   // Before io_: the io_context is destroyed first, and with it the handlers still holding
   // sessions whose queues hold frames of the subjects' pipelines' pools.
   std::vector<std::unique_ptr<SubjectStream>> subjects_;

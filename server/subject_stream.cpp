@@ -66,7 +66,9 @@ SubjectStream::SubjectStream(SubjectConfig config, const SubjectStreamOptions& o
   if (!subject_.deformation)
     spdlog::warn("subject {}: {}: no deformation model (built without --mesh): publishing markers only (MeshInfo with V = 0)",
                  name_, config_.file);
-  hub_ = std::make_unique<SubscriberHub>(metrics_, options.hub, mesh_info_of(subject_), subject_.deformation.has_value());
+  subscriber::MeshInfo mesh_info = mesh_info_of(subject_);
+  mesh_info.subject = name_;
+  hub_ = std::make_unique<SubscriberHub>(metrics_, options.hub, std::move(mesh_info), subject_.deformation.has_value());
   try {
     pipeline_ = std::make_unique<Pipeline>(subject_.model, subject_.deformation ? &*subject_.deformation : nullptr, options.pipeline,
                                            mailbox_, *hub_, metrics_);
@@ -134,6 +136,7 @@ void SubjectStream::broadcast_status(SourceState state, std::string_view source_
   status.frames_published = metrics_.frames_published.load();
   {
     std::lock_guard lock(mutex_);
+    status.subject_present = present_;
     status.detail = present_ || state != SourceState::Streaming
                         ? std::string(source_detail)
                         : "subject " + name_ + " absent, waiting for it: " + presence_detail_;

@@ -18,7 +18,7 @@ void WebSocketSubscriber::accept(http::request<http::string_body> request) {
       self->on_disconnected("WebSocket handshake failed: " + ec.message());
       return;
     }
-    self->start_hello_timer(self->hub_.options().hello_timeout);
+    self->start_hello_timer(self->hub_->options().hello_timeout);
     self->read_next();
   });
 }
@@ -43,7 +43,7 @@ void WebSocketSubscriber::read_next() {
       const subscriber::MessageHeader header = subscriber::decode_header(bytes, 1024);
       if (header.payload_bytes != bytes.size() - subscriber::kHeaderBytes)
         throw subscriber::DecodeError("WebSocket message is not exactly one protocol message");
-      self->on_subscriber_message(header.type, bytes.subspan(subscriber::kHeaderBytes));
+      self->on_subscriber_message(header.type, bytes.subspan(subscriber::kHeaderBytes), header.version);
     } catch (const subscriber::DecodeError& e) {
       self->on_protocol_error(e.what());
       return;

@@ -59,13 +59,13 @@ size_t FramePool::allocated() const {
   return all_.size();
 }
 
-size_t FramePool::prepare(uint32_t flags, size_t bytes) {
-  if (flags >= EncodedFrame::kEncodings || bytes == 0) return 0;
+size_t FramePool::prepare(uint32_t slot, size_t bytes) {
+  if (slot >= EncodedFrame::kEncodings || bytes == 0) return 0;
   std::lock_guard serial(prepare_mutex_);
   size_t missing = 0;
   {
     std::lock_guard lock(mutex_);
-    const size_t covered = sized_[flags] + ready_[flags].size();
+    const size_t covered = sized_[slot] + ready_[slot].size();
     missing = all_.size() > covered ? all_.size() - covered : 0;
   }
   // Made outside the lock: value-initialised, so every page is touched here and not on the
@@ -74,16 +74,16 @@ size_t FramePool::prepare(uint32_t flags, size_t bytes) {
   made.reserve(missing);
   for (size_t i = 0; i < missing; ++i) made.emplace_back(bytes);
   std::lock_guard lock(mutex_);
-  for (auto& buffer : made) ready_[flags].push_back(std::move(buffer));
+  for (auto& buffer : made) ready_[slot].push_back(std::move(buffer));
   return missing;
 }
 
-bool FramePool::size_message(EncodedFrame& frame, uint32_t flags, size_t bytes) {
-  std::vector<unsigned char>& message = frame.messages[flags];
+bool FramePool::size_message(EncodedFrame& frame, uint32_t slot, size_t bytes) {
+  std::vector<unsigned char>& message = frame.messages[slot];
   if (message.size() == bytes) return false;
   std::lock_guard lock(mutex_);
-  if (message.empty()) ++sized_[flags];  // this frame now holds the encoding, either way
-  std::vector<std::vector<unsigned char>>& ready = ready_[flags];
+  if (message.empty()) ++sized_[slot];  // this frame now holds the encoding, either way
+  std::vector<std::vector<unsigned char>>& ready = ready_[slot];
   if (!ready.empty() && ready.back().size() == bytes) {
     message.swap(ready.back());
     ready.pop_back();  // the frame's old buffer, empty unless the size changed (never, for one mesh)

@@ -125,27 +125,29 @@ void Pipeline::process(const MarkerFrame& frame, uint64_t generation) {
 
   const long sequence = sequence_++;
   held_[static_cast<size_t>(sequence) % held_.size()] = {frame.frame_number, frame.source_time_ns, frame.receive_time_ns,
-                                                        clamp16(stats.filled + stats.held), clamp16(stats.relabelled)};
+                                                        clamp16(stats.filled + stats.held), clamp16(stats.relabelled), frame.timecode};
   long released = 0;
   if (blender_.push(filled_, filled_status_, sequence, {released_positions_, released_status_}, released))
     publish(held_[static_cast<size_t>(released) % held_.size()], released_positions_, released_status_);
 }
 
-size_t Pipeline::message_bytes(uint32_t flags) const {
+size_t Pipeline::message_bytes(uint32_t slot) const {
+  const uint32_t flags = slot_frame_flags(slot);
   return subscriber::frame_message_bytes(flags, (flags & subscriber::kFrameNoPositions) ? 0 : vertex_count(),
-                                         (flags & subscriber::kFrameMarkers) ? static_cast<uint32_t>(model_.marker_count()) : 0);
+                                         (flags & subscriber::kFrameMarkers) ? static_cast<uint32_t>(model_.marker_count()) : 0,
+                                         slot_version(slot));
 }
 
-void Pipeline::prepare_encoding(uint32_t flags) {
-  const size_t made = pool_.prepare(flags, message_bytes(flags));
+void Pipeline::prepare_encoding(uint32_t slot) {
+  const size_t made = pool_.prepare(slot, message_bytes(slot));
   metrics_.frame_buffers_allocated.fetch_add(made, std::memory_order_relaxed);
 }
 
 void Pipeline::publish(const Released& meta, std::span<const Vec3> positions, std::span<const MarkerStatus> status) {
   const uint32_t wanted = consumer_.wanted_encodings();
   bool want_normals = false;
-  for (uint32_t f = 0; f < 16; ++f)
-    if (((wanted >> f) & 1u) && (f & subscriber::kFrameNormals)) want_normals = true;
+  for (uint32_t slot = 0; slot < EncodedFrame::kEncodings; ++slot)
+    if (((wanted >> slot) & 1u) && (slot_frame_flags(slot) & subscriber::kFrameNormals)) want_normals = true;
 
   if (deformer_) {
     const auto start = std::chrono::steady_clock::now();
@@ -174,16 +176,20 @@ void Pipeline::publish(const Released& meta, std::span<const Vec3> positions, st
   info.markers_filled = meta.filled;
   info.markers_relabelled = meta.relabelled;
   info.pipeline_dropped = static_cast<uint32_t>(mailbox_.dropped());
+  const SourceTimecode& tc = meta.timecode;
+  info.timecode = {tc.hours, tc.minutes, tc.seconds, tc.frames, tc.subframe, tc.subframes_per_frame, tc.rate_hz,
+                   (tc.drop_frame ? subscriber::kTimecodeDropFrame : 0u) | (tc.field ? subscriber::kTimecodeField : 0u)};
   out.frame_number = meta.frame_number;
   for (uint32_t f = 0; f < EncodedFrame::kEncodings; ++f) {
     if (!((wanted >> f) & 1u)) continue;
-    info.flags = f;
+    const uint16_t version = slot_version(f);
+    info.flags = slot_frame_flags(f) | (version >= 2 && tc.valid ? subscriber::kFrameTimecode : 0u);
     const size_t bytes = message_bytes(f);
     if (pool_.size_message(out, f, bytes)) {  // first use of this encoding in this pooled frame, nothing prepared
       metrics_.frame_buffers_allocated.fetch_add(1, std::memory_order_relaxed);
       metrics_.frame_buffers_allocated_by_pipeline.fetch_add(1, std::memory_order_relaxed);
     }
-    subscriber::encode_frame(info, positions_, normals_, marker_floats_, marker_status_bytes_, out.messages[f]);
+    subscriber::encode_frame(info, positions_, normals_, marker_floats_, marker_status_bytes_, out.messages[f], version);
     out.encoded_mask |= 1u << f;
   }
   metrics_.encode.observe_ns(since_ns(encode_start));

@@ -28,7 +28,8 @@ namespace skinstream::server {
 class FrameConsumer {
  public:
   virtual ~FrameConsumer() = default;
-  // Bit f set: some subscriber receives frames with flags f (subscriber::frame_flags_for).
+  // Bit s set: some subscriber receives the frames of slot s (encoding_slot: its frame flags,
+  // subscriber::frame_flags_for, in its protocol version).
   virtual uint32_t wanted_encodings() const = 0;
   // Called on the pipeline thread; must not block.
   virtual void publish(const FrameRef& frame) = 0;
@@ -59,19 +60,20 @@ class Pipeline {
   bool has_mesh() const { return deformer_ != nullptr; }
   uint32_t vertex_count() const { return deformer_ ? static_cast<uint32_t>(deformer_->vertex_count()) : 0; }
   uint64_t frames_published() const { return published_.load(); }
-  // Any thread, before the pipeline is told anyone wants encoding `flags` (subscriber frame
-  // flags): makes its buffers for every pooled frame, so the first frames encoded that way do
-  // not allocate (and fault in 640 kB each) on the pipeline thread.
-  void prepare_encoding(uint32_t flags);
+  // Any thread, before the pipeline is told anyone wants slot `slot` (encoding_slot): makes its
+  // buffers for every pooled frame, so the first frames encoded that way do not allocate (and
+  // fault in 640 kB each) on the pipeline thread.
+  void prepare_encoding(uint32_t slot);
 
  private:
-  size_t message_bytes(uint32_t flags) const;  // a Frame message with these flags
+  size_t message_bytes(uint32_t slot) const;  // a Frame message of this slot
   struct Released {
     uint32_t frame_number = 0;
     int64_t source_time_ns = 0;
     int64_t receive_time_ns = 0;
     uint16_t filled = 0;
     uint16_t relabelled = 0;
+    SourceTimecode timecode;
   };
   void run();
   void process(const MarkerFrame& frame, uint64_t generation);

@@ -15,7 +15,7 @@ std::atomic<uint64_t> next_id{1};
 
 SubscriberSession::SubscriberSession(asio::io_context& io, SubscriberHub& hub, std::string transport, std::string remote)
     : io_(io),
-      hub_(hub),
+      hub_(&hub),
       id_(next_id.fetch_add(1)),
       transport_(std::move(transport)),
       remote_(std::move(remote)),
@@ -24,7 +24,7 @@ SubscriberSession::SubscriberSession(asio::io_context& io, SubscriberHub& hub, s
       pump_slot_(std::make_shared<HandlerSlot>()) {}
 
 void SubscriberSession::offer(const FrameRef& frame) {
-  if (!frame->has(flags_.load())) return;  // encoding not ready in this frame (wants just changed)
+  if (!frame->has(slot_.load())) return;  // encoding not ready in this frame (wants just changed)
   queue_.push_frame(frame);
   kick();
 }
@@ -49,14 +49,18 @@ void SubscriberSession::start_hello_timer(std::chrono::milliseconds timeout) {
     if (ec || self->greeted_ || self->closed_) return;
     spdlog::info("subscriber {} ({} {}): no Hello within the timeout, sending positions only", self->id_, self->transport_,
                  self->remote_);
-    self->on_hello(0);
+    self->on_hello(subscriber::Hello{});
   });
 }
 
-void SubscriberSession::on_subscriber_message(subscriber::MessageType type, std::span<const unsigned char> payload) {
+void SubscriberSession::on_subscriber_message(subscriber::MessageType type, std::span<const unsigned char> payload,
+                                              uint16_t version) {
   switch (type) {
     case subscriber::MessageType::Hello:
-      on_hello(subscriber::decode_hello(payload).wants);
+      if (greeted_ && version != version_)
+        throw subscriber::DecodeError("a Hello of version " + std::to_string(version) + " after one of version " +
+                                      std::to_string(version_));
+      on_hello(subscriber::decode_hello(payload, version));
       return;
     case subscriber::MessageType::Ack:
       subscriber::decode_ack(payload);  // checks the length
@@ -74,23 +78,75 @@ void SubscriberSession::on_ack() {
   if (!writing_) pump();
 }
 
-void SubscriberSession::on_hello(uint32_t wants) {
-  if (closed_) return;
-  paced_ = (wants & subscriber::kWantPaced) != 0;
-  const uint32_t flags = subscriber::frame_flags_for(wants, hub_.has_mesh());
-  const bool changed = !greeted_ || flags != flags_.load();
+void SubscriberSession::on_hello(const subscriber::Hello& hello) {
+  if (closed_ || close_when_sent_) return;
+  std::string note;  // a Status says so when the Hello asks for what is not served
+  uint32_t flags = 0;
+  if (hello.version >= subscriber::kVersion2) {
+    // The subject is chosen by the first Hello; a later one changes what is sent, not to whom.
+    if (!greeted_ && !join_subject(hello.subject)) return;
+    subscriber::Encoding served = subscriber::Encoding::Float;
+    if (hello.encoding == static_cast<uint32_t>(subscriber::Encoding::Quantised)) {
+      served = subscriber::Encoding::Quantised;
+    } else if (hello.encoding != static_cast<uint32_t>(subscriber::Encoding::Float)) {
+      const std::string asked = hello.encoding < subscriber::kEncodingCount
+                                    ? subscriber::to_string(static_cast<subscriber::Encoding>(hello.encoding))
+                                    : "number " + std::to_string(hello.encoding);
+      note = "encoding " + asked + " is not served: positions in float";
+    }
+    flags = subscriber::frame_flags_for(hello.wants, served, hub_->has_mesh());
+  } else {
+    flags = subscriber::frame_flags_for(hello.wants, hub_->has_mesh());
+  }
+  const uint32_t slot = encoding_slot(flags, hello.version);
+  paced_ = (hello.wants & subscriber::kWantPaced) != 0;
+  version_ = hello.version;
+  const bool changed = !greeted_ || slot != slot_.load();
   greeted_ = true;
   hello_timer_.cancel();
+  if (changed) {
+    slot_.store(slot);
+    offer_control(hub_->mesh_info_message(slot));
+    offer_control(hub_->status_message(slot));
+  }
+  if (!note.empty()) offer_control(hub_->status_saying(slot, note));
   if (!changed) return;
-  flags_.store(flags);
-  offer_control(hub_.mesh_info_message(flags));
-  offer_control(hub_.status_message());
-  hub_.activate(*this, flags);
-  spdlog::info("subscriber {} ({} {}): wants {:#x}, frame flags {:#x}", id_, transport_, remote_, wants, flags);
+  hub_->activate(*this, slot);
+  spdlog::info("subscriber {} ({} {}): version {}, subject {}, wants {:#x}, frame flags {:#x}", id_, transport_, remote_,
+               hello.version, hub_->subject(), hello.wants, flags);
+}
+
+bool SubscriberSession::join_subject(const std::string& subject) {
+  const SubjectDirectory* directory = hub_->directory();
+  SubscriberHub* chosen = directory ? directory->find(subject) : (subject.empty() || subject == hub_->subject() ? hub_ : nullptr);
+  if (!chosen) {
+    refuse(subject, "no subject \"" + subject + "\" here (this daemon serves " +
+                        (directory ? directory->names() : hub_->subject()) + ")");
+    return false;
+  }
+  if (chosen != hub_) {
+    std::shared_ptr<SubscriberSession> self = shared_from_this();  // the old hub held it
+    hub_->remove(*this);
+    hub_ = chosen;
+    hub_->add(self, /*accepted=*/false);
+  }
+  return true;
+}
+
+void SubscriberSession::refuse(const std::string& subject, const std::string& detail) {
+  hub_->metrics().bad_subscriber_messages.fetch_add(1, std::memory_order_relaxed);
+  hub_->log_refusal("subscriber " + std::to_string(id_) + " (" + transport_ + " " + remote_ + ") refused: " + detail);
+  subscriber::Status status;
+  status.state = subscriber::SourceStateCode::Refused;
+  status.detail = detail;
+  status.subject = subject;
+  offer_control(std::make_shared<const std::vector<unsigned char>>(subscriber::encode_status(status, subscriber::kVersion2)));
+  close_when_sent_ = true;
+  hello_timer_.cancel();
 }
 
 void SubscriberSession::on_protocol_error(const std::string& reason) {
-  hub_.metrics().bad_subscriber_messages.fetch_add(1, std::memory_order_relaxed);
+  hub_->metrics().bad_subscriber_messages.fetch_add(1, std::memory_order_relaxed);
   spdlog::warn("subscriber {} ({} {}): {}; closing", id_, transport_, remote_, reason);
   close();
 }
@@ -101,7 +157,7 @@ void SubscriberSession::on_disconnected(const std::string& reason) {
   hello_timer_.cancel();
   spdlog::info("subscriber {} ({} {}) gone: {} (sent {}, dropped {})", id_, transport_, remote_, reason, sent_.load(),
                queue_.frames_dropped());
-  hub_.remove(*this);
+  hub_->remove(*this);
 }
 
 void SubscriberSession::kick() {
@@ -124,8 +180,11 @@ void SubscriberSession::pump() {
     const bool window_full = paced_ && unacked_ >= subscriber::kPacedWindow;
     const auto take = window_full ? SubscriberQueue::Take::ControlOnly
                                   : (paced_ ? SubscriberQueue::Take::NewestFrame : SubscriberQueue::Take::OldestFrame);
-    if (!queue_.pop(in_flight_, take)) return;
-    if (in_flight_.control || in_flight_.frame->has(flags_.load())) break;
+    if (!queue_.pop(in_flight_, take)) {
+      if (close_when_sent_) close();  // a refusal, sent
+      return;
+    }
+    if (in_flight_.control || in_flight_.frame->has(slot_.load())) break;
     in_flight_.frame.reset();  // encoded for this subscriber's previous wants
   }
   writing_ = true;
@@ -135,9 +194,9 @@ void SubscriberSession::pump() {
   }
   if (paced_) ++unacked_;
   write_started_ = std::chrono::steady_clock::now();
-  hub_.metrics().subscriber_queue_wait.observe_ns(
+  hub_->metrics().subscriber_queue_wait.observe_ns(
       std::chrono::duration_cast<std::chrono::nanoseconds>(write_started_ - in_flight_.frame->published).count());
-  const std::span<const unsigned char> message = in_flight_.frame->message(flags_.load());
+  const std::span<const unsigned char> message = in_flight_.frame->message(slot_.load());
   const size_t prefix = std::min(frame_prefix_.size(), message.size());
   std::memcpy(frame_prefix_.data(), message.data(), prefix);
   subscriber::patch_subscriber_dropped(std::span(frame_prefix_).first(prefix), static_cast<uint32_t>(queue_.frames_dropped()));
@@ -155,7 +214,7 @@ void SubscriberSession::write_done(const boost::system::error_code& ec) {
   }
   if (was_frame) {
     sent_.fetch_add(1, std::memory_order_relaxed);
-    hub_.metrics().subscriber_write.observe_ns(
+    hub_->metrics().subscriber_write.observe_ns(
         std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - write_started_).count());
   }
   pump();

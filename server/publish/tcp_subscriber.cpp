@@ -9,7 +9,7 @@ TcpSubscriber::TcpSubscriber(asio::io_context& io, SubscriberHub& hub, tcp::sock
     : SubscriberSession(io, hub, "tcp", std::move(remote)), socket_(std::move(socket)), placement_(std::move(placement)) {}
 
 void TcpSubscriber::start() {
-  start_hello_timer(hub_.options().hello_timeout);
+  start_hello_timer(hub_->options().hello_timeout);
   read_next();
 }
 
@@ -31,7 +31,7 @@ void TcpSubscriber::read_next() {
                             try {
                               self->decoder_.feed(std::span(self->read_buffer_).first(n));
                               while (auto message = self->decoder_.next())
-                                self->on_subscriber_message(message->type, message->payload);
+                                self->on_subscriber_message(message->type, message->payload, message->version);
                             } catch (const subscriber::DecodeError& e) {
                               self->on_protocol_error(e.what());
                               return;

@@ -23,6 +23,7 @@
 #include "support/socket_lookup.h"
 #include "support/test_data.h"
 #include "support/thread_names.h"
+#include "support/wait_until.h"
 
 namespace skinstream::server {
 namespace {
@@ -66,17 +67,7 @@ DaemonConfig test_config() {
   return config;
 }
 
-// Waits for a condition the daemon must reach soon; a test stuck here fails instead of hanging.
-void wait_until(const std::function<bool()>& done) {
-  const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(60);
-  while (!done()) {
-    if (std::chrono::steady_clock::now() > give_up) {
-      ADD_FAILURE() << "condition not reached within 60 s";
-      return;
-    }
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
-  }
-}
+using test::wait_until;
 
 std::string http_get(int port, const std::string& target, int* out_status = nullptr) {
   asio::io_context io;

@@ -25,37 +25,17 @@
 #include "server/tcp_congestion.h"
 #include "server/vicon/vicon_server.h"
 #include "support/allocation_counter.h"
+#include "support/io_thread.h"
 #include "support/socket_lookup.h"
 #include "support/test_data.h"
 
 namespace skinstream::server {
 namespace {
 
+using test::IoThread;
+
 using namespace std::chrono_literals;
 constexpr auto kPatience = 20s;  // only bounds a failing test; passing ones never wait this long
-
-// An io_context running on its own thread; call() runs a function there and waits for it.
-class IoThread {
- public:
-  IoThread() : guard_(asio::make_work_guard(io)), thread_([this] { io.run(); }) {}
-  ~IoThread() {
-    guard_.reset();
-    io.stop();
-    thread_.join();
-  }
-  template <typename F>
-  auto call(F&& f) {
-    std::packaged_task<decltype(f())()> task(std::forward<F>(f));
-    auto result = task.get_future();
-    asio::post(io, [&task] { task(); });
-    return result.get();
-  }
-  asio::io_context io;
-
- private:
-  asio::executor_work_guard<asio::io_context::executor_type> guard_;
-  std::thread thread_;
-};
 
 struct ReceivedFrame {
   uint32_t number = 0;
