@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
+#include <optional>
 #include <nlohmann/json.hpp>
 
 #include "server/client/subscriber_client.h"
@@ -41,6 +42,9 @@ int main(int argc, char** argv) {
   app.add_option("--frames", frames_wanted, "exit after this many frames (0 = run until the daemon closes)");
   std::vector<std::string> save_arguments;
   app.add_option("--save-every", save_arguments, "N DIR: save every Nth frame as DIR/frame_<frame number>.ply")->expected(2);
+  std::optional<std::string> subject;
+  app.add_option("--subject", subject,
+                 "the subject to follow on a daemon serving several (protocol version 2; \"\" = the first)");
   app.add_flag("--stats", stats, "print rates and latency once a second");
   app.add_flag("--json", json, "JSON: one line per frame, then a summary");
   CLI11_PARSE(app, argc, argv);
@@ -58,10 +62,19 @@ int main(int argc, char** argv) {
   }
   try {
     const auto [host, port] = sub::split_host_port(address);
-    const uint32_t wants = (normals ? subscriber::kWantNormals : 0) | (quantised ? subscriber::kWantQuantised : 0) |
-                           (markers ? subscriber::kWantMarkers : 0) | (no_mesh ? subscriber::kWantNoMesh : 0);
+    const uint32_t wants = (normals ? subscriber::kWantNormals : 0) | (markers ? subscriber::kWantMarkers : 0) |
+                           (no_mesh ? subscriber::kWantNoMesh : 0);
+    // Version 1 unless a subject is named; version 2 says the encoding apart from the wants.
+    subscriber::Hello hello{.wants = wants | (quantised ? subscriber::kWantQuantised : 0)};
+    if (subject)
+      hello = {.wants = wants,
+               .version = subscriber::kVersion2,
+               .encoding = static_cast<uint32_t>(quantised ? subscriber::Encoding::Quantised : subscriber::Encoding::Float),
+               .subject = *subject};
+    const uint16_t version = hello.version;
     if (save_every > 0) std::filesystem::create_directories(save_dir);
-    sub::SubscriberClient client(host, port, wants);
+    sub::SubscriberClient client(host, port, hello);
+    std::string refused;  // the daemon's reason, when it refused this subscriber
 
     std::vector<synth::Face> faces;
     long frames = 0, out_of_order = 0, saved = 0;
@@ -75,7 +88,7 @@ int main(int argc, char** argv) {
     const bool finished = client.run([&](subscriber::MessageType type, std::span<const unsigned char> payload, int64_t now) {
       bytes += payload.size() + subscriber::kHeaderBytes;
       if (type == subscriber::MessageType::MeshInfo) {
-        const subscriber::MeshInfo info = subscriber::decode_mesh_info(payload);
+        const subscriber::MeshInfo info = subscriber::decode_mesh_info(payload, version);
         faces.clear();
         for (const auto& f : info.faces) faces.push_back({static_cast<int>(f[0]), static_cast<int>(f[1]), static_cast<int>(f[2]), -1});
         if (!json)
@@ -84,7 +97,11 @@ int main(int argc, char** argv) {
         return true;
       }
       if (type == subscriber::MessageType::Status) {
-        const subscriber::Status status = subscriber::decode_status(payload);
+        const subscriber::Status status = subscriber::decode_status(payload, version);
+        if (status.state == subscriber::SourceStateCode::Refused) {
+          refused = status.detail;
+          return false;
+        }
         if (!json && stats)
           std::printf("status: state %u, %.2f Hz, received %llu, published %llu, %s\n", static_cast<unsigned>(status.state),
                       status.source_rate_hz, static_cast<unsigned long long>(status.frames_received),
@@ -92,7 +109,7 @@ int main(int argc, char** argv) {
         return true;
       }
       if (type != subscriber::MessageType::Frame) return true;
-      const subscriber::Frame frame = subscriber::decode_frame(payload);
+      const subscriber::Frame frame = subscriber::decode_frame(payload, version);
       const subscriber::FrameInfo& info = frame.info;
       ++frames;
       if (static_cast<int64_t>(info.frame_number) <= last_frame_number) ++out_of_order;
@@ -143,6 +160,10 @@ int main(int argc, char** argv) {
       }
       return frames_wanted <= 0 || frames < frames_wanted;
     });
+    if (!refused.empty()) {
+      std::fprintf(stderr, "skinstream-sub: error: the daemon refused this subscriber: %s\n", refused.c_str());
+      return 1;
+    }
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     nlohmann::json summary = {{"frames", frames},
                               {"out_of_order", out_of_order},

@@ -86,5 +86,32 @@ TEST_F(DaemonSubjects, TwoDaemonsReadOneReplayServerEachFollowingItsOwnActor) {
   test::expect_frames_follow_recording(read_capture(take_b_), actor2, -kApartMm);
 }
 
+// One daemon follows both actors; skinstream-sub names the one it wants (protocol version 2), and
+// a name the daemon does not serve is refused with the reason.
+TEST_F(DaemonSubjects, OneDaemonServesBothActorsToSubscribersNamingThem) {
+  ReplayProcess replay(replay_arguments(), 0, "--subject Actor1 --subject Actor2");
+  DaemonProcess daemon("--subject Actor1=" + subject_ + " --subject Actor2=" + subject_ + " --vicon 127.0.0.1:" +
+                       std::to_string(replay.port));
+  const std::string sub = std::string(SKINSTREAM_SUB) + " 127.0.0.1:" + std::to_string(daemon.sub_port);
+  constexpr int kFrames = 120;
+  ProgramRun actor2;
+  std::thread other([&] { actor2 = test::run_program(sub + " --subject Actor2 --markers --json --frames " + std::to_string(kFrames)); });
+  const ProgramRun actor1 = test::run_program(sub + " --subject Actor1 --markers --json --frames " + std::to_string(kFrames));
+  other.join();
+  const ProgramRun nobody = test::run_program(sub + " --subject Nobody --frames 1");
+  const nlohmann::json health = server::fetch_health(daemon.http_port);
+  EXPECT_EQ(daemon.stop(), 0) << daemon.log();
+  ASSERT_EQ(actor1.exit_code, 0) << actor1.output << daemon.log();
+  ASSERT_EQ(actor2.exit_code, 0) << actor2.output << daemon.log();
+  test::expect_frames_follow_recording(read_capture(take_a_), test::frames_of(actor1.output), kApartMm);
+  test::expect_frames_follow_recording(read_capture(take_b_), test::frames_of(actor2.output), -kApartMm);
+  EXPECT_EQ(nobody.exit_code, 1);
+  EXPECT_NE(nobody.output.find("the daemon refused this subscriber: no subject \"Nobody\" here (this daemon serves Actor1, Actor2)"),
+            std::string::npos)
+      << nobody.output;
+  ASSERT_EQ(health["subjects"].size(), 2u);
+  for (const auto& subject : health["subjects"]) EXPECT_TRUE(subject["present"].get<bool>()) << subject.dump();
+}
+
 }  // namespace
 }  // namespace skinstream
