@@ -313,7 +313,8 @@ int main(int argc, char** argv) {
       threads.emplace_back([&, s] {
         SubscriberTally& tally = tallies[s];
         try {
-          sub::SubscriberClient client("127.0.0.1", std::to_string(sub_port), wants);
+          const subscriber::Hello hello = bench::subscriber_hello(s, subjects, wants);
+          sub::SubscriberClient client("127.0.0.1", std::to_string(sub_port), hello);
           tally.reserve(static_cast<size_t>(seconds * capture.rate_hz * 1.2) + 16);
           int64_t last_frame = -1, last_arrival = 0;
           uint32_t pipeline_dropped = 0;
@@ -321,7 +322,7 @@ int main(int argc, char** argv) {
           client.run([&](subscriber::MessageType type, std::span<const unsigned char> payload, int64_t now) {
             if (type == subscriber::MessageType::Frame) {
               // The numbers only: copying the vertices out is a renderer's work, not the daemon's.
-              const subscriber::FrameInfo info = subscriber::decode_frame_info(payload);
+              const subscriber::FrameInfo info = subscriber::decode_frame_info(payload, hello.version);
               const int64_t sent = send_times.find(info.frame_number);
               if (sent > 0) {
                 tally.end_to_end.ms.push_back((now - sent) * 1e-6);
@@ -377,8 +378,7 @@ int main(int argc, char** argv) {
     const uint64_t sent = replay.stats().frame_packets_sent.load() - sent_before;
     const uint64_t replay_dropped = replay.stats().frames_dropped.load() - replay_dropped_before;
     const auto [cpu_total, peak_rss_kb] = process_usage(pid);
-    const nlohmann::json per_subject =
-        bench::per_subject_report(subjects, thread_cpu_before, bench::thread_cpu_seconds(pid), health_before, health, seconds);
+    const std::map<std::string, double> thread_cpu_after = bench::thread_cpu_seconds(pid);
     const double own_cpu_seconds = process_usage(getpid()).first - own_cpu_before;
     const double cpu_seconds = cpu_total - cpu_before;
     kill(pid, SIGTERM);
@@ -400,11 +400,19 @@ int main(int argc, char** argv) {
     SubscriberTally all;
     long total_dropped = 0;
     nlohmann::json per_subscriber = nlohmann::json::array();
-    for (const SubscriberTally& tally : tallies) {
+    std::vector<SubscriberTally> by_subject(static_cast<size_t>(subjects));  // subscriber s follows subject s mod N
+    for (size_t s = 0; s < tallies.size(); ++s) {
+      const SubscriberTally& tally = tallies[s];
       all.add(tally);
+      by_subject[s % by_subject.size()].add(tally);
       total_dropped += tally.dropped();
       per_subscriber.push_back({{"received", tally.received}, {"dropped", tally.dropped()}, {"longest_gap_ms", tally.longest_gap_ms}});
     }
+    std::vector<nlohmann::json> subject_subscribers;
+    for (SubscriberTally& t : by_subject)
+      subject_subscribers.push_back({{"received", t.received}, {"end_to_end", t.end_to_end.summary()}, {"daemon_processing", t.processing.summary()}});
+    const nlohmann::json per_subject = bench::per_subject_report(subjects, thread_cpu_before, thread_cpu_after, health_before, health,
+                                                                 subject_subscribers, seconds);
     auto delta = [&](const char* key) { return health["frames"][key].get<uint64_t>() - health_before["frames"][key].get<uint64_t>(); };
     // CPU: the measured window only; peak RSS: the daemon's whole life.
     const nlohmann::json report = {
@@ -484,9 +492,10 @@ int main(int argc, char** argv) {
       }
       std::printf("frames: %s\n", report["frames"].dump().c_str());
       for (const auto& row : per_subject["subjects"])
-        std::printf("subject %s: %.0f%% of one core, receive to publish p99 <= %.3f ms, frames %s\n",
+        std::printf("subject %s: %.0f%% of one core, end to end p50 %.3f ms p99 %.3f ms (%ld frames to its subscribers), frames %s\n",
                     row["name"].get<std::string>().c_str(), 100 * row["cpu_share_of_one_core"].get<double>(),
-                    row["daemon_stages_ms"]["receive_to_publish"]["p99_le"].get<double>(), row["frames"].dump().c_str());
+                    row["subscribers"]["end_to_end"]["p50_ms"].get<double>(), row["subscribers"]["end_to_end"]["p99_ms"].get<double>(),
+                    row["subscribers"]["received"].get<long>(), row["frames"].dump().c_str());
       std::printf("daemon: %.2f s CPU (%.0f%% of one core), peak RSS %ld kB, RSS %ld kB after 1 s and %ld kB at the end\n",
                   cpu_seconds, 100 * cpu_seconds / seconds, peak_rss_kb, rss_samples.empty() ? 0L : rss_samples.front(),
                   rss_samples.empty() ? 0L : rss_samples.back());

@@ -46,6 +46,15 @@ std::vector<std::string> daemon_subject_arguments(const std::string& subject_fil
   return out;
 }
 
+subscriber::Hello subscriber_hello(int index, int subjects, uint32_t wants) {
+  if (subjects <= 1) return {.wants = wants};
+  const bool quantised = wants & subscriber::kWantQuantised;
+  return {.wants = wants & ~subscriber::kWantQuantised,
+          .version = subscriber::kVersion2,
+          .encoding = static_cast<uint32_t>(quantised ? subscriber::Encoding::Quantised : subscriber::Encoding::Float),
+          .subject = "Actor" + std::to_string(index % subjects + 1)};
+}
+
 double cpu_seconds_of_stat(const std::string& text) {
   const size_t close = text.rfind(')');
   if (close == std::string::npos || close + 2 > text.size()) return 0.0;
@@ -77,7 +86,7 @@ std::map<std::string, double> thread_cpu_seconds(pid_t pid) {
 
 nlohmann::json per_subject_report(int subjects, const std::map<std::string, double>& cpu_before,
                                   const std::map<std::string, double>& cpu_after, const nlohmann::json& health_before,
-                                  const nlohmann::json& health_after, double seconds) {
+                                  const nlohmann::json& health_after, const std::vector<nlohmann::json>& subscribers, double seconds) {
   std::vector<double> subject_cpu(static_cast<size_t>(subjects), 0.0);
   nlohmann::json shared = nlohmann::json::object();
   for (const auto& [name, after] : cpu_after) {
@@ -98,6 +107,7 @@ nlohmann::json per_subject_report(int subjects, const std::map<std::string, doub
                     {"cpu_share_of_one_core", subject_cpu[static_cast<size_t>(k)] / seconds},
                     {"frames", {{"received", delta("received")}, {"published", delta("published")}, {"dropped", delta("dropped")}}},
                     {"deform", now["deform"]},
+                    {"subscribers", k < static_cast<int>(subscribers.size()) ? subscribers[static_cast<size_t>(k)] : nlohmann::json()},
                     // The daemon's histograms over its whole life (warm-up included): upper bounds.
                     {"daemon_stages_ms", now["latency_ms"]}});
   }

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "core/capture.h"
+#include "protocol/subscriber_stream.h"
 #include "protocol/vicon_capture_encoder.h"
 
 namespace skinstream::bench {
@@ -27,17 +28,23 @@ ReplayStage replay_stage(const Capture& recording, int subjects, double spacing_
 // skinstreamd's --subject arguments: the file as it is for one subject, ActorK=FILE for several.
 std::vector<std::string> daemon_subject_arguments(const std::string& subject_file, int subjects);
 
+// The Hello of subscriber `index` (wants in version 1's form, kWantQuantised included): with one
+// subject, version 1 as before; with several, version 2 naming Actor(index mod subjects + 1), so
+// the subscribers spread over the subjects.
+subscriber::Hello subscriber_hello(int index, int subjects, uint32_t wants);
+
 // CPU seconds (user + system) in the text of a /proc/PID/stat or /proc/PID/task/TID/stat.
 double cpu_seconds_of_stat(const std::string& text);
 
 // CPU seconds (user + system) of each of a process's threads, summed by thread name.
 std::map<std::string, double> thread_cpu_seconds(pid_t pid);
 
-// Per subject over the window: its threads' CPU share of one core, and the daemon's own figures
-// for it (/health's subjects: frames and stage latencies); plus the threads no subject owns (io,
-// publish-N) and the mean share a subject costs.
+// Per subject over the window: its threads' CPU share of one core, its subscribers' figures
+// (`subscribers[k]`, as measured by them) and the daemon's own figures for it (/health's subjects:
+// frames and stage latencies); plus the threads no subject owns (io, publish-N) and the mean
+// share a subject costs.
 nlohmann::json per_subject_report(int subjects, const std::map<std::string, double>& cpu_before,
                                   const std::map<std::string, double>& cpu_after, const nlohmann::json& health_before,
-                                  const nlohmann::json& health_after, double seconds);
+                                  const nlohmann::json& health_after, const std::vector<nlohmann::json>& subscribers, double seconds);
 
 }  // namespace skinstream::bench

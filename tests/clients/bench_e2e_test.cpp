@@ -92,11 +92,12 @@ TEST(BenchProgram, ShortRunReportsEveryFrameItCounted) {
   EXPECT_EQ(j["daemon"]["exit_status"], 0);  // SIGTERM stops it cleanly
 }
 
-// --subjects 2: two actors (the recording twice, apart), each followed by the daemon and
-// reported with its own threads' CPU and frames; the io and publish threads are nobody's.
-TEST(BenchProgram, SeveralSubjectsAreEachReportedWithTheirOwnThreads) {
+// --subjects 2: two actors (the recording twice, apart), each followed by the daemon, with a
+// subscriber each, and reported with its own threads' CPU, frames and its subscriber's latency;
+// the io and publish threads are nobody's.
+TEST(BenchProgram, SeveralSubjectsAreEachReportedWithTheirOwnThreadsAndSubscribers) {
   const test::ProgramRun r = test::run_program(
-      bench("--subject " + kDemo + "/subject.sksubj --recording " + kDemo + "/live.c3d --seconds 2 --subjects 2 --json"),
+      bench("--subject " + kDemo + "/subject.sksubj --recording " + kDemo + "/live.c3d --seconds 2 --subjects 2 --subscribers 2 --json"),
       /*stderr_too=*/false);
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const auto j = nlohmann::json::parse(r.output);
@@ -110,9 +111,14 @@ TEST(BenchProgram, SeveralSubjectsAreEachReportedWithTheirOwnThreads) {
     EXPECT_GT(rows[k]["frames"]["received"].get<long>(), 0);
     EXPECT_GT(rows[k]["cpu_share_of_one_core"].get<double>(), 0.0);
     EXPECT_EQ(rows[k]["deform"]["threads"], 2);
+    EXPECT_GT(rows[k]["subscribers"]["received"].get<long>(), 0);
+    EXPECT_LE(rows[k]["subscribers"]["end_to_end"]["count"].get<long>(), rows[k]["subscribers"]["received"].get<long>());
+    EXPECT_LE(rows[k]["subscribers"]["end_to_end"]["p50_ms"].get<double>(), rows[k]["subscribers"]["end_to_end"]["p99_ms"].get<double>());
     total += rows[k]["cpu_share_of_one_core"].get<double>();
   }
   EXPECT_DOUBLE_EQ(j["per_subject"]["mean_cpu_share_per_subject"].get<double>(), total / 2);
+  EXPECT_EQ(rows[0]["subscribers"]["received"].get<long>() + rows[1]["subscribers"]["received"].get<long>(),
+            j["frames"]["received_by_subscribers"].get<long>());
   EXPECT_TRUE(j["per_subject"]["shared_threads_cpu_share"].contains("io")) << j["per_subject"].dump();
   EXPECT_FALSE(j["per_subject"]["shared_threads_cpu_share"].contains("pipeline-0"));
   EXPECT_EQ(j["daemon"]["exit_status"], 0);
