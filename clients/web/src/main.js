@@ -2,12 +2,13 @@
 // the page draws the newest frame on each animation frame and keeps the status bar and banner
 // current.
 import * as THREE from 'three';
-import { Wants, Decoded, FrameHeader, decodeFrameArrays } from './protocol.js';
+import { Wants, Decoded, FrameHeader, SourceState, decodeFrameArrays } from './protocol.js';
 import { ViewerScene } from './viewer_scene.js';
 import { BodyMesh } from './body_mesh.js';
 import { MarkerOverlay } from './marker_overlay.js';
 import { StatusBar } from './status_bar.js';
 import { installToggles } from './toggles.js';
+import { chosenSubject, installSubjectPicker } from './subject_picker.js';
 
 const SAMPLED_POINTS = 8;
 const STATUS_INTERVAL_MS = 250;
@@ -19,6 +20,7 @@ const params = new URLSearchParams(window.location.search);
 // Quantised by default: half the bytes (640 kB a frame for 53,500 vertices with normals),
 // measured 2.5x more frames reaching a software-WebGL page; positions stay within 0.03 mm.
 const quantised = params.get('quantised') !== '0';
+const version2 = chosenSubject(params, quantised);
 const streamUrl = params.get('stream') ||
   `${window.location.protocol === 'https:' ? 'wss:' : 'ws:'}//${window.location.host}/stream`;
 
@@ -183,13 +185,17 @@ function statusSnapshot() {
 function updateStatus() {
   statusBar.show(statusSnapshot());
   const state = stats ? stats.connectionState : 'connecting';
-  if (state === 'closed') {
+  const status = stats ? stats.status : null;
+  if (status && status.state === SourceState.REFUSED) {
+    statusBar.showBanner('error', `The daemon refused this page: ${status.detail}`);
+  } else if (status && status.subject && !status.subjectPresent && status.state === SourceState.STREAMING) {
+    statusBar.showBanner('source', `Subject ${status.subject} is not in the stream; waiting for it.`);
+  } else if (state === 'closed') {
     const seconds = (stats.retryInMs / 1000).toFixed(1);
     statusBar.showBanner('connection', `Connection to the daemon closed (${stats.closeReason}). Reconnecting in ${seconds} s…`);
   } else if (state === 'connecting') {
     statusBar.showBanner('connection', `Connecting to ${streamUrl}…`);
   } else if (stats.sourceGone) {
-    const status = stats.status;
     const why = status && status.state >= 2 ? `the daemon reports the source ${status.stateName}${status.detail ? ` (${status.detail})` : ''}`
       : 'no frames for over 1 s';
     statusBar.showBanner('source', `Source gone: ${why}.`);
@@ -226,12 +232,15 @@ window.skinstreamViewer = Object.freeze({
   get reconnects() { return stats ? stats.reconnects : 0; },
   get sourceState() { return stats && stats.status ? stats.status.stateName : 'unknown'; },
   get quantised() { return quantised; },
+  get subject() { return meshInfo ? meshInfo.subject : ''; },
   get webgl() { return viewerScene !== null; },
   get webglVersion() { return viewerScene ? (viewerScene.renderer.capabilities.isWebGL2 ? 2 : 1) : 0; },
   get bannerText() { return banner.hidden ? '' : banner.textContent; },
 });
 
-worker.postMessage({ kind: 'start', url: streamUrl, wants: Wants.NORMALS | Wants.MARKERS | Wants.PACED | (quantised ? Wants.QUANTISED : 0) });
+worker.postMessage({ kind: 'start', url: streamUrl, wants: Wants.NORMALS | Wants.MARKERS | Wants.PACED | (quantised ? Wants.QUANTISED : 0),
+  version2 });
+installSubjectPicker(document.getElementById('panel'), params);
 setInterval(updateStatus, STATUS_INTERVAL_MS);
 updateStatus();
 requestAnimationFrame(animate);

@@ -1,9 +1,12 @@
-// The subscriber protocol, version 1 (docs/subscriber-protocol.md): one protocol message per
-// binary WebSocket message. Everything is little-endian; DataView reads are used throughout, so
-// the decoder does not depend on the host's byte order or on alignment (MeshInfo is unaligned).
+// The subscriber protocol (docs/subscriber-protocol.md): one protocol message per binary
+// WebSocket message. Everything is little-endian; DataView reads are used throughout, so the
+// decoder does not depend on the host's byte order or on alignment (MeshInfo is unaligned).
+// Version 1, and version 2's float and quantised encodings: a page naming a subject speaks
+// version 2, and every message says its version in its header.
 
 export const MAGIC = 0x46534b53; // "SKSF" read as a little-endian u32
 export const PROTOCOL_VERSION = 1;
+export const VERSION_2 = 2;
 export const HEADER_BYTES = 12;
 export const MAX_PAYLOAD_BYTES = 64 * 1024 * 1024;
 
@@ -21,11 +24,18 @@ export const NO_PART = 255;
 // Which arrays decodeFrameArrays wrote.
 export const Decoded = Object.freeze({ POSITIONS: 1, NORMALS: 2, MARKERS: 4 });
 
-export const SourceState = Object.freeze({ CONNECTING: 0, STREAMING: 1, DISCONNECTED: 2, FINISHED: 3 });
-export const SOURCE_STATE_NAMES = ['connecting', 'streaming', 'disconnected', 'finished'];
+// REFUSED (version 2): the daemon refuses this subscriber (e.g. a subject it does not serve).
+export const SourceState = Object.freeze({ CONNECTING: 0, STREAMING: 1, DISCONNECTED: 2, FINISHED: 3, REFUSED: 4 });
+export const SOURCE_STATE_NAMES = ['connecting', 'streaming', 'disconnected', 'finished', 'refused'];
+// Version 2: how positions are sent.
+export const Encoding = Object.freeze({ FLOAT: 0, QUANTISED: 1, COMPRESSED: 2, PARAMETERS: 3 });
+const TIMECODE_FLAG = 0x80; // version 2 Frames: the timecode fields hold the source's timecode
 
-// Size of the fixed Frame fields before the arrays.
+// Size of the fixed Frame fields before the arrays (version 2 adds 16 bytes of timecode).
 const FRAME_FIXED_BYTES = 4 + 4 + 8 + 8 + 8 + 4 + 4 + 2 + 2 + 4 + 4;
+const frameFixedBytes = (version) => FRAME_FIXED_BYTES + (version >= VERSION_2 ? 16 : 0);
+// The version a message's header says.
+export const messageVersion = (view) => view.getUint16(4, true);
 
 // A message that breaks the spec: the connection must be closed.
 export class ProtocolError extends Error {
@@ -47,9 +57,31 @@ function encodeU32Message(type, value) {
   return buffer;
 }
 
-export function encodeHello(wants) {
+const utf8Encoder = new TextEncoder();
+
+// Version 1 without `version2`; with it ({ subject, encoding, token }), version 2: the wants
+// without the quantised bit (the encoding says it), the encoding, the subject's name ('' = the
+// daemon's first) and the daemon's token ('' = none).
+export function encodeHello(wants, version2 = null) {
   if ((wants & ~0x1f) !== 0) throw new ProtocolError(`Hello wants 0x${wants.toString(16)} has unknown bits`);
-  return encodeU32Message(MessageType.HELLO, wants);
+  if (version2 === null) return encodeU32Message(MessageType.HELLO, wants);
+  const subject = utf8Encoder.encode(version2.subject || '');
+  const token = utf8Encoder.encode(version2.token || '');
+  if (subject.length > 256 || token.length > 256) throw new ProtocolError('Hello subject and token are at most 256 bytes');
+  const payload = 8 + 2 + subject.length + 2 + token.length;
+  const buffer = new ArrayBuffer(HEADER_BYTES + payload);
+  const view = new DataView(buffer);
+  view.setUint32(0, MAGIC, true);
+  view.setUint16(4, VERSION_2, true);
+  view.setUint16(6, MessageType.HELLO, true);
+  view.setUint32(8, payload, true);
+  view.setUint32(12, wants & ~Wants.QUANTISED, true);
+  view.setUint32(16, version2.encoding || Encoding.FLOAT, true);
+  view.setUint16(20, subject.length, true);
+  new Uint8Array(buffer, 22, subject.length).set(subject);
+  view.setUint16(22 + subject.length, token.length, true);
+  new Uint8Array(buffer, 24 + subject.length, token.length).set(token);
+  return buffer;
 }
 
 export function encodeAck(frameNumber) {
@@ -62,7 +94,7 @@ export function readHeader(view) {
   const magic = view.getUint32(0, true);
   if (magic !== MAGIC) throw new ProtocolError(`bad magic 0x${magic.toString(16)}`);
   const version = view.getUint16(4, true);
-  if (version !== PROTOCOL_VERSION) throw new ProtocolError(`protocol version ${version}, expected ${PROTOCOL_VERSION}`);
+  if (version !== PROTOCOL_VERSION && version !== VERSION_2) throw new ProtocolError(`protocol version ${version}, expected 1 or 2`);
   const type = view.getUint16(6, true);
   if (type < MessageType.HELLO || type > MessageType.STATUS) throw new ProtocolError(`unknown message type ${type}`);
   const payload = view.getUint32(8, true);
@@ -98,6 +130,7 @@ class PayloadReader {
     this.offset += count;
     return b;
   }
+  string(field) { const length = this.u16(`${field} length`); return utf8.decode(this.bytes(length, field)); }
   expectEnd() {
     if (this.offset !== this.view.byteLength) {
       throw new ProtocolError(`${this.what} has ${this.view.byteLength - this.offset} unexpected trailing bytes`);
@@ -132,25 +165,30 @@ export function decodeMeshInfo(view) {
     }
   }
   const markerNames = new Array(markerCount);
-  for (let i = 0; i < markerCount; ++i) {
-    const length = r.u16('marker name length');
-    markerNames[i] = utf8.decode(r.bytes(length, 'marker name'));
-  }
+  for (let i = 0; i < markerCount; ++i) markerNames[i] = r.string('marker name');
+  // Version 2: the subject and the encoding served.
+  const version2 = messageVersion(view) >= VERSION_2;
+  const subject = version2 ? r.string('subject') : '';
+  const encoding = version2 ? r.u32('encoding') : Encoding.FLOAT;
   r.expectEnd();
-  return { vertexCount, faceCount, markerCount, partCount, sourceRateHz, faces, dominantPart, markerTriangles, markerNames };
+  return { vertexCount, faceCount, markerCount, partCount, sourceRateHz, faces, dominantPart, markerTriangles, markerNames, subject, encoding };
 }
 
 export function decodeStatus(view) {
   const r = new PayloadReader(view, 'Status');
+  const version2 = messageVersion(view) >= VERSION_2;
   const state = r.u32('source state');
-  if (state > SourceState.FINISHED) throw new ProtocolError(`Status has unknown source state ${state}`);
+  if (state > (version2 ? SourceState.REFUSED : SourceState.FINISHED)) throw new ProtocolError(`Status has unknown source state ${state}`);
   const sourceRateHz = r.f32('source_rate_hz');
   const framesReceived = r.u64('frames received');
   const framesPublished = r.u64('frames published');
-  const detailLength = r.u16('detail length');
-  const detail = utf8.decode(r.bytes(detailLength, 'detail'));
+  const detail = r.string('detail');
+  // Version 2: the subject, whether it is in the source's latest frames, the encoding served.
+  const subject = version2 ? r.string('subject') : '';
+  const subjectPresent = version2 ? r.u32('subject present') !== 0 : true;
+  const encoding = version2 ? r.u32('encoding') : Encoding.FLOAT;
   r.expectEnd();
-  return { state, stateName: SOURCE_STATE_NAMES[state], sourceRateHz, framesReceived, framesPublished, detail };
+  return { state, stateName: SOURCE_STATE_NAMES[state], sourceRateHz, framesReceived, framesPublished, detail, subject, subjectPresent, encoding };
 }
 
 // The fixed fields of a Frame, read in place into a reused object (no allocation per frame).
@@ -167,11 +205,13 @@ export class FrameHeader {
     this.markersRelabelled = 0;
     this.framesDroppedPipeline = 0;
     this.framesDroppedSubscriber = 0;
+    this.fixedBytes = FRAME_FIXED_BYTES; // of this frame's version
   }
 
   // Reads the fixed fields and checks that the arrays the flags announce fit the message exactly.
   read(view) {
-    if (view.byteLength < HEADER_BYTES + FRAME_FIXED_BYTES) {
+    this.fixedBytes = frameFixedBytes(messageVersion(view));
+    if (view.byteLength < HEADER_BYTES + this.fixedBytes) {
       throw new ProtocolError(`Frame of ${view.byteLength} bytes is shorter than its fixed fields`);
     }
     let o = HEADER_BYTES;
@@ -186,8 +226,10 @@ export class FrameHeader {
     this.markersRelabelled = view.getUint16(o, true); o += 2;
     this.framesDroppedPipeline = view.getUint32(o, true); o += 4;
     this.framesDroppedSubscriber = view.getUint32(o, true); o += 4;
-    if ((this.flags & ~0xf) !== 0) throw new ProtocolError(`Frame ${this.frameNumber} has unknown flags 0x${this.flags.toString(16)}`);
-    const expected = frameBytes(this.flags, this.vertexCount, this.markerCount);
+    // Version 2's timecode (bit 7) is read past; its other encodings are not asked for.
+    const known = this.fixedBytes > FRAME_FIXED_BYTES ? 0xf | TIMECODE_FLAG : 0xf;
+    if ((this.flags & ~known) !== 0) throw new ProtocolError(`Frame ${this.frameNumber} has unknown flags 0x${this.flags.toString(16)}`);
+    const expected = frameBytes(this.flags, this.vertexCount, this.markerCount, this.fixedBytes);
     if (expected !== view.byteLength) {
       throw new ProtocolError(`Frame ${this.frameNumber} is ${view.byteLength} bytes, its flags and counts need ${expected}`);
     }
@@ -198,10 +240,10 @@ export class FrameHeader {
 const paddingTo4 = (bytes) => (4 - (bytes % 4)) % 4;
 
 // Total message size a Frame must have for these flags and counts.
-export function frameBytes(flags, vertexCount, markerCount) {
+export function frameBytes(flags, vertexCount, markerCount, fixedBytes = FRAME_FIXED_BYTES) {
   const quantised = (flags & FrameFlags.QUANTISED) !== 0;
   const quantisedBlock = 6 * vertexCount + paddingTo4(6 * vertexCount);
-  let bytes = HEADER_BYTES + FRAME_FIXED_BYTES;
+  let bytes = HEADER_BYTES + fixedBytes;
   if ((flags & FrameFlags.NO_POSITIONS) === 0) bytes += quantised ? 24 + quantisedBlock : 12 * vertexCount;
   if ((flags & FrameFlags.NORMALS) !== 0) bytes += quantised ? quantisedBlock : 12 * vertexCount;
   if ((flags & FrameFlags.MARKERS) !== 0) bytes += 13 * markerCount + paddingTo4(markerCount);
@@ -211,7 +253,7 @@ export function frameBytes(flags, vertexCount, markerCount) {
 // Decodes the arrays of a Frame whose header was read by FrameHeader.read into the caller's
 // preallocated arrays. Returns which arrays were written, as Decoded bits.
 export function decodeFrameArrays(view, header, out) {
-  let o = HEADER_BYTES + FRAME_FIXED_BYTES;
+  let o = HEADER_BYTES + header.fixedBytes;
   const V = header.vertexCount;
   const quantised = (header.flags & FrameFlags.QUANTISED) !== 0;
   let written = 0;

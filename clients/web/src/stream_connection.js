@@ -10,9 +10,10 @@ const MAX_RETRY_MS = 5000;
 
 export class StreamConnection {
   // listener: { onOpen(), onMessage(ArrayBuffer), onClose(reason, retryInMs) }
-  constructor(url, wants, listener) {
+  // version2: null for a version 1 Hello, else { subject, encoding } (protocol.js encodeHello).
+  constructor(url, wants, listener, version2 = null) {
     this.url = url;
-    this.hello = encodeHello(wants);
+    this.hello = encodeHello(wants, version2);
     this.paced = (wants & Wants.PACED) !== 0;
     this.listener = listener;
     this.state = ConnectionState.CLOSED;

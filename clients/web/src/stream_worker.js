@@ -2,7 +2,8 @@
 // software WebGL) never stops the socket from being drained. The daemon's queue then stays
 // short and the page always gets the newest frame instead of a backlog seconds old.
 //
-// Page -> worker: { kind: 'start', url, wants }, { kind: 'ready' } (the page can take a frame).
+// Page -> worker: { kind: 'start', url, wants, version2 }, { kind: 'ready' } (the page can take a
+// frame); version2: null, or the subject and encoding of a version 2 Hello.
 // Worker -> page: { kind: 'meshInfo', meshInfo }, { kind: 'frame', buffer } (transferred),
 //                 { kind: 'stats', ... } four times a second.
 import { StreamConnection } from './stream_connection.js';
@@ -72,7 +73,7 @@ self.onmessage = (event) => {
         retryAtMs = wallClockMs() + retryInMs;
         postStats();
       },
-    });
+    }, message.version2 || null);
     connection.start();
     setInterval(postStats, STATS_INTERVAL_MS);
   }

@@ -1,7 +1,8 @@
 // The browser live preview against the real daemon: starts skinstreamd replaying a recording in a
 // loop, opens the page it serves in the system Chromium (headless, WebGL through SwiftShader),
 // and checks that frames arrive, are drawn and move, that the status bar shows the source rate,
-// and that stopping the daemon puts up the banner.
+// that a page naming the subject (protocol version 2) is served it and one naming an unknown
+// subject is told it was refused, and that stopping the daemon puts up the banner.
 //
 // node viewer_test.mjs --daemon BIN --subject FILE --recording FILE --web-root DIR --out DIR
 //                      [--cli SKINSTREAM] [--chromium /usr/bin/chromium]
@@ -83,6 +84,30 @@ async function checkGoldenFixtures() {
   assert.equal(status.framesReceived, 1000);
   assert.equal(status.detail, 'vicon 127.0.0.1:801: connection refused');
 
+  // Version 2 (a page naming a subject): Hello, MeshInfo and Status with the subject, a Frame with
+  // the timecode before its arrays.
+  assert.deepEqual(new Uint8Array(protocol.encodeHello(protocol.Wants.NORMALS | protocol.Wants.MARKERS | protocol.Wants.PACED,
+    { subject: 'Actor2', encoding: protocol.Encoding.PARAMETERS, token: 'stage-token' })),
+  new Uint8Array(read('hello_v2.bin').buffer), 'version 2 Hello bytes');
+  const infoV2 = protocol.decodeMeshInfo(read('mesh_info_v2.bin'));
+  assert.equal(infoV2.subject, 'Actor2');
+  assert.equal(infoV2.encoding, protocol.Encoding.COMPRESSED);
+  assert.deepEqual(infoV2.markerNames, ['LSHO', 'RSHO', 'C7']);
+  const statusV2 = protocol.decodeStatus(read('status_v2.bin'));
+  assert.equal(statusV2.stateName, 'refused');
+  assert.equal(statusV2.subject, 'Actor3');
+  assert.equal(statusV2.subjectPresent, false);
+  const frameV2 = read('frame_v2_float.bin');
+  const headerV2 = new protocol.FrameHeader();
+  headerV2.read(frameV2);
+  assert.equal(headerV2.frameNumber, 1234);
+  assert.equal(headerV2.framesDroppedSubscriber, 2);
+  const outV2 = { positions: new Float32Array(9), normals: new Float32Array(0), markers: new Float32Array(6), markerStatus: new Uint8Array(2) };
+  protocol.decodeFrameArrays(frameV2, headerV2, outV2);
+  close(outV2.positions, positions, 'version 2 positions');
+  close(outV2.markers, markers, 'version 2 markers');
+  assert.deepEqual(Array.from(outV2.markerStatus), [0, 2], 'version 2 marker status');
+
   // A receiver rejects a corrupt header and a truncated message.
   const bad = read('frame_float.bin');
   bad.setUint8(0, 0x58);
@@ -156,6 +181,8 @@ const paintedPixels = (page) => page.evaluate(() => {
 
 async function main() {
   const options = parseArguments(process.argv.slice(2));
+  // The daemon calls a subject file given without a name by the file's stem.
+  options.subjectName = path.parse(options.subject).name;
   await checkGoldenFixtures();
   if (!fs.existsSync(options.chromium)) {
     throw new Error(`chromium not found at ${options.chromium} (Debian 12: apt-get install chromium)`);
@@ -319,6 +346,19 @@ async function main() {
     assert.equal(float.vertexCount, after.vertexCount);
     assert.ok(float.samplePositions.every(Number.isFinite), 'float sample positions not finite');
     await floatPage.close();
+
+    // A page naming the subject speaks version 2 and shows its subject in the menu; a name the
+    // daemon does not serve is refused, and the page says so.
+    const named = await browser.newPage({ viewport: { width: 480, height: 360 } });
+    named.on('pageerror', (error) => pageErrors.push(`named page: ${error.message}`));
+    await named.goto(`${url}?subject=${encodeURIComponent(options.subjectName)}`);
+    await waitUntil(named, 'the page naming its subject rendered no frame', () => window.skinstreamViewer && window.skinstreamViewer.framesRendered > 2);
+    assert.equal(await named.evaluate(() => window.skinstreamViewer.subject), options.subjectName);
+    assert.equal(await named.evaluate(() => document.getElementById('subject').value), options.subjectName);
+    await named.goto(`${url}?subject=Nobody`);
+    await waitUntil(named, 'no refusal shown for an unknown subject', () => /refused/.test(window.skinstreamViewer.bannerText));
+    console.log(`unknown subject: "${await named.evaluate(() => window.skinstreamViewer.bannerText)}"`);
+    await named.close();
 
     assert.deepEqual(pageErrors, [], 'errors on the page');
 
