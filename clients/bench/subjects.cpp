@@ -103,8 +103,11 @@ nlohmann::json per_subject_report(int subjects, const std::map<std::string, doub
     const nlohmann::json& then = health_before["subjects"][k];
     auto delta = [&](const char* key) { return now["frames"][key].get<uint64_t>() - then["frames"][key].get<uint64_t>(); };
     total += subject_cpu[static_cast<size_t>(k)];
+    const uint64_t published = delta("published");
     rows.push_back({{"name", now["name"]},
                     {"cpu_share_of_one_core", subject_cpu[static_cast<size_t>(k)] / seconds},
+                    // What a frame costs: less sensitive than the share to how much CPU the machine had to give.
+                    {"cpu_ms_per_published_frame", published > 0 ? 1e3 * subject_cpu[static_cast<size_t>(k)] / static_cast<double>(published) : 0.0},
                     {"frames", {{"received", delta("received")}, {"published", delta("published")}, {"dropped", delta("dropped")}}},
                     {"deform", now["deform"]},
                     {"subscribers", k < static_cast<int>(subscribers.size()) ? subscribers[static_cast<size_t>(k)] : nlohmann::json()},
