@@ -22,7 +22,9 @@
 #include "server/daemon.h"
 #include "server/vicon/vicon_server.h"
 #include "support/io_thread.h"
+#include "support/loopback_config.h"
 #include "support/recording_match.h"
+#include "support/stalled_subscriber.h"
 #include "support/test_data.h"
 #include "support/wait_until.h"
 
@@ -91,14 +93,9 @@ class StageServer {
 };
 
 DaemonConfig stage_config(uint16_t vicon_port) {
-  DaemonConfig config;
+  DaemonConfig config = test::loopback_config();
   config.subjects = {{"Actor1", stage().subject_path}, {"Actor2", stage().subject_path}};
   config.vicon = "127.0.0.1:" + std::to_string(vicon_port);
-  config.bind_address = "127.0.0.1";
-  config.http_port = 0;
-  config.sub_port = 0;
-  config.hello_timeout_ms = 200;
-  config.log_level = "warn";
   return config;
 }
 
@@ -303,13 +300,9 @@ TEST(DaemonSubjects, AStalledSubscriberOfOneSubjectDoesNotSlowTheOthersSubscribe
   config.max_frame_wait_ms = 1000;       // nor waits that long on a busy machine
   Daemon daemon(config);
   daemon.start_serving();
-  // Actor1's subscriber asks for markers and never reads; its receive buffer is tiny.
+  // Actor1's subscriber asks for markers and never reads.
   asio::io_context io;
-  tcp::socket stalled(io);
-  stalled.open(tcp::v4());
-  stalled.set_option(asio::socket_base::receive_buffer_size(1024));
-  stalled.connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), static_cast<unsigned short>(daemon.sub_port())));
-  asio::write(stalled, asio::buffer(subscriber::encode_hello(hello_v2("Actor1"))));
+  tcp::socket stalled = test::stalled_subscriber(io, daemon.sub_port(), subscriber::encode_hello(hello_v2("Actor1")));
   wait_until([&] { return daemon.subject(0).hub().wanted_encodings() != 0; });
   daemon.start_source();
   auto stalled_dropped = [&] {

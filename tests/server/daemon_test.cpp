@@ -21,6 +21,8 @@
 #include "server/publish/subscriber_hub.h"
 #include "server/tcp_congestion.h"
 #include "support/socket_lookup.h"
+#include "support/loopback_config.h"
+#include "support/stalled_subscriber.h"
 #include "support/test_data.h"
 #include "support/thread_names.h"
 #include "support/wait_until.h"
@@ -56,14 +58,9 @@ const Fixture& fixture() {
 }
 
 DaemonConfig test_config() {
-  DaemonConfig config;
+  DaemonConfig config = test::loopback_config();
   config.subjects = {{"", fixture().subject_path}};
   config.replay = fixture().take_path;
-  config.bind_address = "127.0.0.1";
-  config.http_port = 0;
-  config.sub_port = 0;
-  config.hello_timeout_ms = 200;
-  config.log_level = "warn";
   return config;
 }
 
@@ -186,13 +183,9 @@ TEST(Daemon, StalledSubscriberDoesNotHoldBackTheOthers) {
   Daemon daemon(config);
   daemon.start_serving();
 
-  // The stalled subscriber asks for everything and never reads; its receive buffer is tiny.
+  // The stalled subscriber asks for markers and never reads.
   asio::io_context io;
-  tcp::socket stalled(io);
-  stalled.open(tcp::v4());
-  stalled.set_option(asio::socket_base::receive_buffer_size(1024));
-  stalled.connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), static_cast<unsigned short>(daemon.sub_port())));
-  asio::write(stalled, asio::buffer(subscriber::encode_hello({.wants = subscriber::kWantMarkers})));
+  tcp::socket stalled = test::stalled_subscriber(io, daemon.sub_port(), subscriber::encode_hello({.wants = subscriber::kWantMarkers}));
   wait_until([&] { return daemon.subject(0).hub().wanted_encodings() != 0; });
 
   daemon.start_source();
