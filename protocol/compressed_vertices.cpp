@@ -34,11 +34,38 @@ T get(const unsigned char*& at) {
   return value;
 }
 
+// The identity when `order` is empty; otherwise checked to be a permutation of 0..count-1.
+std::vector<uint32_t> checked_order(std::vector<uint32_t> order, int count) {
+  if (order.empty()) {
+    order.resize(static_cast<size_t>(count));
+    for (int v = 0; v < count; ++v) order[v] = static_cast<uint32_t>(v);
+    return order;
+  }
+  std::vector<char> seen(static_cast<size_t>(count), 0);
+  bool permutation = order.size() == static_cast<size_t>(count);
+  for (size_t i = 0; permutation && i < order.size(); ++i) {
+    permutation = order[i] < static_cast<uint32_t>(count) && !seen[order[i]];
+    if (permutation) seen[order[i]] = 1;
+  }
+  if (!permutation) throw std::invalid_argument("the compressed vertex order is not a permutation of the " + std::to_string(count) + " vertices");
+  return order;
+}
+
 }  // namespace
 
-CompressedVertexEncoder::CompressedVertexEncoder(int vertex_count, int key_interval, float margin_mm)
+std::vector<uint32_t> compressed_vertex_order(std::span<const float> reference_positions) {
+  const size_t v = reference_positions.size() / 3;
+  std::vector<unsigned int> remap(v);  // remap[vertex] = its position in the order
+  if (v > 0) meshopt_spatialSortRemap(remap.data(), reference_positions.data(), v, 3 * sizeof(float));
+  std::vector<uint32_t> order(v);
+  for (size_t i = 0; i < v; ++i) order[remap[i]] = static_cast<uint32_t>(i);
+  return order;
+}
+
+CompressedVertexEncoder::CompressedVertexEncoder(int vertex_count, std::vector<uint32_t> order, int key_interval, float margin_mm)
     : vertex_count_(vertex_count), key_interval_(std::max(key_interval, 1)), margin_mm_(std::max(margin_mm, 0.0f)) {
   if (vertex_count < 0) throw std::invalid_argument("CompressedVertexEncoder: negative vertex count");
+  order_ = checked_order(std::move(order), vertex_count);
   key_q_.assign(4 * static_cast<size_t>(vertex_count), 0);
   vertices_.assign(4 * static_cast<size_t>(vertex_count), 0);
   octahedral_in_.assign(4 * static_cast<size_t>(vertex_count), 0.0f);
@@ -69,18 +96,20 @@ size_t CompressedVertexEncoder::encode_positions(uint32_t frame_number, std::spa
   const size_t v = static_cast<size_t>(vertex_count_);
   key = since_key_ < 0 || since_key_ + 1 >= key_interval_ || key_requested_.exchange(false, std::memory_order_relaxed);
   if (!key) {
-    // On the key's grid; a coordinate that left it makes this frame a key instead.
-    for (size_t i = 0; i < v && !key; ++i)
+    // On the key's grid, as differences from the key modulo 2^16 (exact, both being on the
+    // grid); a coordinate off the grid (or not finite) makes this frame a key instead. One pass
+    // without an early exit, so that it runs in vector lanes: it was most of the encoding.
+    const float inverse[3] = {1.0f / step_[0], 1.0f / step_[1], 1.0f / step_[2]};
+    bool off_grid = false;
+    for (size_t i = 0; i < v; ++i) {
+      const float* x = &positions[3 * size_t{order_[i]}];
       for (int a = 0; a < 3; ++a) {
-        const float x = positions[3 * i + a];
-        const float q = std::isfinite(x) ? std::nearbyint((x - origin_[a]) / step_[a]) : 0.0f;
-        if (!(q >= 0.0f && q <= 65535.0f)) {
-          key = true;
-          break;
-        }
-        // The difference from the key, modulo 2^16: exact, since both are on the grid.
-        vertices_[4 * i + a] = static_cast<uint16_t>(static_cast<uint16_t>(q) - key_q_[4 * i + a]);
+        const float q = std::nearbyint((x[a] - origin_[a]) * inverse[a]);
+        off_grid |= !(q >= 0.0f && q <= 65535.0f);
+        vertices_[4 * i + a] = static_cast<uint16_t>(static_cast<uint16_t>(static_cast<int32_t>(q)) - key_q_[4 * i + a]);
       }
+    }
+    key = off_grid;
   }
   if (key) {
     float lo[3], hi[3];
@@ -97,10 +126,11 @@ size_t CompressedVertexEncoder::encode_positions(uint32_t frame_number, std::spa
       origin_[a] = lo[a] - margin_mm_;
       step_[a] = std::max((hi[a] - lo[a] + 2.0f * margin_mm_) / 65535.0f, 1e-6f);
     }
+    const float inverse[3] = {1.0f / step_[0], 1.0f / step_[1], 1.0f / step_[2]};
     for (size_t i = 0; i < v; ++i) {
+      const float* x = &positions[3 * size_t{order_[i]}];
       for (int a = 0; a < 3; ++a) {
-        const float x = positions[3 * i + a];
-        const float q = std::isfinite(x) ? std::nearbyint((x - origin_[a]) / step_[a]) : 0.0f;
+        const float q = std::isfinite(x[a]) ? std::nearbyint((x[a] - origin_[a]) * inverse[a]) : 0.0f;
         key_q_[4 * i + a] = vertices_[4 * i + a] = static_cast<uint16_t>(std::clamp(q, 0.0f, 65535.0f));
       }
     }
@@ -127,7 +157,7 @@ size_t CompressedVertexEncoder::encode_normals(std::span<const float> normals, u
   const size_t v = static_cast<size_t>(vertex_count_);
   for (size_t i = 0; i < v; ++i) {
     for (int a = 0; a < 3; ++a) {
-      const float n = normals[3 * i + a];
+      const float n = normals[3 * size_t{order_[i]} + a];
       octahedral_in_[4 * i + a] = std::isfinite(n) ? n : 0.0f;
     }
     octahedral_in_[4 * i + 3] = 0.0f;
@@ -142,8 +172,9 @@ size_t CompressedVertexEncoder::encode_normals(std::span<const float> normals, u
   return 4 + coded + padding_to_4(coded);
 }
 
-CompressedVertexDecoder::CompressedVertexDecoder(int vertex_count) : vertex_count_(vertex_count) {
+CompressedVertexDecoder::CompressedVertexDecoder(int vertex_count, std::vector<uint32_t> order) : vertex_count_(vertex_count) {
   if (vertex_count < 0) throw std::invalid_argument("CompressedVertexDecoder: negative vertex count");
+  order_ = checked_order(std::move(order), vertex_count);
   key_q_.assign(4 * static_cast<size_t>(vertex_count), 0);
   vertices_.assign(4 * static_cast<size_t>(vertex_count), 0);
   octahedral_.assign(4 * static_cast<size_t>(vertex_count), 0);
@@ -180,7 +211,7 @@ CompressedVertexDecoder::Result CompressedVertexDecoder::decode(std::span<const 
   for (size_t i = 0; i < v; ++i)
     for (int a = 0; a < 3; ++a) {
       const uint16_t q = key ? vertices_[4 * i + a] : static_cast<uint16_t>(key_q_[4 * i + a] + vertices_[4 * i + a]);
-      positions[3 * i + a] = origin_[a] + q * step_[a];
+      positions[3 * size_t{order_[i]} + a] = origin_[a] + q * step_[a];
     }
   if (!normals.empty() && !normals_block.empty()) {
     if (normals_block.size() < 4) throw DecodeError("compressed normals: block truncated");
@@ -196,7 +227,8 @@ CompressedVertexDecoder::Result CompressedVertexDecoder::decode(std::span<const 
       const float x = octahedral_[4 * i], y = octahedral_[4 * i + 1], z = octahedral_[4 * i + 2];
       const float length = std::sqrt(x * x + y * y + z * z);
       const float scale = length > 0.0f ? 1.0f / length : 0.0f;
-      normals[3 * i] = x * scale, normals[3 * i + 1] = y * scale, normals[3 * i + 2] = z * scale;
+      float* out = &normals[3 * size_t{order_[i]}];
+      out[0] = x * scale, out[1] = y * scale, out[2] = z * scale;
     }
   }
   return Result::Decoded;

@@ -4,7 +4,7 @@
 // frame to the next, key frames coded as they are and the frames between as their difference
 // from the key, both with meshoptimizer's vertex codec; normals as 8-bit octahedral vectors,
 // every frame on its own. The codec itself is lossless on the quantised values, so positions
-// come back within half a grid step (about 0.02 mm on a body) and normals within 1.25 degrees.
+// come back within half a grid step (about 0.02 mm on a body) and normals within 1.5 degrees.
 //
 // The daemon keeps one encoder per subject and codes each frame once, whoever subscribes; a
 // subscriber keeps one decoder, which must see a frame's key before it can decode the frame.
@@ -22,11 +22,17 @@ struct CompressedBlocks {
   bool key = false;
 };
 
+// The order the codec reads the vertices in: each vertex after a near neighbour in space, so that
+// the codec's differences between consecutive vertices are small (MeshInfo sends it to
+// compressed subscribers). From the reference pose; order[i] is the vertex coded i-th.
+std::vector<uint32_t> compressed_vertex_order(std::span<const float> reference_positions);
+
 class CompressedVertexEncoder {
  public:
   // A key frame at least every `key_interval` frames. The key's grid reaches `margin_mm` beyond
   // the key frame's bounding box, so the body can move that far before a key comes early.
-  explicit CompressedVertexEncoder(int vertex_count, int key_interval = 30, float margin_mm = 250.0f);
+  // `order`: the vertices' coding order (a permutation of 0..V-1; empty: their own order).
+  CompressedVertexEncoder(int vertex_count, std::vector<uint32_t> order = {}, int key_interval = 10, float margin_mm = 250.0f);
 
   // The most the blocks can take (size the output once with this).
   size_t max_bytes(bool normals) const;
@@ -45,6 +51,7 @@ class CompressedVertexEncoder {
   size_t encode_normals(std::span<const float> normals, unsigned char* out);
 
   int vertex_count_;
+  std::vector<uint32_t> order_;
   int key_interval_;
   float margin_mm_;
   std::vector<uint16_t> key_q_;      // the key frame's grid positions, 4 per vertex (x y z 0)
@@ -59,7 +66,9 @@ class CompressedVertexEncoder {
 
 class CompressedVertexDecoder {
  public:
-  explicit CompressedVertexDecoder(int vertex_count);
+  // `order` as the encoder's (MeshInfo's compressed vertex order); throws std::invalid_argument
+  // when it is not a permutation of 0..vertex_count-1.
+  CompressedVertexDecoder(int vertex_count, std::vector<uint32_t> order = {});
 
   enum class Result { Decoded, NeedsKey };
   // Decodes a frame's blocks (FrameView::positions and ::normals) into 3V floats each (normals
@@ -73,6 +82,7 @@ class CompressedVertexDecoder {
 
  private:
   int vertex_count_;
+  std::vector<uint32_t> order_;
   std::vector<uint16_t> key_q_;
   std::vector<uint16_t> vertices_;
   std::vector<int8_t> octahedral_;

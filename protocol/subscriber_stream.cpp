@@ -200,6 +200,8 @@ std::vector<unsigned char> encode_mesh_info(const MeshInfo& info, uint16_t versi
   if (version >= kVersion2) {
     put_short_string(p, info.subject);
     p.put<uint32_t>(static_cast<uint32_t>(info.encoding));
+    p.put<uint32_t>(static_cast<uint32_t>(info.compressed_order.size()));
+    p.put_bytes(info.compressed_order.data(), info.compressed_order.size() * sizeof(uint32_t));
   }
   return with_header(MessageType::MeshInfo, p, version);
 }
@@ -419,6 +421,14 @@ MeshInfo decode_mesh_info(std::span<const unsigned char> payload, uint16_t versi
     if (version >= kVersion2) {
       info.subject = get_short_string(r, "MeshInfo: subject name");
       info.encoding = encoding_of(r.get<uint32_t>(), "MeshInfo");
+      const uint32_t order = r.get<uint32_t>();
+      if (order != 0 && order != info.vertex_count)
+        throw DecodeError("MeshInfo: a compressed vertex order of " + std::to_string(order) + " for " + std::to_string(info.vertex_count) + " vertices");
+      if (order > r.remaining() / 4) throw std::out_of_range("compressed vertex order truncated");
+      info.compressed_order.resize(order);
+      r.get_array(info.compressed_order.data(), order);
+      for (uint32_t v : info.compressed_order)
+        if (v >= info.vertex_count) throw DecodeError("MeshInfo: compressed vertex order names vertex " + std::to_string(v));
     }
     return info;
   });

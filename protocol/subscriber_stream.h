@@ -114,8 +114,10 @@ struct MeshInfo {
   std::vector<std::array<uint32_t, 3>> marker_triangles;
   std::vector<std::string> marker_names;  // marker_count of them
   // Version 2 only.
-  std::string subject;
+  std::string subject{};
   Encoding encoding = Encoding::Float;  // served
+  // Compressed only (empty otherwise): the vertex coded at each place of the compressed stream.
+  std::vector<uint32_t> compressed_order{};
 };
 
 // The source's SMPTE timecode of a frame (version 2 Frames, valid with kFrameTimecode).

@@ -1,7 +1,6 @@
 #include "protocol/vicon_capture_encoder.h"
 
 #include <algorithm>
-#include <charconv>
 #include <cmath>
 #include <stdexcept>
 
@@ -10,20 +9,9 @@ namespace {
 
 constexpr double kMarkerRadiusMm = 7.0;  // a 14 mm marker; the SDK does not use it for positions
 
-// "*12" -> 12; "" (or anything unparsable) -> the channel index.
-uint32_t unlabelled_id(const std::string& label, int channel) {
-  uint32_t id = 0;
-  if (label.size() > 1 && label[0] == '*') {
-    const auto [end, ec] = std::from_chars(label.data() + 1, label.data() + label.size(), id);
-    if (ec == std::errc() && end == label.data() + label.size()) return id;
-  }
-  return static_cast<uint32_t>(channel);
-}
-
 }  // namespace
 
-CaptureFrameEncoder::CaptureFrameEncoder(std::vector<CaptureSubject> subjects, double rate_hz, bool loop)
-    : loop_(loop) {
+CaptureFrameEncoder::CaptureFrameEncoder(std::span<const ReplaySubject> subjects, double rate_hz, bool loop) : loop_(loop) {
   if (subjects.empty()) throw std::invalid_argument("no recording to stream");
   if (subjects.size() > kMaxSubjects) throw std::invalid_argument("at most " + std::to_string(kMaxSubjects) + " recordings");
   const double own_rate = subjects.front().capture->rate_hz;
@@ -31,27 +19,21 @@ CaptureFrameEncoder::CaptureFrameEncoder(std::vector<CaptureSubject> subjects, d
   stream_info_.frame_period_ticks = frame_period_ticks(rate_hz_);
   for (size_t s = 0; s < subjects.size(); ++s) {
     const Capture& capture = *subjects[s].capture;
-    if (std::abs(capture.rate_hz - own_rate) > 1e-6)
+    if (!(rate_hz > 0.0) && std::abs(capture.rate_hz - own_rate) > 1e-6)
       throw std::invalid_argument("recordings at different rates (" + subjects.front().name + " " + std::to_string(own_rate) + " Hz, " +
                                   subjects[s].name + " " + std::to_string(capture.rate_hz) + " Hz): one stream has one rate");
     Subject& subject = subjects_.emplace_back();
     subject.capture = &capture;
     subject.info.subject_id = static_cast<uint32_t>(s + 1);
-    subject.info.name = std::move(subjects[s].name);
+    subject.info.name = subjects[s].name;
+    subject.channels = replay_channels(capture);
     subject.id_base = static_cast<uint32_t>(s) << 24;
-    for (int channel = 0; channel < capture.point_count(); ++channel) {
-      if (capture.is_labelled(channel)) {
-        subject.info.markers.push_back({static_cast<uint32_t>(subject.labelled_channels.size()), capture.labels[channel]});
-        subject.labelled_channels.push_back(channel);
-      } else {
-        subject.unlabelled_channels.push_back(channel);
-        subject.unlabelled_ids.push_back(subject.id_base + unlabelled_id(capture.labels[channel], channel));
-      }
-    }
-    frame_count_ = std::max(frame_count_, capture.frame_count);
-    labeled_.reserve(labeled_.capacity() + subject.labelled_channels.size());
-    unlabeled_.reserve(unlabeled_.capacity() + subject.unlabelled_channels.size());
+    for (size_t marker = 0; marker < subject.channels.labelled.size(); ++marker)
+      subject.info.markers.push_back({static_cast<uint32_t>(marker), capture.labels[static_cast<size_t>(subject.channels.labelled[marker])]});
+    labeled_.reserve(labeled_.capacity() + subject.channels.labelled.size());
+    unlabeled_.reserve(unlabeled_.capacity() + subject.channels.unlabelled.size());
   }
+  frame_count_ = replay_frame_count(subjects);
 }
 
 ObjectEnums CaptureFrameEncoder::offered_types() {
@@ -68,7 +50,7 @@ int CaptureFrameEncoder::index_of(const Subject& subject, uint64_t sequence) con
 
 bool CaptureFrameEncoder::on_stage(const Subject& subject, int index) const {
   if (index < 0) return false;
-  for (int channel : subject.labelled_channels)
+  for (int channel : subject.channels.labelled)
     if (subject.capture->present(index, channel)) return true;
   return false;
 }
@@ -98,23 +80,23 @@ void CaptureFrameEncoder::encode_frame(uint64_t sequence, uint32_t frame_number,
     if (index < 0) continue;
     const Capture& capture = *subject.capture;
     const bool on_stage_now = (listed_now >> s) & 1u;  // else it has no labelled marker to send
-    for (size_t marker = 0; on_stage_now && marker < subject.labelled_channels.size(); ++marker) {
-      const Vec3& p = capture.at(index, subject.labelled_channels[marker]);
+    for (size_t marker = 0; on_stage_now && marker < subject.channels.labelled.size(); ++marker) {
+      const Vec3& p = capture.at(index, subject.channels.labelled[marker]);
       if (!is_present(p)) continue;  // occluded: absent from the frame
       LabeledRecon& r = labeled_.emplace_back();
       r.subject_id = subject.info.subject_id;
       r.marker_id = static_cast<uint32_t>(marker);
       r.radius = kMarkerRadiusMm;
       r.position = {p.x(), p.y(), p.z()};
-      r.trajectory_id = subject.id_base + static_cast<uint32_t>(subject.labelled_channels[marker]);
+      r.trajectory_id = subject.id_base + static_cast<uint32_t>(subject.channels.labelled[marker]);
     }
-    for (size_t k = 0; k < subject.unlabelled_channels.size(); ++k) {
-      const Vec3& p = capture.at(index, subject.unlabelled_channels[k]);
+    for (size_t k = 0; k < subject.channels.unlabelled.size(); ++k) {
+      const Vec3& p = capture.at(index, subject.channels.unlabelled[k]);
       if (!is_present(p)) continue;
       UnlabeledRecon& r = unlabeled_.emplace_back();
       r.radius = kMarkerRadiusMm;
       r.position = {p.x(), p.y(), p.z()};
-      r.trajectory_id = subject.unlabelled_ids[k];
+      r.trajectory_id = subject.id_base + subject.channels.unlabelled_ids[k];
     }
   }
   writer.add(std::span<const LabeledRecon>(labeled_));

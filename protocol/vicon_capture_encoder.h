@@ -18,31 +18,27 @@
 // (Film 24 fps, PAL 25 or ATSC 30, whichever divides the rate, with subframes).
 
 #include <cstdint>
+#include <span>
 #include <string>
 #include <vector>
 
 #include "core/capture.h"
+#include "protocol/replay_subject.h"
 #include "protocol/vicon_datastream.h"
 #include "protocol/vicon_packet_writer.h"
 
 namespace skinstream::vicon {
 
-// One recording streamed as one subject. The capture must outlive the encoder.
-struct CaptureSubject {
-  const Capture* capture = nullptr;
-  std::string name;
-};
-
 class CaptureFrameEncoder {
  public:
   static constexpr size_t kMaxSubjects = 64;  // listed() is a bit per subject
 
-  // rate_hz: the rate announced in StreamInfo (0 = the first recording's own rate). Throws
-  // std::invalid_argument for no subject, more than kMaxSubjects, or recordings whose rates
-  // differ (one stream has one rate).
-  CaptureFrameEncoder(std::vector<CaptureSubject> subjects, double rate_hz = 0.0, bool loop = false);
+  // rate_hz: the rate announced in StreamInfo (0 = the recordings' own rate). Throws
+  // std::invalid_argument for no subject, more than kMaxSubjects, or, without rate_hz,
+  // recordings whose rates differ (one stream has one rate).
+  CaptureFrameEncoder(std::span<const ReplaySubject> subjects, double rate_hz = 0.0, bool loop = false);
   CaptureFrameEncoder(const Capture& capture, std::string subject_name, double rate_hz = 0.0)
-      : CaptureFrameEncoder({{&capture, std::move(subject_name)}}, rate_hz) {}
+      : CaptureFrameEncoder(std::vector<ReplaySubject>{{std::move(subject_name), &capture}}, rate_hz) {}
 
   const StreamInfo& stream_info() const { return stream_info_; }
   double rate_hz() const { return rate_hz_; }
@@ -67,10 +63,8 @@ class CaptureFrameEncoder {
   struct Subject {
     const Capture* capture = nullptr;
     SubjectInfo info;
-    std::vector<int> labelled_channels;    // marker id -> channel
-    std::vector<int> unlabelled_channels;
-    std::vector<uint32_t> unlabelled_ids;  // per unlabelled channel
-    uint32_t id_base = 0;                  // added to its trajectory ids
+    ReplayChannels channels;  // labelled: marker id -> channel
+    uint32_t id_base = 0;     // added to its trajectory ids
   };
   int index_of(const Subject& subject, uint64_t sequence) const;  // -1: the recording has ended
   bool on_stage(const Subject& subject, int index) const;

@@ -3,6 +3,8 @@
 #include "server/pipeline/deform_cpus.h"
 #include "server/tcp_congestion.h"
 
+#include <arpa/inet.h>
+
 #include <CLI/CLI.hpp>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -49,11 +51,13 @@ SubjectConfig parse_subject(const std::string& text) {
 
 void apply_json(const nlohmann::json& json, DaemonConfig& c, const std::string& origin) {
   if (!json.is_object()) throw ConfigError(origin + ": the configuration must be a JSON object");
-  static const char* const kKeys[] = {"subject", "subjects", "replay", "replay_subject", "loop", "speed", "vicon", "vicon_pull", "vicon_multicast", "bind_address",
+  static const char* const kKeys[] = {"subject", "subjects", "replay", "replay_subject", "loop", "speed", "vicon", "vicon_pull",
+                                      "vicon_multicast", "qtm", "natnet", "natnet_interface", "bind_address",
                                       "http_port", "sub_port", "web_root", "lookahead", "max_frame_wait_ms", "deform_threads",
                                       "deform_cpus", "deform_spin_lead_us",
                                       "continuity_seconds", "use_pca", "ports_file", "log_level", "hello_timeout_ms",
-                                      "subscriber_queue_frames", "subscriber_tcp_congestion", "publish_threads", "status_interval_ms", "default_rate_hz"};
+                                      "subscriber_queue_frames", "subscriber_tcp_congestion", "publish_threads", "status_interval_ms", "default_rate_hz",
+                                      "compressed_key_interval"};
   for (const auto& [key, value] : json.items()) {
     bool known = false;
     for (const char* k : kKeys) known = known || key == k;
@@ -77,6 +81,9 @@ void apply_json(const nlohmann::json& json, DaemonConfig& c, const std::string& 
   take(json, "vicon", c.vicon, origin);
   take(json, "vicon_pull", c.vicon_pull, origin);
   take(json, "vicon_multicast", c.vicon_multicast, origin);
+  take(json, "qtm", c.qtm, origin);
+  take(json, "natnet", c.natnet, origin);
+  take(json, "natnet_interface", c.natnet_interface, origin);
   take(json, "bind_address", c.bind_address, origin);
   take(json, "http_port", c.http_port, origin);
   take(json, "sub_port", c.sub_port, origin);
@@ -92,6 +99,7 @@ void apply_json(const nlohmann::json& json, DaemonConfig& c, const std::string& 
   take(json, "log_level", c.log_level, origin);
   take(json, "hello_timeout_ms", c.hello_timeout_ms, origin);
   take(json, "subscriber_queue_frames", c.subscriber_queue_frames, origin);
+  take(json, "compressed_key_interval", c.compressed_key_interval, origin);
   take(json, "subscriber_tcp_congestion", c.subscriber_tcp_congestion, origin);
   take(json, "publish_threads", c.publish_threads, origin);
   take(json, "status_interval_ms", c.status_interval_ms, origin);
@@ -125,6 +133,9 @@ nlohmann::json to_json(const DaemonConfig& c) {
           {"vicon", c.vicon},
           {"vicon_pull", c.vicon_pull},
           {"vicon_multicast", c.vicon_multicast},
+          {"qtm", c.qtm},
+          {"natnet", c.natnet},
+          {"natnet_interface", c.natnet_interface},
           {"bind_address", c.bind_address},
           {"http_port", c.http_port},
           {"sub_port", c.sub_port},
@@ -140,6 +151,7 @@ nlohmann::json to_json(const DaemonConfig& c) {
           {"log_level", c.log_level},
           {"hello_timeout_ms", c.hello_timeout_ms},
           {"subscriber_queue_frames", c.subscriber_queue_frames},
+          {"compressed_key_interval", c.compressed_key_interval},
           {"subscriber_tcp_congestion", c.subscriber_tcp_congestion},
           {"publish_threads", c.publish_threads},
           {"status_interval_ms", c.status_interval_ms},
@@ -148,8 +160,8 @@ nlohmann::json to_json(const DaemonConfig& c) {
 
 void validate(const DaemonConfig& c) {
   auto fail = [](const std::string& what) { throw ConfigError("configuration: " + what); };
-  if (!c.replay.empty() + !c.vicon.empty() + !c.vicon_multicast.empty() > 1)
-    fail("give one source: a replay file, a Vicon server or a Vicon multicast address");
+  if (!c.replay.empty() + !c.vicon.empty() + !c.vicon_multicast.empty() + !c.qtm.empty() + !c.natnet.empty() > 1)
+    fail("give one source: a replay file, a Vicon server, a Vicon multicast address, a QTM or a NatNet server");
   if (!(c.speed > 0 && c.speed <= 100)) fail("speed must be in (0, 100]");
   for (size_t i = 0; i < c.subjects.size(); ++i) {
     const SubjectConfig& subject = c.subjects[i];
@@ -170,6 +182,7 @@ void validate(const DaemonConfig& c) {
   if (c.continuity_seconds < 0) fail("continuity_seconds must be >= 0");
   if (c.hello_timeout_ms < 0) fail("hello_timeout_ms must be >= 0");
   if (c.subscriber_queue_frames < 1 || c.subscriber_queue_frames > 64) fail("subscriber_queue_frames must be 1-64");
+  if (c.compressed_key_interval < 1 || c.compressed_key_interval > 1200) fail("compressed_key_interval must be 1-1200");
   if (c.publish_threads < 0 || c.publish_threads > 16) fail("publish_threads must be 0-16");
   if (!c.subscriber_tcp_congestion.empty() && !is_tcp_congestion_name(c.subscriber_tcp_congestion))
     fail("subscriber_tcp_congestion must be empty (the system's) or a Linux congestion control name such as reno, not \"" +
@@ -184,6 +197,12 @@ void validate(const DaemonConfig& c) {
     fail("vicon must be HOST:PORT with a port of 1-65535 (Vicon's default is 801), not \"" + c.vicon + "\"");
   if (!c.vicon_multicast.empty() && !parse_host_port(c.vicon_multicast))
     fail("vicon_multicast must be GROUP:PORT with a port of 1-65535 (Vicon's default is 44801), not \"" + c.vicon_multicast + "\"");
+  if (!c.qtm.empty() && !parse_host_with_port(c.qtm, 22223))
+    fail("qtm must be HOST or HOST:PORT with a port of 1-65535 (QTM's little-endian port is 22223), not \"" + c.qtm + "\"");
+  if (!c.natnet.empty() && !parse_host_with_port(c.natnet, 1510))
+    fail("natnet must be HOST or HOST:PORT with a port of 1-65535 (the command port is 1510), not \"" + c.natnet + "\"");
+  in_addr address{};
+  if (inet_pton(AF_INET, c.natnet_interface.c_str(), &address) != 1) fail("natnet_interface must be an IPv4 address of this host, not \"" + c.natnet_interface + "\"");
 }
 
 std::optional<HostPort> parse_host_port(const std::string& text) {
@@ -194,6 +213,12 @@ std::optional<HostPort> parse_host_port(const std::string& text) {
   const int number = std::stoi(port);
   if (number < 1 || number > 65535) return std::nullopt;
   return HostPort{text.substr(0, colon), static_cast<uint16_t>(number)};
+}
+
+std::optional<HostPort> parse_host_with_port(const std::string& text, uint16_t default_port) {
+  if (text.empty()) return std::nullopt;
+  if (text.find(':') == std::string::npos) return HostPort{text, default_port};
+  return parse_host_port(text);
 }
 
 std::optional<CommandLine> parse_command_line(int argc, const char* const* argv, int& out_exit_code) {
@@ -217,6 +242,10 @@ std::optional<CommandLine> parse_command_line(int argc, const char* const* argv,
   auto* vicon_pull = app.add_flag("--vicon-pull", flags.vicon_pull, "Vicon: ask for each frame (ClientPull) instead of the server pushing them");
   auto* vicon_multicast = app.add_option("--vicon-multicast", flags.vicon_multicast,
                                          "receive Vicon DataStream UDP datagrams sent to GROUP:PORT as the source");
+  auto* qtm = app.add_option("--qtm", flags.qtm, "Qualisys QTM RT server HOST[:PORT] as the source (little-endian port, 22223)");
+  auto* natnet = app.add_option("--natnet", flags.natnet, "OptiTrack NatNet server HOST[:PORT] as the source (command port, 1510)");
+  auto* natnet_interface = app.add_option("--natnet-interface", flags.natnet_interface,
+                                          "NatNet: this host's IPv4 address to join the multicast group on");
   auto* bind = app.add_option("--bind", flags.bind_address, "address to listen on");
   auto* http_port = app.add_option("--http-port", flags.http_port, "HTTP/WebSocket port (0 = ephemeral)");
   auto* sub_port = app.add_option("--sub-port", flags.sub_port, "TCP subscriber port (0 = ephemeral)");
@@ -251,11 +280,14 @@ std::optional<CommandLine> parse_command_line(int argc, const char* const* argv,
   }
   if (given(replay_subject)) c.replay_subject = flags.replay_subject;
   // A source given on the command line replaces the file's (several on the command line: validate() refuses).
-  if (given(replay) || given(vicon) || given(vicon_multicast)) {
+  if (given(replay) || given(vicon) || given(vicon_multicast) || given(qtm) || given(natnet)) {
     c.replay = given(replay) ? flags.replay : std::string();
     c.vicon = given(vicon) ? flags.vicon : std::string();
     c.vicon_multicast = given(vicon_multicast) ? flags.vicon_multicast : std::string();
+    c.qtm = given(qtm) ? flags.qtm : std::string();
+    c.natnet = given(natnet) ? flags.natnet : std::string();
   }
+  if (given(natnet_interface)) c.natnet_interface = flags.natnet_interface;
   if (given(loop)) c.loop = flags.loop;
   if (given(speed)) c.speed = flags.speed;
   if (given(vicon_pull)) c.vicon_pull = flags.vicon_pull;

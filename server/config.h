@@ -35,6 +35,9 @@ struct DaemonConfig {
   std::string vicon;              // HOST:PORT of a Vicon DataStream server; empty = none
   bool vicon_pull = false;        // Vicon: ask for each frame instead of server push
   std::string vicon_multicast;    // GROUP:PORT (or this host's address:PORT) of Vicon UDP datagrams; empty = none
+  std::string qtm;                // HOST[:PORT] of a QTM RT server (its little-endian port, 22223); empty = none
+  std::string natnet;             // HOST[:PORT] of a NatNet server's command port (1510); empty = none
+  std::string natnet_interface = "0.0.0.0";  // NatNet: this host's address to join the multicast group on
   std::string bind_address = "0.0.0.0";
   int http_port = 8480;           // 0 = ephemeral
   int sub_port = 8481;            // 0 = ephemeral
@@ -52,6 +55,7 @@ struct DaemonConfig {
   int publish_threads = 2;        // threads writing to TCP subscribers; 0 = the io thread (server/publish/publish_threads.h)
   std::string subscriber_tcp_congestion = "reno";  // on subscriber and HTTP connections; empty = the system's (server/tcp_congestion.h)
   int subscriber_queue_frames = 32;  // per subscriber at most; max_frame_wait_ms bounds their age
+  int compressed_key_interval = 10;  // frames between key frames of the compressed encoding
   int status_interval_ms = 1000;
   double default_rate_hz = 120.0;  // until the source says its rate
 };
@@ -77,6 +81,8 @@ struct HostPort {
   uint16_t port = 0;
 };
 std::optional<HostPort> parse_host_port(const std::string& text);
+// "HOST" (with `default_port`) or "HOST:PORT" as parse_host_port: the form of the qtm and natnet keys.
+std::optional<HostPort> parse_host_with_port(const std::string& text, uint16_t default_port);
 
 struct CommandLine {
   DaemonConfig config;

@@ -12,6 +12,8 @@
 #include "protocol/file_error.h"
 #include "server/http/http_server.h"
 #include "server/ingest/file_replay_source.h"
+#include "server/ingest/natnet_source.h"
+#include "server/ingest/qtm_source.h"
 #include "server/ingest/vicon_multicast_source.h"
 #include "server/ingest/vicon_source.h"
 #include "server/listener.h"
@@ -49,6 +51,7 @@ std::vector<std::unique_ptr<SubjectStream>> load_subjects(const DaemonConfig& co
   pipeline.default_rate_hz = config.default_rate_hz;
   pipeline.filler.continuity_seconds = config.continuity_seconds;
   pipeline.filler.use_pca = config.use_pca;
+  pipeline.compressed_key_interval = config.compressed_key_interval;
   const bool several = config.subjects.size() > 1;
   std::vector<std::unique_ptr<SubjectStream>> subjects;
   for (size_t k = 0; k < config.subjects.size(); ++k) {
@@ -82,6 +85,13 @@ std::vector<SubjectTarget> targets_of(const std::vector<std::unique_ptr<SubjectS
 HostPort host_port_of(const std::string& flag, const std::string& text) {
   const std::optional<HostPort> parsed = parse_host_port(text);
   if (!parsed) throw ConfigError(flag + " " + text + ": expected HOST:PORT with a port of 1-65535");
+  return *parsed;
+}
+
+// A "HOST[:PORT]" key (qtm, natnet), likewise.
+HostPort host_port_of(const std::string& flag, const std::string& text, uint16_t default_port) {
+  const std::optional<HostPort> parsed = parse_host_with_port(text, default_port);
+  if (!parsed) throw ConfigError(flag + " " + text + ": expected HOST or HOST:PORT with a port of 1-65535");
   return *parsed;
 }
 
@@ -134,8 +144,24 @@ Daemon::Daemon(const DaemonConfig& config)
     spdlog::info("source: Vicon DataStream {}:{} ({})", options.host, options.port,
                  options.mode == ViconSourceOptions::Mode::ClientPull ? "client pull" : "server push");
     source_ = std::make_unique<ViconSource>(io_, std::move(options), static_cast<SourceSink&>(*this));
+  } else if (!config.qtm.empty()) {
+    const HostPort address = host_port_of("--qtm", config.qtm, qtm::kLittleEndianPort);
+    QtmSourceOptions options;
+    options.host = address.host;
+    options.port = address.port;
+    spdlog::info("source: QTM RT {}:{}", options.host, options.port);
+    source_ = std::make_unique<QtmSource>(io_, std::move(options), static_cast<SourceSink&>(*this));
+  } else if (!config.natnet.empty()) {
+    const HostPort address = host_port_of("--natnet", config.natnet, natnet::kCommandPort);
+    NatNetSourceOptions options;
+    options.host = address.host;
+    options.command_port = address.port;
+    options.interface_address = config.natnet_interface;
+    spdlog::info("source: NatNet {}:{}", options.host, options.command_port);
+    source_ = std::make_unique<NatNetSource>(io_, std::move(options), static_cast<SourceSink&>(*this));
   } else {
-    spdlog::warn("no source configured (--replay FILE, --vicon HOST:PORT or --vicon-multicast GROUP:PORT): serving subscribers without frames");
+    spdlog::warn("no source configured (--replay FILE, --vicon HOST:PORT, --vicon-multicast GROUP:PORT, --qtm HOST[:PORT] "
+                 "or --natnet HOST[:PORT]): serving subscribers without frames");
   }
 
   sub_listener_ = std::make_unique<Listener>(io_, config.bind_address, config.sub_port, "subscriber port", [this](tcp::socket socket) {

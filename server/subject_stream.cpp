@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "protocol/file_error.h"
+#include "protocol/subscriber_model.h"
 
 namespace skinstream::server {
 namespace {
@@ -48,6 +49,7 @@ nlohmann::json latency_summaries(const Metrics& metrics) {
   add("deform", metrics.deform);
   add("normals", metrics.normals);
   add("encode", metrics.encode);
+  add("encode_compressed", metrics.encode_compressed);
   add("receive_to_publish", metrics.receive_to_publish);
   add("subscriber_queue_wait", metrics.subscriber_queue_wait);
   add("subscriber_write", metrics.subscriber_write);
@@ -75,7 +77,13 @@ SubjectStream::SubjectStream(SubjectConfig config, const SubjectStreamOptions& o
   } catch (const std::invalid_argument& e) {
     throw FileError(config_.file, std::string("deformation model unusable: ") + e.what());
   }
-  hub_->set_encoding_preparer([pipeline = pipeline_.get()](uint32_t frame_flags) { pipeline->prepare_encoding(frame_flags); });
+  hub_->set_encoding_preparer([pipeline = pipeline_.get()](StreamKey key) { pipeline->prepare_encoding(key); });
+  hub_->set_compressed_order(pipeline_->compressed_order());
+  if (const EvaluationModel* evaluation = pipeline_->evaluation_model()) {
+    hub_->set_model_message(std::make_shared<const std::vector<unsigned char>>(subscriber::encode_model(*evaluation)));
+    spdlog::info("subject {}: parameter encoding: Model message of {} bytes ({} parts, {} RBF centres, {} influences)", name_,
+                 hub_->model_message()->size(), evaluation->part_count(), evaluation->member_count(), evaluation->influence_count());
+  }
 }
 
 SubjectStream::~SubjectStream() { stop(); }

@@ -34,7 +34,7 @@ ReplayStage replay_stage(const Capture& recording, int subjects, double spacing_
     for (int f = 0; f < copy.frame_count; ++f)
       for (int c = 0; c < copy.point_count(); ++c)
         if (copy.present(f, c)) copy.at(f, c) += offset;
-    stage.subjects.push_back({&copy, subjects == 1 ? single_name : "Actor" + std::to_string(k + 1)});
+    stage.subjects.push_back({subjects == 1 ? single_name : "Actor" + std::to_string(k + 1), &copy});
   }
   return stage;
 }

@@ -18,7 +18,7 @@ namespace skinstream::bench {
 
 struct ReplayStage {
   std::vector<Capture> captures;               // one per subject
-  std::vector<vicon::CaptureSubject> subjects;  // pointing into captures
+  std::vector<ReplaySubject> subjects;  // pointing into captures
 };
 
 // One subject: the recording as it is, named `single_name`; several: copies k = 0..n-1 moved

@@ -1,17 +1,20 @@
-// skinstream-replay: streams recorded captures (C3D or TRC) as a Vicon DataStream server, so that
-// skinstreamd, benchmarks and unmodified Vicon SDK clients can run without a capture stage. Several
-// recordings stream as several subjects of one stream (a stage with several actors), each frame
-// holding one frame of each.
+// skinstream-replay: streams recorded captures (C3D or TRC) as a capture system would, so that
+// skinstreamd, benchmarks and unmodified clients can run without a capture stage: a Vicon
+// DataStream, QTM RT or NatNet server; several recordings become several subjects of one stream
+// (a stage with several actors: server/vicon/vicon_server.h, server/qtm/qtm_server.h,
+// server/natnet/natnet_server.h).
 //
-//   skinstream-replay RECORDING... --port P [--rate HZ] [--speed X] [--loop | --hold]
-//                     [--subject NAME]... [--multicast GROUP[:PORT]] [--multicast-ttl N] [--start-now]
+//   skinstream-replay [--protocol vicon|qtm|natnet] RECORDING... --port P [--rate HZ] [--speed X]
+//                     [--loop | --hold] [--subject NAME]... [--multicast GROUP[:PORT]] [--multicast-ttl N]
+//                     [--start-now] [--unicast] [--multicast-interface ADDR] [--natnet-version 3.1|4.0|4.1]
 //
 // Prints one JSON line {"port": N} on stdout once listening (port 0 picks a free one); logs go to
 // stderr. Errors are one line on stderr and a non-zero exit code.
 #include <csignal>
 #include <cstdio>
-#include <filesystem>
+#include <functional>
 #include <iostream>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -20,9 +23,10 @@
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
-#include "protocol/capture_file.h"
-#include "protocol/file_error.h"
 #include "server/asio.h"
+#include "server/natnet/natnet_server.h"
+#include "server/qtm/qtm_server.h"
+#include "server/replay/replay_recordings.h"
 #include "server/tcp_congestion.h"
 #include "server/vicon/vicon_server.h"
 
@@ -31,8 +35,9 @@ namespace {
 using namespace skinstream;
 
 struct Arguments {
+  std::string protocol = "vicon";
   std::vector<std::string> recordings;
-  int port = vicon::kDefaultPort;
+  int port = -1;  // the protocol's own default
   std::string bind = "0.0.0.0";
   double rate = 0.0;
   double speed = 1.0;
@@ -44,6 +49,9 @@ struct Arguments {
   int multicast_ttl = 1;
   int max_queued = 4;
   std::string tcp_congestion;  // the system's
+  bool unicast = false;           // NatNet
+  std::string multicast_interface;  // NatNet: the interface multicast leaves by; empty: the system's
+  std::string natnet_version = "4.1";
 };
 
 // "239.1.2.3:44801" or "239.1.2.3" -> address and port.
@@ -55,37 +63,23 @@ std::pair<std::string, uint16_t> split_address(const std::string& text) {
   return {text.substr(0, colon), static_cast<uint16_t>(port)};
 }
 
-// The recordings, read, each with the name of the subject it streams as.
-struct Recordings {
-  std::vector<Capture> captures;
-  std::vector<vicon::CaptureSubject> subjects;
-};
+int run_qtm_or_natnet(const Arguments& args);
 
-Recordings read_recordings(const Arguments& args) {
-  if (!args.subjects.empty() && args.subjects.size() != args.recordings.size())
-    throw std::invalid_argument("--subject is given " + std::to_string(args.subjects.size()) + " times for " +
-                                std::to_string(args.recordings.size()) + " recordings: once per recording, or not at all");
-  Recordings out;
-  out.captures.reserve(args.recordings.size());  // the subjects point into it
-  for (size_t r = 0; r < args.recordings.size(); ++r) {
-    const std::string& path = args.recordings[r];
-    const Capture& capture = out.captures.emplace_back(read_capture(path));
-    if (capture.frame_count <= 0) throw FileError(path, "holds no frames");
-    if (!(capture.rate_hz > 0.0) && !(args.rate > 0.0)) throw FileError(path, "has no frame rate; pass --rate");
-    const std::string name = args.subjects.empty() ? std::filesystem::path(path).stem().string() : args.subjects[r];
-    for (const vicon::CaptureSubject& other : out.subjects)
-      if (other.name == name) throw std::invalid_argument("two recordings stream as subject \"" + name + "\": name each with --subject");
-    out.subjects.push_back({&capture, name});
-  }
-  return out;
+void log_streaming(const server::ReplayRecordings& recordings, const Arguments& args, uint16_t port) {
+  for (const ReplaySubject& s : recordings.subjects)
+    spdlog::info("streaming '{}' ({} markers, {} frames) at {} Hz, speed {}, as subject '{}' of a {} stream on {}:{}", s.name,
+                 s.capture->point_count(), s.capture->frame_count, recordings.rate_hz, args.speed, s.name, args.protocol,
+                 args.bind, port);
 }
 
 int run(const Arguments& args) {
-  const Recordings recordings = read_recordings(args);
+  if (args.protocol != "vicon") return run_qtm_or_natnet(args);
+  const server::ReplayRecordings recordings = server::load_replay_recordings(args.recordings, args.subjects, args.rate);
+
   server::ViconServerOptions options;
   options.bind_address = args.bind;
-  options.port = static_cast<uint16_t>(args.port);
-  options.rate_hz = args.rate;
+  options.port = static_cast<uint16_t>(args.port < 0 ? vicon::kDefaultPort : args.port);
+  options.rate_hz = recordings.rate_hz;
   options.speed = args.speed;
   options.loop = args.loop;
   options.start_on_first_request = !args.start_now;
@@ -131,12 +125,86 @@ int run(const Arguments& args) {
   }
 
   std::cout << "{\"port\": " << vicon_server.port() << "}" << std::endl;
-  for (size_t r = 0; r < args.recordings.size(); ++r) {
-    const Capture& capture = recordings.captures[r];
-    spdlog::info("streaming {} ({} markers, {} frames at {} Hz, speed {}) as subject '{}' on {}:{}", args.recordings[r],
-                 capture.point_count(), capture.frame_count, args.rate > 0.0 ? args.rate : capture.rate_hz, args.speed,
-                 recordings.subjects[r].name, args.bind, vicon_server.port());
+  log_streaming(recordings, args, vicon_server.port());
+  io.run();
+  return 0;
+}
+
+// QTM RT and NatNet: several recordings as several subjects. Without --loop or --hold the
+// program exits once the last frame has left (QTM: once every client's queue has drained, at
+// most 2 s).
+int run_qtm_or_natnet(const Arguments& args) {
+  const server::ReplayRecordings recordings = server::load_replay_recordings(args.recordings, args.subjects, args.rate);
+  server::asio::io_context io;
+  std::unique_ptr<server::QtmServer> qtm;
+  std::unique_ptr<server::NatNetServer> natnet;
+  std::function<bool()> idle = [] { return true; };
+  std::function<void()> stop;
+  uint16_t port = 0;
+  if (args.protocol == "qtm") {
+    server::QtmServerOptions options;
+    options.bind_address = args.bind;
+    options.port = static_cast<uint16_t>(args.port < 0 ? qtm::kLittleEndianPort : args.port);
+    options.rate_hz = recordings.rate_hz;
+    options.speed = args.speed;
+    options.loop = args.loop;
+    options.start_on_first_request = !args.start_now;
+    options.max_queued_frames = static_cast<size_t>(args.max_queued);
+    qtm = std::make_unique<server::QtmServer>(io, recordings.subjects, options);
+    qtm->start();
+    port = qtm->port();
+    idle = [&] { return qtm->all_clients_idle(); };
+    stop = [&] { qtm->stop(); };
+  } else {
+    server::NatNetServerOptions options;
+    options.bind_address = args.bind;
+    options.command_port = static_cast<uint16_t>(args.port < 0 ? natnet::kCommandPort : args.port);
+    options.multicast = !args.unicast;
+    if (!args.multicast.empty()) {
+      const auto [group, data_port] = split_address(args.multicast);
+      options.multicast_group = group;
+      if (args.multicast.find(':') != std::string::npos) options.data_port = data_port;
+    }
+    options.multicast_ttl = args.multicast_ttl;
+    options.multicast_interface = args.multicast_interface;
+    options.version = {args.natnet_version[0] - '0', args.natnet_version[2] - '0'};
+    options.rate_hz = recordings.rate_hz;
+    options.speed = args.speed;
+    options.loop = args.loop;
+    options.start_on_first_request = !args.start_now;
+    natnet = std::make_unique<server::NatNetServer>(io, recordings.subjects, options);
+    natnet->start();
+    port = natnet->command_port();
+    stop = [&] { natnet->stop(); };
   }
+
+  server::asio::steady_timer drain_timer(io);
+  int drain_checks = 0;
+  std::function<void()> drain = [&] {
+    if (idle() || ++drain_checks > 200) {
+      spdlog::info("recording finished");
+      stop();
+      io.stop();
+      return;
+    }
+    drain_timer.expires_after(std::chrono::milliseconds(10));
+    drain_timer.async_wait([&](const boost::system::error_code& ec) {
+      if (!ec) drain();
+    });
+  };
+  if (!args.loop && !args.hold) {
+    if (qtm) qtm->set_on_finished(drain);
+    if (natnet) natnet->set_on_finished(drain);
+  }
+  server::asio::signal_set signals(io, SIGINT, SIGTERM);
+  signals.async_wait([&](const boost::system::error_code& ec, int signal_number) {
+    if (ec) return;
+    spdlog::info("signal {}: stopping", signal_number);
+    stop();
+    io.stop();
+  });
+  std::cout << "{\"port\": " << port << "}" << std::endl;
+  log_streaming(recordings, args, port);
   io.run();
   return 0;
 }
@@ -146,11 +214,15 @@ int run(const Arguments& args) {
 int main(int argc, char** argv) {
   spdlog::set_default_logger(spdlog::stderr_color_mt("replay"));
   Arguments args;
-  CLI::App app{"skinstream-replay: stream recorded captures (C3D/TRC) as a Vicon DataStream server"};
-  app.add_option("RECORDING", args.recordings, "capture files (.c3d or .trc), each streamed as one subject")->required();
-  app.add_option("--port", args.port, "TCP port to listen on (0: pick a free one; printed as {\"port\": N})")
-      ->check(CLI::Range(0, 65535))
+  CLI::App app{"skinstream-replay: stream recorded captures (C3D/TRC) as a Vicon DataStream, QTM RT or NatNet server"};
+  app.add_option("--protocol", args.protocol, "the capture system to stream as")
+      ->check(CLI::IsMember({"vicon", "qtm", "natnet"}))
       ->capture_default_str();
+  app.add_option("RECORDING", args.recordings, "capture files (.c3d or .trc); several: one subject each")->required();
+  app.add_option("--port", args.port,
+                 "port to listen on: TCP for vicon (801) and qtm (22223, little-endian), the UDP command port for "
+                 "natnet (1510); 0: pick a free one; printed as {\"port\": N}")
+      ->check(CLI::Range(0, 65535));
   app.add_option("--bind", args.bind, "address to listen on")->capture_default_str();
   app.add_option("--rate", args.rate, "frame rate to announce and stream, Hz (default: the recording's)")
       ->check(CLI::PositiveNumber);
@@ -165,7 +237,15 @@ int main(int argc, char** argv) {
   app.add_option("--subject", args.subjects, "subject name, once per recording in their order (default: each file's stem)")
       ->expected(1)
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
-  app.add_option("--multicast", args.multicast, "also send every frame as UDP datagrams to GROUP[:PORT]");
+  app.add_option("--multicast", args.multicast,
+                 "vicon: also send every frame as UDP datagrams to GROUP[:PORT]; natnet: the group and data port "
+                 "(default 239.255.42.99:1511)");
+  app.add_option("--multicast-interface", args.multicast_interface,
+                 "natnet: address of the interface multicast frames leave by (default: the system's choice)");
+  app.add_flag("--unicast", args.unicast, "natnet: send frames to each connected client instead of multicast");
+  app.add_option("--natnet-version", args.natnet_version, "natnet: the NatNet layout streamed")
+      ->check(CLI::IsMember({"3.0", "3.1", "4.0", "4.1"}))
+      ->capture_default_str();
   app.add_option("--multicast-ttl", args.multicast_ttl, "multicast TTL (hops)")
       ->check(CLI::Range(0, 255))
       ->capture_default_str();
@@ -180,9 +260,10 @@ int main(int argc, char** argv) {
       })
       ->capture_default_str();
   app.footer(
-      "The recording starts when the first client asks for a frame (RequestFrame), unless --start-now.\n"
-      "Several recordings stream as several subjects, frame k of each in frame k of the stream; a subject\n"
-      "is listed only in frames where its recording has a marker (it leaves the stage, and comes back).\n"
+      "The recording starts when the first client asks for frames (vicon: RequestFrame, qtm: StreamFrames,\n"
+      "natnet: CONNECT), unless --start-now.\n"
+      "Several recordings stream as several subjects, frame k of each in frame k of the stream; a Vicon\n"
+      "subject is listed only in frames where its recording has a marker (it leaves the stage, and comes back).\n"
       "Without --loop or --hold the program exits 0 once the last frame has been sent to the connected\n"
       "clients. SIGINT/SIGTERM stop it cleanly (exit 0).");
   CLI11_PARSE(app, argc, argv);

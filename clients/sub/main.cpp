@@ -1,14 +1,17 @@
-// skinstream-sub: subscribes to a skinstreamd over TCP, prints rates and latency, and can save
-// frames as PLY. With --json: one JSON line per frame, then a summary line.
+// skinstream-sub: subscribes to a skinstreamd (through the C++ client library), prints rates and
+// latency, and can save frames as PLY or record them as a PC2 point cache. With --json: one JSON
+// line per frame, then a summary line.
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
-#include <optional>
+#include <memory>
 #include <nlohmann/json.hpp>
+#include <optional>
 
-#include "server/client/subscriber_client.h"
 #include "protocol/mesh_ply.h"
+#include "protocol/point_cache.h"
+#include "skinstream/client.h"
 
 namespace {
 
@@ -26,25 +29,48 @@ struct Percentiles {
   }
 };
 
+// "HOST:PORT" -> host, port; throws std::invalid_argument.
+std::pair<std::string, uint16_t> split_host_port(const std::string& address) {
+  const size_t colon = address.rfind(':');
+  if (colon == std::string::npos || colon == 0 || colon + 1 == address.size())
+    throw std::invalid_argument("\"" + address + "\" is not HOST:PORT");
+  const std::string port = address.substr(colon + 1);
+  if (port.find_first_not_of("0123456789") != std::string::npos || port.size() > 5 || std::stoi(port) < 1 || std::stoi(port) > 65535)
+    throw std::invalid_argument("\"" + address + "\": the port must be 1-65535");
+  return {address.substr(0, colon), static_cast<uint16_t>(std::stoi(port))};
+}
+
+std::vector<Vec3> to_points(std::span<const float> xyz) {
+  std::vector<Vec3> points(xyz.size() / 3);
+  for (size_t v = 0; v < points.size(); ++v) points[v] = Vec3(xyz[3 * v], xyz[3 * v + 1], xyz[3 * v + 2]);
+  return points;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"skinstream-sub: subscribe to skinstreamd and report what arrives"};
-  std::string address, save_dir;
-  bool normals = false, quantised = false, markers = false, no_mesh = false, stats = false, json = false;
+  std::string address, save_dir, encoding_name, record_path, subject, token;
+  bool normals = false, quantised = false, markers = false, no_mesh = false, stats = false, json = false, evaluate = false, paced = false;
   long frames_wanted = 0;
-  int save_every = 0;
+  int save_every = 0, protocol = 2;
   app.add_option("ADDRESS", address, "HOST:PORT of the daemon's subscriber port")->required();
-  app.add_flag("--normals", normals, "ask for vertex normals");
-  app.add_flag("--quantised", quantised, "ask for the quantised encoding");
+  app.add_option("--encoding", encoding_name, "how positions travel: float (default), quantised, compressed or parameters")
+      ->check(CLI::IsMember({"float", "quantised", "compressed", "parameters"}));
+  app.add_flag("--evaluate", evaluate,
+               "parameters: evaluate them into vertices here (the time counts in the latency; implied by --save-every and --record)");
+  app.add_flag("--normals", normals, "ask for vertex normals (parameters: computed here)");
+  app.add_flag("--quantised", quantised, "the quantised encoding (as --encoding quantised)");
   app.add_flag("--markers", markers, "ask for the filled markers and their status");
   app.add_flag("--no-mesh", no_mesh, "markers only, no vertex positions");
+  app.add_flag("--paced", paced, "acknowledge each frame: at most 2 in flight");
+  app.add_option("--subject", subject, "the subject's name (protocol 2; default: the daemon's first)");
+  app.add_option("--token", token, "the daemon's shared token, when it has one");
+  app.add_option("--protocol", protocol, "subscriber protocol version: 2 (default) or 1 (float and quantised only)")->check(CLI::Range(1, 2));
   app.add_option("--frames", frames_wanted, "exit after this many frames (0 = run until the daemon closes)");
   std::vector<std::string> save_arguments;
   app.add_option("--save-every", save_arguments, "N DIR: save every Nth frame as DIR/frame_<frame number>.ply")->expected(2);
-  std::optional<std::string> subject;
-  app.add_option("--subject", subject,
-                 "the subject to follow on a daemon serving several (protocol version 2; \"\" = the first)");
+  app.add_option("--record", record_path, "FILE.pc2: record every frame's vertices as a PC2 point cache (Blender's Mesh Cache modifier)");
   app.add_flag("--stats", stats, "print rates and latency once a second");
   app.add_flag("--json", json, "JSON: one line per frame, then a summary");
   CLI11_PARSE(app, argc, argv);
@@ -60,125 +86,143 @@ int main(int argc, char** argv) {
       return 1;
     }
   }
+  if (quantised && !encoding_name.empty() && encoding_name != "quantised") {
+    std::fprintf(stderr, "skinstream-sub: error: --quantised and --encoding %s disagree\n", encoding_name.c_str());
+    return 1;
+  }
   try {
-    const auto [host, port] = sub::split_host_port(address);
-    const uint32_t wants = (normals ? subscriber::kWantNormals : 0) | (markers ? subscriber::kWantMarkers : 0) |
-                           (no_mesh ? subscriber::kWantNoMesh : 0);
-    // Version 1 unless a subject is named; version 2 says the encoding apart from the wants.
-    subscriber::Hello hello{.wants = wants | (quantised ? subscriber::kWantQuantised : 0)};
-    if (subject)
-      hello = {.wants = wants,
-               .version = subscriber::kVersion2,
-               .encoding = static_cast<uint32_t>(quantised ? subscriber::Encoding::Quantised : subscriber::Encoding::Float),
-               .subject = *subject};
-    const uint16_t version = hello.version;
+    client::Options options;
+    std::tie(options.host, options.port) = split_host_port(address);
+    options.encoding = quantised ? client::Encoding::Quantised
+                                 : (encoding_name.empty() ? client::Encoding::Float : client::encoding_from_string(encoding_name));
+    options.normals = normals;
+    options.markers = markers;
+    options.mesh = !no_mesh;
+    options.paced = paced;
+    options.evaluate = evaluate || save_every > 0 || !record_path.empty();
+    options.subject = subject;
+    options.token = token;
+    options.protocol_version = protocol;
     if (save_every > 0) std::filesystem::create_directories(save_dir);
-    sub::SubscriberClient client(host, port, hello);
-    std::string refused;  // the daemon's reason, when it refused this subscriber
+    client::Subscriber sub(options);
 
-    std::vector<synth::Face> faces;
+    std::unique_ptr<PointCacheWriter> recording;
     long frames = 0, out_of_order = 0, saved = 0;
-    uint64_t bytes = 0;
     int64_t last_frame_number = -1;
     uint32_t pipeline_dropped = 0, subscriber_dropped = 0;
-    Percentiles since_publish, since_receive, end_to_end;
+    uint64_t frame_bytes = 0;
+    bool announced = false;
+    Percentiles since_publish, since_receive, end_to_end, decode;
     const auto start = std::chrono::steady_clock::now();
     auto last_report = start;
     long frames_at_report = 0;
-    const bool finished = client.run([&](subscriber::MessageType type, std::span<const unsigned char> payload, int64_t now) {
-      bytes += payload.size() + subscriber::kHeaderBytes;
-      if (type == subscriber::MessageType::MeshInfo) {
-        const subscriber::MeshInfo info = subscriber::decode_mesh_info(payload, version);
-        faces.clear();
-        for (const auto& f : info.faces) faces.push_back({static_cast<int>(f[0]), static_cast<int>(f[1]), static_cast<int>(f[2]), -1});
+    bool finished = false;
+    client::Frame frame;
+    for (;;) {
+      try {
+        if (!sub.next(frame, std::chrono::seconds(1))) continue;
+      } catch (const client::Error& e) {
+        const std::string what = e.what();
+        if (what.find("closed the connection") == std::string::npos) throw;
+        finished = true;  // the daemon stopped: a normal end
+        break;
+      }
+      const client::Mesh& mesh = sub.mesh();
+      if (!announced) {
+        announced = true;
         if (!json)
-          std::printf("mesh: %u vertices, %zu faces, %u markers, %u parts, %.2f Hz\n", info.vertex_count, info.faces.size(),
-                      info.marker_count, info.part_count, info.source_rate_hz);
-        return true;
-      }
-      if (type == subscriber::MessageType::Status) {
-        const subscriber::Status status = subscriber::decode_status(payload, version);
-        if (status.state == subscriber::SourceStateCode::Refused) {
-          refused = status.detail;
-          return false;
+          std::printf("mesh: %u vertices, %zu faces, %zu markers, %u parts, %.2f Hz, subject \"%s\", encoding %s%s\n", mesh.vertex_count,
+                      mesh.indices.size() / 3, mesh.marker_names.size(), mesh.part_count, mesh.source_rate_hz, mesh.subject.c_str(),
+                      client::to_string(mesh.encoding),
+                      sub.model_bytes() ? (", model " + std::to_string(sub.model_bytes()) + " bytes").c_str() : "");
+        if (!record_path.empty()) {
+          if (mesh.vertex_count == 0) throw std::runtime_error("--record: the daemon sends no vertices");
+          recording = std::make_unique<PointCacheWriter>(record_path, static_cast<int>(mesh.vertex_count));
         }
-        if (!json && stats)
-          std::printf("status: state %u, %.2f Hz, received %llu, published %llu, %s\n", static_cast<unsigned>(status.state),
-                      status.source_rate_hz, static_cast<unsigned long long>(status.frames_received),
-                      static_cast<unsigned long long>(status.frames_published), status.detail.c_str());
-        return true;
       }
-      if (type != subscriber::MessageType::Frame) return true;
-      const subscriber::Frame frame = subscriber::decode_frame(payload, version);
-      const subscriber::FrameInfo& info = frame.info;
       ++frames;
-      if (static_cast<int64_t>(info.frame_number) <= last_frame_number) ++out_of_order;
-      last_frame_number = info.frame_number;
-      pipeline_dropped = info.pipeline_dropped;
-      subscriber_dropped = info.subscriber_dropped;
-      since_publish.values.push_back((now - info.publish_time_ns) * 1e-6);
-      since_receive.values.push_back((now - info.receive_time_ns) * 1e-6);
+      frame_bytes += frame.message_bytes;
+      if (static_cast<int64_t>(frame.frame_number) <= last_frame_number) ++out_of_order;
+      last_frame_number = frame.frame_number;
+      pipeline_dropped = frame.pipeline_dropped;
+      subscriber_dropped = frame.subscriber_dropped;
+      // Latency to the moment the frame could be drawn: decoding (and evaluating) included.
+      const int64_t ready = frame.ready_time_ns;
+      since_publish.values.push_back((ready - frame.publish_time_ns) * 1e-6);
+      since_receive.values.push_back((ready - frame.receive_time_ns) * 1e-6);
+      decode.values.push_back((ready - frame.arrival_time_ns) * 1e-6);
       // A source timestamp after 2001 is wall-clock time, so end to end is measurable.
-      const bool wall_clock_source = info.source_time_ns > 1'000'000'000'000'000'000;
-      if (wall_clock_source) end_to_end.values.push_back((now - info.source_time_ns) * 1e-6);
+      const bool wall_clock_source = frame.source_time_ns > 1'000'000'000'000'000'000;
+      if (wall_clock_source) end_to_end.values.push_back((ready - frame.source_time_ns) * 1e-6);
       if (json) {
-        nlohmann::json line = {{"frame", info.frame_number},
-                               {"flags", info.flags},
-                               {"source_time_ns", info.source_time_ns},
-                               {"receive_time_ns", info.receive_time_ns},
-                               {"publish_time_ns", info.publish_time_ns},
-                               {"arrival_time_ns", now},
-                               {"vertices", info.vertex_count},
-                               {"filled", info.markers_filled},
-                               {"relabelled", info.markers_relabelled},
-                               {"pipeline_dropped", info.pipeline_dropped},
-                               {"subscriber_dropped", info.subscriber_dropped}};
+        nlohmann::json line = {{"frame", frame.frame_number},
+                               {"source_time_ns", frame.source_time_ns},
+                               {"receive_time_ns", frame.receive_time_ns},
+                               {"publish_time_ns", frame.publish_time_ns},
+                               {"arrival_time_ns", frame.arrival_time_ns},
+                               {"ready_time_ns", frame.ready_time_ns},
+                               {"bytes", frame.message_bytes},
+                               {"vertices", frame.positions.size() / 3},
+                               {"filled", frame.markers_filled},
+                               {"relabelled", frame.markers_relabelled},
+                               {"pipeline_dropped", frame.pipeline_dropped},
+                               {"subscriber_dropped", frame.subscriber_dropped}};
+        if (frame.timecode.valid) {
+          char text[32];
+          std::snprintf(text, sizeof text, "%02d:%02d:%02d%c%02d", frame.timecode.hours, frame.timecode.minutes, frame.timecode.seconds,
+                        frame.timecode.drop_frame ? ';' : ':', frame.timecode.frames);
+          line["timecode"] = {{"text", text}, {"subframe", frame.timecode.subframe}, {"rate_hz", frame.timecode.rate_hz}};
+        }
         if (!frame.markers.empty()) {
-          line["markers"] = frame.markers;
-          line["status"] = frame.marker_status;
+          line["markers"] = std::vector<float>(frame.markers.begin(), frame.markers.end());
+          line["status"] = std::vector<uint8_t>(frame.marker_status.begin(), frame.marker_status.end());
         }
         std::printf("%s\n", line.dump().c_str());
       }
       if (save_every > 0 && frames % save_every == 0 && !frame.positions.empty()) {
-        std::vector<Vec3> vertices(info.vertex_count);
-        for (uint32_t v = 0; v < info.vertex_count; ++v)
-          vertices[v] = Vec3(frame.positions[3 * v], frame.positions[3 * v + 1], frame.positions[3 * v + 2]);
+        std::vector<synth::Face> faces;
+        for (size_t i = 0; i + 2 < mesh.indices.size(); i += 3)
+          faces.push_back({static_cast<int>(mesh.indices[i]), static_cast<int>(mesh.indices[i + 1]), static_cast<int>(mesh.indices[i + 2]), -1});
         char name[64];
-        std::snprintf(name, sizeof name, "frame_%06u.ply", info.frame_number);
-        write_ply((std::filesystem::path(save_dir) / name).string(), vertices, faces);
+        std::snprintf(name, sizeof name, "frame_%06u.ply", frame.frame_number);
+        write_ply((std::filesystem::path(save_dir) / name).string(), to_points(frame.positions), faces);
         ++saved;
       }
+      if (recording && !frame.positions.empty()) recording->append(to_points(frame.positions));
       const auto t = std::chrono::steady_clock::now();
       if (stats && !json && t - last_report >= std::chrono::seconds(1)) {
         const double seconds = std::chrono::duration<double>(t - last_report).count();
         std::printf("%.1f frames/s, %.2f MB/s total, latency since publish p50 %.2f ms, since receive p50 %.2f ms, dropped %u/%u\n",
-                    (frames - frames_at_report) / seconds, bytes / 1e6 / std::chrono::duration<double>(t - start).count(),
+                    (frames - frames_at_report) / seconds, sub.bytes_received() / 1e6 / std::chrono::duration<double>(t - start).count(),
                     since_publish.at(0.5), since_receive.at(0.5), pipeline_dropped, subscriber_dropped);
         std::fflush(stdout);
         last_report = t;
         frames_at_report = frames;
       }
-      return frames_wanted <= 0 || frames < frames_wanted;
-    });
-    if (!refused.empty()) {
-      std::fprintf(stderr, "skinstream-sub: error: the daemon refused this subscriber: %s\n", refused.c_str());
-      return 1;
+      if (frames_wanted > 0 && frames >= frames_wanted) break;
     }
+    if (recording) recording->close();
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     nlohmann::json summary = {{"frames", frames},
                               {"out_of_order", out_of_order},
                               {"seconds", seconds},
                               {"frames_per_second", seconds > 0 ? frames / seconds : 0.0},
-                              {"megabytes", bytes / 1e6},
+                              {"megabytes", sub.bytes_received() / 1e6},
+                              {"encoding", sub.has_mesh() ? client::to_string(sub.mesh().encoding) : "none"},
+                              {"bytes_per_frame", frames > 0 ? static_cast<double>(frame_bytes) / frames : 0.0},
+                              {"model_bytes", sub.model_bytes()},
+                              {"frames_skipped", sub.frames_skipped()},
                               {"pipeline_dropped", pipeline_dropped},
                               {"subscriber_dropped", subscriber_dropped},
                               {"saved", saved},
+                              {"recorded", recording ? recording->sample_count() : 0},
+                              {"decode", decode.summary()},
                               {"latency_since_publish", since_publish.summary()},
                               {"latency_since_receive", since_receive.summary()}};
     if (!end_to_end.values.empty()) summary["latency_end_to_end"] = end_to_end.summary();
     if (json) std::printf("%s\n", nlohmann::json{{"summary", summary}}.dump().c_str());
     else std::printf("%s\n", summary.dump(2).c_str());
-    if (!finished && frames_wanted > 0 && frames < frames_wanted) {
+    if (finished && frames_wanted > 0 && frames < frames_wanted) {
       std::fprintf(stderr, "skinstream-sub: error: the daemon closed the connection after %ld of %ld frames\n", frames, frames_wanted);
       return 1;
     }

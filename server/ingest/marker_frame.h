@@ -19,7 +19,7 @@ struct MarkerFrame {
   int64_t source_time_ns = 0;        // capture time: the source's timecode or frame * period
   int64_t receive_time_ns = 0;       // wall clock (system_clock, ns since epoch) when complete
   double source_rate_hz = 0.0;       // from the source (StreamInfo frame period, file rate)
-  SourceTimecode timecode;           // the capture system's, when it sends one
+  SourceTimecode timecode;           // the source's SMPTE timecode, when it sends one
 
   std::vector<Vec3> labelled;        // one per subject marker, NaN = missing
   std::vector<Vec3> unlabelled;      // capacity kMaxUnlabelled; the first unlabelled_count used
@@ -42,6 +42,7 @@ struct MarkerFrame {
     unlabelled_count = 0;
     unknown_labels = 0;
     rejected_points = 0;
+    timecode = SourceTimecode{};
   }
 };
 

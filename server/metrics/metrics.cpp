@@ -127,6 +127,7 @@ std::string render_prometheus(const Metrics& source, const std::vector<SubjectMe
   per_subject("markers_held_total", "Marker samples held relative to their anchors.", &Metrics::markers_held);
   per_subject("bad_subscriber_messages_total", "Subscriber messages that broke the protocol.", &Metrics::bad_subscriber_messages);
   per_subject("subscribers_accepted_total", "Subscriber connections accepted.", &Metrics::subscribers_connected);
+  per_subject("subscribers_refused_total", "Subscribers refused after their Hello (unknown subject, ...).", &Metrics::subscribers_refused);
   per_subject("frame_buffers_allocated_total", "Encoded frame buffers created (steady state: constant).", &Metrics::frame_buffers_allocated);
   per_subject("frame_buffers_allocated_by_pipeline_total",
               "Of those, created on the pipeline thread because none was prepared when the subscriber asked (expected: 0).",
@@ -145,7 +146,9 @@ std::string render_prometheus(const Metrics& source, const std::vector<SubjectMe
   histogram("fill_seconds", "Gap filler time per frame.", &Metrics::fill);
   histogram("deform_seconds", "Mesh deformation time per frame (parts and vertices).", &Metrics::deform);
   histogram("normals_seconds", "Normal computation time per frame.", &Metrics::normals);
-  histogram("encode_seconds", "Frame encoding time per frame.", &Metrics::encode);
+  histogram("encode_seconds", "Frame encoding time per frame (every encoding but the compressed one).", &Metrics::encode);
+  histogram("encode_compressed_seconds", "The compressed encoding's time per frame (vertex codec, after the other encodings were handed over).",
+            &Metrics::encode_compressed);
   histogram("receive_to_publish_seconds", "From frame received to handed to the publishers.", &Metrics::receive_to_publish);
   histogram("subscriber_queue_wait_seconds",
             "Per frame and subscriber: from published to its write starting (the subscriber's queue and its io thread's turn).",

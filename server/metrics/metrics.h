@@ -64,11 +64,12 @@ class Metrics {
   std::atomic<uint64_t> markers_held{0};
   std::atomic<uint64_t> bad_subscriber_messages{0};
   std::atomic<uint64_t> subscribers_connected{0};  // total accepted
+  std::atomic<uint64_t> subscribers_refused{0};    // Hello refused (unknown subject, ...)
   std::atomic<uint64_t> frame_buffers_allocated{0};              // every encoded frame buffer made
   std::atomic<uint64_t> frame_buffers_allocated_by_pipeline{0};  // of those, made on the 120 Hz thread (none prepared)
 
   // receive_to_take: waiting in the mailbox, the pipeline thread's wake-up included.
-  LatencyHistogram receive_to_take, fill, deform, normals, encode, receive_to_publish;
+  LatencyHistogram receive_to_take, fill, deform, normals, encode, encode_compressed, receive_to_publish;
   // Delivery inside the daemon, per frame and subscriber: published -> its write starts (the
   // subscriber's queue and its io thread's turn), and write started -> the socket took the last
   // byte (a subscriber that reads slowly fills its socket buffers and lengthens this one).

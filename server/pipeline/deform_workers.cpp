@@ -110,9 +110,10 @@ bool DeformWorkers::run(std::span<const Vec3> markers, std::span<float> position
   markers_ = markers;
   positions_ = positions;
   normals_ = normals;
+  fits_only_ = positions.empty();  // seen by the workers through the generation's release below
   reset(fits_and_clusters_, generation, false);
-  reset(vertices_, generation, false);
-  reset(normals_stage_, generation, normals.empty());
+  reset(vertices_, generation, fits_only_);
+  reset(normals_stage_, generation, fits_only_ || normals.empty());
   generation_.store(generation, std::memory_order_release);
   get_ready();
 
@@ -238,6 +239,7 @@ void DeformWorkers::fit_or_cluster_task(uint32_t task, uint32_t generation) {
     part_fitted_[part].store(generation, std::memory_order_release);
     return;
   }
+  if (fits_only_) return;  // the parameters alone were wanted
   const ClusterChunk& chunk = cluster_chunks_[task - parts];
   int spins = 0;
   // Every fit task was taken before any cluster task, so the part's fit is under way.

@@ -51,8 +51,10 @@ class DeformWorkers {
   DeformWorkers& operator=(const DeformWorkers&) = delete;
 
   // Fits the parts to `markers` and deforms into `positions` (3V floats) and, when `normals`
-  // is not empty, `normals` (3V). Returns false, changing nothing, when the deformer does not
-  // accept the markers (wrong count, a marker not finite).
+  // is not empty, `normals` (3V). With `positions` empty, only fits the parts (the parameters,
+  // MeshDeformer::parameters()): the clusters, the blend and the normals are skipped. Returns
+  // false, changing nothing, when the deformer does not accept the markers (wrong count, a
+  // marker not finite).
   bool run(std::span<const Vec3> markers, std::span<float> positions, std::span<float> normals);
   // Says a run() is coming soon (the caller is about to fill the frame): a sleeping worker
   // wakes now, and its wake-up overlaps the caller's work instead of the deformation.
@@ -110,6 +112,7 @@ class DeformWorkers {
   // Set by run() before the generation is published, read by tasks after they take one.
   std::span<const Vec3> markers_;
   std::span<float> positions_, normals_;
+  bool fits_only_ = false;  // this frame: the part fits alone
   std::vector<std::thread> workers_;
   int64_t deform_ns_ = 0, normals_ns_ = 0;
 };

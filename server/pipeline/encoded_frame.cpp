@@ -50,7 +50,7 @@ FrameRef FramePool::acquire() {
     std::lock_guard lock(mutex_);
     frame = free_.empty() ? create_locked() : free_.pop();
   }
-  frame->encoded_mask = 0;
+  frame->encoded = {};
   return FrameRef(frame);
 }
 
@@ -59,13 +59,13 @@ size_t FramePool::allocated() const {
   return all_.size();
 }
 
-size_t FramePool::prepare(uint32_t slot, size_t bytes) {
-  if (slot >= EncodedFrame::kEncodings || bytes == 0) return 0;
+size_t FramePool::prepare(StreamKey key, size_t bytes) {
+  if (key >= EncodedFrame::kEncodings || bytes == 0) return 0;
   std::lock_guard serial(prepare_mutex_);
   size_t missing = 0;
   {
     std::lock_guard lock(mutex_);
-    const size_t covered = sized_[slot] + ready_[slot].size();
+    const size_t covered = sized_[key] + ready_[key].size();
     missing = all_.size() > covered ? all_.size() - covered : 0;
   }
   // Made outside the lock: value-initialised, so every page is touched here and not on the
@@ -74,18 +74,23 @@ size_t FramePool::prepare(uint32_t slot, size_t bytes) {
   made.reserve(missing);
   for (size_t i = 0; i < missing; ++i) made.emplace_back(bytes);
   std::lock_guard lock(mutex_);
-  for (auto& buffer : made) ready_[slot].push_back(std::move(buffer));
+  for (auto& buffer : made) ready_[key].push_back(std::move(buffer));
   return missing;
 }
 
-bool FramePool::size_message(EncodedFrame& frame, uint32_t slot, size_t bytes) {
-  std::vector<unsigned char>& message = frame.messages[slot];
+bool FramePool::size_message(EncodedFrame& frame, StreamKey key, size_t bytes) {
+  std::vector<unsigned char>& message = frame.messages[key];
   if (message.size() == bytes) return false;
+  if (message.capacity() >= bytes) {  // a compressed message, smaller or larger than the last
+    message.resize(bytes);
+    return false;
+  }
   std::lock_guard lock(mutex_);
-  if (message.empty()) ++sized_[slot];  // this frame now holds the encoding, either way
-  std::vector<std::vector<unsigned char>>& ready = ready_[slot];
-  if (!ready.empty() && ready.back().size() == bytes) {
+  if (message.capacity() == 0) ++sized_[key];  // this frame now holds the encoding, either way
+  std::vector<std::vector<unsigned char>>& ready = ready_[key];
+  if (!ready.empty() && ready.back().capacity() >= bytes) {
     message.swap(ready.back());
+    message.resize(bytes);
     ready.pop_back();  // the frame's old buffer, empty unless the size changed (never, for one mesh)
     return false;
   }

@@ -23,29 +23,25 @@
 #include <vector>
 
 #include "server/pipeline/bounded_ring.h"
+#include "server/pipeline/stream_key.h"
 
 namespace skinstream::server {
 
 class FramePool;
 
-// Which of an EncodedFrame's messages a subscriber takes, its "slot": its frame flags (the 16
-// combinations of normals, quantised, markers and no positions) in version 1, and the same 16
-// again in version 2 (whose Frames carry the timecode).
-constexpr uint32_t encoding_slot(uint32_t frame_flags, uint16_t version) { return (frame_flags & 15u) + (version >= 2 ? 16u : 0u); }
-constexpr uint32_t slot_frame_flags(uint32_t slot) { return slot & 15u; }
-constexpr uint16_t slot_version(uint32_t slot) { return slot >= 16u ? 2 : 1; }
-
 struct EncodedFrame {
-  static constexpr int kEncodings = 32;  // one per slot (encoding_slot)
+  static constexpr int kEncodings = kStreamKeys;  // one per stream key (version and frame flags)
 
   uint32_t frame_number = 0;
   int64_t publish_time_ns = 0;                     // wall clock, as sent
   std::chrono::steady_clock::time_point published;  // for the subscriber queues' wait limit
-  uint32_t encoded_mask = 0;  // bit s: messages[s] holds the frame for slot s
-  std::array<std::vector<unsigned char>, kEncodings> messages;  // sized on first use, then reused
+  StreamKeySet encoded;  // key k: messages[k] holds the frame for stream key k
+  // Sized on first use, then reused. A message of the compressed encoding changes size from
+  // frame to frame within its buffer's capacity (made for the largest it can be).
+  std::array<std::vector<unsigned char>, kEncodings> messages;
 
-  std::span<const unsigned char> message(uint32_t slot) const { return messages[slot]; }
-  bool has(uint32_t slot) const { return (encoded_mask >> slot) & 1u; }
+  std::span<const unsigned char> message(StreamKey key) const { return messages[key]; }
+  bool has(StreamKey key) const { return encoded.has(key); }
 
  private:
   friend class FramePool;
@@ -86,12 +82,13 @@ class FramePool {
   FrameRef acquire();
   size_t allocated() const;
 
-  // Any thread but the pipeline's: makes a buffer of `bytes` for slot `slot` ready for every
-  // pooled frame that has none yet. Returns the number of buffers it made.
-  size_t prepare(uint32_t slot, size_t bytes);
-  // Pipeline thread: gives frame.messages[slot] `bytes` bytes, from a prepared buffer when one
-  // is ready. Returns true when it had to allocate here instead.
-  bool size_message(EncodedFrame& frame, uint32_t slot, size_t bytes);
+  // Any thread but the pipeline's: makes a buffer of `bytes` (the most a message of this key can
+  // take) for stream key `key` ready for every pooled frame that has none yet. Returns the
+  // number of buffers it made.
+  size_t prepare(StreamKey key, size_t bytes);
+  // Pipeline thread: gives frame.messages[key] `bytes` bytes, within its capacity, or from a
+  // prepared buffer when one is ready. Returns true when it had to allocate here instead.
+  bool size_message(EncodedFrame& frame, StreamKey key, size_t bytes);
 
  private:
   friend class FrameRef;

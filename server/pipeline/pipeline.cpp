@@ -5,6 +5,7 @@
 #include <chrono>
 #include <stdexcept>
 
+#include "protocol/frame_parameters.h"
 #include "protocol/subscriber_stream.h"
 #include "server/pipeline/deform_cpus.h"
 #include "server/thread_name.h"
@@ -21,6 +22,39 @@ int64_t since_ns(std::chrono::steady_clock::time_point start) {
 }
 
 uint16_t clamp16(int v) { return static_cast<uint16_t>(std::clamp(v, 0, 65535)); }
+
+subscriber::FrameTimecode frame_timecode(const SourceTimecode& t) {
+  return {t.hours, t.minutes, t.seconds, t.frames, t.subframe, t.subframes_per_frame, t.rate_hz,
+          (t.drop_frame ? subscriber::kTimecodeDropFrame : 0u) | (t.field ? subscriber::kTimecodeField : 0u)};
+}
+
+// What one frame's subscribers need computed, from the stream keys they hold.
+struct FrameNeeds {
+  bool vertices = false;             // some encoding sends positions (float, quantised, compressed)
+  bool normals = false;              // ... with normals
+  bool parameters = false;           // some subscriber takes the parameters
+  bool compressed = false;
+  bool compressed_normals = false;
+};
+
+FrameNeeds needs_of(const StreamKeySet& wanted) {
+  FrameNeeds needs;
+  wanted.for_each([&](StreamKey key) {
+    const uint32_t flags = stream_flags(key);
+    if (flags & subscriber::kFrameNoPositions) return;
+    if (flags & subscriber::kFrameParameters) {
+      needs.parameters = true;
+      return;
+    }
+    needs.vertices = true;
+    needs.normals |= (flags & subscriber::kFrameNormals) != 0;
+    if (flags & subscriber::kFrameCompressed) {
+      needs.compressed = true;
+      needs.compressed_normals |= (flags & subscriber::kFrameNormals) != 0;
+    }
+  });
+  return needs;
+}
 
 }  // namespace
 
@@ -49,6 +83,12 @@ Pipeline::Pipeline(const SubjectModel& model, const DeformationModel* deformatio
     normals_.resize(positions_.size());
     workers_ = std::make_unique<DeformWorkers>(
         *deformer_, DeformWorkerOptions{options.deform_threads, options.deform_spin_lead, options.deform_cpus, options.deform_thread_name});
+    const EvaluationModel& evaluation = deformer_->evaluation_model();
+    parameter_block_.resize(subscriber::parameter_block_bytes(evaluation.part_count(), evaluation.member_count()));
+    compressed_order_ = subscriber::compressed_vertex_order(evaluation.reference_vertices);
+    compressed_ = std::make_unique<subscriber::CompressedVertexEncoder>(deformer_->vertex_count(), compressed_order_,
+                                                                        options.compressed_key_interval);
+    compressed_blocks_.resize(compressed_->max_bytes(true));
     if (workers_->unpinned_workers() > 0)
       spdlog::warn("pipeline: {} deform worker(s) could not be pinned to their CPU; they run where the OS puts them",
                    workers_->unpinned_workers());
@@ -125,35 +165,44 @@ void Pipeline::process(const MarkerFrame& frame, uint64_t generation) {
 
   const long sequence = sequence_++;
   held_[static_cast<size_t>(sequence) % held_.size()] = {frame.frame_number, frame.source_time_ns, frame.receive_time_ns,
-                                                        clamp16(stats.filled + stats.held), clamp16(stats.relabelled), frame.timecode};
+                                                        clamp16(stats.filled + stats.held), clamp16(stats.relabelled),
+                                                        frame_timecode(frame.timecode), frame.timecode.valid};
   long released = 0;
   if (blender_.push(filled_, filled_status_, sequence, {released_positions_, released_status_}, released))
     publish(held_[static_cast<size_t>(released) % held_.size()], released_positions_, released_status_);
 }
 
-size_t Pipeline::message_bytes(uint32_t slot) const {
-  const uint32_t flags = slot_frame_flags(slot);
-  return subscriber::frame_message_bytes(flags, (flags & subscriber::kFrameNoPositions) ? 0 : vertex_count(),
-                                         (flags & subscriber::kFrameMarkers) ? static_cast<uint32_t>(model_.marker_count()) : 0,
-                                         slot_version(slot));
+size_t Pipeline::message_bytes(StreamKey key) const {
+  const uint32_t flags = stream_flags(key);
+  const uint32_t markers = (flags & subscriber::kFrameMarkers) ? static_cast<uint32_t>(model_.marker_count()) : 0;
+  if ((flags & subscriber::kFrameParameters) && deformer_)
+    return subscriber::frame_message_bytes_with_block(parameter_block_.size(), flags, markers);
+  if ((flags & subscriber::kFrameCompressed) && compressed_)
+    return subscriber::frame_message_bytes_with_block(compressed_->max_bytes(flags & subscriber::kFrameNormals), flags, markers);
+  return subscriber::frame_message_bytes(flags, (flags & subscriber::kFrameNoPositions) ? 0 : vertex_count(), markers,
+                                         stream_version(key));
 }
 
-void Pipeline::prepare_encoding(uint32_t slot) {
-  const size_t made = pool_.prepare(slot, message_bytes(slot));
+void Pipeline::prepare_encoding(StreamKey key) {
+  const size_t made = pool_.prepare(key, message_bytes(key));
   metrics_.frame_buffers_allocated.fetch_add(made, std::memory_order_relaxed);
+  if ((stream_flags(key) & subscriber::kFrameCompressed) && compressed_) compressed_->request_key();
 }
 
 void Pipeline::publish(const Released& meta, std::span<const Vec3> positions, std::span<const MarkerStatus> status) {
-  const uint32_t wanted = consumer_.wanted_encodings();
-  bool want_normals = false;
-  for (uint32_t slot = 0; slot < EncodedFrame::kEncodings; ++slot)
-    if (((wanted >> slot) & 1u) && (slot_frame_flags(slot) & subscriber::kFrameNormals)) want_normals = true;
+  const StreamKeySet wanted = consumer_.wanted_encodings();
+  const FrameNeeds needs = needs_of(wanted);
 
-  if (deformer_) {
+  // The mesh only when someone takes vertices; the part fits alone when only parameters are
+  // wanted; nothing for markers alone.
+  // A frame the deformer refuses keeps the last fit and mesh (as the float encoding always did).
+  if (deformer_ && (needs.vertices || needs.parameters)) {
     const auto start = std::chrono::steady_clock::now();
-    if (workers_->run(positions, positions_, want_normals ? std::span<float>(normals_) : std::span<float>())) {
+    const std::span<float> vertices = needs.vertices ? std::span<float>(positions_) : std::span<float>();
+    const std::span<float> normals = needs.vertices && needs.normals ? std::span<float>(normals_) : std::span<float>();
+    if (workers_->run(positions, vertices, normals)) {
       metrics_.deform.observe_ns(since_ns(start) - workers_->last_normals_ns());
-      if (want_normals) metrics_.normals.observe_ns(workers_->last_normals_ns());
+      if (!normals.empty()) metrics_.normals.observe_ns(workers_->last_normals_ns());
     } else {
       metrics_.count_bad_input("deform_failed");
     }
@@ -164,50 +213,91 @@ void Pipeline::publish(const Released& meta, std::span<const Vec3> positions, st
     for (int a = 0; a < 3; ++a) marker_floats_[3 * m + a] = static_cast<float>(positions[m][a]);
     marker_status_bytes_[m] = static_cast<uint8_t>(status[m]);
   }
-  FrameRef ref = pool_.acquire();
-  EncodedFrame& out = *ref.mutable_frame();
   subscriber::FrameInfo info;
   info.frame_number = meta.frame_number;
   info.source_time_ns = meta.source_time_ns;
   info.receive_time_ns = meta.receive_time_ns;
-  info.publish_time_ns = 0;  // stamped below, once every encoding is written
-  info.vertex_count = vertex_count();
+  info.publish_time_ns = 0;  // stamped when handed over, once every encoding of the ref is written
   info.marker_count = static_cast<uint32_t>(status.size());
   info.markers_filled = meta.filled;
   info.markers_relabelled = meta.relabelled;
   info.pipeline_dropped = static_cast<uint32_t>(mailbox_.dropped());
-  const SourceTimecode& tc = meta.timecode;
-  info.timecode = {tc.hours, tc.minutes, tc.seconds, tc.frames, tc.subframe, tc.subframes_per_frame, tc.rate_hz,
-                   (tc.drop_frame ? subscriber::kTimecodeDropFrame : 0u) | (tc.field ? subscriber::kTimecodeField : 0u)};
-  out.frame_number = meta.frame_number;
-  for (uint32_t f = 0; f < EncodedFrame::kEncodings; ++f) {
-    if (!((wanted >> f) & 1u)) continue;
-    const uint16_t version = slot_version(f);
-    info.flags = slot_frame_flags(f) | (version >= 2 && tc.valid ? subscriber::kFrameTimecode : 0u);
-    const size_t bytes = message_bytes(f);
-    if (pool_.size_message(out, f, bytes)) {  // first use of this encoding in this pooled frame, nothing prepared
+  info.timecode = meta.timecode;
+  // Two hand-overs: every encoding but the compressed one first, then the compressed one, whose
+  // vertex codec takes about a millisecond a frame (docs/measurements-log.md): its subscribers
+  // wait for it, the others do not. Each subscriber takes the ref that holds its key.
+  if (deformer_ && needs.parameters) subscriber::encode_parameter_block(deformer_->parameters(), parameter_block_);
+  StreamKeySet first, compressed_keys;
+  wanted.for_each([&](StreamKey key) { ((stream_flags(key) & subscriber::kFrameCompressed) ? compressed_keys : first).add(key); });
+  if (!first.empty()) {
+    hand_over(encode(first, info, meta.has_timecode, {}), meta, true);
+    metrics_.encode.observe_ns(since_ns(encode_start));
+  }
+  if (!compressed_keys.empty() && compressed_) {
+    const auto compressed_start = std::chrono::steady_clock::now();
+    const subscriber::CompressedBlocks blocks = compressed_->encode(
+        meta.frame_number, positions_, needs.compressed_normals ? std::span<const float>(normals_) : std::span<const float>(), compressed_blocks_);
+    hand_over(encode(compressed_keys, info, meta.has_timecode, blocks), meta, first.empty());
+    metrics_.encode_compressed.observe_ns(since_ns(compressed_start));
+  }
+}
+
+// Every key of `keys` encoded into one pooled frame.
+FrameRef Pipeline::encode(const StreamKeySet& keys, subscriber::FrameInfo info, bool has_timecode,
+                          const subscriber::CompressedBlocks& compressed) {
+  FrameRef ref = pool_.acquire();
+  EncodedFrame& out = *ref.mutable_frame();
+  out.frame_number = info.frame_number;
+  keys.for_each([&](StreamKey key) {
+    const uint16_t version = stream_version(key);
+    info.flags = stream_flags(key);
+    info.vertex_count = vertex_count();
+    if (version >= subscriber::kVersion2 && has_timecode) info.flags |= subscriber::kFrameTimecode;
+    std::span<const unsigned char> block;
+    if (info.flags & subscriber::kFrameParameters) {
+      block = parameter_block_;
+    } else if (info.flags & subscriber::kFrameCompressed) {
+      if (compressed.key) info.flags |= subscriber::kFrameKey;
+      const bool with_normals = info.flags & subscriber::kFrameNormals;
+      block = std::span<const unsigned char>(compressed_blocks_).first(compressed.positions_bytes + (with_normals ? compressed.normals_bytes : 0));
+    }
+    const uint32_t markers = (info.flags & subscriber::kFrameMarkers) ? info.marker_count : 0;
+    const bool coded = (info.flags & (subscriber::kFrameParameters | subscriber::kFrameCompressed)) != 0;
+    const size_t bytes = coded ? subscriber::frame_message_bytes_with_block(block.size(), info.flags, markers)
+                               : subscriber::frame_message_bytes(info.flags, (info.flags & subscriber::kFrameNoPositions) ? 0 : info.vertex_count,
+                                                                 markers, version);
+    if (pool_.size_message(out, key, bytes)) {  // first use of this encoding in this pooled frame, nothing prepared
       metrics_.frame_buffers_allocated.fetch_add(1, std::memory_order_relaxed);
       metrics_.frame_buffers_allocated_by_pipeline.fetch_add(1, std::memory_order_relaxed);
     }
-    subscriber::encode_frame(info, positions_, normals_, marker_floats_, marker_status_bytes_, out.messages[f], version);
-    out.encoded_mask |= 1u << f;
-  }
-  metrics_.encode.observe_ns(since_ns(encode_start));
+    if (coded)
+      subscriber::encode_frame_with_block(info, block, marker_floats_, marker_status_bytes_, out.messages[key]);
+    else
+      subscriber::encode_frame(info, positions_, normals_, marker_floats_, marker_status_bytes_, out.messages[key], version);
+    out.encoded.add(key);
+  });
+  return ref;
+}
+
+// `first`: the frame's first hand-over, which counts it as published.
+void Pipeline::hand_over(FrameRef ref, const Released& meta, bool first) {
+  EncodedFrame& out = *ref.mutable_frame();
   // The publish time is taken last, so that publish - receive (in every frame's header) is the
   // daemon's whole processing, encoding included; delivery starts here.
   out.publish_time_ns = wall_clock_ns();
   out.published = std::chrono::steady_clock::now();
-  for (uint32_t f = 0; f < EncodedFrame::kEncodings; ++f)
-    if ((out.encoded_mask >> f) & 1u) subscriber::patch_publish_time(out.messages[f], out.publish_time_ns);
-  metrics_.frames_dropped.store(mailbox_.dropped(), std::memory_order_relaxed);
-  metrics_.frames_dropped_mailbox_full.store(mailbox_.dropped_mailbox_full(), std::memory_order_relaxed);
-  // Counted before the hand-over, so that no reader of the counters (/health, the bench) can
-  // find a subscriber holding a frame the count does not include yet: a publish thread may
-  // write it out before this thread runs its next line.
-  published_.fetch_add(1, std::memory_order_relaxed);
-  metrics_.frames_published.fetch_add(1, std::memory_order_relaxed);
+  out.encoded.for_each([&](StreamKey key) { subscriber::patch_publish_time(out.messages[key], out.publish_time_ns); });
+  if (first) {
+    metrics_.frames_dropped.store(mailbox_.dropped(), std::memory_order_relaxed);
+    metrics_.frames_dropped_mailbox_full.store(mailbox_.dropped_mailbox_full(), std::memory_order_relaxed);
+    // Counted before the hand-over, so that no reader of the counters (/health, the bench) can
+    // find a subscriber holding a frame the count does not include yet: a publish thread may
+    // write it out before this thread runs its next line.
+    published_.fetch_add(1, std::memory_order_relaxed);
+    metrics_.frames_published.fetch_add(1, std::memory_order_relaxed);
+  }
   consumer_.publish(ref);
-  if (meta.receive_time_ns > 0) metrics_.receive_to_publish.observe_ns(wall_clock_ns() - meta.receive_time_ns);
+  if (first && meta.receive_time_ns > 0) metrics_.receive_to_publish.observe_ns(wall_clock_ns() - meta.receive_time_ns);
 }
 
 }  // namespace skinstream::server

@@ -1,9 +1,11 @@
 #pragma once
 // The pipeline thread: takes the marker frames from the mailbox in order, fills each (GapFiller,
-// then the optional lookahead blend of GapEndBlender, as core/capture_filler.cpp does), deforms the
-// mesh (MeshDeformer over DeformWorkers), encodes the Frame message in every encoding someone
-// subscribed to into a pooled buffer, and hands it to the publishers. Allocates nothing per
-// frame in steady state; never waits for a subscriber.
+// then the optional lookahead blend of GapEndBlender, as core/capture_filler.cpp does), fits the
+// parts and, when a subscriber wants vertices, deforms the mesh (MeshDeformer over
+// DeformWorkers), encodes the Frame message once for every stream key someone subscribed to
+// (version, encoding, normals, markers) into a pooled buffer, and hands it to the publishers.
+// Subscribers of the parameters alone cost no deformation: their frames carry the part fits.
+// Allocates nothing per frame in steady state; never waits for a subscriber.
 
 #include <atomic>
 #include <memory>
@@ -13,6 +15,7 @@
 #include <vector>
 
 #include "core/deform/deformation_model.h"
+#include "core/deform/evaluation_model.h"
 #include "core/deform/mesh_deformer.h"
 #include "core/gap_end_blender.h"
 #include "core/gap_filler.h"
@@ -21,6 +24,8 @@
 #include "server/pipeline/deform_workers.h"
 #include "server/pipeline/encoded_frame.h"
 #include "server/pipeline/frame_mailbox.h"
+#include "server/pipeline/stream_key.h"
+#include "protocol/compressed_vertices.h"
 
 namespace skinstream::server {
 
@@ -28,9 +33,8 @@ namespace skinstream::server {
 class FrameConsumer {
  public:
   virtual ~FrameConsumer() = default;
-  // Bit s set: some subscriber receives the frames of slot s (encoding_slot: its frame flags,
-  // subscriber::frame_flags_for, in its protocol version).
-  virtual uint32_t wanted_encodings() const = 0;
+  // The stream keys some subscriber receives.
+  virtual StreamKeySet wanted_encodings() const = 0;
   // Called on the pipeline thread; must not block.
   virtual void publish(const FrameRef& frame) = 0;
 };
@@ -42,6 +46,7 @@ struct PipelineOptions {
   std::vector<int> deform_cpus;                   // DeformWorkerOptions; index 0 the pipeline thread's
   double default_rate_hz = 120.0;
   GapFillerOptions filler;
+  int compressed_key_interval = 10;  // frames; the compressed encoding's key frames (protocol/compressed_vertices.h)
   std::string thread_name = "pipeline";  // its deform workers: DeformWorkerOptions::thread_name
   std::string deform_thread_name = "deform";
 };
@@ -60,24 +65,33 @@ class Pipeline {
   bool has_mesh() const { return deformer_ != nullptr; }
   uint32_t vertex_count() const { return deformer_ ? static_cast<uint32_t>(deformer_->vertex_count()) : 0; }
   uint64_t frames_published() const { return published_.load(); }
-  // Any thread, before the pipeline is told anyone wants slot `slot` (encoding_slot): makes its
-  // buffers for every pooled frame, so the first frames encoded that way do not allocate (and
-  // fault in 640 kB each) on the pipeline thread.
-  void prepare_encoding(uint32_t slot);
+  // The static half of the parameter encoding (what the Model message sends); null without a mesh.
+  const EvaluationModel* evaluation_model() const { return deformer_ ? &deformer_->evaluation_model() : nullptr; }
+  // The order the compressed encoding codes the vertices in (MeshInfo sends it); empty without a mesh.
+  const std::vector<uint32_t>& compressed_order() const { return compressed_order_; }
+  // Any thread, before the pipeline is told anyone wants stream `key`: makes its buffers for
+  // every pooled frame, so the first frames encoded that way do not allocate (and fault in
+  // 640 kB each) on the pipeline thread. For the compressed encoding, the next frame becomes a
+  // key frame, so the new subscriber need not wait for one.
+  void prepare_encoding(StreamKey key);
 
  private:
-  size_t message_bytes(uint32_t slot) const;  // a Frame message of this slot
+  // A Frame message of this key: its size, or for the compressed encoding the most it can take.
+  size_t message_bytes(StreamKey key) const;
   struct Released {
     uint32_t frame_number = 0;
     int64_t source_time_ns = 0;
     int64_t receive_time_ns = 0;
     uint16_t filled = 0;
     uint16_t relabelled = 0;
-    SourceTimecode timecode;
+    subscriber::FrameTimecode timecode;
+    bool has_timecode = false;
   };
   void run();
   void process(const MarkerFrame& frame, uint64_t generation);
   void publish(const Released& meta, std::span<const Vec3> positions, std::span<const MarkerStatus> status);
+  FrameRef encode(const StreamKeySet& keys, subscriber::FrameInfo info, bool has_timecode, const subscriber::CompressedBlocks& compressed);
+  void hand_over(FrameRef ref, const Released& meta, bool first);
 
   const SubjectModel& model_;
   PipelineOptions options_;
@@ -105,6 +119,11 @@ class Pipeline {
   std::vector<float> marker_floats_;
   std::vector<uint8_t> marker_status_bytes_;
   std::vector<float> positions_, normals_;
+  // Encoded once a frame for all the subscribers of the encoding.
+  std::vector<unsigned char> parameter_block_;
+  std::vector<uint32_t> compressed_order_;
+  std::unique_ptr<subscriber::CompressedVertexEncoder> compressed_;
+  std::vector<unsigned char> compressed_blocks_;
 
   std::atomic<bool> running_{false};
   std::atomic<uint64_t> published_{0};

@@ -23,10 +23,10 @@ class SubjectDirectory {
     return nullptr;
   }
 
-  // "Actor1, Actor2": what a refusal says the daemon serves.
+  // "\"Actor1\", \"Actor2\"": what a refusal says the daemon serves.
   std::string names() const {
     std::string out;
-    for (const auto& entry : entries_) out += (out.empty() ? "" : ", ") + entry.first;
+    for (const auto& entry : entries_) out += (out.empty() ? "\"" : ", \"") + entry.first + "\"";
     return out;
   }
 

@@ -8,20 +8,30 @@ namespace skinstream::server {
 
 namespace {
 
-// The encoding a version 2 subscriber of this slot is served.
-subscriber::Encoding served_in(uint32_t slot) {
-  return (slot_frame_flags(slot) & subscriber::kFrameQuantised) ? subscriber::Encoding::Quantised : subscriber::Encoding::Float;
+// The encoding a stream key's frames are in.
+subscriber::Encoding encoding_of(StreamKey key) {
+  const uint32_t flags = stream_flags(key);
+  if (flags & subscriber::kFrameParameters) return subscriber::Encoding::Parameters;
+  if (flags & subscriber::kFrameCompressed) return subscriber::Encoding::Compressed;
+  if (flags & subscriber::kFrameQuantised) return subscriber::Encoding::Quantised;
+  return subscriber::Encoding::Float;
 }
 
-ControlMessage message_of(std::vector<unsigned char> bytes) { return std::make_shared<const std::vector<unsigned char>>(std::move(bytes)); }
+size_t status_index(StreamKey key) {
+  return stream_version(key) >= subscriber::kVersion2 ? 1 + static_cast<size_t>(encoding_of(key)) : 0;
+}
+
+ControlMessage encode_status_for(subscriber::Status status, StreamKey key) {
+  status.encoding = encoding_of(key);
+  return std::make_shared<const std::vector<unsigned char>>(subscriber::encode_status(status, stream_version(key)));
+}
 
 }  // namespace
 
 SubscriberHub::SubscriberHub(Metrics& metrics, const HubOptions& options, subscriber::MeshInfo mesh_info, bool has_mesh)
     : metrics_(metrics), options_(options), has_mesh_(has_mesh), mesh_info_(std::move(mesh_info)) {
-  subscriber::Status status;
-  status.subject = mesh_info_.subject;
-  broadcast_status(status);  // nobody to send it to yet: it becomes the latest
+  status_.subject = mesh_info_.subject;
+  broadcast_status(status_);
 }
 
 void SubscriberHub::add(const std::shared_ptr<SubscriberSession>& session, bool accepted) {
@@ -30,8 +40,8 @@ void SubscriberHub::add(const std::shared_ptr<SubscriberSession>& session, bool 
   if (accepted) metrics_.subscribers_connected.fetch_add(1, std::memory_order_relaxed);
 }
 
-void SubscriberHub::activate(SubscriberSession& session, uint32_t slot) {
-  if (prepare_encoding_) prepare_encoding_(slot);  // does nothing once the slot is prepared
+void SubscriberHub::activate(SubscriberSession& session, StreamKey key) {
+  if (prepare_encoding_) prepare_encoding_(key);  // makes nothing once the key's buffers are made
   std::lock_guard lock(mutex_);
   if (std::find(active_.begin(), active_.end(), &session) == active_.end()) active_.push_back(&session);
   update_wanted_locked();
@@ -59,23 +69,25 @@ void SubscriberHub::close_all() {
 }
 
 void SubscriberHub::update_wanted_locked() {
-  uint32_t mask = 0;
-  for (const SubscriberSession* s : active_) mask |= 1u << s->slot();
-  wanted_.store(mask);
+  StreamKeySet set;
+  for (const SubscriberSession* s : active_) set.add(s->stream_key());
+  wanted_[0].store(set.bits[0]);
+  wanted_[1].store(set.bits[1]);
 }
 
-ControlMessage SubscriberHub::mesh_info_message(uint32_t slot) {
+ControlMessage SubscriberHub::mesh_info_message(StreamKey key) {
   std::lock_guard lock(mesh_info_mutex_);
-  ControlMessage& cached = mesh_info_messages_[slot % mesh_info_messages_.size()];
+  ControlMessage& cached = mesh_info_messages_[key % kStreamKeys];
   if (!cached) {
     subscriber::MeshInfo info = mesh_info_;
-    if (slot_frame_flags(slot) & subscriber::kFrameNoPositions) {
+    if (stream_flags(key) & subscriber::kFrameNoPositions) {
       info.vertex_count = 0;
       info.faces.clear();
       info.dominant_part.clear();
     }
-    info.encoding = served_in(slot);
-    cached = message_of(subscriber::encode_mesh_info(info, slot_version(slot)));
+    info.encoding = encoding_of(key);
+    if (info.encoding == subscriber::Encoding::Compressed) info.compressed_order = compressed_order_;
+    cached = std::make_shared<const std::vector<unsigned char>>(subscriber::encode_mesh_info(info, stream_version(key)));
   }
   return cached;
 }
@@ -87,42 +99,35 @@ void SubscriberHub::set_source_rate(float rate_hz) {
   for (ControlMessage& m : mesh_info_messages_) m.reset();
 }
 
-ControlMessage SubscriberHub::status_message(uint32_t slot) const {
+ControlMessage SubscriberHub::status_message(StreamKey key) const {
   std::lock_guard lock(mutex_);
-  return status_locked(slot);
+  return status_messages_[status_index(key)];
 }
 
-ControlMessage SubscriberHub::status_locked(uint32_t slot) const {
-  return slot_version(slot) >= 2 ? status_v2_[static_cast<size_t>(served_in(slot))] : status_v1_;
-}
-
-ControlMessage SubscriberHub::status_saying(uint32_t slot, std::string_view detail) const {
+ControlMessage SubscriberHub::status_message(StreamKey key, const std::string& detail, subscriber::SourceStateCode state) const {
   subscriber::Status status;
   {
     std::lock_guard lock(mutex_);
     status = status_;
   }
-  status.detail = std::string(detail);
-  status.encoding = served_in(slot);
-  return message_of(subscriber::encode_status(status, slot_version(slot)));
+  status.detail = detail;
+  status.state = state;
+  return encode_status_for(status, key);
 }
 
-void SubscriberHub::log_refusal(std::string_view text) { refusal_log_.warn("subscriber_refused", text); }
-
-void SubscriberHub::broadcast_status(const subscriber::Status& status) {
-  subscriber::Status v2 = status;
-  v2.subject = mesh_info_.subject;
-  std::array<ControlMessage, 2> by_encoding;
-  for (subscriber::Encoding encoding : {subscriber::Encoding::Float, subscriber::Encoding::Quantised}) {
-    v2.encoding = encoding;
-    by_encoding[static_cast<size_t>(encoding)] = message_of(subscriber::encode_status(v2, subscriber::kVersion2));
-  }
-  const ControlMessage v1 = message_of(subscriber::encode_status(status, subscriber::kVersion1));
+void SubscriberHub::broadcast_status(const subscriber::Status& in) {
+  subscriber::Status status = in;
+  if (status.subject.empty()) status.subject = mesh_info_.subject;
+  std::array<ControlMessage, 1 + subscriber::kEncodingCount> messages;
+  messages[0] = encode_status_for(status, stream_key(0, subscriber::kVersion1));
+  const uint32_t encoding_flags[subscriber::kEncodingCount] = {0, subscriber::kFrameQuantised, subscriber::kFrameCompressed,
+                                                              subscriber::kFrameParameters};
+  for (uint32_t e = 0; e < subscriber::kEncodingCount; ++e)
+    messages[1 + e] = encode_status_for(status, stream_key(encoding_flags[e], subscriber::kVersion2));
   std::lock_guard lock(mutex_);
-  status_ = v2;
-  status_v1_ = v1;
-  status_v2_ = by_encoding;
-  for (SubscriberSession* s : active_) s->offer_control(status_locked(s->slot()));
+  status_ = status;
+  status_messages_ = messages;
+  for (SubscriberSession* s : active_) s->offer_control(status_messages_[status_index(s->stream_key())]);
 }
 
 void SubscriberHub::publish(const FrameRef& frame) {

@@ -1,9 +1,8 @@
 #pragma once
-// Every subscriber of one subject (TCP and WebSocket): fans each published frame out to their
-// queues without waiting for any of them, keeps the MeshInfo for each encoding slot and the
-// latest Status in each version, and says which slots are wanted so the pipeline encodes only
-// those. A new subscriber starts in the first subject's hub and moves to the hub of the subject
-// its Hello names (SubjectDirectory) before it receives anything.
+// Every subscriber of one subject (TCP and WebSocket): fans each published frame out to their queues
+// without waiting for any of them, keeps the MeshInfo for each stream key, the Model message and
+// the latest Status in each version, and says which stream keys are wanted so the pipeline
+// encodes only those.
 
 #include <array>
 #include <atomic>
@@ -11,12 +10,10 @@
 #include <functional>
 #include <memory>
 #include <mutex>
-#include <string_view>
 #include <vector>
 
 #include "protocol/subscriber_stream.h"
 #include "server/asio.h"
-#include "server/logging.h"
 #include "server/metrics/metrics.h"
 #include "server/pipeline/pipeline.h"
 #include "server/publish/subject_directory.h"
@@ -34,40 +31,51 @@ struct HubOptions {
 
 class SubscriberHub : public FrameConsumer {
  public:
-  // `mesh_info` describes the full mesh (its subject: the name subscribers know the subject
-  // by); subscribers without positions get it with V = F = 0.
+  // `mesh_info` describes the full mesh (its subject field names the subject); subscribers
+  // without positions get it with V = F = 0.
   SubscriberHub(Metrics& metrics, const HubOptions& options, subscriber::MeshInfo mesh_info, bool has_mesh);
 
   const HubOptions& options() const { return options_; }
   Metrics& metrics() { return metrics_; }
   bool has_mesh() const { return has_mesh_; }
-  const std::string& subject() const { return mesh_info_.subject; }
-  // Every subject's hub, for a Hello naming one; null: this hub serves alone.
+  const std::string& subject_name() const { return mesh_info_.subject; }
+  // Every subject's hub, for a Hello naming one (a new subscriber starts in the first subject's
+  // hub and moves to the one it names); null: this hub serves alone. Set before any subscriber.
   void set_directory(const SubjectDirectory* directory) { directory_ = directory; }
   const SubjectDirectory* directory() const { return directory_; }
 
-  // `accepted`: a new connection (counted); false for one moving in from another hub.
+  // `accepted`: a new connection (counted); false for one moving in from another subject's hub.
   void add(const std::shared_ptr<SubscriberSession>& session, bool accepted = true);
-  // Called by activate() on the subscriber's thread before its slot becomes wanted, so the
-  // pipeline can make that slot's buffers there (Pipeline::prepare_encoding). Set before any
+  // Called by activate() on the subscriber's thread before its stream key becomes wanted, so
+  // the pipeline can make that key's buffers there (Pipeline::prepare_encoding). Set before any
   // subscriber connects.
-  void set_encoding_preparer(std::function<void(uint32_t slot)> prepare) { prepare_encoding_ = std::move(prepare); }
-  // After Hello (or its timeout): the session starts receiving the frames of this slot
-  // (encoding_slot: its frame flags in its protocol version).
-  void activate(SubscriberSession& session, uint32_t slot);
+  void set_encoding_preparer(std::function<void(StreamKey key)> prepare) { prepare_encoding_ = std::move(prepare); }
+  // After Hello (or its timeout): the session starts receiving frames of this stream key.
+  void activate(SubscriberSession& session, StreamKey key);
   void remove(SubscriberSession& session);
   void close_all();
 
-  ControlMessage mesh_info_message(uint32_t slot);
-  ControlMessage status_message(uint32_t slot) const;  // the latest, in the slot's version
-  ControlMessage status_saying(uint32_t slot, std::string_view detail) const;  // the latest, with this detail
-  void log_refusal(std::string_view text);  // a subscriber refused (rate-limited: a flood logs once a second)
+  ControlMessage mesh_info_message(StreamKey key);
+  // The compressed encoding's vertex order, sent in its MeshInfo. Set before any subscriber connects.
+  void set_compressed_order(std::vector<uint32_t> order) { compressed_order_ = std::move(order); }
+  // The Model message of the parameter encoding (null without a mesh). Set before any
+  // subscriber connects.
+  void set_model_message(ControlMessage model) { model_message_ = std::move(model); }
+  const ControlMessage& model_message() const { return model_message_; }
+  // The latest Status, in the key's version (and with the encoding it serves).
+  ControlMessage status_message(StreamKey key) const;
+  // The latest Status with another detail (a notice to one subscriber, e.g. an encoding it
+  // asked for and does not get), in the key's version.
+  ControlMessage status_message(StreamKey key, const std::string& detail, subscriber::SourceStateCode state) const;
   void set_source_rate(float rate_hz);
-  // Encodes a Status in each version once and sends it to every greeted subscriber (version 2
-  // adds the subject, its presence and the encoding each subscriber is served).
+  // Encodes and sends a Status to every greeted subscriber, each in its version.
   void broadcast_status(const subscriber::Status& status);
 
-  uint32_t wanted_encodings() const override { return wanted_.load(); }
+  StreamKeySet wanted_encodings() const override {
+    StreamKeySet set;
+    set.bits = {wanted_[0].load(std::memory_order_relaxed), wanted_[1].load(std::memory_order_relaxed)};
+    return set;
+  }
   void publish(const FrameRef& frame) override;
 
   std::vector<SubscriberMetrics> subscriber_metrics() const;
@@ -75,7 +83,6 @@ class SubscriberHub : public FrameConsumer {
 
  private:
   void update_wanted_locked();
-  ControlMessage status_locked(uint32_t slot) const;
 
   Metrics& metrics_;
   HubOptions options_;
@@ -84,17 +91,17 @@ class SubscriberHub : public FrameConsumer {
   // subscriber's Hello) under mutex_ held the pipeline's publish() for 14 ms at start-up.
   std::mutex mesh_info_mutex_;
   subscriber::MeshInfo mesh_info_;
-  std::array<ControlMessage, EncodedFrame::kEncodings> mesh_info_messages_;
+  std::array<ControlMessage, kStreamKeys> mesh_info_messages_;
+  ControlMessage model_message_;
+  std::vector<uint32_t> compressed_order_;
   mutable std::mutex mutex_;  // the sessions and the status
   std::vector<std::shared_ptr<SubscriberSession>> sessions_;
   std::vector<SubscriberSession*> active_;
-  // The latest Status: version 1, and version 2 for each encoding served (float, quantised).
   subscriber::Status status_;
-  ControlMessage status_v1_;
-  std::array<ControlMessage, 2> status_v2_;
-  RateLimitedLog refusal_log_;
-  std::atomic<uint32_t> wanted_{0};
-  std::function<void(uint32_t)> prepare_encoding_;
+  // The status encoded: version 1, then version 2 per encoding served.
+  std::array<ControlMessage, 1 + subscriber::kEncodingCount> status_messages_;
+  std::array<std::atomic<uint64_t>, 2> wanted_{};  // StreamKeySet::bits
+  std::function<void(StreamKey)> prepare_encoding_;
   const SubjectDirectory* directory_ = nullptr;
 };
 

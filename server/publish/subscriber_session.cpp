@@ -24,7 +24,7 @@ SubscriberSession::SubscriberSession(asio::io_context& io, SubscriberHub& hub, s
       pump_slot_(std::make_shared<HandlerSlot>()) {}
 
 void SubscriberSession::offer(const FrameRef& frame) {
-  if (!frame->has(slot_.load())) return;  // encoding not ready in this frame (wants just changed)
+  if (!frame->has(key_.load())) return;  // encoding not ready in this frame (wants just changed)
   queue_.push_frame(frame);
   kick();
 }
@@ -55,11 +55,11 @@ void SubscriberSession::start_hello_timer(std::chrono::milliseconds timeout) {
 
 void SubscriberSession::on_subscriber_message(subscriber::MessageType type, std::span<const unsigned char> payload,
                                               uint16_t version) {
+  if (version_ != 0 && version != version_)
+    throw subscriber::DecodeError("a version " + std::to_string(version) + " message after a version " + std::to_string(version_) +
+                                  " Hello");
   switch (type) {
     case subscriber::MessageType::Hello:
-      if (greeted_ && version != version_)
-        throw subscriber::DecodeError("a Hello of version " + std::to_string(version) + " after one of version " +
-                                      std::to_string(version_));
       on_hello(subscriber::decode_hello(payload, version));
       return;
     case subscriber::MessageType::Ack:
@@ -79,49 +79,55 @@ void SubscriberSession::on_ack() {
 }
 
 void SubscriberSession::on_hello(const subscriber::Hello& hello) {
-  if (closed_ || close_when_sent_) return;
-  std::string note;  // a Status says so when the Hello asks for what is not served
-  uint32_t flags = 0;
-  if (hello.version >= subscriber::kVersion2) {
-    // The subject is chosen by the first Hello; a later one changes what is sent, not to whom.
-    if (!greeted_ && !join_subject(hello.subject)) return;
-    subscriber::Encoding served = subscriber::Encoding::Float;
-    if (hello.encoding == static_cast<uint32_t>(subscriber::Encoding::Quantised)) {
-      served = subscriber::Encoding::Quantised;
-    } else if (hello.encoding != static_cast<uint32_t>(subscriber::Encoding::Float)) {
-      const std::string asked = hello.encoding < subscriber::kEncodingCount
-                                    ? subscriber::to_string(static_cast<subscriber::Encoding>(hello.encoding))
-                                    : "number " + std::to_string(hello.encoding);
-      note = "encoding " + asked + " is not served: positions in float";
-    }
-    flags = subscriber::frame_flags_for(hello.wants, served, hub_->has_mesh());
-  } else {
-    flags = subscriber::frame_flags_for(hello.wants, hub_->has_mesh());
-  }
-  const uint32_t slot = encoding_slot(flags, hello.version);
-  paced_ = (hello.wants & subscriber::kWantPaced) != 0;
+  if (closed_) return;
   version_ = hello.version;
-  const bool changed = !greeted_ || slot != slot_.load();
+  paced_ = (hello.wants & subscriber::kWantPaced) != 0;
+  // Version 2: the encoding asked for, or what can be served instead, and why.
+  std::string notice;
+  uint32_t flags = subscriber::frame_flags_for(hello.wants, hub_->has_mesh());
+  if (hello.version >= subscriber::kVersion2) {
+    // The first Hello chooses the subject; a later one may not name another.
+    if (!greeted_ && !join_subject(hello.subject)) return;
+    if (greeted_ && !hello.subject.empty() && hello.subject != hub_->subject_name()) {
+      refuse("a Hello naming subject \"" + hello.subject + "\" after one naming \"" + hub_->subject_name() + "\"");
+      return;
+    }
+    subscriber::Encoding served = subscriber::Encoding::Float;
+    if (hello.encoding < subscriber::kEncodingCount) {
+      served = static_cast<subscriber::Encoding>(hello.encoding);
+    } else {
+      notice = "encoding " + std::to_string(hello.encoding) + " is not one this daemon serves: positions in float";
+    }
+    const bool needs_mesh = served == subscriber::Encoding::Parameters || served == subscriber::Encoding::Compressed;
+    if (needs_mesh && !hub_->has_mesh())
+      notice = std::string("no ") + subscriber::to_string(served) + " encoding for a subject without a mesh: markers only";
+    flags = subscriber::frame_flags_for(hello.wants, served, hub_->has_mesh());
+  }
+  const StreamKey key = server::stream_key(flags, hello.version);
+  const bool changed = !greeted_ || key != key_.load();
   greeted_ = true;
   hello_timer_.cancel();
-  if (changed) {
-    slot_.store(slot);
-    offer_control(hub_->mesh_info_message(slot));
-    offer_control(hub_->status_message(slot));
-  }
-  if (!note.empty()) offer_control(hub_->status_saying(slot, note));
   if (!changed) return;
-  hub_->activate(*this, slot);
-  spdlog::info("subscriber {} ({} {}): version {}, subject {}, wants {:#x}, frame flags {:#x}", id_, transport_, remote_,
-               hello.version, hub_->subject(), hello.wants, flags);
+  key_.store(key);
+  offer_control(hub_->mesh_info_message(key));
+  if ((flags & subscriber::kFrameParameters) && hub_->model_message()) offer_control(hub_->model_message());
+  offer_control(hub_->status_message(key));
+  if (!notice.empty()) {
+    offer_control(hub_->status_message(key, notice, subscriber::SourceStateCode::Streaming));
+    spdlog::info("subscriber {} ({} {}): {}", id_, transport_, remote_, notice);
+  }
+  hub_->activate(*this, key);
+  spdlog::info("subscriber {} ({} {}): protocol {}, wants {:#x}, frame flags {:#x}", id_, transport_, remote_, hello.version,
+               hello.wants, flags);
 }
 
 bool SubscriberSession::join_subject(const std::string& subject) {
   const SubjectDirectory* directory = hub_->directory();
-  SubscriberHub* chosen = directory ? directory->find(subject) : (subject.empty() || subject == hub_->subject() ? hub_ : nullptr);
+  SubscriberHub* chosen =
+      directory ? directory->find(subject) : (subject.empty() || subject == hub_->subject_name() ? hub_ : nullptr);
   if (!chosen) {
-    refuse(subject, "no subject \"" + subject + "\" here (this daemon serves " +
-                        (directory ? directory->names() : hub_->subject()) + ")");
+    refuse("no subject \"" + subject + "\" here (this daemon serves " +
+           (directory ? directory->names() : "\"" + hub_->subject_name() + "\"") + ")");
     return false;
   }
   if (chosen != hub_) {
@@ -133,16 +139,14 @@ bool SubscriberSession::join_subject(const std::string& subject) {
   return true;
 }
 
-void SubscriberSession::refuse(const std::string& subject, const std::string& detail) {
-  hub_->metrics().bad_subscriber_messages.fetch_add(1, std::memory_order_relaxed);
-  hub_->log_refusal("subscriber " + std::to_string(id_) + " (" + transport_ + " " + remote_ + ") refused: " + detail);
-  subscriber::Status status;
-  status.state = subscriber::SourceStateCode::Refused;
-  status.detail = detail;
-  status.subject = subject;
-  offer_control(std::make_shared<const std::vector<unsigned char>>(subscriber::encode_status(status, subscriber::kVersion2)));
-  close_when_sent_ = true;
+void SubscriberSession::refuse(const std::string& reason) {
+  hub_->metrics().subscribers_refused.fetch_add(1, std::memory_order_relaxed);
+  spdlog::warn("subscriber {} ({} {}): refused: {}", id_, transport_, remote_, reason);
+  greeted_ = true;
   hello_timer_.cancel();
+  // The Status goes out first; the session closes once its queue has been written.
+  close_after_write_ = true;
+  offer_control(hub_->status_message(server::stream_key(0, version_), reason, subscriber::SourceStateCode::Refused));
 }
 
 void SubscriberSession::on_protocol_error(const std::string& reason) {
@@ -180,11 +184,8 @@ void SubscriberSession::pump() {
     const bool window_full = paced_ && unacked_ >= subscriber::kPacedWindow;
     const auto take = window_full ? SubscriberQueue::Take::ControlOnly
                                   : (paced_ ? SubscriberQueue::Take::NewestFrame : SubscriberQueue::Take::OldestFrame);
-    if (!queue_.pop(in_flight_, take)) {
-      if (close_when_sent_) close();  // a refusal, sent
-      return;
-    }
-    if (in_flight_.control || in_flight_.frame->has(slot_.load())) break;
+    if (!queue_.pop(in_flight_, take)) return;
+    if (in_flight_.control || in_flight_.frame->has(key_.load())) break;
     in_flight_.frame.reset();  // encoded for this subscriber's previous wants
   }
   writing_ = true;
@@ -196,7 +197,7 @@ void SubscriberSession::pump() {
   write_started_ = std::chrono::steady_clock::now();
   hub_->metrics().subscriber_queue_wait.observe_ns(
       std::chrono::duration_cast<std::chrono::nanoseconds>(write_started_ - in_flight_.frame->published).count());
-  const std::span<const unsigned char> message = in_flight_.frame->message(slot_.load());
+  const std::span<const unsigned char> message = in_flight_.frame->message(key_.load());
   const size_t prefix = std::min(frame_prefix_.size(), message.size());
   std::memcpy(frame_prefix_.data(), message.data(), prefix);
   subscriber::patch_subscriber_dropped(std::span(frame_prefix_).first(prefix), static_cast<uint32_t>(queue_.frames_dropped()));
@@ -218,6 +219,7 @@ void SubscriberSession::write_done(const boost::system::error_code& ec) {
         std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - write_started_).count());
   }
   pump();
+  if (close_after_write_ && !writing_) close();  // a refused subscriber: its Status is written
 }
 
 }  // namespace skinstream::server

@@ -1,9 +1,7 @@
 #pragma once
 // What the TCP and WebSocket subscribers share: the Hello handshake (2 s default, then
-// positions only, version 1), the choice of a subject (version 2's Hello names it; a name the
-// daemon does not serve is refused with a Status and the connection closed once it is sent), the
-// bounded queue, one write in flight, pacing by Acks for subscribers that ask for it, and the
-// per-subscriber counters.
+// positions only), the bounded queue, one write in flight, pacing by Acks for subscribers that
+// ask for it, and the per-subscriber counters.
 // Everything but offer() runs on the session's io thread (the daemon's, or one of the publish
 // threads for a TCP subscriber); offer() is called by the pipeline thread.
 
@@ -18,6 +16,7 @@
 #include "server/metrics/metrics.h"
 #include "protocol/subscriber_stream.h"
 #include "server/publish/handler_slot.h"
+#include "server/pipeline/stream_key.h"
 #include "server/publish/subscriber_queue.h"
 
 namespace skinstream::server {
@@ -33,7 +32,7 @@ class SubscriberSession : public std::enable_shared_from_this<SubscriberSession>
   void offer(const FrameRef& frame);
   void offer_control(ControlMessage message);
 
-  uint32_t slot() const { return slot_.load(); }  // encoding_slot: its frame flags in its version
+  StreamKey stream_key() const { return key_.load(); }
   SubscriberMetrics stats() const;
   uint64_t id() const { return id_; }
   virtual void close() = 0;  // the session's io thread; idempotent
@@ -45,10 +44,12 @@ class SubscriberSession : public std::enable_shared_from_this<SubscriberSession>
   // For the transports (io thread).
   void start_hello_timer(std::chrono::milliseconds timeout);
   void on_hello(const subscriber::Hello& hello);
-  // A message from the subscriber (Hello or Ack) in the version its header says; DecodeError for
+  // A message from the subscriber (Hello or Ack) in protocol `version`; DecodeError for
   // anything else.
   void on_subscriber_message(subscriber::MessageType type, std::span<const unsigned char> payload, uint16_t version);
   void on_ack();
+  // Sends a Status "refused" with the reason, then closes.
+  void refuse(const std::string& reason);
   void on_protocol_error(const std::string& reason);
   void on_disconnected(const std::string& reason);
   // Writes the buffers as one protocol message, then calls write_done().
@@ -56,29 +57,29 @@ class SubscriberSession : public std::enable_shared_from_this<SubscriberSession>
   void write_done(const boost::system::error_code& ec);
 
   asio::io_context& io_;
-  SubscriberHub* hub_;  // the subject's; changes only at a version 2 Hello, before frames flow
+  SubscriberHub* hub_;  // the subject's; changes only at the first version 2 Hello, before frames flow
 
  private:
   void kick();
   void pump();
-  // Version 2: into the hub of the subject the Hello names; false when refused.
+  // Version 2's first Hello: into the hub of the subject it names (SubjectDirectory); false when
+  // refused (no such subject).
   bool join_subject(const std::string& subject);
-  void refuse(const std::string& subject, const std::string& detail);
 
   uint64_t id_;
   std::string transport_, remote_;
   SubscriberQueue queue_;
   asio::steady_timer hello_timer_;
   bool greeted_ = false;  // Hello received or timed out
-  uint16_t version_ = subscriber::kVersion1;  // the first Hello's
-  bool close_when_sent_ = false;  // refused: close once the queue is written
   bool closed_ = false;
   bool writing_ = false;
+  bool close_after_write_ = false;  // refused: close once the Status is written
   bool paced_ = false;  // Hello asked for kWantPaced
+  uint16_t version_ = 0;  // of the first Hello; 0 before it
   int unacked_ = 0;     // Frames sent (or being sent) and not acknowledged yet
   std::atomic<bool> pump_scheduled_{false};
   std::shared_ptr<HandlerSlot> pump_slot_;  // the posted pump's memory: the pipeline thread posts it
-  std::atomic<uint32_t> slot_{0};
+  std::atomic<StreamKey> key_{0};
   std::atomic<uint64_t> sent_{0};
   SubscriberQueue::Item in_flight_;
   std::chrono::steady_clock::time_point write_started_;  // of the frame in flight

@@ -52,11 +52,11 @@ Packet filter_packet(const Packet& packet, const std::vector<uint32_t>& wanted) 
 struct ViconServer::State : std::enable_shared_from_this<ViconServer::State> {
   struct Session;
 
-  State(asio::io_context& io_context, std::vector<vicon::CaptureSubject> subjects, ViconServerOptions opts)
+  State(asio::io_context& io_context, std::vector<ReplaySubject> subjects, ViconServerOptions opts)
       : io(io_context),
         options(std::move(opts)),
         congestion("vicon server", options.tcp_congestion),
-        encoder(std::move(subjects), options.rate_hz, options.loop),
+        encoder(subjects, options.rate_hz, options.loop),
         acceptor(io),
         timer(io),
         multicast_socket(io) {}
@@ -424,11 +424,11 @@ struct ViconServer::State : std::enable_shared_from_this<ViconServer::State> {
   uint32_t latest_frame_number = 0;
 };
 
-ViconServer::ViconServer(asio::io_context& io, std::vector<vicon::CaptureSubject> subjects, ViconServerOptions options)
+ViconServer::ViconServer(asio::io_context& io, std::vector<ReplaySubject> subjects, ViconServerOptions options)
     : state_(std::make_shared<State>(io, std::move(subjects), std::move(options))) {}
 
 ViconServer::ViconServer(asio::io_context& io, const Capture& capture, ViconServerOptions options)
-    : ViconServer(io, {{&capture, options.subject_name}}, options) {}
+    : ViconServer(io, {{options.subject_name, &capture}}, options) {}
 
 ViconServer::~ViconServer() { stop(); }
 

@@ -77,7 +77,7 @@ class ViconServer {
   // The captures must outlive the server. Everything but stats() runs on the io_context's
   // thread (or before it runs / after it stopped), destruction included: the sessions live there.
   // Throws std::invalid_argument for recordings that cannot share a stream (different rates).
-  ViconServer(asio::io_context& io, std::vector<vicon::CaptureSubject> subjects, ViconServerOptions options);
+  ViconServer(asio::io_context& io, std::vector<ReplaySubject> subjects, ViconServerOptions options);
   // One recording, streamed as the subject options.subject_name.
   ViconServer(asio::io_context& io, const Capture& capture, ViconServerOptions options);
   ~ViconServer();

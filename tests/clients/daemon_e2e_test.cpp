@@ -199,10 +199,11 @@ TEST_F(DaemonProgram, SigtermStopsCleanlyWithMarkersOnly) {
   EXPECT_NE(daemon.log().find("no deformation model"), std::string::npos) << daemon.log();
 }
 
-// skinstream-replay -> skinstreamd --vicon -> skinstream-sub, in both Vicon modes: frames arrive
-// in order, and a measured marker is the recording's sample of the same frame number (so the
-// numbering and the marker mapping survive the DataStream round trip).
-enum class ViconMode { Push, Pull, Multicast };
+// skinstream-replay -> skinstreamd --vicon -> skinstream-sub, in both Vicon modes (and the same
+// with --qtm and --natnet): frames arrive in order, and a measured marker is the recording's
+// sample of the same frame number (so the numbering and the marker mapping survive the round trip
+// through each capture system's protocol).
+enum class ViconMode { Push, Pull, Multicast, Qtm, NatNet };
 
 
 void expect_vicon_stream_in_order(const std::string& subject, const std::string& take, ViconMode mode) {
@@ -218,6 +219,14 @@ void expect_vicon_stream_in_order(const std::string& subject, const std::string&
     daemon_process = std::make_unique<DaemonProcess>("--subject " + subject + " --vicon-multicast 127.0.0.1:" + std::to_string(udp_port));
     replay = std::make_unique<ReplayProcess>(take, 0, "--multicast 127.0.0.1:" + std::to_string(udp_port) + " --start-now");
     expected_log = "multicast";
+  } else if (mode == ViconMode::Qtm) {
+    replay = std::make_unique<ReplayProcess>(take, 0, "--protocol qtm");
+    daemon_process = std::make_unique<DaemonProcess>("--subject " + subject + " --qtm 127.0.0.1:" + std::to_string(replay->port));
+    expected_log = "source: QTM RT";
+  } else if (mode == ViconMode::NatNet) {
+    replay = std::make_unique<ReplayProcess>(take, 0, "--protocol natnet --unicast");
+    daemon_process = std::make_unique<DaemonProcess>("--subject " + subject + " --natnet 127.0.0.1:" + std::to_string(replay->port));
+    expected_log = "source: NatNet";
   } else {
     replay = std::make_unique<ReplayProcess>(take, 0);
     daemon_process = std::make_unique<DaemonProcess>("--subject " + subject + " --vicon 127.0.0.1:" + std::to_string(replay->port) +
@@ -244,6 +253,10 @@ TEST_F(DaemonProgram, ViconServerPushReachesTheSubscriberInOrder) { expect_vicon
 TEST_F(DaemonProgram, ViconClientPullReachesTheSubscriberInOrder) { expect_vicon_stream_in_order(subject_, take_, ViconMode::Pull); }
 
 TEST_F(DaemonProgram, ViconUdpDatagramsReachTheSubscriberInOrder) { expect_vicon_stream_in_order(subject_, take_, ViconMode::Multicast); }
+
+TEST_F(DaemonProgram, QtmReachesTheSubscriberInOrder) { expect_vicon_stream_in_order(subject_, take_, ViconMode::Qtm); }
+
+TEST_F(DaemonProgram, NatNetReachesTheSubscriberInOrder) { expect_vicon_stream_in_order(subject_, take_, ViconMode::NatNet); }
 
 TEST_F(DaemonProgram, ViconUnreachableIsReportedAndServingGoesOn) {
   const int port = test::free_loopback_port(SOCK_STREAM);  // nobody listens on it

@@ -106,7 +106,7 @@ TEST_F(DaemonSubjects, OneDaemonServesBothActorsToSubscribersNamingThem) {
   test::expect_frames_follow_recording(read_capture(take_a_), test::frames_of(actor1.output), kApartMm);
   test::expect_frames_follow_recording(read_capture(take_b_), test::frames_of(actor2.output), -kApartMm);
   EXPECT_EQ(nobody.exit_code, 1);
-  EXPECT_NE(nobody.output.find("the daemon refused this subscriber: no subject \"Nobody\" here (this daemon serves Actor1, Actor2)"),
+  EXPECT_NE(nobody.output.find("the daemon refused this subscriber: no subject \"Nobody\" here (this daemon serves \"Actor1\", \"Actor2\")"),
             std::string::npos)
       << nobody.output;
   ASSERT_EQ(health["subjects"].size(), 2u);

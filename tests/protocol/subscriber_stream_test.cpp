@@ -292,6 +292,7 @@ TEST(SubscriberStreamV2, MeshInfoMatchesGoldenBytes) {
   MeshInfo info = fixture_mesh_info();
   info.subject = "Actor2";
   info.encoding = Encoding::Compressed;
+  info.compressed_order = {2, 0, 3, 1};
   const std::vector<unsigned char> golden = fixture("mesh_info_v2.bin");
   EXPECT_EQ(encode_mesh_info(info, kVersion2), golden);
   const MeshInfo decoded = decode_mesh_info(payload_of(golden), kVersion2);
@@ -299,11 +300,18 @@ TEST(SubscriberStreamV2, MeshInfoMatchesGoldenBytes) {
   EXPECT_EQ(decoded.marker_names, info.marker_names);
   EXPECT_EQ(decoded.subject, "Actor2");
   EXPECT_EQ(decoded.encoding, Encoding::Compressed);
+  EXPECT_EQ(decoded.compressed_order, info.compressed_order);
   // Version 1's MeshInfo is the same bytes without the two version 2 fields.
   const std::vector<unsigned char> v1 = fixture("mesh_info.bin");
   EXPECT_TRUE(std::equal(v1.begin() + kHeaderBytes, v1.end(), golden.begin() + kHeaderBytes));
   std::vector<unsigned char> bad = golden;
-  bad.back() = 4;  // encoding 4 does not exist
+  bad[bad.size() - 24] = 4;  // encoding 4 does not exist
+  EXPECT_THROW(decode_mesh_info(payload_of(bad), kVersion2), DecodeError);
+  bad = golden;
+  bad[bad.size() - 4] = 4;  // the order names vertex 4 of 4
+  EXPECT_THROW(decode_mesh_info(payload_of(bad), kVersion2), DecodeError);
+  bad = golden;
+  bad[bad.size() - 20] = 3;  // an order of 3 for 4 vertices
   EXPECT_THROW(decode_mesh_info(payload_of(bad), kVersion2), DecodeError);
 }
 

@@ -34,7 +34,7 @@ DecodedPacket encode(CaptureFrameEncoder& encoder, uint64_t sequence, bool inclu
 
 TEST(CaptureFrameEncoder, SeveralRecordingsAreSeveralSubjectsOfOneFrame) {
   const Capture one = actor(4, 0.0), two = actor(4, 5000.0);
-  CaptureFrameEncoder encoder({{&one, "Actor1"}, {&two, "Actor2"}});
+  CaptureFrameEncoder encoder(std::vector<ReplaySubject>{{"Actor1", &one}, {"Actor2", &two}});
   const DecodedPacket d = encode(encoder, 2, true);
   ASSERT_EQ(d.subjects.size(), 2u);
   EXPECT_EQ(d.subjects[0].name, "Actor1");
@@ -57,7 +57,7 @@ TEST(CaptureFrameEncoder, SeveralRecordingsAreSeveralSubjectsOfOneFrame) {
 
 TEST(CaptureFrameEncoder, ASubjectWithoutMarkersLeavesTheListAndComesBack) {
   const Capture one = actor(6, 0.0), two = actor(6, 5000.0, {2, 3});
-  CaptureFrameEncoder encoder({{&one, "Actor1"}, {&two, "Actor2"}});
+  CaptureFrameEncoder encoder(std::vector<ReplaySubject>{{"Actor1", &one}, {"Actor2", &two}});
   EXPECT_EQ(encoder.listed(1), 3u);
   EXPECT_EQ(encoder.listed(2), 1u);
   EXPECT_EQ(encoder.listed(4), 3u);
@@ -71,11 +71,11 @@ TEST(CaptureFrameEncoder, ASubjectWithoutMarkersLeavesTheListAndComesBack) {
 
 TEST(CaptureFrameEncoder, ShorterRecordingsEndOrLoopOnTheirOwn) {
   const Capture longer = actor(5, 0.0), shorter = actor(2, 5000.0);
-  CaptureFrameEncoder once({{&longer, "Long"}, {&shorter, "Short"}});
+  CaptureFrameEncoder once(std::vector<ReplaySubject>{{"Long", &longer}, {"Short", &shorter}});
   EXPECT_EQ(once.frame_count(), 5);
   EXPECT_EQ(once.listed(1), 3u);
   EXPECT_EQ(once.listed(2), 1u);  // Short has ended
-  CaptureFrameEncoder looped({{&longer, "Long"}, {&shorter, "Short"}}, 0.0, true);
+  CaptureFrameEncoder looped(std::vector<ReplaySubject>{{"Long", &longer}, {"Short", &shorter}}, 0.0, true);
   EXPECT_EQ(looped.listed(3), 3u);
   const DecodedPacket d = encode(looped, 3, false);
   for (const LabeledRecon& r : d.labeled)
@@ -89,12 +89,12 @@ TEST(CaptureFrameEncoder, RecordingsThatCannotShareAStreamAreRefused) {
   at_100.rate_hz = 100.0;
   const Capture at_120 = actor(2, 0.0);
   try {
-    CaptureFrameEncoder encoder({{&at_120, "A"}, {&at_100, "B"}});
+    CaptureFrameEncoder encoder(std::vector<ReplaySubject>{{"A", &at_120}, {"B", &at_100}});
     FAIL() << "two rates in one stream";
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("different rates"), std::string::npos) << e.what();
   }
-  EXPECT_THROW(CaptureFrameEncoder(std::vector<CaptureSubject>{}), std::invalid_argument);
+  EXPECT_THROW(CaptureFrameEncoder(std::vector<ReplaySubject>{}), std::invalid_argument);
 }
 
 }  // namespace

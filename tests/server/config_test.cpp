@@ -165,6 +165,24 @@ TEST(Config, OutOfRangeValuesAndConflictsAreErrors) {
   EXPECT_NE(error_of([] { parse({"--vicon-multicast", "239.1.1.1"}); }).find("GROUP:PORT"), std::string::npos);
   EXPECT_NE(error_of([] { parse({"--log-level", "loud"}); }).find("log_level"), std::string::npos);
   EXPECT_NE(error_of([] { parse({"--vicon", "nohost"}); }).find("HOST:PORT"), std::string::npos);
+  EXPECT_NE(error_of([] { parse({"--qtm", "h", "--natnet", "h"}); }).find("one source"), std::string::npos);
+  EXPECT_NE(error_of([] { parse({"--vicon", "h:1", "--qtm", "h"}); }).find("one source"), std::string::npos);
+  EXPECT_NE(error_of([] { parse({"--qtm", "h:99999"}); }).find("qtm must be HOST or HOST:PORT"), std::string::npos);
+  EXPECT_NE(error_of([] { parse({"--natnet", "h:x"}); }).find("natnet must be HOST or HOST:PORT"), std::string::npos);
+  EXPECT_NE(error_of([] { parse({"--natnet", "h", "--natnet-interface", "eth0"}); }).find("natnet_interface"),
+            std::string::npos);
+}
+
+TEST(Config, QtmAndNatNetTakeAHostWithOrWithoutItsPort) {
+  const auto qtm = parse({"--qtm", "qtm-pc"});
+  ASSERT_TRUE(qtm);
+  EXPECT_EQ(qtm->config.qtm, "qtm-pc");
+  EXPECT_EQ(parse_host_with_port(qtm->config.qtm, 22223)->port, 22223);
+  const auto natnet = parse({"--natnet", "10.0.0.5:1600", "--natnet-interface", "10.0.0.9"});
+  ASSERT_TRUE(natnet);
+  EXPECT_EQ(parse_host_with_port(natnet->config.natnet, 1510)->port, 1600);
+  EXPECT_EQ(natnet->config.natnet_interface, "10.0.0.9");
+  EXPECT_FALSE(parse_host_with_port("", 1510));
 }
 
 TEST(Config, PrintConfigIsAFlag) {

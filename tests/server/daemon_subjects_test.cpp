@@ -75,7 +75,7 @@ class StageServer {
     options.speed = speed;
     options.loop = true;
     io_.call([&] {
-      server_ = std::make_unique<ViconServer>(io_.io, std::vector<vicon::CaptureSubject>{{&actor1, "Actor1"}, {&actor2, "Actor2"}},
+      server_ = std::make_unique<ViconServer>(io_.io, std::vector<ReplaySubject>{{"Actor1", &actor1}, {"Actor2", &actor2}},
                                               options);
       server_->start();
       port_ = server_->port();
@@ -209,9 +209,8 @@ TEST(DaemonSubjects, AHelloNamingAnUnknownSubjectIsRefusedWithAStatusAndClosed) 
   EXPECT_TRUE(refused.frames.empty());
   ASSERT_EQ(refused.statuses.size(), 1u);
   EXPECT_EQ(refused.statuses[0].state, subscriber::SourceStateCode::Refused);
-  EXPECT_EQ(refused.statuses[0].detail, "no subject \"Nobody\" here (this daemon serves Actor1, Actor2)");
-  EXPECT_EQ(refused.statuses[0].subject, "Nobody");
-  EXPECT_EQ(daemon.subject(0).metrics().bad_subscriber_messages.load(), 1u);
+  EXPECT_EQ(refused.statuses[0].detail, "no subject \"Nobody\" here (this daemon serves \"Actor1\", \"Actor2\")");
+  EXPECT_EQ(daemon.subject(0).metrics().subscribers_refused.load(), 1u);
 
   // The same over WebSocket: one Status, refused, then the daemon closes the connection.
   asio::io_context io;
@@ -232,13 +231,16 @@ TEST(DaemonSubjects, AHelloNamingAnUnknownSubjectIsRefusedWithAStatusAndClosed) 
   ws.read(rest, ec);
   EXPECT_TRUE(ec) << "the connection stayed open";
 
-  // An encoding this daemon does not serve is said in a Status, and float positions come.
-  const Received asked = subscribe(daemon, hello_v2("Actor2", subscriber::kWantMarkers, subscriber::Encoding::Parameters),
-                                   frames_at_least(3));
+  // An encoding the daemon does not know is said in a Status, and float positions come, from
+  // the subject named.
+  subscriber::Hello unknown_encoding = hello_v2("Actor2");
+  unknown_encoding.encoding = 7;
+  const Received asked = subscribe(daemon, unknown_encoding, frames_at_least(3));
   ASSERT_EQ(asked.mesh_infos.size(), 1u);
+  EXPECT_EQ(asked.mesh_infos[0].subject, "Actor2");
   EXPECT_EQ(asked.mesh_infos[0].encoding, subscriber::Encoding::Float);
   bool said = false;
-  for (const subscriber::Status& s : asked.statuses) said = said || s.detail == "encoding parameters is not served: positions in float";
+  for (const subscriber::Status& s : asked.statuses) said = said || s.detail.find("encoding 7 is not one this daemon serves") == 0;
   EXPECT_TRUE(said);
   EXPECT_EQ(asked.frames.size(), 3u);
   daemon.stop();
@@ -303,7 +305,7 @@ TEST(DaemonSubjects, AStalledSubscriberOfOneSubjectDoesNotSlowTheOthersSubscribe
   // Actor1's subscriber asks for markers and never reads.
   asio::io_context io;
   tcp::socket stalled = test::stalled_subscriber(io, daemon.sub_port(), subscriber::encode_hello(hello_v2("Actor1")));
-  wait_until([&] { return daemon.subject(0).hub().wanted_encodings() != 0; });
+  wait_until([&] { return !daemon.subject(0).hub().wanted_encodings().empty(); });
   daemon.start_source();
   auto stalled_dropped = [&] {
     uint64_t most = 0;

@@ -104,7 +104,7 @@ TEST(Daemon, NamedSubjectIsTheReplaysOneSubject) {
   config.replay_subject = "Actor1";
   Daemon daemon(config);
   daemon.start();
-  wait_until([&] { return nlohmann::json::parse(daemon.health_json())["frames"]["published"].get<int>() > 0; });
+  wait_until([&] { return nlohmann::json::parse(daemon.health_json())["frames"]["processed"].get<int>() > 0; });
   const nlohmann::json subject = nlohmann::json::parse(daemon.health_json())["subject"];
   daemon.stop();
   EXPECT_EQ(subject["name"], "Actor1");
@@ -142,7 +142,7 @@ TEST(Daemon, PublishesTheOfflineFillFrameByFrameInOrder) {
   });
   // The replay starts only once the subscriber listens, so it sees the take from its first frame.
   daemon.start_serving();
-  wait_until([&] { return daemon.subject(0).hub().wanted_encodings() != 0; });
+  wait_until([&] { return !daemon.subject(0).hub().wanted_encodings().empty(); });
   daemon.start_source();
   reader.join();
   daemon.stop();
@@ -186,7 +186,7 @@ TEST(Daemon, StalledSubscriberDoesNotHoldBackTheOthers) {
   // The stalled subscriber asks for markers and never reads.
   asio::io_context io;
   tcp::socket stalled = test::stalled_subscriber(io, daemon.sub_port(), subscriber::encode_hello({.wants = subscriber::kWantMarkers}));
-  wait_until([&] { return daemon.subject(0).hub().wanted_encodings() != 0; });
+  wait_until([&] { return !daemon.subject(0).hub().wanted_encodings().empty(); });
 
   daemon.start_source();
   long received = 0;
@@ -260,7 +260,7 @@ TEST_P(DaemonPublishThreads, EverySubscriberGetsEveryFrameInOrderAndStopClosesTh
         return numbers[s].size() < kFrames;
       });
     });
-  wait_until([&] { return daemon.subject(0).hub().subscriber_count() == kSubscribers + 1 && daemon.subject(0).hub().wanted_encodings() != 0; });
+  wait_until([&] { return daemon.subject(0).hub().subscriber_count() == kSubscribers + 1 && !daemon.subject(0).hub().wanted_encodings().empty(); });
   daemon.start_source();
   for (std::thread& t : readers) t.join();
   daemon.stop();
@@ -326,7 +326,7 @@ TEST(Daemon, PacedSubscriberHasAtMostTheWindowInFlightAndGetsTheNewestFrameOnAck
   tcp::socket paced(io);
   paced.connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), static_cast<unsigned short>(daemon.sub_port())));
   asio::write(paced, asio::buffer(subscriber::encode_hello({.wants = subscriber::kWantMarkers | subscriber::kWantPaced})));
-  wait_until([&] { return daemon.subject(0).hub().wanted_encodings() != 0; });
+  wait_until([&] { return !daemon.subject(0).hub().wanted_encodings().empty(); });
   daemon.start_source();
   subscriber::StreamDecoder decoder;
   using std::chrono::milliseconds;

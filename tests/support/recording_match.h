@@ -1,7 +1,8 @@
 #pragma once
 // What a subscriber received against the recording the source streamed: every marker finite,
-// the measured samples unchanged (C3D float -> Vicon double -> published float), and, on a stage
-// with another actor, no marker nearer that actor than its own.
+// the measured samples unchanged (C3D float -> Vicon double / QTM float / NatNet float metres ->
+// published float, NatNet's metres within 0.2 um), and, on a stage with another actor, no marker
+// nearer that actor than its own.
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -144,7 +144,13 @@ void Subscriber::State::on_mesh_info(std::span<const unsigned char> payload) {
   marker_status.assign(info.marker_names.size(), 0);
   evaluator.reset();
   compressed.reset();
-  if (mesh.encoding == Encoding::Compressed) compressed = std::make_unique<wire::CompressedVertexDecoder>(static_cast<int>(mesh.vertex_count));
+  if (mesh.encoding == Encoding::Compressed) {
+    try {
+      compressed = std::make_unique<wire::CompressedVertexDecoder>(static_cast<int>(mesh.vertex_count), info.compressed_order);
+    } catch (const std::invalid_argument& e) {
+      throw Error(std::string("MeshInfo: ") + e.what());
+    }
+  }
 }
 
 void Subscriber::State::on_model(std::span<const unsigned char> payload) {

@@ -50,7 +50,7 @@ DeformationModel one_part_over(const SubjectModel& subject) {
 class CountingConsumer : public FrameConsumer {
  public:
   CountingConsumer(SubscriberHub& hub, int first, int last) : hub_(hub), first_(first), last_(last) {}
-  uint32_t wanted_encodings() const override { return hub_.wanted_encodings(); }
+  StreamKeySet wanted_encodings() const override { return hub_.wanted_encodings(); }
   void publish(const FrameRef& frame) override {
     hub_.publish(frame);
     const int n = ++published_;
@@ -129,9 +129,9 @@ TEST(Pipeline, AllocatesNothingPerFrameFromMailboxToSubscriber) {
     subscriber_thread.join();
   }};
   const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(30);
-  while (hub.wanted_encodings() == 0 && std::chrono::steady_clock::now() < give_up)
+  while (hub.wanted_encodings().empty() && std::chrono::steady_clock::now() < give_up)
     std::this_thread::sleep_for(std::chrono::milliseconds(2));
-  ASSERT_NE(hub.wanted_encodings(), 0u) << "the subscriber never said Hello";
+  ASSERT_FALSE(hub.wanted_encodings().empty()) << "the subscriber never said Hello";
 
   constexpr int kFrames = 200, kFirst = 40, kLast = 180;
   FrameMailbox mailbox(subject.marker_count());

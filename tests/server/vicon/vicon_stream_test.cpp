@@ -295,7 +295,7 @@ TEST(ViconStream, TwoRecordingsAreTwoSubjectsThatNeverMixAndOneLeavesAndReturns)
     }
   Loopback net;
   net.server_io.call([&] {
-    net.server = std::make_unique<ViconServer>(net.server_io.io, std::vector<vicon::CaptureSubject>{{&one, "Actor1"}, {&two, "Actor2"}},
+    net.server = std::make_unique<ViconServer>(net.server_io.io, std::vector<ReplaySubject>{{"Actor1", &one}, {"Actor2", &two}},
                                                fast_options(4.0));
     net.server->start();
     net.port = net.server->port();

@@ -38,8 +38,8 @@ struct Options {
   bool mesh = true;          // false: markers only, no vertices
   bool paced = false;        // acknowledge each frame: at most 2 in flight (for slow readers)
   bool evaluate = true;      // parameters: evaluate them into vertices (false: parameters only)
-  std::string subject;       // the capture system's subject name; empty: the daemon's first
-  std::string token;         // the daemon's shared token, when it has one
+  std::string subject{};     // the capture system's subject name; empty: the daemon's first
+  std::string token{};       // the daemon's shared token, when it has one
   int protocol_version = 2;  // 1 speaks to a daemon older than version 2 (float or quantised)
   std::chrono::milliseconds connect_timeout{5000};
 };

@@ -1,0 +1,82 @@
+#pragma once
+// A NatNet server streaming recorded captures as Motive streams a take, so that NatNet clients
+// and skinstream's own NatNetSource run without a capture stage (protocol/natnet.h).
+//
+// Commands arrive on the command port (UDP, 1510 by default) and are answered to their sender:
+//   CONNECT               SERVERINFO (this server's NatNet version, data port, multicast group);
+//                         unicast: the sender joins the clients frames are sent to
+//   REQUEST_MODELDEF      MODELDEF: one marker set per recording, in this server's layout
+//   REQUEST_FRAMEOFDATA   the newest frame
+//   KEEPALIVE             keeps a unicast client (one silent for client_timeout is dropped)
+//   DISCONNECT            drops the client
+//   REQUEST (text)        UNRECOGNIZED_REQUEST: a replay takes no text commands
+//   anything else         ignored (never answered)
+// Frames go to group:data_port (multicast), or to every connected client's command socket
+// (unicast), on the replay clock (server/replay/replay_timeline.h). The timeline starts with the
+// first CONNECT unless start_on_first_request is false. Malformed datagrams are counted, logged at
+// a limited rate and ignored.
+//
+// Threading: everything but stats() runs on the io_context's thread (or before it runs).
+
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "protocol/natnet.h"
+#include "protocol/replay_subject.h"
+#include "server/asio.h"
+
+namespace skinstream::server {
+
+struct NatNetServerOptions {
+  std::string bind_address = "0.0.0.0";
+  uint16_t command_port = natnet::kCommandPort;  // 0: an ephemeral port (see NatNetServer::command_port())
+  uint16_t data_port = natnet::kDataPort;        // multicast destination port, announced in SERVERINFO
+  bool multicast = true;
+  std::string multicast_group = natnet::kMulticastGroup;
+  std::string multicast_interface;  // address of the interface to send from; empty: the system's
+  int multicast_ttl = 1;
+  natnet::Version version;  // the layout streamed (3.0 to 4.1)
+  double rate_hz = 0.0;     // 0: the first recording's
+  double speed = 1.0;
+  bool loop = false;
+  bool start_on_first_request = true;
+  std::chrono::milliseconds client_timeout{10'000};  // unicast clients without a keep-alive
+};
+
+struct NatNetServerStats {
+  std::atomic<uint64_t> requests{0};
+  std::atomic<uint64_t> bad_datagrams{0};
+  std::atomic<uint64_t> clients_connected{0};
+  std::atomic<uint64_t> clients_timed_out{0};
+  std::atomic<uint64_t> frames_produced{0};
+  std::atomic<uint64_t> datagrams_sent{0};
+  std::atomic<uint64_t> frames_too_large{0};  // over one UDP datagram: not sent
+};
+
+class NatNetServer {
+ public:
+  // The captures behind `subjects` must outlive the server.
+  NatNetServer(asio::io_context& io, std::vector<ReplaySubject> subjects, NatNetServerOptions options);
+  ~NatNetServer();
+  NatNetServer(const NatNetServer&) = delete;
+  NatNetServer& operator=(const NatNetServer&) = delete;
+
+  void start();  // binds the command port; throws std::runtime_error naming the address on failure
+  void stop();   // safe to call twice
+  uint16_t command_port() const;
+
+  void set_on_finished(std::function<void()> on_finished);  // once, after the last frame
+  bool finished() const;
+  const NatNetServerStats& stats() const;
+
+ private:
+  struct State;
+  std::shared_ptr<State> state_;
+};
+
+}  // namespace skinstream::server

@@ -1,0 +1,379 @@
+#include "server/qtm/qtm_server.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <deque>
+#include <optional>
+#include <stdexcept>
+
+#include <spdlog/spdlog.h>
+
+#include "protocol/qtm_capture_encoder.h"
+#include "protocol/qtm_command.h"
+#include "protocol/qtm_packet_framer.h"
+#include "protocol/qtm_packet_reader.h"
+#include "protocol/qtm_packet_writer.h"
+#include "server/logging.h"
+#include "server/replay/replay_timeline.h"
+
+namespace skinstream::server {
+namespace {
+
+using Packet = std::shared_ptr<const std::vector<unsigned char>>;
+
+Packet shared(std::vector<unsigned char> bytes) {
+  return std::make_shared<const std::vector<unsigned char>>(std::move(bytes));
+}
+Packet shared(std::span<const unsigned char> bytes) {
+  return std::make_shared<const std::vector<unsigned char>>(bytes.begin(), bytes.end());
+}
+
+bool names(const std::vector<std::string>& components, std::string_view wanted) {
+  return std::any_of(components.begin(), components.end(),
+                     [&](const std::string& c) { return qtm::same_word(c, wanted) || qtm::same_word(c, "All"); });
+}
+
+}  // namespace
+
+struct QtmServer::State : std::enable_shared_from_this<QtmServer::State> {
+  struct Session;
+
+  State(asio::io_context& io_context, std::vector<ReplaySubject> subjects, QtmServerOptions opts)
+      : io(io_context),
+        options(std::move(opts)),
+        encoder(std::move(subjects), options.rate_hz),
+        acceptor(io),
+        udp_socket(io),
+        timeline(io, encoder.rate_hz(), options.speed, static_cast<uint64_t>(encoder.frame_count()), options.loop) {}
+
+  asio::io_context& io;
+  QtmServerOptions options;
+  qtm::CaptureEncoder encoder;
+  qtm::DataPacketWriter writer;
+  tcp::acceptor acceptor;
+  udp::socket udp_socket;
+  ReplayTimeline timeline;
+  std::vector<std::shared_ptr<Session>> sessions;
+  bool running = false;
+  uint64_t latest = 0;                  // stream index of the newest frame
+  std::array<Packet, 3> latest_packets;  // 3D + no labels, 3D only, no labels only: made on demand
+  std::function<void()> on_finished;
+  QtmServerStats stats;
+  RateLimitedLog log;
+
+  struct Session : std::enable_shared_from_this<Session> {
+    Session(State& owner, tcp::socket s) : state(owner), socket(std::move(s)) {}
+
+    State& state;  // sessions never outlive State: State closes them in stop()
+    tcp::socket socket;
+    qtm::PacketFramer framer{1u << 20};  // a client's commands are short; a megabyte is plenty
+    struct Outgoing {
+      Packet packet;
+      bool is_frame;
+    };
+    std::deque<Outgoing> queue;  // front is being written while `writing`
+    bool writing = false;
+    bool open = true;
+    bool streaming = false;
+    bool labelled = true, unlabelled = true;
+    uint64_t divisor = 1;
+    std::optional<udp::endpoint> udp_destination;
+
+    void begin() {
+      send(qtm::encode_text(qtm::PacketType::Command, qtm::kWelcome));
+      read();
+    }
+
+    void read() {
+      const auto room = framer.prepare(4096);
+      socket.async_read_some(asio::buffer(room.data(), room.size()),
+                             [self = shared_from_this()](const boost::system::error_code& ec, size_t n) {
+                               self->on_read(ec, n);
+                             });
+    }
+
+    void on_read(const boost::system::error_code& ec, size_t n) {
+      if (!open) return;
+      if (ec) {
+        close();
+        return;
+      }
+      framer.commit(n);
+      qtm::Bytes packet;
+      for (;;) {
+        const auto status = framer.next(packet);
+        if (status == qtm::PacketFramer::Status::NeedMore) break;
+        std::string error;
+        if (status == qtm::PacketFramer::Status::Error || !handle(packet, error)) {
+          reject(status == qtm::PacketFramer::Status::Error ? framer.error() : error);
+          return;
+        }
+        if (!open) return;
+      }
+      read();
+    }
+
+    void send(std::vector<unsigned char> bytes) { enqueue(shared(std::move(bytes)), false); }
+    void refuse(const std::string& reason) {
+      ++state.stats.commands_refused;
+      send(qtm::encode_text(qtm::PacketType::Error, reason));
+    }
+
+    bool handle(qtm::Bytes packet, std::string& error) {
+      uint32_t type = 0;
+      if (!qtm::read_header(packet, type, error)) return false;
+      if (type != static_cast<uint32_t>(qtm::PacketType::Command)) {
+        refuse(std::string("skinstream-replay takes commands only, not ") + qtm::packet_type_name(type) + " packets");
+        return true;
+      }
+      std::string text;
+      if (!qtm::decode_text(packet, text, error)) return false;
+      ++state.stats.commands;
+      qtm::Command command;
+      if (!qtm::parse_command(text, command, error)) {
+        refuse(error);
+        return true;
+      }
+      using Kind = qtm::Command::Kind;
+      switch (command.kind) {
+        case Kind::Version:
+          if (command.minor < 0)
+            send(qtm::encode_text(qtm::PacketType::Command, "Version is 1." + std::to_string(qtm::kSpokenMinorVersion)));
+          else if (command.major == 1 && command.minor >= qtm::kMinMinorVersion && command.minor <= qtm::kMaxMinorVersion)
+            send(qtm::encode_text(qtm::PacketType::Command, "Version set to 1." + std::to_string(command.minor)));
+          else
+            refuse("Version NOT supported");
+          break;
+        case Kind::QtmVersion:
+          send(qtm::encode_text(qtm::PacketType::Command, "QTM Version is 0.1 (build 0) skinstream-replay"));
+          break;
+        case Kind::ByteOrder:
+          send(qtm::encode_text(qtm::PacketType::Command, "Byte order is little endian"));
+          break;
+        case Kind::GetState:
+          send(qtm::encode_event(state.timeline.finished() ? qtm::Event::RtFromFileStopped
+                                                           : qtm::Event::RtFromFileStarted));
+          break;
+        case Kind::GetParameters: {
+          qtm::Parameters p = state.encoder.parameters();
+          if (!names(command.components, "General")) p.frequency_hz = 0.0;  // General is left out
+          p.has_3d = names(command.components, "3D");
+          if (!p.has_3d) p.labels.clear();
+          send(qtm::encode_text(qtm::PacketType::Xml, qtm::write_parameters_xml(p, qtm::kSpokenMinorVersion)));
+          break;
+        }
+        case Kind::GetCurrentFrame:
+          if (!choose_components(command.components)) break;
+          if (state.stats.frames_produced == 0)
+            send(qtm::encode_no_more_data());
+          else
+            enqueue(state.packet(labelled, unlabelled), true);
+          break;
+        case Kind::StreamFrames:
+          start_streaming(command);
+          break;
+        case Kind::StreamFramesStop:
+          streaming = false;
+          break;
+        case Kind::Other:
+          refuse("Command not supported by skinstream-replay: " + command.word);
+          break;
+      }
+      return true;
+    }
+
+    bool choose_components(const std::vector<std::string>& components) {
+      labelled = names(components, "3D");
+      unlabelled = names(components, "3DNoLabels");
+      if (labelled || unlabelled) return true;
+      refuse("skinstream-replay streams the 3D and 3DNoLabels components only");
+      return false;
+    }
+
+    void start_streaming(const qtm::Command& command) {
+      if (!choose_components(command.components)) return;
+      const double rate = state.encoder.rate_hz();
+      divisor = 1;
+      if (command.rate == qtm::Command::Rate::FrequencyDivisor) divisor = command.rate_value;
+      if (command.rate == qtm::Command::Rate::Frequency)
+        divisor = std::max<uint64_t>(1, static_cast<uint64_t>(std::llround(rate / command.rate_value)));
+      udp_destination.reset();
+      if (command.udp) {
+        boost::system::error_code ec;
+        const auto address = command.udp_address.empty() ? socket.remote_endpoint(ec).address()
+                                                          : asio::ip::make_address(command.udp_address, ec);
+        if (ec) {
+          refuse("StreamFrames: bad UDP address " + command.udp_address);
+          return;
+        }
+        udp_destination = udp::endpoint(address, command.udp_port);
+      }
+      streaming = true;
+      state.timeline.start();
+    }
+
+    // Queues a packet; frames beyond the bound push out the oldest waiting frame.
+    void enqueue(Packet packet, bool is_frame) {
+      if (!open) return;
+      if (is_frame) {
+        size_t waiting = 0;
+        for (size_t i = writing ? 1 : 0; i < queue.size(); ++i) waiting += queue[i].is_frame ? 1 : 0;
+        if (waiting >= std::max<size_t>(1, state.options.max_queued_frames)) {
+          const auto oldest = std::find_if(queue.begin() + (writing ? 1 : 0), queue.end(),
+                                           [](const Outgoing& o) { return o.is_frame; });
+          queue.erase(oldest);
+          ++state.stats.frames_dropped;
+        }
+      }
+      queue.push_back({std::move(packet), is_frame});
+      write();
+    }
+
+    void write() {
+      if (writing || queue.empty() || !open) return;
+      writing = true;
+      asio::async_write(socket, asio::buffer(*queue.front().packet),
+                        [self = shared_from_this()](const boost::system::error_code& ec, size_t) {
+                          self->writing = false;
+                          if (!self->open) return;
+                          if (ec) return self->close();
+                          if (self->queue.front().is_frame) ++self->state.stats.frame_packets_sent;
+                          self->queue.pop_front();
+                          self->write();
+                        });
+    }
+
+    void reject(const std::string& reason) {
+      ++state.stats.bad_clients;
+      state.log.warn("qtm_bad_client", "qtm server: closing a client that sent malformed input: " + reason);
+      close();
+    }
+
+    void close() {
+      if (!open) return;
+      open = false;
+      boost::system::error_code ignored;
+      socket.shutdown(tcp::socket::shutdown_both, ignored);
+      socket.close(ignored);
+      queue.clear();
+      --state.stats.clients_open;
+      state.forget(this);
+    }
+  };
+
+  // The newest frame with the components asked for (encoded once per frame and combination).
+  Packet packet(bool labelled, bool unlabelled) {
+    const size_t slot = labelled && unlabelled ? 0 : (labelled ? 1 : 2);
+    if (!latest_packets[slot]) latest_packets[slot] = shared(encoder.encode_frame(latest, writer, labelled, unlabelled));
+    return latest_packets[slot];
+  }
+
+  void forget(Session* session) {
+    asio::post(io, [self = shared_from_this(), session] {  // posted: the session may be in its own handler
+      auto& s = self->sessions;
+      s.erase(std::remove_if(s.begin(), s.end(), [session](const auto& p) { return p.get() == session; }), s.end());
+    });
+  }
+
+  void start() {
+    const tcp::endpoint endpoint(asio::ip::make_address(options.bind_address), options.port);
+    boost::system::error_code ec;
+    acceptor.open(endpoint.protocol(), ec);
+    if (!ec) acceptor.set_option(tcp::acceptor::reuse_address(true), ec);
+    if (!ec) acceptor.bind(endpoint, ec);
+    if (!ec) acceptor.listen(asio::socket_base::max_listen_connections, ec);
+    if (ec)
+      throw std::runtime_error("cannot listen on " + options.bind_address + ":" + std::to_string(options.port) + ": " +
+                               ec.message());
+    running = true;
+    timeline.set_on_frame([this](uint64_t k) { produce(k); });
+    timeline.set_on_finished([this] { finish(); });
+    accept();
+    if (!options.start_on_first_request) timeline.start();
+  }
+
+  void accept() {
+    acceptor.async_accept([self = shared_from_this()](const boost::system::error_code& ec, tcp::socket socket) {
+      if (!self->running) return;
+      if (ec == asio::error::operation_aborted) return;
+      if (!ec) {
+        boost::system::error_code ignored;
+        socket.set_option(tcp::no_delay(true), ignored);
+        auto session = std::make_shared<Session>(*self, std::move(socket));
+        self->sessions.push_back(session);
+        ++self->stats.clients_accepted;
+        ++self->stats.clients_open;
+        session->begin();
+      }
+      self->accept();
+    });
+  }
+
+  void stop() {
+    if (!running) return;
+    running = false;
+    boost::system::error_code ignored;
+    acceptor.close(ignored);
+    udp_socket.close(ignored);
+    timeline.stop();
+    for (auto& session : std::vector<std::shared_ptr<Session>>(sessions)) session->close();
+    sessions.clear();
+  }
+
+  void produce(uint64_t k) {
+    latest = k;
+    latest_packets = {};
+    ++stats.frames_produced;
+    for (auto& session : std::vector<std::shared_ptr<Session>>(sessions)) {
+      if (!session->open || !session->streaming || k % session->divisor != 0) continue;
+      Packet p = packet(session->labelled, session->unlabelled);
+      if (session->udp_destination)
+        send_datagram(std::move(p), *session->udp_destination);
+      else
+        session->enqueue(std::move(p), true);
+    }
+  }
+
+  void send_datagram(Packet packet, const udp::endpoint& destination) {
+    boost::system::error_code ec;
+    if (!udp_socket.is_open()) udp_socket.open(destination.protocol(), ec);
+    if (ec) return;
+    udp_socket.async_send_to(asio::buffer(*packet), destination,
+                             [self = shared_from_this(), packet](const boost::system::error_code& e, size_t) {
+                               if (!e) ++self->stats.datagrams_sent;
+                             });
+  }
+
+  void finish() {
+    for (auto& session : std::vector<std::shared_ptr<Session>>(sessions)) {
+      if (!session->open || !session->streaming) continue;
+      session->send(qtm::encode_event(qtm::Event::RtFromFileStopped));
+      session->send(qtm::encode_no_more_data());
+      session->streaming = false;
+    }
+    if (on_finished) on_finished();
+  }
+};
+
+QtmServer::QtmServer(asio::io_context& io, std::vector<ReplaySubject> subjects, QtmServerOptions options)
+    : state_(std::make_shared<State>(io, std::move(subjects), std::move(options))) {}
+
+QtmServer::~QtmServer() { stop(); }
+
+void QtmServer::start() { state_->start(); }
+void QtmServer::stop() { state_->stop(); }
+uint16_t QtmServer::port() const {
+  boost::system::error_code ec;
+  const auto endpoint = state_->acceptor.local_endpoint(ec);
+  return ec ? 0 : endpoint.port();
+}
+void QtmServer::set_on_finished(std::function<void()> on_finished) { state_->on_finished = std::move(on_finished); }
+bool QtmServer::finished() const { return state_->timeline.finished(); }
+bool QtmServer::all_clients_idle() const {
+  return std::all_of(state_->sessions.begin(), state_->sessions.end(),
+                     [](const auto& s) { return s->queue.empty() && !s->writing; });
+}
+const QtmServerStats& QtmServer::stats() const { return state_->stats; }
+
+}  // namespace skinstream::server

@@ -1,0 +1,245 @@
+// The C++ client library against the real skinstreamd replaying the demo subject over loopback:
+// each encoding's vertices against the daemon's own float vertex buffer of the same frame, and
+// the bad paths (no daemon, a refused Hello, bytes that break the protocol) as one-line errors.
+#include "skinstream/client.h"
+
+#include <gtest/gtest.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <map>
+#include <mutex>
+#include <thread>
+
+#include "support/daemon_process.h"
+#include "support/test_data.h"
+
+namespace skinstream {
+namespace {
+
+using client::Encoding;
+
+struct Received {
+  std::vector<float> positions, normals;
+};
+
+// Frames by number from one subscriber, until it has `count` frames past the first.
+std::map<uint32_t, Received> receive(uint16_t port, Encoding encoding, bool normals, int count, size_t* model_bytes = nullptr) {
+  client::Options options;
+  options.port = port;
+  options.encoding = encoding;
+  options.normals = normals;
+  client::Subscriber sub(options);
+  std::map<uint32_t, Received> frames;
+  client::Frame frame;
+  const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+  while (static_cast<int>(frames.size()) < count && std::chrono::steady_clock::now() < give_up) {
+    if (!sub.next(frame, std::chrono::seconds(1))) continue;
+    Received& r = frames[frame.frame_number];
+    r.positions.assign(frame.positions.begin(), frame.positions.end());
+    r.normals.assign(frame.normals.begin(), frame.normals.end());
+  }
+  EXPECT_EQ(sub.mesh().encoding, encoding);
+  if (model_bytes) *model_bytes = sub.model_bytes();
+  return frames;
+}
+
+struct Difference {
+  double position_mm = 0.0;     // largest coordinate difference
+  double normal_degrees = 0.0;  // largest angle between normals
+  int frames = 0;               // frames both received
+};
+
+Difference compare(const std::map<uint32_t, Received>& reference, const std::map<uint32_t, Received>& other) {
+  Difference d;
+  for (const auto& [number, frame] : other) {
+    const auto it = reference.find(number);
+    if (it == reference.end()) continue;
+    ++d.frames;
+    const Received& truth = it->second;
+    EXPECT_EQ(frame.positions.size(), truth.positions.size());
+    for (size_t i = 0; i < std::min(frame.positions.size(), truth.positions.size()); ++i)
+      d.position_mm = std::max(d.position_mm, std::abs(double(frame.positions[i]) - truth.positions[i]));
+    for (size_t v = 0; 3 * v + 2 < std::min(frame.normals.size(), truth.normals.size()); ++v) {
+      // The angle as atan2(|a x b|, a . b): exact near 0, where acos of the dot product is not.
+      const double a[3] = {frame.normals[3 * v], frame.normals[3 * v + 1], frame.normals[3 * v + 2]};
+      const double b[3] = {truth.normals[3 * v], truth.normals[3 * v + 1], truth.normals[3 * v + 2]};
+      const double cross[3] = {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+      const double sine = std::sqrt(cross[0] * cross[0] + cross[1] * cross[1] + cross[2] * cross[2]);
+      const double cosine = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+      d.normal_degrees = std::max(d.normal_degrees, std::atan2(sine, cosine) * 180.0 / M_PI);
+    }
+  }
+  return d;
+}
+
+// The demo subject (53,514 vertices) replaying its jump-rope take; four subscribers of the
+// library at once, one per encoding, compared frame by frame with the float subscriber.
+TEST(ClientSubscriberDemo, EveryEncodingGivesTheDaemonsVertices) {
+  const std::string demo = SKINSTREAM_DEMO_DIR;
+  // A fifth of real time: every subscriber takes every frame on this shared machine.
+  test::DaemonProcess daemon(SKINSTREAMD, "--subject " + demo + "/subject.sksubj --replay " + demo + "/live.c3d --loop --speed 0.2");
+  ASSERT_GT(daemon.sub_port, 0);
+  const uint16_t port = static_cast<uint16_t>(daemon.sub_port);
+  constexpr int kFrames = 40;
+  std::map<uint32_t, Received> by_encoding[4];
+  size_t model_bytes = 0;
+  std::vector<std::thread> threads;
+  for (int e = 0; e < 4; ++e)
+    threads.emplace_back([&, e] { by_encoding[e] = receive(port, static_cast<Encoding>(e), true, kFrames, e == 3 ? &model_bytes : nullptr); });
+  for (std::thread& t : threads) t.join();
+  EXPECT_EQ(daemon.stop(), 0) << daemon.log();
+  const auto& reference = by_encoding[static_cast<int>(Encoding::Float)];
+  ASSERT_EQ(static_cast<int>(reference.size()), kFrames);
+  ASSERT_EQ(reference.begin()->second.positions.size(), 3u * 53514u);
+
+  // Parameters, evaluated here with the daemon's own evaluator on the same floats: within the
+  // 0.01 mm the library promises (the same code and numbers give the same bits).
+  const Difference parameters = compare(reference, by_encoding[static_cast<int>(Encoding::Parameters)]);
+  EXPECT_GE(parameters.frames, kFrames / 2);
+  EXPECT_LE(parameters.position_mm, 0.01);
+  EXPECT_LE(parameters.normal_degrees, 0.01);
+  EXPECT_GT(model_bytes, 0u);
+  EXPECT_LE(model_bytes, 4u << 20);  // the bound for the demo subject
+
+  // Quantised: half of a step of the frame's box (under 2.5 m / 65535 / 2); normals within half
+  // a 1/32767 step per component.
+  const Difference quantised = compare(reference, by_encoding[static_cast<int>(Encoding::Quantised)]);
+  EXPECT_GE(quantised.frames, kFrames / 2);
+  EXPECT_LE(quantised.position_mm, 0.02);
+  EXPECT_LE(quantised.normal_degrees, 0.01);
+
+  // Compressed: half of a step of the key's grid (the body plus 250 mm a side, under 3 m /
+  // 65535 / 2); 8-bit octahedral normals within 1.5 degrees (the worst of the demo's: 1.25).
+  const Difference compressed = compare(reference, by_encoding[static_cast<int>(Encoding::Compressed)]);
+  EXPECT_GE(compressed.frames, kFrames / 2);
+  EXPECT_LE(compressed.position_mm, 0.025);
+  EXPECT_LE(compressed.normal_degrees, 1.5);
+  std::printf("largest differences from the float buffer over %d/%d/%d frames: parameters %.3g mm %.3g deg, quantised %.3g mm, "
+              "compressed %.3g mm %.4g deg; Model message %zu bytes\n",
+              parameters.frames, quantised.frames, compressed.frames, parameters.position_mm, parameters.normal_degrees,
+              quantised.position_mm, compressed.position_mm, compressed.normal_degrees, model_bytes);
+}
+
+TEST(ClientSubscriberDemo, AnUnknownSubjectIsRefusedWithTheReason) {
+  const std::string demo = SKINSTREAM_DEMO_DIR;
+  test::DaemonProcess daemon(SKINSTREAMD, "--subject " + demo + "/subject.sksubj");
+  client::Options options;
+  options.port = static_cast<uint16_t>(daemon.sub_port);
+  options.subject = "Actor9";
+  client::Subscriber sub(options);
+  client::Frame frame;
+  try {
+    sub.next(frame, std::chrono::seconds(10));
+    FAIL() << "no refusal";
+  } catch (const client::Error& e) {
+    EXPECT_NE(std::string(e.what()).find("refused"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("Actor9"), std::string::npos) << e.what();
+  }
+}
+
+TEST(ClientSubscriber, NoDaemonIsAOneLineError) {
+  // A port nothing listens on: bound, then closed.
+  const int fd = socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in address{};
+  address.sin_family = AF_INET;
+  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  socklen_t length = sizeof address;
+  ASSERT_EQ(bind(fd, reinterpret_cast<sockaddr*>(&address), sizeof address), 0);
+  getsockname(fd, reinterpret_cast<sockaddr*>(&address), &length);
+  close(fd);
+  client::Options options;
+  options.port = ntohs(address.sin_port);
+  try {
+    client::Subscriber sub(options);
+    FAIL() << "connected to nothing";
+  } catch (const client::Error& e) {
+    EXPECT_NE(std::string(e.what()).find("refused"), std::string::npos) << e.what();
+    EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos);
+  }
+  EXPECT_THROW(client::Subscriber(client::Options{.encoding = Encoding::Parameters, .protocol_version = 1}), std::invalid_argument);
+}
+
+// A "daemon" that answers the Hello with the bytes given, then closes.
+class FakeDaemon {
+ public:
+  explicit FakeDaemon(std::vector<unsigned char> reply) : reply_(std::move(reply)) {
+    listener_ = socket(AF_INET, SOCK_STREAM, 0);
+    sockaddr_in address{};
+    address.sin_family = AF_INET;
+    address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    socklen_t length = sizeof address;
+    bind(listener_, reinterpret_cast<sockaddr*>(&address), sizeof address);
+    listen(listener_, 1);
+    getsockname(listener_, reinterpret_cast<sockaddr*>(&address), &length);
+    port = ntohs(address.sin_port);
+    thread_ = std::thread([this] {
+      const int peer = accept(listener_, nullptr, nullptr);
+      unsigned char hello[1024];
+      if (recv(peer, hello, sizeof hello, 0) > 0) send(peer, reply_.data(), reply_.size(), MSG_NOSIGNAL);
+      std::this_thread::sleep_for(std::chrono::milliseconds(200));
+      close(peer);
+    });
+  }
+  ~FakeDaemon() {
+    thread_.join();
+    close(listener_);
+  }
+  uint16_t port = 0;
+
+ private:
+  std::vector<unsigned char> reply_;
+  int listener_ = -1;
+  std::thread thread_;
+};
+
+std::string error_for(std::vector<unsigned char> reply, Encoding encoding = Encoding::Parameters) {
+  FakeDaemon fake(std::move(reply));
+  client::Options options;
+  options.port = fake.port;
+  options.encoding = encoding;
+  client::Subscriber sub(options);
+  client::Frame frame;
+  try {
+    while (sub.next(frame, std::chrono::seconds(5))) {
+    }
+    return "no error";
+  } catch (const client::Error& e) {
+    return e.what();
+  }
+}
+
+std::vector<unsigned char> golden(const std::string& name) {
+  const std::string bytes = test::read_bytes(test::source_path("tests/protocol/fixtures/subscriber/" + name));
+  return {bytes.begin(), bytes.end()};
+}
+
+TEST(ClientSubscriber, BytesThatBreakTheProtocolAreOneLineErrors) {
+  std::vector<unsigned char> bad_magic = golden("mesh_info_v2.bin");
+  bad_magic[0] = 'X';
+  EXPECT_NE(error_for(bad_magic).find("bad magic"), std::string::npos);
+  std::vector<unsigned char> version_one = golden("mesh_info.bin");  // a version 1 answer to a version 2 Hello
+  EXPECT_NE(error_for(version_one).find("version 1"), std::string::npos);
+  // A Model before MeshInfo; a Model whose vertex count differs from MeshInfo's.
+  EXPECT_NE(error_for(golden("model.bin")).find("before MeshInfo"), std::string::npos);
+  std::vector<unsigned char> both = golden("mesh_info_v2.bin");
+  const std::vector<unsigned char> model = golden("model.bin");  // 3 vertices; the MeshInfo has 4
+  both.insert(both.end(), model.begin(), model.end());
+  EXPECT_NE(error_for(both).find("vertices"), std::string::npos);
+  // A truncated Model message: the connection ends inside it.
+  std::vector<unsigned char> cut = golden("mesh_info_v2.bin");
+  cut.insert(cut.end(), model.begin(), model.end() - 10);
+  EXPECT_NE(error_for(cut).find("closed the connection"), std::string::npos);
+  // A parameter Frame before any Model.
+  std::vector<unsigned char> frame_first = golden("mesh_info_v2.bin");
+  const std::vector<unsigned char> parameters = golden("frame_v2_parameters.bin");
+  frame_first.insert(frame_first.end(), parameters.begin(), parameters.end());
+  EXPECT_NE(error_for(frame_first).find("before the Model"), std::string::npos);
+  for (const std::string& e : {error_for(bad_magic), error_for(version_one), error_for(frame_first)})
+    EXPECT_EQ(e.find('\n'), std::string::npos) << e;
+}
+
+}  // namespace
+}  // namespace skinstream
