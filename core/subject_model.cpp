@@ -1,6 +1,7 @@
 #include "core/subject_model.h"
 
 #include <cmath>
+#include <cstdint>
 #include <sstream>
 
 namespace skinstream {
@@ -34,8 +35,13 @@ std::string SubjectModel::validate() const {
   if (!why.str().empty()) return why.str();
   for (size_t i = 0; i < n; ++i) {
     if (!is_present(reference_positions[i])) why << "marker " << marker_names[i] << " has no reference position; ";
-    const int rs = ring_offsets[i + 1] - ring_offsets[i];
-    if (rs < 0 || rs > kMaxRing) why << "marker " << marker_names[i] << " ring size " << rs << "; ";
+    // In 64 bits and judged before it sizes anything: offsets from a file can be any int.
+    const int64_t ring_size = int64_t{ring_offsets[i + 1]} - ring_offsets[i];
+    if (ring_size < 0 || ring_size > kMaxRing) {
+      why << "marker " << marker_names[i] << " ring size " << ring_size << "; ";
+      continue;
+    }
+    const int rs = static_cast<int>(ring_size);
     const MarkerPcaModel& m = pca[i];
     if (m.mean.size() != 3 * rs || m.basis.rows() != 3 * rs || m.basis.cols() != m.variance.size())
       why << "marker " << marker_names[i] << " PCA shape does not match its ring; ";

@@ -24,6 +24,7 @@ class ByteWriter {
     bytes_.insert(bytes_.end(), s.begin(), s.end());
   }
   void put_bytes(const void* data, size_t size) {
+    if (size == 0) return;
     const auto* p = static_cast<const unsigned char*>(data);
     bytes_.insert(bytes_.end(), p, p + size);
   }
@@ -62,11 +63,13 @@ class ByteReader {
     return n;
   }
   // `count` values at once: one bounds check and one copy (the stream's byte order is the host's,
-  // little-endian, as for get()).
+  // little-endian, as for get()). No values may come with no storage (an empty vector's data()):
+  // memcpy must not be given a null pointer, even for 0 bytes.
   template <typename T>
   void get_array(T* out, size_t count) {
     static_assert(std::is_arithmetic_v<T>);
     if (count > (size_ - pos_) / sizeof(T)) throw std::out_of_range("truncated at byte " + std::to_string(pos_));
+    if (count == 0) return;
     std::memcpy(out, data_ + pos_, count * sizeof(T));
     pos_ += count * sizeof(T);
   }

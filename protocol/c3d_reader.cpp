@@ -230,7 +230,7 @@ class ParameterSection {
 
   // Parameter body: type, dimension count, dimensions, data (then a description we skip).
   Parameter read_parameter(const std::string& name, uint64_t at, uint64_t end) const {
-    const std::string where = "parameter " + name;
+    const std::string where = "parameter " + quoted_text(name);
     if (at + 2 > end) throw corrupt(where, end);
     const uint8_t* b = prefix_.at(at, 2, where);
     Parameter p;
@@ -265,7 +265,7 @@ double unit_to_millimetres(const std::string& path, const std::string& units) {
   if (u == "CM") return 10.0;
   if (u == "DM") return 100.0;
   if (u == "M") return 1000.0;
-  throw FileError(path, "unknown POINT:UNITS '" + units + "' (expected mm, cm, dm or m)");
+  throw FileError(path, "unknown POINT:UNITS " + quoted_text(units) + " (expected mm, cm, dm or m)");
 }
 
 // Everything needed to decode the data section, gathered from header and parameters.

@@ -65,14 +65,6 @@ bool parse_integer(std::string_view token, long long& out) {
   return ec == std::errc() && end == token.data() + token.size();
 }
 
-std::string quoted(std::string_view token) {
-  // Keeps messages one printable line even when the token is binary garbage.
-  std::string s(token.substr(0, 40));
-  for (char& c : s)
-    if (!std::isprint(static_cast<unsigned char>(c))) c = '?';
-  return "'" + s + (token.size() > 40 ? "...'" : "'");
-}
-
 // Adds the fan v0 v1 v2, v0 v2 v3, ... of one polygon.
 void add_fan(const std::vector<int>& polygon, std::vector<std::array<int, 3>>& faces) {
   for (size_t k = 1; k + 1 < polygon.size(); ++k) faces.push_back({polygon[0], polygon[k], polygon[k + 1]});
@@ -115,7 +107,7 @@ TriangleMesh read_obj_file(const std::string& path, const std::string& bytes) {
       double xyz[3];
       for (size_t k = 1; k < tokens.size(); ++k) {
         double value = 0.0;
-        if (!parse_double(tokens[k], value)) throw FileError(path, where + "bad number " + quoted(tokens[k]));
+        if (!parse_double(tokens[k], value)) throw FileError(path, where + "bad number " + quoted_text(tokens[k]));
         if (k <= 3) xyz[k - 1] = value;
       }
       mesh.vertices.emplace_back(xyz[0], xyz[1], xyz[2]);
@@ -128,7 +120,7 @@ TriangleMesh read_obj_file(const std::string& path, const std::string& bytes) {
         long long index = 0;
         if (!parse_integer(head, index) || index == 0 ||
             token.find_first_not_of("0123456789-/", head.size()) != std::string_view::npos)
-          throw FileError(path, where + "bad face index " + quoted(token));
+          throw FileError(path, where + "bad face index " + quoted_text(token));
         // Negative: relative to the vertices read so far. Positive indices are checked at the
         // end, against every vertex in the file.
         const long long resolved = index > 0 ? index - 1 : static_cast<long long>(mesh.vertices.size()) + index;
@@ -141,7 +133,7 @@ TriangleMesh read_obj_file(const std::string& path, const std::string& bytes) {
     } else if (!std::isalpha(static_cast<unsigned char>(keyword[0])) ||
                !std::all_of(keyword.begin(), keyword.end(),
                             [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; })) {
-      throw FileError(path, where + "not an OBJ statement: " + quoted(keyword));
+      throw FileError(path, where + "not an OBJ statement: " + quoted_text(keyword));
     }
   }
   return mesh;
@@ -233,7 +225,7 @@ PlyHeader read_ply_header(const std::string& path, const std::string& bytes) {
       if (tokens[1] == "ascii") header.format = PlyFormat::ascii;
       else if (tokens[1] == "binary_little_endian") header.format = PlyFormat::binary_little_endian;
       else if (tokens[1] == "binary_big_endian") header.format = PlyFormat::binary_big_endian;
-      else throw FileError(path, where + "unknown format " + quoted(tokens[1]));
+      else throw FileError(path, where + "unknown format " + quoted_text(tokens[1]));
       have_format = true;
     } else if (keyword == "element") {
       long long count = 0;
@@ -250,14 +242,14 @@ PlyHeader read_ply_header(const std::string& path, const std::string& bytes) {
           throw FileError(path, where + "bad list property");
         p.name = tokens[4];
       } else if (tokens.size() == 3) {
-        if (!ply_type(tokens[1], p.type)) throw FileError(path, where + "unknown property type " + quoted(tokens[1]));
+        if (!ply_type(tokens[1], p.type)) throw FileError(path, where + "unknown property type " + quoted_text(tokens[1]));
         p.name = tokens[2];
       } else {
         throw FileError(path, where + "bad property line");
       }
       header.elements.back().properties.push_back(p);
     } else {
-      throw FileError(path, where + "unknown header keyword " + quoted(keyword));
+      throw FileError(path, where + "unknown header keyword " + quoted_text(keyword));
     }
   }
   if (!have_format) throw FileError(path, "PLY header has no format line");
@@ -336,11 +328,11 @@ class PlyData {
     const std::string_view token = tokens_[next_token_++];
     if (is_integer(type)) {
       long long v = 0;
-      if (!parse_integer(token, v)) throw FileError(path_, "corrupt: bad integer " + quoted(token) + " in " + what_);
+      if (!parse_integer(token, v)) throw FileError(path_, "corrupt: bad integer " + quoted_text(token) + " in " + what_);
       return static_cast<double>(v);
     }
     double v = 0.0;
-    if (!parse_double(token, v)) throw FileError(path_, "corrupt: bad number " + quoted(token) + " in " + what_);
+    if (!parse_double(token, v)) throw FileError(path_, "corrupt: bad number " + quoted_text(token) + " in " + what_);
     return v;
   }
 

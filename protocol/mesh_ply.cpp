@@ -71,7 +71,17 @@ PlyMesh read_ply(const std::string& path) {
     if (a == "element" && b == "vertex") s >> nv;
     if (a == "element" && b == "face") s >> nf;
   }
+  if (!in) throw FileError(path, "truncated: the header has no end_header");
   if (!binary_le) throw FileError(path, "only binary little-endian PLY is read");
+  // The counts are judged against the bytes that follow before anything is sized by them.
+  const std::streamoff header_end = in.tellg();
+  in.seekg(0, std::ios::end);
+  const auto data_bytes = static_cast<uint64_t>(in.tellg() - header_end);
+  in.seekg(header_end);
+  constexpr uint64_t kVertexBytes = 12, kMinFaceBytes = 1 + 3 * 4;
+  if (nv > data_bytes / kVertexBytes || nf > (data_bytes - nv * kVertexBytes) / kMinFaceBytes)
+    throw FileError(path, "truncated: header says " + std::to_string(nv) + " vertices and " + std::to_string(nf) +
+                              " faces, the file holds " + std::to_string(data_bytes) + " bytes of data");
   PlyMesh mesh;
   mesh.vertices.reserve(nv);
   for (size_t i = 0; i < nv; ++i) {
@@ -85,6 +95,9 @@ PlyMesh read_ply(const std::string& path) {
       throw FileError(path, "bad face " + std::to_string(i));
     int32_t idx[4] = {0, 0, 0, -1};
     if (!in.read(reinterpret_cast<char*>(idx), 4 * k)) throw FileError(path, "truncated face data");
+    for (int c = 0; c < k; ++c)
+      if (idx[c] < 0 || static_cast<size_t>(idx[c]) >= nv)
+        throw FileError(path, "face " + std::to_string(i) + " uses vertex " + std::to_string(idx[c]) + " of " + std::to_string(nv));
     mesh.faces.push_back({idx[0], idx[1], idx[2], k == 4 ? idx[3] : -1});
   }
   return mesh;

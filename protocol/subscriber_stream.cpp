@@ -26,6 +26,7 @@ class SpanWriter {
   // A whole array in one copy: value by value, the compiler must assume each byte written may
   // be the cursor itself and reload it, which made the 640 kB of a mesh's positions a scalar loop.
   void put_floats(std::span<const float> values) {
+    if (values.empty()) return;  // its data() may be null, which memcpy must not be given
     std::memcpy(out_.data() + pos_, values.data(), values.size_bytes());
     pos_ += values.size_bytes();
   }

@@ -90,16 +90,16 @@ class CellParser {
     double value = 0.0;
     const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
     if (text.empty() || error != std::errc() || end != text.data() + text.size())
-      throw FileError(path_, "line " + std::to_string(line) + ", column " + std::to_string(column) + ": '" +
-                                 std::string(cell.substr(0, 40)) + "' is not a number");
+      throw FileError(path_, "line " + std::to_string(line) + ", column " + std::to_string(column) + ": " +
+                                 quoted_text(cell) + " is not a number");
     return value;
   }
 
   long long whole_number(std::string_view cell, size_t line, size_t column) const {
     const double value = number(cell, line, column);
     if (!(std::abs(value) < 9e15) || value != std::floor(value))
-      throw FileError(path_, "line " + std::to_string(line) + ", column " + std::to_string(column) + ": '" +
-                                 std::string(cell.substr(0, 40)) + "' is not a whole number");
+      throw FileError(path_, "line " + std::to_string(line) + ", column " + std::to_string(column) + ": " +
+                                 quoted_text(cell) + " is not a whole number");
     return static_cast<long long>(value);
   }
 
@@ -113,7 +113,7 @@ double unit_to_millimetres(const std::string& path, std::string_view units) {
   if (u == "cm") return 10.0;
   if (u == "dm") return 100.0;
   if (u == "m") return 1000.0;
-  throw FileError(path, "unknown Units '" + std::string(units) + "' (expected mm, cm, dm or m)");
+  throw FileError(path, "unknown Units " + quoted_text(units) + " (expected mm, cm, dm or m)");
 }
 
 struct TrcHeader {
@@ -145,13 +145,13 @@ TrcHeader read_header(const std::string& path, const TextLines& lines, const Cel
   const auto [rate, rate_column] = required("datarate", "DataRate");
   header.rate = parse.number(rate, kValueLine, rate_column);
   if (!(header.rate > 0.0) || !std::isfinite(header.rate))
-    throw FileError(path, "bad DataRate " + std::string(rate) + " (must be positive)");
+    throw FileError(path, "bad DataRate " + printable_text(rate, 40) + " (must be positive)");
   const auto [frames, frames_column] = required("numframes", "NumFrames");
   header.frames = parse.whole_number(frames, kValueLine, frames_column);
   const auto [markers, markers_column] = required("nummarkers", "NumMarkers");
   header.markers = parse.whole_number(markers, kValueLine, markers_column);
   if (header.frames < 0 || header.markers < 0 || header.frames > std::numeric_limits<int>::max())
-    throw FileError(path, "bad NumFrames " + std::string(frames) + " or NumMarkers " + std::string(markers));
+    throw FileError(path, "bad NumFrames " + printable_text(frames, 40) + " or NumMarkers " + printable_text(markers, 40));
   header.to_millimetres = unit_to_millimetres(path, required("units", "Units").first);
   if (const auto it = value_of.find("origdatastartframe"); it != value_of.end() && !it->second.first.empty())
     header.start_frame = parse.whole_number(it->second.first, kValueLine, it->second.second);
@@ -176,7 +176,7 @@ std::vector<std::string> read_names(const std::string& path, const TextLines& li
     if (cells[column].empty()) continue;
     const size_t marker = (column - 2) / 3;
     if ((column - 2) % 3 != 0 || marker >= names.size())
-      throw FileError(path, "line 4: marker name '" + std::string(cells[column]) + "' in column " +
+      throw FileError(path, "line 4: marker name " + quoted_text(cells[column]) + " in column " +
                                 std::to_string(column + 1) + " does not match NumMarkers " +
                                 std::to_string(markers));
     names[marker] = std::string(cells[column]);

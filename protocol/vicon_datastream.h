@@ -128,6 +128,21 @@ struct Timecode {
 };
 constexpr uint32_t kTimecodeFilm = 3;
 
+// What one source may describe, so that a broken or hostile server cannot make a client decode,
+// remember or log without end (a SubjectInfo of 10,000 new names every frame). A packet beyond
+// these is malformed. skinstreamd's source_max_* keys set them.
+struct DescriptionLimits {
+  uint32_t max_subjects = 128;              // SubjectInfo objects in one packet
+  uint32_t max_markers_per_subject = 1024;  // markers of one SubjectInfo; its segments and attachments alike
+  uint32_t max_name_bytes = 256;            // a subject's, segment's or marker's name
+};
+
+// The frame rates a StreamInfo may give, 1 Hz to 10 kHz (real systems run at 30 Hz to 2 kHz),
+// as periods in ticks. Inside this range frame_id (u32) x period cannot overflow an int64.
+constexpr int64_t kMinFramePeriodTicks = kTicksPerSecond / 10'000;  // 10 kHz
+constexpr int64_t kMaxFramePeriodTicks = kTicksPerSecond;           // 1 Hz
+static_assert(kMaxFramePeriodTicks <= INT64_MAX / UINT32_MAX, "frame_id x period must fit an int64");
+
 // Bytes each record takes on the wire (for counts that must fit in what is left).
 constexpr size_t kLabeledReconBytes = 4 + 4 + 8 + 3 * 8 + 9 * 8 + 4;  // 116
 constexpr size_t kUnlabeledReconBytes = 8 + 3 * 8 + 9 * 8 + 4;        // 108

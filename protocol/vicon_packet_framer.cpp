@@ -53,7 +53,7 @@ PacketFramer::Status PacketFramer::next(Bytes& out_packet) {
   if (available - kPacketHeaderBytes < length) return Status::NeedMore;
   const Bytes packet(head, kPacketHeaderBytes + length);
   std::string reason;
-  if (!split_objects(packet, objects_, reason)) return fail(std::move(reason));
+  if (!split_objects(packet, objects_, reason, limits_)) return fail(std::move(reason));
   begin_ += packet.size();
   out_packet = packet;
   return Status::Packet;

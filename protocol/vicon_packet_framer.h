@@ -18,7 +18,8 @@ class PacketFramer {
  public:
   enum class Status { NeedMore, Packet, Error };
 
-  explicit PacketFramer(uint32_t max_packet_length = kMaxPacketLength) : max_length_(max_packet_length) {}
+  explicit PacketFramer(uint32_t max_packet_length = kMaxPacketLength, DescriptionLimits limits = {})
+      : max_length_(max_packet_length), limits_(limits) {}
 
   // Room for `size` more bytes (e.g. a socket read straight into it); then commit what was written.
   std::span<unsigned char> prepare(size_t size);
@@ -44,6 +45,7 @@ class PacketFramer {
   Status fail(std::string reason);
 
   uint32_t max_length_;
+  DescriptionLimits limits_;  // the subjects of a packet (split_objects)
   std::vector<unsigned char> buffer_;
   size_t begin_ = 0;  // first unread byte
   size_t end_ = 0;    // one past the last written byte

@@ -1,6 +1,7 @@
 #include "protocol/vicon_packet_reader.h"
 
 #include <algorithm>
+#include <cstdio>
 #include <cstring>
 
 namespace skinstream::vicon {
@@ -32,18 +33,25 @@ class Cursor {
       if (!read(v)) return false;
     return true;
   }
-  bool read(std::string& out) {
+  // A name (u32 length + bytes) of at most max_bytes.
+  bool read_name(std::string& out, uint32_t max_bytes, const char* what) {
     uint32_t n = 0;
     if (!read(n)) return false;
+    if (n > max_bytes)
+      return fail(std::string(what) + " name of " + std::to_string(n) + " bytes exceeds the limit of " +
+                  std::to_string(max_bytes));
     if (n > remaining())
-      return fail("string of " + std::to_string(n) + " bytes overruns the object at offset " + std::to_string(pos_));
+      return fail(std::string(what) + " name of " + std::to_string(n) + " bytes overruns the object at offset " +
+                  std::to_string(pos_));
     out.assign(reinterpret_cast<const char*>(bytes_.data() + pos_), n);
     pos_ += n;
     return true;
   }
-  // A count whose items (at least min_item_bytes each) must fit in what is left.
-  bool read_count(uint32_t& out, size_t min_item_bytes, const char* what) {
+  // A count of at most `limit` whose items (at least min_item_bytes each) must fit in what is left.
+  bool read_count(uint32_t& out, size_t min_item_bytes, const char* what, uint32_t limit = UINT32_MAX) {
     if (!read(out)) return false;
+    if (out > limit)
+      return fail(std::string(what) + " count " + std::to_string(out) + " exceeds the limit of " + std::to_string(limit));
     if (min_item_bytes > 0 && out > remaining() / min_item_bytes)
       return fail(std::string(what) + " count " + std::to_string(out) + " exceeds the " + std::to_string(remaining()) +
                   " bytes left");
@@ -79,7 +87,8 @@ bool read_type_set(Cursor& c, std::vector<uint32_t>& out) {
 
 }  // namespace
 
-bool split_objects(Bytes packet, std::vector<ObjectView>& out_objects, std::string& out_error) {
+bool split_objects(Bytes packet, std::vector<ObjectView>& out_objects, std::string& out_error,
+                   const DescriptionLimits& limits) {
   out_objects.clear();
   if (packet.size() < kPacketHeaderBytes) {
     out_error = "packet of " + std::to_string(packet.size()) + " bytes is shorter than its 8-byte header";
@@ -104,6 +113,7 @@ bool split_objects(Bytes packet, std::vector<ObjectView>& out_objects, std::stri
     return false;
   }
   size_t pos = kPacketHeaderBytes;
+  uint32_t subjects = 0;
   while (pos < packet.size()) {
     if (packet.size() - pos < kObjectHeaderBytes) {
       out_error = "truncated object header at offset " + std::to_string(pos);
@@ -122,6 +132,10 @@ bool split_objects(Bytes packet, std::vector<ObjectView>& out_objects, std::stri
     }
     object.payload = packet.subspan(pos, object_length);
     pos += object_length;
+    if (object.type == object_type::SubjectInfo && ++subjects > limits.max_subjects) {
+      out_error = "more than " + std::to_string(limits.max_subjects) + " SubjectInfo objects in one packet (the limit)";
+      return false;
+    }
     out_objects.push_back(object);
   }
   return true;
@@ -180,25 +194,35 @@ bool decode(Bytes payload, Filter& out, std::string& out_error) {
 
 bool decode(Bytes payload, StreamInfo& out, std::string& out_error) {
   Cursor c(payload);
-  return finish(c, c.read(out.frame_period_ticks), "StreamInfo", out_error);
+  bool ok = c.read(out.frame_period_ticks);
+  if (ok && (out.frame_period_ticks < kMinFramePeriodTicks || out.frame_period_ticks > kMaxFramePeriodTicks)) {
+    char rate[32];
+    std::snprintf(rate, sizeof rate, "%.6g", rate_from_period(out.frame_period_ticks));
+    ok = c.fail("frame period of " + std::to_string(out.frame_period_ticks) + " ticks (" +
+                (out.frame_period_ticks > 0 ? std::string(rate) + " Hz" : std::string("no rate")) +
+                ") is outside 1 Hz to 10 kHz");
+  }
+  return finish(c, ok, "StreamInfo", out_error);
 }
 
-bool decode(Bytes payload, SubjectInfo& out, std::string& out_error) {
+bool decode(Bytes payload, SubjectInfo& out, std::string& out_error, const DescriptionLimits& limits) {
   Cursor c(payload);
   uint32_t n = 0;
-  bool ok = c.read(out.subject_id) && c.read(out.name) && c.read_count(n, 4 + 4 + 24 + 4, "segment");
+  const uint32_t max_items = limits.max_markers_per_subject, max_name = limits.max_name_bytes;
+  bool ok = c.read(out.subject_id) && c.read_name(out.name, max_name, "subject") &&
+            c.read_count(n, 4 + 4 + 24 + 4, "segment", max_items);
   if (ok) {
     out.segments.resize(n);
     for (SubjectSegment& s : out.segments)
-      if (!(ok = c.read(s.parent_id) && c.read(s.segment_id) && c.read(s.bounds) && c.read(s.name))) break;
+      if (!(ok = c.read(s.parent_id) && c.read(s.segment_id) && c.read(s.bounds) && c.read_name(s.name, max_name, "segment"))) break;
   }
-  ok = ok && c.read_count(n, 4 + 4, "marker");
+  ok = ok && c.read_count(n, 4 + 4, "marker", max_items);
   if (ok) {
     out.markers.resize(n);
     for (SubjectMarker& m : out.markers)
-      if (!(ok = c.read(m.marker_id) && c.read(m.name))) break;
+      if (!(ok = c.read(m.marker_id) && c.read_name(m.name, max_name, "marker"))) break;
   }
-  ok = ok && c.read_count(n, 4 + 4, "attachment");
+  ok = ok && c.read_count(n, 4 + 4, "attachment", max_items);
   if (ok) {
     out.attachments.resize(n);
     for (SubjectAttachment& a : out.attachments)
@@ -249,10 +273,10 @@ bool DecodedPacket::has(uint32_t type) const {
   return std::find(object_types.begin(), object_types.end(), type) != object_types.end();
 }
 
-bool decode_packet(Bytes packet, DecodedPacket& out, std::string& out_error) {
+bool decode_packet(Bytes packet, DecodedPacket& out, std::string& out_error, const DescriptionLimits& limits) {
   out = DecodedPacket{};
   std::vector<ObjectView> objects;
-  if (!split_objects(packet, objects, out_error)) return false;
+  if (!split_objects(packet, objects, out_error, limits)) return false;
   for (const ObjectView& object : objects) {
     out.object_types.push_back(object.type);
     bool ok = true;
@@ -266,7 +290,7 @@ bool decode_packet(Bytes packet, DecodedPacket& out, std::string& out_error) {
       case object_type::Contents: ok = decode(object.payload, out.contents, out_error); break;
       case object_type::Filter: ok = decode(object.payload, out.filter, out_error); break;
       case object_type::StreamInfo: ok = decode(object.payload, out.stream_info, out_error); break;
-      case object_type::SubjectInfo: ok = decode(object.payload, out.subjects.emplace_back(), out_error); break;
+      case object_type::SubjectInfo: ok = decode(object.payload, out.subjects.emplace_back(), out_error, limits); break;
       case object_type::FrameInfo: ok = decode(object.payload, out.frame_info, out_error); break;
       case object_type::Timecode: ok = decode(object.payload, out.timecode, out_error); break;
       case object_type::LabeledRecons: ok = decode(object.payload, out.labeled, out_error); break;

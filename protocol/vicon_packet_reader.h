@@ -20,12 +20,16 @@ struct ObjectView {
   Bytes payload;
 };
 
-// Checks the header (magic, length = bytes that follow, <= kMaxPacketLength) and that the objects
-// tile the payload exactly; out_objects is cleared and refilled (its capacity is reused).
-bool split_objects(Bytes packet, std::vector<ObjectView>& out_objects, std::string& out_error);
+// Checks the header (magic, length = bytes that follow, <= kMaxPacketLength), that the objects
+// tile the payload exactly and that there are at most limits.max_subjects SubjectInfo objects;
+// out_objects is cleared and refilled (its capacity is reused).
+bool split_objects(Bytes packet, std::vector<ObjectView>& out_objects, std::string& out_error,
+                   const DescriptionLimits& limits = {});
 
 // One object payload each. Bytes after the fields an object defines are ignored, as the SDK does
-// (newer servers may append fields); missing bytes and implausible counts are errors.
+// (newer servers may append fields); missing bytes and implausible counts are errors, and so are
+// a StreamInfo period outside kMinFramePeriodTicks..kMaxFramePeriodTicks and a SubjectInfo
+// beyond `limits`.
 bool decode(Bytes payload, ObjectEnums& out, std::string& out_error);
 bool decode(Bytes payload, RequestFrame& out, std::string& out_error);
 bool decode(Bytes payload, RequestNextFrame& out, std::string& out_error);
@@ -34,7 +38,7 @@ bool decode(Bytes payload, StartMulticastSender& out, std::string& out_error);
 bool decode(Bytes payload, Contents& out, std::string& out_error);
 bool decode(Bytes payload, Filter& out, std::string& out_error);
 bool decode(Bytes payload, StreamInfo& out, std::string& out_error);
-bool decode(Bytes payload, SubjectInfo& out, std::string& out_error);
+bool decode(Bytes payload, SubjectInfo& out, std::string& out_error, const DescriptionLimits& limits = {});
 bool decode(Bytes payload, FrameInfo& out, std::string& out_error);
 bool decode(Bytes payload, Timecode& out, std::string& out_error);
 bool decode(Bytes payload, std::vector<LabeledRecon>& out, std::string& out_error);
@@ -63,6 +67,6 @@ struct DecodedPacket {
   bool has(uint32_t type) const;
 };
 
-bool decode_packet(Bytes packet, DecodedPacket& out, std::string& out_error);
+bool decode_packet(Bytes packet, DecodedPacket& out, std::string& out_error, const DescriptionLimits& limits = {});
 
 }  // namespace skinstream::vicon

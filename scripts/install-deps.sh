@@ -8,6 +8,12 @@ packages=(
   libeigen3-dev libboost-dev libboost-system-dev nlohmann-json3-dev libspdlog-dev libfmt-dev
   libopenmesh-dev libmeshoptimizer-dev libgtest-dev libgmock-dev libbenchmark-dev libcli11-dev zlib1g-dev libexpat1-dev
   chromium
+  clang libclang-rt-14-dev  # scripts/fuzz.sh: libFuzzer and clang's sanitizer runtimes
+  # The Python package (clients/python): Debian's python3 and numpy; pip, venv, setuptools and
+  # wheel for its offline `pip install` test.
+  python3 python3-numpy python3-pip python3-venv python3-setuptools python3-wheel
+  # The Blender add-on's headless test (clients/blender): Blender 3.4, about a minute to install.
+  blender
 )
 # The web viewer's build (npm) and its browser test (node + playwright-core + chromium). A
 # machine with Node.js from elsewhere (e.g. NodeSource, which bundles npm) keeps it.

@@ -57,7 +57,8 @@ void apply_json(const nlohmann::json& json, DaemonConfig& c, const std::string& 
                                       "deform_cpus", "deform_spin_lead_us",
                                       "continuity_seconds", "use_pca", "ports_file", "log_level", "hello_timeout_ms",
                                       "subscriber_queue_frames", "subscriber_tcp_congestion", "publish_threads", "status_interval_ms", "default_rate_hz",
-                                      "compressed_key_interval"};
+                                      "compressed_key_interval", "source_max_subjects", "source_max_markers_per_subject",
+                                      "source_max_name_bytes"};
   for (const auto& [key, value] : json.items()) {
     bool known = false;
     for (const char* k : kKeys) known = known || key == k;
@@ -104,6 +105,9 @@ void apply_json(const nlohmann::json& json, DaemonConfig& c, const std::string& 
   take(json, "publish_threads", c.publish_threads, origin);
   take(json, "status_interval_ms", c.status_interval_ms, origin);
   take(json, "default_rate_hz", c.default_rate_hz, origin);
+  take(json, "source_max_subjects", c.source_max_subjects, origin);
+  take(json, "source_max_markers_per_subject", c.source_max_markers_per_subject, origin);
+  take(json, "source_max_name_bytes", c.source_max_name_bytes, origin);
 }
 
 DaemonConfig load_config_file(const std::string& path) {
@@ -155,7 +159,10 @@ nlohmann::json to_json(const DaemonConfig& c) {
           {"subscriber_tcp_congestion", c.subscriber_tcp_congestion},
           {"publish_threads", c.publish_threads},
           {"status_interval_ms", c.status_interval_ms},
-          {"default_rate_hz", c.default_rate_hz}};
+          {"default_rate_hz", c.default_rate_hz},
+          {"source_max_subjects", c.source_max_subjects},
+          {"source_max_markers_per_subject", c.source_max_markers_per_subject},
+          {"source_max_name_bytes", c.source_max_name_bytes}};
 }
 
 void validate(const DaemonConfig& c) {
@@ -189,6 +196,10 @@ void validate(const DaemonConfig& c) {
          c.subscriber_tcp_congestion + "\"");
   if (c.status_interval_ms < 10) fail("status_interval_ms must be >= 10");
   if (!(c.default_rate_hz > 0)) fail("default_rate_hz must be > 0");
+  if (c.source_max_subjects < 1 || c.source_max_subjects > 4096) fail("source_max_subjects must be 1-4096");
+  if (c.source_max_markers_per_subject < 1 || c.source_max_markers_per_subject > 65536)
+    fail("source_max_markers_per_subject must be 1-65536");
+  if (c.source_max_name_bytes < 1 || c.source_max_name_bytes > 4096) fail("source_max_name_bytes must be 1-4096");
   static const char* const kLevels[] = {"trace", "debug", "info", "warn", "error", "critical", "off"};
   bool level_ok = false;
   for (const char* l : kLevels) level_ok = level_ok || c.log_level == l;

@@ -58,6 +58,10 @@ struct DaemonConfig {
   int compressed_key_interval = 10;  // frames between key frames of the compressed encoding
   int status_interval_ms = 1000;
   double default_rate_hz = 120.0;  // until the source says its rate
+  // What one source message may describe (vicon::DescriptionLimits); more is a malformed packet.
+  int source_max_subjects = 128;
+  int source_max_markers_per_subject = 1024;
+  int source_max_name_bytes = 256;
 };
 
 // Thrown for a bad config file, a bad key or value, or conflicting flags: one line, says which.

@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include "protocol/file_error.h"
+#include "protocol/printable_text.h"
 #include "server/http/http_server.h"
 #include "server/ingest/file_replay_source.h"
 #include "server/ingest/natnet_source.h"
@@ -104,6 +105,14 @@ ViconSourceOptions vicon_options_of(const DaemonConfig& config) {
   return options;
 }
 
+vicon::DescriptionLimits description_limits_of(const DaemonConfig& config) {
+  vicon::DescriptionLimits limits;
+  limits.max_subjects = static_cast<uint32_t>(config.source_max_subjects);
+  limits.max_markers_per_subject = static_cast<uint32_t>(config.source_max_markers_per_subject);
+  limits.max_name_bytes = static_cast<uint32_t>(config.source_max_name_bytes);
+  return limits;
+}
+
 }  // namespace
 
 Daemon::Daemon(const DaemonConfig& config)
@@ -137,6 +146,7 @@ Daemon::Daemon(const DaemonConfig& config)
     ViconMulticastSourceOptions options;
     options.group = address.host;
     options.port = address.port;
+    options.limits = description_limits_of(config);
     spdlog::info("source: Vicon DataStream multicast {}:{} (receive only)", options.group, options.port);
     source_ = std::make_unique<ViconMulticastSource>(io_, std::move(options), static_cast<SourceSink&>(*this));
   } else if (!config.vicon.empty()) {
@@ -191,15 +201,16 @@ Daemon::Daemon(const DaemonConfig& config)
     auto subscriber = std::make_shared<TcpSubscriber>(placed.io, hub, std::move(socket), remote, std::move(placed.token));
     hub.add(subscriber);
     asio::post(placed.io, [subscriber] { subscriber->start(); });
-  }, config.subscriber_tcp_congestion);
+  }, ListenerOptions{config.subscriber_tcp_congestion, &source_metrics_, &descriptor_reserve_, false});
   HttpRoutes routes;
   routes.health_json = [this] { return health_json(); };
   routes.metrics_text = [this] { return metrics_text(); };
   routes.web_root = config.web_root;
   if (!config.web_root.empty() && !std::filesystem::is_directory(config.web_root))
     throw FileError(config.web_root, "web root is not a directory");
+  // Out of descriptors, the HTTP port spends the reserve: /health answers while subscribers hold the rest.
   http_ = std::make_unique<HttpServer>(io_, config.bind_address, config.http_port, subject(0).hub(), std::move(routes),
-                                       config.subscriber_tcp_congestion);
+                                       ListenerOptions{config.subscriber_tcp_congestion, &source_metrics_, &descriptor_reserve_, true});
 }
 
 Daemon::~Daemon() { stop(); }
@@ -318,7 +329,7 @@ void Daemon::on_match(int target, bool present, std::string_view detail) {
 }
 
 void Daemon::on_unknown_subjects(std::span<const std::string> names, size_t not_listed) {
-  for (const std::string& name : names) spdlog::info("source: subject \"{}\" is none of ours: ignored", name);
+  for (const std::string& name : names) bad_input_log_.warn("unknown_subject", "source subject " + quoted_text(name) + " is none of ours: ignored");
   if (not_listed > 0)
     bad_input_log_.warn("unknown_subjects", std::to_string(not_listed) + " more source subjects that are none of ours (no longer listed)");
 }
@@ -327,7 +338,9 @@ void Daemon::on_unknown_labels(int target, std::span<const std::string> names, s
   SubjectStream& s = subject(target);
   for (const std::string& name : names) {
     s.metrics().count_bad_input("unknown_label");
-    spdlog::info("subject {}: label \"{}\" is not one of its markers: used as an unlabelled point", s.name(), name);
+    // Rate-limited and made printable: the names come from the source, which may send thousands.
+    bad_input_log_.warn("unknown_label", "subject " + s.name() + ": source label " + quoted_text(name) +
+                                             " is not one of its markers: used as an unlabelled point");
   }
   if (not_listed > 0)
     bad_input_log_.warn("unknown_labels", "subject " + s.name() + ": " + std::to_string(not_listed) +
@@ -382,6 +395,10 @@ std::string Daemon::health_json() const {
       {"frames", first["frames"]},
       {"frame_buffers_allocated", first["frame_buffers_allocated"]},
       {"frame_buffers_allocated_by_pipeline", first["frame_buffers_allocated_by_pipeline"]},
+      {"source_limits",
+       {{"max_subjects", config_.source_max_subjects},
+        {"max_markers_per_subject", config_.source_max_markers_per_subject},
+        {"max_name_bytes", config_.source_max_name_bytes}}},
       {"latency_ms", first["latency_ms"]}};
   return health.dump();
 }

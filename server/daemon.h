@@ -18,6 +18,7 @@
 
 #include "server/asio.h"
 #include "server/config.h"
+#include "server/descriptor_reserve.h"
 #include "server/ingest/frame_source.h"
 #include "server/ingest/subject_router.h"
 #include "server/logging.h"
@@ -85,6 +86,7 @@ class Daemon : private SourceSink, private SubjectRouter::Observer {
   // The TCP subscribers' threads: destroyed before io_ and after the listeners (declared
   // between), once every session was closed on its own thread.
   PublishThreads publish_;
+  DescriptorReserve descriptor_reserve_;  // the HTTP port's, for when subscribers hold every other descriptor
   std::unique_ptr<Listener> sub_listener_;
   std::unique_ptr<HttpServer> http_;
   std::unique_ptr<FrameSource> source_;

@@ -38,7 +38,8 @@ SkinWeights SkinWeights::from_lists(const std::vector<std::vector<std::pair<int,
         throw std::invalid_argument("skin weights: vertex " + std::to_string(v) + " has weight " +
                                     std::to_string(w));
       if (w <= 1e-6) continue;
-      auto it = std::find_if(row.begin(), row.end(), [&](const auto& e) { return e.first == bone; });
+      // The bone by value: clang 14 cannot capture a structured binding.
+      auto it = std::find_if(row.begin(), row.end(), [b = bone](const auto& e) { return e.first == b; });
       if (it != row.end())
         it->second += w;
       else

@@ -102,12 +102,12 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
 }  // namespace
 
 HttpServer::HttpServer(asio::io_context& io, const std::string& address, int port, SubscriberHub& hub, HttpRoutes routes,
-                       std::string tcp_congestion)
+                       ListenerOptions listening)
     : io_(io),
       hub_(hub),
       routes_(std::make_shared<const HttpRoutes>(std::move(routes))),
       listener_(io, address, port, "HTTP port", [this](tcp::socket socket) {
         std::make_shared<HttpSession>(io_, std::move(socket), hub_, routes_)->read_next();
-      }, std::move(tcp_congestion)) {}
+      }, std::move(listening)) {}
 
 }  // namespace skinstream::server

@@ -20,9 +20,9 @@ struct HttpRoutes {
 
 class HttpServer {
  public:
-  // `tcp_congestion`: set on every connection, so WebSocket subscribers get it (empty: the system's).
+  // `listening.tcp_congestion`: set on every connection, so WebSocket subscribers get it.
   HttpServer(asio::io_context& io, const std::string& address, int port, SubscriberHub& hub, HttpRoutes routes,
-             std::string tcp_congestion = {});
+             ListenerOptions listening = {});
   void start() { listener_.start(); }
   void stop() { listener_.stop(); }
   int port() const { return listener_.port(); }

@@ -1,5 +1,7 @@
 #include "server/http/websocket_subscriber.h"
 
+#include <spdlog/spdlog.h>
+
 #include "protocol/subscriber_stream.h"
 #include "server/publish/subscriber_hub.h"
 
@@ -37,6 +39,7 @@ void WebSocketSubscriber::read_next() {
       self->on_disconnected(ec == websocket::error::closed ? "closed by the subscriber" : ec.message());
       return;
     }
+    if (!self->ws_.got_binary()) return self->refuse_text_message();
     const auto data = self->read_buffer_.cdata();
     const std::span<const unsigned char> bytes(static_cast<const unsigned char*>(data.data()), data.size());
     try {
@@ -51,6 +54,16 @@ void WebSocketSubscriber::read_next() {
     self->read_buffer_.consume(self->read_buffer_.size());
     self->read_next();
   });
+}
+
+void WebSocketSubscriber::refuse_text_message() {
+  hub_->metrics().bad_subscriber_messages.fetch_add(1, std::memory_order_relaxed);
+  spdlog::warn("subscriber {} (websocket {}): a text message; the subscriber protocol is binary only; closing", id(),
+               stats().remote);
+  // Closed with a reason (1003, data of a kind the daemon does not take) the peer's WebSocket API
+  // shows, then the socket; a peer that never answers the close is cut by the handshake timeout.
+  ws_.async_close(websocket::close_reason(websocket::close_code::unknown_data, "binary messages only"),
+                  [self = shared_from_this()](const boost::system::error_code&) { self->close(); });
 }
 
 void WebSocketSubscriber::start_write(const std::array<asio::const_buffer, 2>& buffers) {

@@ -1,5 +1,7 @@
 #pragma once
-// A subscriber on ws://HOST:PORT/stream: one protocol message per binary WebSocket message.
+// A subscriber on ws://HOST:PORT/stream: one protocol message per binary WebSocket message. A
+// text message breaks the protocol: it is counted (bad_subscriber_messages) and the connection
+// closed with WebSocket close code 1003.
 
 #include "server/beast.h"
 #include "server/publish/subscriber_session.h"
@@ -15,6 +17,7 @@ class WebSocketSubscriber : public SubscriberSession {
 
  private:
   void read_next();
+  void refuse_text_message();
   void start_write(const std::array<asio::const_buffer, 2>& buffers) override;
 
   websocket::stream<beast::tcp_stream> ws_;

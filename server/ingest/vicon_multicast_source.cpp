@@ -87,7 +87,7 @@ struct ViconMulticastSource::State : std::enable_shared_from_this<ViconMulticast
     std::string error;
     const vicon::Bytes packet(datagram.data(), n);
     auto result = ViconFrameAssembler::Result::Malformed;
-    if (vicon::split_objects(packet, objects, error)) result = assembler.handle(objects, now, error);
+    if (vicon::split_objects(packet, objects, error, options.limits)) result = assembler.handle(objects, now, error);
     if (stopped) return;
     if (result == ViconFrameAssembler::Result::Malformed) {
       sink.on_bad_input("malformed_packet", "datagram of " + std::to_string(n) + " bytes: " + error);

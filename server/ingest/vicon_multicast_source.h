@@ -23,6 +23,7 @@ struct ViconMulticastSourceOptions {
   uint16_t port = vicon::kDefaultMulticastPort;
   std::string interface_address = "0.0.0.0";
   double silence_timeout_seconds = 1.0;
+  vicon::DescriptionLimits limits{};  // the subjects a datagram may carry
 };
 
 class ViconMulticastSource : public FrameSource {

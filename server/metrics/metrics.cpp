@@ -117,6 +117,10 @@ std::string render_prometheus(const Metrics& source, const std::vector<SubjectMe
   };
   header(out, "source_frames_total", "Frames received from the source (every subject's together).", "counter");
   out += "skinstream_source_frames_total " + std::to_string(source.frames_received.load()) + "\n";
+  header(out, "accepts_failed_no_descriptor_total",
+         "Accepts (HTTP and subscriber ports) that failed for lack of file descriptors; each pauses that port's accepts, 10 ms doubling to 1 s.",
+         "counter");
+  out += "skinstream_accepts_failed_no_descriptor_total " + std::to_string(source.accepts_failed_no_descriptor.load()) + "\n";
   per_subject("frames_received_total", "Marker frames of the subject received from the source.", &Metrics::frames_received);
   per_subject("frames_processed_total", "Frames through the gap filler.", &Metrics::frames_processed);
   per_subject("frames_published_total", "Frames handed to the publishers.", &Metrics::frames_published);

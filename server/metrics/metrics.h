@@ -65,6 +65,7 @@ class Metrics {
   std::atomic<uint64_t> bad_subscriber_messages{0};
   std::atomic<uint64_t> subscribers_connected{0};  // total accepted
   std::atomic<uint64_t> subscribers_refused{0};    // Hello refused (unknown subject, ...)
+  std::atomic<uint64_t> accepts_failed_no_descriptor{0};  // both ports: each pauses that port's accepts (server/listener.h)
   std::atomic<uint64_t> frame_buffers_allocated{0};              // every encoded frame buffer made
   std::atomic<uint64_t> frame_buffers_allocated_by_pipeline{0};  // of those, made on the 120 Hz thread (none prepared)
 
@@ -91,8 +92,8 @@ struct SubjectMetricsView {
   std::vector<SubscriberMetrics> subscribers;
 };
 
-// /metrics: the source's own counters (its frames, as skinstream_source_frames_total, and its bad
-// input) without a subject label, then every subject's series labelled subject="NAME" (each
+// /metrics: the daemon's own counters (the source's frames, as skinstream_source_frames_total, its
+// bad input, the failed accepts) without a subject label, then every subject's series labelled subject="NAME" (each
 // metric's HELP and TYPE once, its samples for every subject after them).
 std::string render_prometheus(const Metrics& source, const std::vector<SubjectMetricsView>& subjects);
 

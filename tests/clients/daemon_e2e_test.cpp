@@ -8,8 +8,10 @@
 #include <csignal>
 #include <cstdio>
 #include <fstream>
+#include <iterator>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <poll.h>
 #include <sys/socket.h>
 #include <netinet/in.h>
 #include <sys/wait.h>
@@ -197,6 +199,110 @@ TEST_F(DaemonProgram, SigtermStopsCleanlyWithMarkersOnly) {
   EXPECT_NE(sub.output.find("\"frames\": 20"), std::string::npos) << sub.output;
   EXPECT_EQ(daemon.stop(), 0) << daemon.log();
   EXPECT_NE(daemon.log().find("no deformation model"), std::string::npos) << daemon.log();
+}
+
+// A loopback TCP connection to `port`, or -1. Connected even when the server has not accepted it
+// (the kernel completes the handshake into the listener's queue).
+int connect_loopback(int port) {
+  const int fd = socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in address{};
+  address.sin_family = AF_INET;
+  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  address.sin_port = htons(static_cast<uint16_t>(port));
+  if (fd >= 0 && connect(fd, reinterpret_cast<sockaddr*>(&address), sizeof address) == 0) return fd;
+  if (fd >= 0) close(fd);
+  return -1;
+}
+
+// GET `target` over a new connection, waiting at most `limit` for the whole reply; "" when none
+// came (a daemon that never accepts must fail the test, not hang it).
+std::string http_get_within(int port, const std::string& target, std::chrono::seconds limit) {
+  const int fd = connect_loopback(port);
+  if (fd < 0) return "";
+  const std::string request = "GET " + target + " HTTP/1.1\r\nHost: 127.0.0.1\r\nConnection: close\r\n\r\n";
+  std::string reply;
+  if (send(fd, request.data(), request.size(), MSG_NOSIGNAL) == static_cast<ssize_t>(request.size())) {
+    const auto end = std::chrono::steady_clock::now() + limit;
+    char buffer[4096];
+    for (;;) {
+      const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(end - std::chrono::steady_clock::now());
+      pollfd readable{fd, POLLIN, 0};
+      if (left.count() <= 0 || poll(&readable, 1, static_cast<int>(left.count())) <= 0) break;
+      const ssize_t n = recv(fd, buffer, sizeof buffer, 0);
+      if (n <= 0) break;
+      reply.append(buffer, static_cast<size_t>(n));
+    }
+  }
+  close(fd);
+  return reply;
+}
+
+// The CPU time a process has used so far (user + system), in seconds, from /proc/PID/stat.
+double cpu_seconds(pid_t pid) {
+  std::ifstream in("/proc/" + std::to_string(pid) + "/stat");
+  std::string stat((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::istringstream fields(stat.substr(stat.rfind(')') + 2));  // after "pid (name) "
+  std::vector<std::string> field{std::istream_iterator<std::string>(fields), std::istream_iterator<std::string>()};
+  if (field.size() < 13) return -1.0;
+  return (std::stod(field[11]) + std::stod(field[12])) / static_cast<double>(sysconf(_SC_CLK_TCK));  // utime, stime
+}
+
+long count_lines_with(const std::string& text, const std::string& needle) {
+  long count = 0;
+  std::istringstream lines(text);
+  for (std::string line; std::getline(lines, line);) count += line.find(needle) != std::string::npos;
+  return count;
+}
+
+// Out of file descriptors (the daemon limited to 64) with subscriber connections still waiting in
+// the kernel's queue, every accept fails at once: the daemon pauses its accepts instead of
+// retrying (it spun, logging every failure), counts the failures, answers /health on the
+// descriptor it keeps in reserve, and accepts again once the connections close.
+TEST_F(DaemonProgram, OutOfDescriptorsPausesAcceptsAndHealthStillAnswers) {
+  DaemonProcess daemon("--subject " + subject_, "ulimit -n 64; ");
+  ASSERT_GT(daemon.pid(), 0);
+  std::vector<int> flood;
+  for (int i = 0; i < 200; ++i) {
+    const int fd = connect_loopback(daemon.sub_port);
+    ASSERT_GE(fd, 0) << "connection " << i;
+    flood.push_back(fd);
+  }
+  ASSERT_TRUE(eventually([&] { return daemon.log().find("Too many open files") != std::string::npos; })) << daemon.log();
+
+  // Two seconds of the episode: a paused listener uses next to no CPU (the spinning one, all of
+  // a core) and logs its start once.
+  const double cpu_before = cpu_seconds(daemon.pid());
+  std::this_thread::sleep_for(std::chrono::seconds(2));
+  const double cpu_used = cpu_seconds(daemon.pid()) - cpu_before;
+  std::printf("daemon CPU in 2 s out of descriptors: %.2f s\n", cpu_used);
+  // A spinning io thread takes what the scheduler gives it (a whole core on an idle machine).
+  EXPECT_LT(cpu_used, 0.2);
+  EXPECT_LE(count_lines_with(daemon.log(), "accept failed"), 2) << daemon.log().substr(0, 2000);
+
+  const std::string health = http_get_within(daemon.http_port, "/health", std::chrono::seconds(10));
+  ASSERT_NE(health.find("200 OK"), std::string::npos) << "no /health reply while out of descriptors: " << health;
+  EXPECT_NE(health.find("\"status\":\"ok\""), std::string::npos) << health;
+  const std::string metrics = http_get_within(daemon.http_port, "/metrics", std::chrono::seconds(10));
+  const std::string counter = "\nskinstream_accepts_failed_no_descriptor_total ";
+  const size_t at = metrics.find(counter);
+  ASSERT_NE(at, std::string::npos) << metrics.substr(0, 2000);
+  EXPECT_GT(std::stol(metrics.substr(at + counter.size())), 0) << metrics.substr(at, 80);
+
+  // The flood leaves: the daemon's sessions close, descriptors come back, a new subscriber is
+  // accepted and answered (MeshInfo after its Hello).
+  for (int fd : flood) close(fd);
+  const int subscriber = connect_loopback(daemon.sub_port);
+  ASSERT_GE(subscriber, 0);
+  const std::vector<unsigned char> hello = subscriber::encode_hello({subscriber::kWantMarkers});
+  ASSERT_EQ(send(subscriber, hello.data(), hello.size(), MSG_NOSIGNAL), static_cast<ssize_t>(hello.size()));
+  pollfd readable{subscriber, POLLIN, 0};
+  ASSERT_EQ(poll(&readable, 1, 20'000), 1) << "no reply to a subscriber after the flood left: " << daemon.log().substr(0, 2000);
+  unsigned char header[subscriber::kHeaderBytes];
+  ASSERT_EQ(recv(subscriber, header, sizeof header, MSG_WAITALL), static_cast<ssize_t>(sizeof header));
+  EXPECT_EQ(subscriber::decode_header(header).type, subscriber::MessageType::MeshInfo);
+  close(subscriber);
+  EXPECT_TRUE(eventually([&] { return daemon.log().find("accepting again after") != std::string::npos; })) << daemon.log();
+  EXPECT_EQ(daemon.stop(), 0) << daemon.log();
 }
 
 // skinstream-replay -> skinstreamd --vicon -> skinstream-sub, in both Vicon modes (and the same

@@ -1,17 +1,27 @@
-# The browser live preview (clients/web) against the real daemon, in the system Chromium with
-# software WebGL: build the bundle once (fixture web_bundle), then tests/clients/web/viewer_test.mjs.
-# Needs node and npm (Debian: nodejs npm) and chromium; the npm packages are pinned in
-# clients/web/package-lock.json and installed by clients/web/build.sh.
+# The browser live preview (clients/web): build the bundle once (fixture web_bundle, which also
+# installs the npm packages pinned in clients/web/package-lock.json), then
+# - web.units: the page's decoders and tables in node (node's test runner);
+# - web.bad_input: the page in the system Chromium against a scripted server sending bad input;
+# - web.viewer: the page in Chromium against the real daemon (tests/clients/web/viewer_test.mjs).
+# Needs node and npm (Debian: nodejs npm) and chromium (software WebGL).
 find_program(SKINSTREAM_NODE NAMES node nodejs)
 if(NOT TARGET skinstreamd)
-  message(STATUS "browser test: skinstreamd is not built yet; web.viewer not added")
+  message(STATUS "browser test: skinstreamd is not built yet; the web tests are not added")
 elseif(NOT SKINSTREAM_NODE)
-  message(STATUS "browser test: node not found (apt-get install nodejs npm); web.viewer not added")
+  message(STATUS "browser test: node not found (apt-get install nodejs npm); the web tests are not added")
 else()
   add_test(NAME web.bundle COMMAND ${PROJECT_SOURCE_DIR}/clients/web/build.sh ${CMAKE_BINARY_DIR}/web)
   set_tests_properties(web.bundle PROPERTIES FIXTURES_SETUP web_bundle LABELS browser TIMEOUT 600)
 
-  add_test(NAME web.viewer COMMAND ${SKINSTREAM_NODE} ${CMAKE_CURRENT_SOURCE_DIR}/web/viewer_test.mjs
+  set(web_tests ${CMAKE_CURRENT_SOURCE_DIR}/web)
+  add_test(NAME web.units COMMAND ${SKINSTREAM_NODE} --test ${web_tests}/protocol_test.mjs ${web_tests}/model_message_test.mjs
+    ${web_tests}/compressed_decoder_test.mjs ${web_tests}/evaluation_tables_test.mjs)
+  set_tests_properties(web.units PROPERTIES FIXTURES_REQUIRED web_bundle TIMEOUT 300)
+
+  add_test(NAME web.bad_input COMMAND ${SKINSTREAM_NODE} ${web_tests}/viewer_bad_input_test.mjs --web-root ${CMAKE_BINARY_DIR}/web)
+  set_tests_properties(web.bad_input PROPERTIES FIXTURES_REQUIRED web_bundle LABELS browser TIMEOUT 600 PROCESSORS 2)
+
+  add_test(NAME web.viewer COMMAND ${SKINSTREAM_NODE} ${web_tests}/viewer_test.mjs
     --daemon $<TARGET_FILE:skinstreamd>
     --cli $<TARGET_FILE:skinstream>
     --subject ${CMAKE_BINARY_DIR}/demo/subject.sksubj

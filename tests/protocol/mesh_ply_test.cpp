@@ -2,9 +2,12 @@
 
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <fstream>
+#include <iterator>
 
 #include "protocol/file_error.h"
+#include "support/file_error_assertion.h"
 #include "support/test_data.h"
 
 namespace skinstream {
@@ -20,6 +23,35 @@ TEST(MeshPly, RejectsBadIndicesUnwritablePathsAndForeignFiles) {
   const std::string truncated = test::scratch_path("truncated.ply");
   std::ofstream(truncated) << "ply\nformat binary_little_endian 1.0\nelement vertex 5\nend_header\nabc";
   EXPECT_THROW(read_ply(truncated), FileError);
+}
+
+// Found by fuzzing (tests/fuzz/ply_fuzz.cpp): a face naming a vertex the file does not have was
+// read as it was, for the caller to index out of bounds.
+TEST(MeshPly, FaceIndexOutOfRangeIsRefused) {
+  const std::string fuzzed = test::source_path("tests/protocol/fixtures/fuzz/ply_face_index_out_of_range.ply");
+  EXPECT_TRUE(test::throws_file_error([&] { read_ply(fuzzed); }, fuzzed, "uses vertex"));
+  const std::string negative = test::scratch_path("negative_index.ply");
+  write_ply(negative, {Vec3::Zero(), Vec3::UnitX(), Vec3::UnitY()}, {{0, 1, 2, -1}});
+  std::string bytes;
+  {
+    std::ifstream in(negative, std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  const int32_t minus_one = -1;
+  std::memcpy(&bytes[bytes.size() - 4], &minus_one, 4);  // the triangle's last corner
+  std::ofstream(negative, std::ios::binary) << bytes;
+  EXPECT_TRUE(test::throws_file_error([&] { read_ply(negative); }, negative, "face 0 uses vertex -1 of 3"));
+}
+
+// A header's counts size nothing before the bytes that follow can hold them: a count near 2^64
+// was handed to reserve() (std::length_error, not a FileError).
+TEST(MeshPly, CountsBeyondTheFileAreRefused) {
+  const std::string huge = test::scratch_path("huge_count.ply");
+  std::ofstream(huge) << "ply\nformat binary_little_endian 1.0\nelement vertex -1\nelement face 1\nend_header\n";
+  EXPECT_TRUE(test::throws_file_error([&] { read_ply(huge); }, huge, "truncated: header says"));
+  const std::string no_end = test::scratch_path("no_end_header.ply");
+  std::ofstream(no_end) << "ply\nformat binary_little_endian 1.0\nelement vertex 3\n";
+  EXPECT_TRUE(test::throws_file_error([&] { read_ply(no_end); }, no_end, "no end_header"));
 }
 
 TEST(MeshPly, QuadsAndTrianglesRoundTrip) {

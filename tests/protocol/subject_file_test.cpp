@@ -76,6 +76,24 @@ TEST_F(SubjectFile, RejectsCorruptContent) {
   EXPECT_NE(message_of(bad).find("CRC"), std::string::npos);
 }
 
+// Found by fuzzing (tests/fuzz/subject_file_fuzz.cpp, which gives an input of odd length the
+// payload size and CRC a writer would, as done here): one-ring offsets 1.3 billion apart made
+// the model check multiply the ring size by 3 in an int, past its range (undefined; the
+// sanitizer builds stop on it). Refused now with the ring size, before it sizes anything.
+TEST_F(SubjectFile, RingOffsetsFarApartAreRefusedWithoutOverflow) {
+  std::vector<char> bytes = slurp(test::source_path("tests/protocol/fixtures/fuzz/subject_ring_offsets_overflow.sks"));
+  ASSERT_GT(bytes.size(), 24u);
+  const uint64_t payload = bytes.size() - 24;
+  std::memcpy(bytes.data() + 12, &payload, 8);
+  const uint32_t crc = crc32(reinterpret_cast<const unsigned char*>(bytes.data()) + 20, payload);
+  std::memcpy(bytes.data() + bytes.size() - 4, &crc, 4);
+  const std::string path = test::scratch_path("ring_offsets_overflow.sks");
+  spit(path, bytes);
+  const std::string message = message_of(path);
+  EXPECT_NE(message.find("inconsistent subject model: marker"), std::string::npos) << message;
+  EXPECT_NE(message.find("ring size -1335885824"), std::string::npos) << message;
+}
+
 TEST_F(SubjectFile, RefusesToWriteAnInconsistentModel) {
   SubjectModel broken = model_;
   broken.pca.pop_back();

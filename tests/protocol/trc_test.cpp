@@ -135,6 +135,21 @@ TEST(TrcInvalid, MarkerCountMismatch) {
   EXPECT_TRUE(throws_file_error([&] { read_trc(extra_name); }, extra_name, "marker name 'LASI'"));
 }
 
+// A name with a terminal escape and a line break, a megabyte long: the error names it escaped and cut.
+TEST(TrcInvalid, HostileMarkerNameStaysOnePrintableLine) {
+  std::string names =
+      small_trc("100\t100\t3\t1\tm\t100\t7\t3", "7\t0\t1\t2\t3\n8\t0\t1\t2\t3\n9\t0\t1\t2\t3\n");
+  names.replace(names.find("X2\tY2\tZ2\t"), 9, "");
+  names.replace(names.find("LASI"), 4, "\x1b[31m\r" + std::string(1 << 20, 'L'));
+  const std::string path = write_text("trc_hostile_name.trc", names);
+  EXPECT_TRUE(throws_file_error([&] { read_trc(path); }, path, "marker name '\\x1b[31m\\x0dLLLL"));
+  try {
+    read_trc(path);
+  } catch (const FileError& e) {
+    EXPECT_LT(std::string(e.what()).size(), 400u) << e.what();
+  }
+}
+
 TEST(TrcInvalid, UnknownUnitsAndMissingKeys) {
   const std::string feet = write_text("trc_feet.trc", small_trc("100\t100\t3\t2\tft\t100\t7\t3"));
   EXPECT_TRUE(throws_file_error([&] { read_trc(feet); }, feet, "unknown Units 'ft'"));

@@ -272,6 +272,95 @@ TEST(ViconWire, CountsThatExceedThePayloadAreRejected) {
   EXPECT_NE(error_of(subject).find("overruns"), std::string::npos) << error_of(subject);
 }
 
+// ---- Hostile descriptions: periods and counts a real system never sends ----
+
+std::string stream_info_error(int64_t period_ticks) { return error_of(encode_packet(StreamInfo{period_ticks})); }
+
+TEST(ViconLimits, StreamInfoPeriodsOutside1HzTo10kHzAreRejectedNamingTheRate) {
+  EXPECT_EQ(stream_info_error(frame_period_ticks(120.0)), "");
+  EXPECT_EQ(stream_info_error(kMinFramePeriodTicks), "");  // 10 kHz
+  EXPECT_EQ(stream_info_error(kMaxFramePeriodTicks), "");  // 1 Hz
+  EXPECT_EQ(stream_info_error(1), "StreamInfo: frame period of 1 ticks (1.35e+08 Hz) is outside 1 Hz to 10 kHz");
+  EXPECT_NE(stream_info_error(kMinFramePeriodTicks - 1).find("(10000.7 Hz) is outside"), std::string::npos);
+  EXPECT_NE(stream_info_error(kMaxFramePeriodTicks + 1).find("is outside 1 Hz to 10 kHz"), std::string::npos);
+  // 1.5e-11 Hz, and periods with no rate at all.
+  EXPECT_NE(stream_info_error(9'000'000'000'000'000'000).find("(1.5e-11 Hz)"), std::string::npos);
+  EXPECT_EQ(stream_info_error(0), "StreamInfo: frame period of 0 ticks (no rate) is outside 1 Hz to 10 kHz");
+  EXPECT_NE(stream_info_error(INT64_MIN).find("(no rate)"), std::string::npos);
+}
+
+SubjectInfo subject_with(int markers, size_t name_bytes = 4) {
+  SubjectInfo s;
+  s.subject_id = 7;
+  s.name = "hostile";
+  for (int m = 0; m < markers; ++m) {
+    std::string name = "M" + std::to_string(m);
+    name.resize(std::max(name.size(), name_bytes), 'x');
+    s.markers.push_back({static_cast<uint32_t>(m), name});
+  }
+  return s;
+}
+
+std::string subject_error(const SubjectInfo& subject, const DescriptionLimits& limits = {}) {
+  DecodedPacket d;
+  std::string error;
+  return decode_packet(encode_packet(subject), d, error, limits) ? "" : error;
+}
+
+TEST(ViconLimits, SubjectInfoBeyondTheMarkerAndNameCapsIsRejectedSayingWhich) {
+  const DescriptionLimits defaults;
+  EXPECT_EQ(subject_error(subject_with(static_cast<int>(defaults.max_markers_per_subject))), "");
+  // The flood a hostile source sent: 10,000 new names in one SubjectInfo.
+  EXPECT_EQ(subject_error(subject_with(10'000)), "SubjectInfo: marker count 10000 exceeds the limit of 1024");
+  EXPECT_EQ(subject_error(subject_with(1, defaults.max_name_bytes)), "");
+  EXPECT_EQ(subject_error(subject_with(1, defaults.max_name_bytes + 1)), "SubjectInfo: marker name of 257 bytes exceeds the limit of 256");
+
+  DescriptionLimits tight;
+  tight.max_markers_per_subject = 2;
+  tight.max_name_bytes = 7;
+  EXPECT_EQ(subject_error(walker_subject(), tight), "");  // 1 segment, 2 markers, names of up to 6 bytes
+  EXPECT_EQ(subject_error(subject_with(3), tight), "SubjectInfo: marker count 3 exceeds the limit of 2");
+  SubjectInfo long_subject_name = walker_subject();
+  long_subject_name.name = "walker78";
+  EXPECT_EQ(subject_error(long_subject_name, tight), "SubjectInfo: subject name of 8 bytes exceeds the limit of 7");
+  SubjectInfo long_segment_name = walker_subject();
+  long_segment_name.segments[0].name = "pelvis78";
+  EXPECT_EQ(subject_error(long_segment_name, tight), "SubjectInfo: segment name of 8 bytes exceeds the limit of 7");
+  SubjectInfo segments = walker_subject();
+  segments.segments.resize(3, segments.segments[0]);
+  EXPECT_EQ(subject_error(segments, tight), "SubjectInfo: segment count 3 exceeds the limit of 2");
+  SubjectInfo attachments = walker_subject();
+  attachments.attachments.resize(3);
+  EXPECT_EQ(subject_error(attachments, tight), "SubjectInfo: attachment count 3 exceeds the limit of 2");
+}
+
+TEST(ViconLimits, MoreSubjectsInOnePacketThanTheCapAreRejectedByTheSplitAndTheFramer) {
+  DescriptionLimits limits;
+  limits.max_subjects = 3;
+  for (int subjects : {3, 4}) {
+    PacketWriter writer;
+    writer.add(FrameInfo{1});
+    for (int s = 0; s < subjects; ++s) writer.add(walker_subject());
+    const ByteVector packet = bytes_of(writer.finish());
+    std::vector<ObjectView> objects;
+    std::string error;
+    const bool split = split_objects(packet, objects, error, limits);
+    PacketFramer framer(kMaxPacketLength, limits);
+    framer.feed(packet);
+    Bytes out;
+    const PacketFramer::Status status = framer.next(out);
+    if (subjects == 3) {
+      EXPECT_TRUE(split) << error;
+      EXPECT_EQ(status, PacketFramer::Status::Packet) << framer.error();
+    } else {
+      EXPECT_FALSE(split);
+      EXPECT_EQ(error, "more than 3 SubjectInfo objects in one packet (the limit)");
+      EXPECT_EQ(status, PacketFramer::Status::Error);
+      EXPECT_EQ(framer.error(), error);
+    }
+  }
+}
+
 TEST(ViconWire, BadHeadersAreRejected) {
   ByteVector bytes = fixture("frame_info.bin");
   bytes[0] = 0x02;

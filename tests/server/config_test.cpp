@@ -5,6 +5,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "protocol/vicon_datastream.h"
 #include "support/test_data.h"
 
 namespace skinstream::server {
@@ -151,6 +152,25 @@ TEST(Config, SubscriberTcpCongestionComesFromFileAndFlags) {
   for (const char* bad : {"Reno", "re no", "a_name_too_long_16"})
     EXPECT_NE(error_of([&] { parse({"--subscriber-tcp-congestion", bad}); }).find("subscriber_tcp_congestion must be"), std::string::npos)
         << bad;
+}
+
+TEST(Config, SourceLimitsDefaultToTheDecodersAndComeFromTheFile) {
+  const DaemonConfig defaults;
+  const vicon::DescriptionLimits decoder;
+  EXPECT_EQ(defaults.source_max_subjects, static_cast<int>(decoder.max_subjects));
+  EXPECT_EQ(defaults.source_max_markers_per_subject, static_cast<int>(decoder.max_markers_per_subject));
+  EXPECT_EQ(defaults.source_max_name_bytes, static_cast<int>(decoder.max_name_bytes));
+  const std::string path = write_file("limits.json", R"({"source_max_subjects": 4, "source_max_markers_per_subject": 400,
+                                                         "source_max_name_bytes": 32})");
+  const auto parsed = parse({"--config", path});
+  ASSERT_TRUE(parsed);
+  EXPECT_EQ(parsed->config.source_max_subjects, 4);
+  EXPECT_EQ(parsed->config.source_max_markers_per_subject, 400);
+  EXPECT_EQ(parsed->config.source_max_name_bytes, 32);
+  for (const char* bad : {R"({"source_max_subjects": 0})", R"({"source_max_markers_per_subject": 65537})", R"({"source_max_name_bytes": -1})"}) {
+    const std::string bad_path = write_file("bad_limits.json", bad);
+    EXPECT_NE(error_of([&] { parse({"--config", bad_path}); }).find("source_max_"), std::string::npos) << bad;
+  }
 }
 
 TEST(Config, OutOfRangeValuesAndConflictsAreErrors) {

@@ -423,6 +423,9 @@ TEST(Daemon, ServesHealthMetricsWebSocketAndSubscribersWithoutHello) {
   EXPECT_GT(health["frames"]["received"].get<long>(), 0);
   EXPECT_LE(health["frames"]["dropped_mailbox_full"].get<uint64_t>(), health["frames"]["dropped"].get<uint64_t>());
   EXPECT_GE(health["subscribers"].get<int>(), 2);
+  EXPECT_EQ(health["source_limits"]["max_subjects"].get<int>(), DaemonConfig{}.source_max_subjects);
+  EXPECT_EQ(health["source_limits"]["max_markers_per_subject"].get<int>(), DaemonConfig{}.source_max_markers_per_subject);
+  EXPECT_EQ(health["source_limits"]["max_name_bytes"].get<int>(), DaemonConfig{}.source_max_name_bytes);
   // Frames went out, so encoded buffers exist (the counter only grows, and frames keep coming).
   EXPECT_GE(health["frame_buffers_allocated"].get<long>(), 1);
   EXPECT_LE(health["frame_buffers_allocated"].get<uint64_t>(), daemon.subject(0).metrics().frame_buffers_allocated.load());
@@ -457,6 +460,29 @@ TEST(Daemon, ServesHealthMetricsWebSocketAndSubscribersWithoutHello) {
   EXPECT_EQ(status, 404);
   http_get(daemon.http_port(), "/", &status);
   EXPECT_EQ(status, 404);  // no web root configured
+  daemon.stop();
+}
+
+// The subscriber protocol is binary (docs/subscriber-protocol.md): a Hello sent as a text message
+// is refused with a close frame saying so (1003), and counted as a bad message.
+TEST(Daemon, WebSocketTextMessageIsRefusedWithACloseAndCounted) {
+  Daemon daemon(test_config());
+  daemon.start();
+  asio::io_context io;
+  websocket::stream<beast::tcp_stream> ws(io);
+  beast::get_lowest_layer(ws).connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), static_cast<unsigned short>(daemon.http_port())));
+  ws.handshake("127.0.0.1", "/stream");
+  ws.text(true);
+  ws.write(asio::buffer(subscriber::encode_hello({subscriber::kWantMarkers})));
+  boost::system::error_code ec;
+  for (int i = 0; i < 100 && !ec; ++i) {  // whatever was under way before the close, then the close
+    beast::flat_buffer message;
+    ws.read(message, ec);
+  }
+  EXPECT_EQ(ec, websocket::error::closed) << ec.message();
+  EXPECT_EQ(ws.reason().code, websocket::close_code::unknown_data);
+  EXPECT_EQ(std::string(ws.reason().reason.c_str()), "binary messages only");
+  EXPECT_EQ(daemon.subject(0).metrics().bad_subscriber_messages.load(), 1u);
   daemon.stop();
 }
 

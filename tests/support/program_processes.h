@@ -26,17 +26,18 @@
 
 namespace skinstream::test {
 
-// A daemon in the background; stopped with SIGTERM.
+// A daemon in the background; stopped with SIGTERM. `shell_prefix` runs before it in the same
+// shell (e.g. "ulimit -n 64; ").
 class DaemonProcess {
  public:
-  explicit DaemonProcess(const std::string& arguments) {
+  explicit DaemonProcess(const std::string& arguments, const std::string& shell_prefix = "") {
     // The process id too: ctest runs each test as its own process, several at once.
     ports_path_ = scratch_path("ports_" + std::to_string(getpid()) + "_" + std::to_string(counter_++) + ".json");
     std::remove(ports_path_.c_str());
     log_path_ = ports_path_ + ".log";
     pid_ = fork();
     if (pid_ == 0) {
-      const std::string command = "exec " + std::string(SKINSTREAMD) + " --bind 127.0.0.1 --http-port 0 --sub-port 0 --ports-file " +
+      const std::string command = shell_prefix + "exec " + std::string(SKINSTREAMD) + " --bind 127.0.0.1 --http-port 0 --sub-port 0 --ports-file " +
                                   ports_path_ + " " + arguments + " > " + log_path_ + " 2>&1";
       execl("/bin/sh", "sh", "-c", command.c_str(), static_cast<char*>(nullptr));
       _exit(127);
@@ -74,6 +75,7 @@ class DaemonProcess {
     text << in.rdbuf();
     return text.str();
   }
+  pid_t pid() const { return pid_; }  // the daemon's own (the shell execs it)
   int http_port = 0, sub_port = 0;
 
  private:

@@ -99,12 +99,18 @@ bool Subscriber::next(Frame& frame, std::chrono::milliseconds timeout) {
           case wire::MessageType::MeshInfo: s.on_mesh_info(message->payload); break;
           case wire::MessageType::Model: s.on_model(message->payload); break;
           case wire::MessageType::Status: s.on_status(message->payload); break;
-          case wire::MessageType::Frame:
-            if (s.on_frame(message->payload, frame)) {
-              if (s.options.paced) s.connection->send_all(wire::encode_ack({frame.frame_number}, s.version));
-              return true;
+          case wire::MessageType::Frame: {
+            const bool ready = s.on_frame(message->payload, frame);
+            // Paced: every Frame taken is acknowledged, a skipped one too (a compressed delta
+            // without its key): the daemon sends nothing more while two wait for an Ack.
+            if (s.options.paced) {
+              uint32_t number;
+              std::memcpy(&number, message->payload.data(), sizeof number);  // on_frame checked the size
+              s.connection->send_all(wire::encode_ack({number}, s.version));
             }
+            if (ready) return true;
             break;
+          }
           default: throw Error(std::string("unexpected ") + wire::to_string(message->type) + " message from the daemon");
         }
       }

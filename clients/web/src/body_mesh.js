@@ -3,37 +3,25 @@
 import * as THREE from 'three';
 import { fillPartColours } from './part_palette.js';
 
-export class BodyMesh {
-  constructor(meshInfo) {
-    const V = meshInfo.vertexCount;
-    this.positions = new Float32Array(3 * V);
-    this.normals = new Float32Array(3 * V);
-    const colours = new Float32Array(3 * V);
+const SKIN = 0xd8c3b0;
+
+// What every body shares: the faces, the part colours and the skin material. Subclasses give the
+// geometry its vertices (BodyMesh from arrays, EvaluatedBodyMesh from the GPU's evaluation).
+export class BodySurface {
+  constructor(meshInfo, geometry) {
+    const colours = new Float32Array(3 * meshInfo.vertexCount);
     fillPartColours(meshInfo.dominantPart, colours);
-
-    this.geometry = new THREE.BufferGeometry();
-    this.positionAttribute = new THREE.BufferAttribute(this.positions, 3).setUsage(THREE.DynamicDrawUsage);
-    this.normalAttribute = new THREE.BufferAttribute(this.normals, 3).setUsage(THREE.DynamicDrawUsage);
-    this.geometry.setAttribute('position', this.positionAttribute);
-    this.geometry.setAttribute('normal', this.normalAttribute);
-    this.geometry.setAttribute('color', new THREE.BufferAttribute(colours, 3));
-    this.geometry.setIndex(new THREE.BufferAttribute(meshInfo.faces, 1));
-
-    this.material = new THREE.MeshStandardMaterial({ color: 0xd8c3b0, roughness: 0.65, metalness: 0.0, side: THREE.DoubleSide });
+    geometry.setAttribute('color', new THREE.BufferAttribute(colours, 3));
+    geometry.setIndex(new THREE.BufferAttribute(meshInfo.faces, 1));
+    this.geometry = geometry;
+    this.material = new THREE.MeshStandardMaterial({ color: SKIN, roughness: 0.65, metalness: 0.0, side: THREE.DoubleSide });
     this.object = new THREE.Mesh(this.geometry, this.material);
     this.object.frustumCulled = false; // the body moves; its first bounding sphere would go stale
   }
 
-  // After the arrays were written: upload them. Without normals in the stream, derive them.
-  commit(hasNormals) {
-    this.positionAttribute.needsUpdate = true;
-    if (hasNormals) this.normalAttribute.needsUpdate = true;
-    else this.geometry.computeVertexNormals();
-  }
-
   setPartColours(on) {
     this.material.vertexColors = on;
-    this.material.color.set(on ? 0xffffff : 0xd8c3b0);
+    this.material.color.set(on ? 0xffffff : SKIN);
     this.material.needsUpdate = true;
   }
 
@@ -44,5 +32,30 @@ export class BodyMesh {
   dispose() {
     this.geometry.dispose();
     this.material.dispose();
+  }
+}
+
+export class BodyMesh extends BodySurface {
+  constructor(meshInfo) {
+    const V = meshInfo.vertexCount;
+    const positions = new Float32Array(3 * V);
+    const normals = new Float32Array(3 * V);
+    const geometry = new THREE.BufferGeometry();
+    const positionAttribute = new THREE.BufferAttribute(positions, 3).setUsage(THREE.DynamicDrawUsage);
+    const normalAttribute = new THREE.BufferAttribute(normals, 3).setUsage(THREE.DynamicDrawUsage);
+    geometry.setAttribute('position', positionAttribute);
+    geometry.setAttribute('normal', normalAttribute);
+    super(meshInfo, geometry);
+    this.positions = positions;
+    this.normals = normals;
+    this.positionAttribute = positionAttribute;
+    this.normalAttribute = normalAttribute;
+  }
+
+  // After the arrays were written: upload them. Without normals in the stream, derive them.
+  commit(hasNormals) {
+    this.positionAttribute.needsUpdate = true;
+    if (hasNormals) this.normalAttribute.needsUpdate = true;
+    else this.geometry.computeVertexNormals();
   }
 }

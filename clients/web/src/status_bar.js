@@ -15,6 +15,8 @@ export class StatusBar {
       dropped: byId('status-dropped'),
       filled: byId('status-filled'),
       source: byId('status-source'),
+      encoding: byId('status-encoding'),
+      error: byId('status-error'),
     };
     this.banner = byId('banner');
   }
@@ -29,6 +31,11 @@ export class StatusBar {
     setText(this.fields.dropped, `pipeline ${s.framesDroppedPipeline} · this viewer ${s.framesDroppedSubscriber} · skipped by page ${s.framesSkipped}`);
     setText(this.fields.filled, s.markerCount > 0 ? `${s.markersFilled} / ${s.markerCount} (relabelled ${s.markersRelabelled})` : '–');
     setText(this.fields.source, s.sourceStateName + (s.sourceDetail ? `: ${s.sourceDetail}` : ''));
+    setText(this.fields.encoding, s.encodingName);
+    // The stream's last error, one line, shown until the page is reloaded: bad input is rare
+    // and a user should see that it happened.
+    this.fields.error.parentElement.hidden = s.errorText === '';
+    setText(this.fields.error, s.errorText);
   }
 
   // kind: '' hides the banner; 'source' or 'connection' or 'error' show it with that style.

@@ -1,6 +1,6 @@
-// The WebSocket to the daemon's /stream: sends Hello first, hands each binary message to the
-// listener, acknowledges each Frame when the Hello asked for pacing, and reconnects with
-// exponential backoff whenever the socket closes.
+// The WebSocket to the daemon's /stream: sends a version 2 Hello first, hands each binary
+// message to the listener, acknowledges each Frame when the Hello asked for pacing, and
+// reconnects with exponential backoff whenever the socket closes.
 import { encodeAck, encodeHello, MessageType, ProtocolError, Wants } from './protocol.js';
 
 export const ConnectionState = Object.freeze({ CONNECTING: 'connecting', OPEN: 'open', CLOSED: 'closed' });
@@ -9,12 +9,12 @@ const FIRST_RETRY_MS = 250;
 const MAX_RETRY_MS = 5000;
 
 export class StreamConnection {
-  // listener: { onOpen(), onMessage(ArrayBuffer), onClose(reason, retryInMs) }
-  // version2: null for a version 1 Hello, else { subject, encoding } (protocol.js encodeHello).
-  constructor(url, wants, listener, version2 = null) {
+  // hello: { wants, encoding, subject, token } (see encodeHello).
+  // listener: { onOpen(), onMessage(ArrayBuffer), onProtocolError(error), onClose(reason, retryInMs) }
+  constructor(url, hello, listener) {
     this.url = url;
-    this.hello = encodeHello(wants, version2);
-    this.paced = (wants & Wants.PACED) !== 0;
+    this.hello = encodeHello(hello.wants, hello);
+    this.paced = (hello.wants & Wants.PACED) !== 0;
     this.listener = listener;
     this.state = ConnectionState.CLOSED;
     this.retryMs = FIRST_RETRY_MS;
@@ -71,7 +71,7 @@ export class StreamConnection {
         if (ack) socket.send(ack);
       } catch (error) {
         if (!(error instanceof ProtocolError)) throw error;
-        console.error(`skinstream: ${error.message}; closing the connection`);
+        this.listener.onProtocolError(error);
         this.lastError = error.message;
         this.abort(error);
       }

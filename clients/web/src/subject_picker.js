@@ -1,16 +1,7 @@
 // The subject to show, on a daemon serving several actors: ?subject=NAME in the page's address
-// (none: the daemon's first, over protocol version 1 as before), and a menu of the daemon's
-// subjects (from /health, with those absent from the stream marked) that reloads the page on the
-// one chosen.
-import { Encoding } from './protocol.js';
-
+// (none: the daemon's first) goes into the Hello; a menu of the daemon's subjects (from /health,
+// with those absent from the stream marked) reloads the page on the one chosen.
 const HEALTH_URL = '/health';
-
-// null: version 1, the first subject; else the version 2 Hello's subject and encoding.
-export function chosenSubject(params, quantised) {
-  const subject = params.get('subject');
-  return subject === null ? null : { subject, encoding: quantised ? Encoding.QUANTISED : Encoding.FLOAT };
-}
 
 // Adds the menu to `panel` once /health has listed more than one subject (or one is chosen).
 export async function installSubjectPicker(panel, params) {

@@ -211,6 +211,11 @@ std::string error_for(std::vector<unsigned char> reply, Encoding encoding = Enco
   }
 }
 
+// A Frame message's flags (after the 12-byte header and the frame number) and vertex count
+// (after the three times), little-endian.
+constexpr size_t wire_flags_offset = 12 + 4;
+constexpr size_t wire_vertex_count_offset = 12 + 32;
+
 std::vector<unsigned char> golden(const std::string& name) {
   const std::string bytes = test::read_bytes(test::source_path("tests/protocol/fixtures/subscriber/" + name));
   return {bytes.begin(), bytes.end()};
@@ -239,6 +244,46 @@ TEST(ClientSubscriber, BytesThatBreakTheProtocolAreOneLineErrors) {
   EXPECT_NE(error_for(frame_first).find("before the Model"), std::string::npos);
   for (const std::string& e : {error_for(bad_magic), error_for(version_one), error_for(frame_first)})
     EXPECT_EQ(e.find('\n'), std::string::npos) << e;
+}
+
+// A paced subscriber acknowledges the compressed deltas it has to skip (their key gave way in its
+// queue) as well as the frames it shows: the daemon sends nothing while two wait for an Ack.
+TEST(ClientSubscriber, PacedSubscriberAcknowledgesSkippedFrames) {
+  std::vector<unsigned char> reply = golden("mesh_info_v2.bin");  // 4 vertices, compressed
+  std::vector<unsigned char> delta = golden("frame_v2_compressed.bin");
+  delta[wire_flags_offset] &= ~0x40;  // not a key frame: a delta of key 1234, which it never saw
+  delta[wire_vertex_count_offset] = 4;  // the MeshInfo's 4 vertices (the coded bytes are never read)
+  for (int i = 0; i < 3; ++i) reply.insert(reply.end(), delta.begin(), delta.end());
+  const int listener = socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in address{};
+  address.sin_family = AF_INET;
+  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  socklen_t length = sizeof address;
+  ASSERT_EQ(bind(listener, reinterpret_cast<sockaddr*>(&address), sizeof address), 0);
+  listen(listener, 1);
+  getsockname(listener, reinterpret_cast<sockaddr*>(&address), &length);
+  size_t acknowledged_bytes = 0;
+  std::thread daemon([&] {
+    const int peer = accept(listener, nullptr, nullptr);
+    unsigned char buffer[1024];
+    recv(peer, buffer, sizeof buffer, 0);  // the Hello
+    send(peer, reply.data(), reply.size(), MSG_NOSIGNAL);
+    for (ssize_t n; (n = recv(peer, buffer, sizeof buffer, 0)) > 0;) acknowledged_bytes += static_cast<size_t>(n);
+    close(peer);
+  });
+  {
+    client::Options options;
+    options.port = ntohs(address.sin_port);
+    options.encoding = Encoding::Compressed;
+    options.paced = true;
+    client::Subscriber sub(options);
+    client::Frame frame;
+    EXPECT_FALSE(sub.next(frame, std::chrono::milliseconds(1500)));
+    EXPECT_EQ(sub.frames_skipped(), 3u);
+  }  // closes the connection: the daemon thread reads to the end
+  daemon.join();
+  close(listener);
+  EXPECT_EQ(acknowledged_bytes, 3u * 16u);  // three Acks of 12 + 4 bytes
 }
 
 }  // namespace

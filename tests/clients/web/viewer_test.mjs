@@ -1,19 +1,23 @@
 // The browser live preview against the real daemon: starts skinstreamd replaying a recording in a
 // loop, opens the page it serves in the system Chromium (headless, WebGL through SwiftShader),
 // and checks that frames arrive, are drawn and move, that the status bar shows the source rate,
-// that a page naming the subject (protocol version 2) is served it and one naming an unknown
-// subject is told it was refused, and that stopping the daemon puts up the banner.
+// that a page naming the subject is served it and one naming an unknown subject is told it was
+// refused, and that stopping the daemon puts up the banner. The page asks for parameters by default and
+// evaluates the mesh on the GPU: its positions and normals, read back, are compared with the
+// daemon's float buffers of the same frames (a second subscriber from node), as are those of the
+// float, quantised and compressed encodings. Then it measures the page's main-thread time and
+// frames per second per encoding, printed as one JSON line (not asserted: timing is the
+// machine's).
 //
 // node viewer_test.mjs --daemon BIN --subject FILE --recording FILE --web-root DIR --out DIR
 //                      [--cli SKINSTREAM] [--chromium /usr/bin/chromium]
 import assert from 'node:assert/strict';
 import { spawn, execFileSync } from 'node:child_process';
-import { createRequire } from 'node:module';
 import fs from 'node:fs';
 import path from 'node:path';
-import { fileURLToPath } from 'node:url';
-
-const repoRoot = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '../../..');
+import { launchChromium, waitUntil, sleep, readDrawnFrame } from './support/browser.mjs';
+import { worstDistance, worstAngleDegrees } from './support/comparisons.mjs';
+import { ReferenceSubscriber } from './support/reference_subscriber.mjs';
 
 function parseArguments(argv) {
   const options = { chromium: '/usr/bin/chromium' };
@@ -27,110 +31,6 @@ function parseArguments(argv) {
   }
   return options;
 }
-
-// The page's decoder (clients/web/src/protocol.js, plain ES module) on the protocol's golden
-// byte fixtures, which were written from the spec independently of both encoder and decoder.
-async function checkGoldenFixtures() {
-  const protocol = await import(path.join(repoRoot, 'clients/web/src/protocol.js'));
-  const fixtureDir = path.join(repoRoot, 'tests/protocol/fixtures/subscriber');
-  const read = (name) => {
-    const bytes = fs.readFileSync(path.join(fixtureDir, name));
-    return new DataView(bytes.buffer.slice(bytes.byteOffset, bytes.byteOffset + bytes.length));
-  };
-  const close = (actual, expected, what) => assert.ok(
-    actual.length === expected.length && expected.every((x, i) => Math.abs(actual[i] - x) <= 1e-4 * Math.max(1, Math.abs(x))),
-    `${what}: ${Array.from(actual)} != ${expected}`);
-
-  assert.deepEqual(new Uint8Array(protocol.encodeHello(protocol.Wants.NORMALS | protocol.Wants.MARKERS)),
-    new Uint8Array(read('hello.bin').buffer), 'Hello bytes');
-
-  const meshView = read('mesh_info.bin');
-  assert.equal(protocol.readHeader(meshView), protocol.MessageType.MESH_INFO);
-  const info = protocol.decodeMeshInfo(meshView);
-  assert.equal(info.vertexCount, 4);
-  assert.equal(info.sourceRateHz, 120);
-  assert.deepEqual(Array.from(info.faces), [0, 1, 2, 0, 2, 3]);
-  assert.deepEqual(Array.from(info.dominantPart), [0, 1, 255, 1]);
-  assert.deepEqual(Array.from(info.markerTriangles), [0, 1, 2]);
-  assert.deepEqual(info.markerNames, ['LSHO', 'RSHO', 'C7']);
-
-  const positions = [0, 100, 5, 65535, 131170, 5, 0, 2100, 5];
-  const normals = [1, 0, 0, 0, -1, 0, 0, 0, 1];
-  const markers = [1.5, 2.5, 3.5, -4.0, 5.0, 6.25];
-  for (const name of ['frame_float.bin', 'frame_quantised.bin', 'frame_markers_only.bin']) {
-    const view = read(name);
-    assert.equal(protocol.readHeader(view), protocol.MessageType.FRAME, name);
-    const header = new protocol.FrameHeader();
-    header.read(view);
-    assert.equal(header.frameNumber, 1234, name);
-    assert.ok(Math.abs(header.receiveTimeNs - 1.7e18) < 1e3, `${name}: receive time ${header.receiveTimeNs}`);
-    assert.equal(header.markersFilled, 3, name);
-    assert.equal(header.framesDroppedPipeline, 7, name);
-    assert.equal(header.framesDroppedSubscriber, 2, name);
-    const vertexCount = name === 'frame_markers_only.bin' ? 0 : 3;
-    const out = { positions: new Float32Array(3 * vertexCount), normals: new Float32Array(3 * vertexCount),
-      markers: new Float32Array(6), markerStatus: new Uint8Array(2) };
-    protocol.decodeFrameArrays(view, header, out);
-    if (vertexCount > 0) {
-      close(out.positions, positions, `${name} positions`);
-      close(out.normals, normals, `${name} normals`);
-    }
-    close(out.markers, markers, `${name} markers`);
-    assert.deepEqual(Array.from(out.markerStatus), [0, 2], `${name} marker status`);
-  }
-
-  const status = protocol.decodeStatus(read('status.bin'));
-  assert.equal(status.stateName, 'disconnected');
-  assert.equal(status.framesReceived, 1000);
-  assert.equal(status.detail, 'vicon 127.0.0.1:801: connection refused');
-
-  // Version 2 (a page naming a subject): Hello, MeshInfo and Status with the subject, a Frame with
-  // the timecode before its arrays.
-  assert.deepEqual(new Uint8Array(protocol.encodeHello(protocol.Wants.NORMALS | protocol.Wants.MARKERS | protocol.Wants.PACED,
-    { subject: 'Actor2', encoding: protocol.Encoding.PARAMETERS, token: 'stage-token' })),
-  new Uint8Array(read('hello_v2.bin').buffer), 'version 2 Hello bytes');
-  const infoV2 = protocol.decodeMeshInfo(read('mesh_info_v2.bin'));
-  assert.equal(infoV2.subject, 'Actor2');
-  assert.equal(infoV2.encoding, protocol.Encoding.COMPRESSED);
-  assert.deepEqual(infoV2.markerNames, ['LSHO', 'RSHO', 'C7']);
-  const statusV2 = protocol.decodeStatus(read('status_v2.bin'));
-  assert.equal(statusV2.stateName, 'refused');
-  assert.equal(statusV2.subject, 'Actor3');
-  assert.equal(statusV2.subjectPresent, false);
-  const frameV2 = read('frame_v2_float.bin');
-  const headerV2 = new protocol.FrameHeader();
-  headerV2.read(frameV2);
-  assert.equal(headerV2.frameNumber, 1234);
-  assert.equal(headerV2.framesDroppedSubscriber, 2);
-  const outV2 = { positions: new Float32Array(9), normals: new Float32Array(0), markers: new Float32Array(6), markerStatus: new Uint8Array(2) };
-  protocol.decodeFrameArrays(frameV2, headerV2, outV2);
-  close(outV2.positions, positions, 'version 2 positions');
-  close(outV2.markers, markers, 'version 2 markers');
-  assert.deepEqual(Array.from(outV2.markerStatus), [0, 2], 'version 2 marker status');
-
-  // A receiver rejects a corrupt header and a truncated message.
-  const bad = read('frame_float.bin');
-  bad.setUint8(0, 0x58);
-  assert.throws(() => protocol.readHeader(bad), /magic/);
-  const truncated = new DataView(read('frame_float.bin').buffer.slice(0, 100));
-  assert.throws(() => protocol.readHeader(truncated), /payload/);
-  console.log('decoder matches the golden fixtures');
-}
-
-// page.waitForFunction with a message that says what never happened.
-async function waitUntil(page, what, predicate, argument = null, timeout = 30000) {
-  try {
-    await page.waitForFunction(predicate, argument, { timeout });
-  } catch (error) {
-    const state = await page.evaluate(() => window.skinstreamViewer && {
-      framesReceived: window.skinstreamViewer.framesReceived, framesRendered: window.skinstreamViewer.framesRendered,
-      connectionState: window.skinstreamViewer.connectionState, bannerText: window.skinstreamViewer.bannerText,
-    }).catch(() => null);
-    throw new Error(`${what} (after ${timeout} ms; viewer ${JSON.stringify(state)}): ${error.message.split('\n')[0]}`);
-  }
-}
-
-const sleep = (ms) => new Promise((resolve) => setTimeout(resolve, ms));
 
 // Waits for the daemon's ports file; fails at once if the daemon exits first.
 async function waitForPorts(daemon, portsFile, logFile) {
@@ -155,7 +55,8 @@ const viewer = (page) => page.evaluate(() => {
     sampleIsMarkers: v.sampleIsMarkers, samplePositions: v.samplePositions, sourceRateHz: v.sourceRateHz,
     announcedRateHz: v.announcedRateHz, connectionState: v.connectionState, webgl: v.webgl,
     webglVersion: v.webglVersion, bannerText: v.bannerText, latencyMs: v.latencyMs,
-    arrivalLatencyMs: v.arrivalLatencyMs, clockSkewMs: v.clockSkewMs, quantised: v.quantised,
+    arrivalLatencyMs: v.arrivalLatencyMs, clockSkewMs: v.clockSkewMs, encoding: v.encoding,
+    framesRejected: v.framesRejected, gpuEvaluation: v.gpuEvaluation,
   };
 });
 
@@ -179,20 +80,89 @@ const paintedPixels = (page) => page.evaluate(() => {
   return count;
 });
 
+// The page's drawn positions and normals against the daemon's float buffers of the same frames,
+// matched by frame number: the worst distance (mm), angle (degrees) and normal difference (length
+// of the difference vector) over `count` frames.
+async function compareWithDaemon(page, reference, count = 3) {
+  const result = { frames: [], worstMm: 0, worstNormalDegrees: 0, worstNormalDifference: 0 };
+  const seen = new Set();
+  for (let attempt = 0; attempt < 300 && result.frames.length < count; ++attempt) {
+    const drawn = await readDrawnFrame(page, reference.keys().filter((key) => !seen.has(key)));
+    if (drawn === null) {
+      await sleep(50);
+      continue;
+    }
+    const expected = reference.frame(drawn.key); // null when it gave way to newer frames meanwhile
+    seen.add(drawn.key);
+    if (expected === null) continue;
+    result.frames.push(drawn.frameNumber);
+    result.worstMm = Math.max(result.worstMm, worstDistance(drawn.positions, expected.positions).worst);
+    result.worstNormalDegrees = Math.max(result.worstNormalDegrees, worstAngleDegrees(drawn.normals, expected.normals));
+    result.worstNormalDifference = Math.max(result.worstNormalDifference, worstDistance(drawn.normals, expected.normals).worst);
+  }
+  if (result.frames.length < count) {
+    throw new Error(`only ${result.frames.length} of the page's frames were among the ${reference.frames.size} the reference subscriber held (errors: ${reference.errors.join('; ') || 'none'})`);
+  }
+  return result;
+}
+
+// Bytes a frame takes in each encoding (with normals and markers, as the page asks), and the
+// Model's size: from subscribers in node, over one second each.
+async function bytesPerFrame(httpPort) {
+  const out = {};
+  const wants = 1 | 4; // normals, markers
+  for (const [name, encoding] of [['parameters', 3], ['compressed', 2], ['quantised', 1], ['float', 0]]) {
+    const subscriber = new ReferenceSubscriber(`ws://127.0.0.1:${httpPort}/stream`, { encoding, wants, keep: 0 });
+    await subscriber.opened;
+    await sleep(1000);
+    subscriber.close();
+    const sizes = subscriber.frameBytes;
+    out[name] = sizes.length > 0 ? Math.round(sizes.reduce((a, b) => a + b, 0) / sizes.length) : 0;
+    if (name === 'parameters') out.model_message = subscriber.modelBytes;
+  }
+  return out;
+}
+
+// One page alone asking for `encoding`: after a warm-up, over a window, its frames per second
+// and its main thread's time per frame drawn, from Chrome's own counters (Performance.getMetrics:
+// TaskDuration, ScriptDuration) and from the page's (frameWorkMs: taking a frame in and drawing).
+async function measureFrameCost(browser, url, encoding, { warmupMs = 3000, windowMs = 10000 } = {}) {
+  const page = await browser.newPage({ viewport: { width: 800, height: 600 } });
+  const cdp = await page.context().newCDPSession(page);
+  await cdp.send('Performance.enable');
+  await page.goto(`${url}?encoding=${encoding}`);
+  await waitUntil(page, `the ${encoding} page rendered no frame`, () => window.skinstreamViewer && window.skinstreamViewer.framesRendered > 2, null, 60000);
+  await sleep(warmupMs);
+  const sample = async () => {
+    const metrics = Object.fromEntries((await cdp.send('Performance.getMetrics')).metrics.map((m) => [m.name, m.value]));
+    const v = await page.evaluate(() => ({ frames: window.skinstreamViewer.framesRendered, work: window.skinstreamViewer.frameWorkMs,
+      received: window.skinstreamViewer.framesReceived }));
+    return { ...v, task: metrics.TaskDuration, script: metrics.ScriptDuration, atMs: Date.now() };
+  };
+  const before = await sample();
+  await sleep(windowMs);
+  const after = await sample();
+  await page.close();
+  const frames = after.frames - before.frames;
+  const seconds = (after.atMs - before.atMs) / 1000;
+  const perFrame = (value) => (frames > 0 ? Number((value / frames).toFixed(2)) : null);
+  return {
+    encoding, frames_drawn: frames, frames_per_second: Number((frames / seconds).toFixed(2)),
+    frames_received_per_second: Number(((after.received - before.received) / seconds).toFixed(1)),
+    main_thread_task_ms_per_frame: perFrame(1000 * (after.task - before.task)),
+    script_ms_per_frame: perFrame(1000 * (after.script - before.script)),
+    page_frame_work_ms_per_frame: perFrame(after.work - before.work),
+  };
+}
+
 async function main() {
   const options = parseArguments(process.argv.slice(2));
   // The daemon calls a subject file given without a name by the file's stem.
   options.subjectName = path.parse(options.subject).name;
-  await checkGoldenFixtures();
-  if (!fs.existsSync(options.chromium)) {
-    throw new Error(`chromium not found at ${options.chromium} (Debian 12: apt-get install chromium)`);
-  }
   for (const file of [options.daemon, options.subject, options.recording, path.join(options.webRoot, 'index.html')]) {
     if (!fs.existsSync(file)) throw new Error(`missing input ${file}`);
   }
   fs.mkdirSync(options.out, { recursive: true });
-  // playwright-core is pinned in clients/web/package.json and installed by clients/web/build.sh.
-  const { chromium } = createRequire(path.join(repoRoot, 'clients/web/package.json'))('playwright-core');
 
   // The rate the recording was captured at, from the offline CLI when it is given.
   let expectedRateHz = 0;
@@ -221,14 +191,8 @@ async function main() {
   let browser = null;
   try {
     const ports = await waitForPorts(daemon, portsFile, logFile);
-    browser = await chromium.launch({
-      executablePath: options.chromium,
-      headless: true,
-      args: ['--headless', '--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run',
-        '--disable-background-networking', '--disable-component-update', '--disable-sync',
-        '--use-angle=swiftshader', '--enable-unsafe-swiftshader'],
-    });
-    const page = await browser.newPage({ viewport: { width: 800, height: 600 } });
+    browser = await launchChromium(options.chromium);
+    let page = await browser.newPage({ viewport: { width: 800, height: 600 } });
     const pageErrors = [];
     page.on('pageerror', (error) => pageErrors.push(error.message));
     page.on('console', (message) => { if (message.type() === 'error') pageErrors.push(message.text()); });
@@ -240,6 +204,7 @@ async function main() {
 
     const start = await viewer(page);
     assert.ok(start.webgl, `no WebGL context was created (banner: ${start.bannerText})`);
+    assert.equal(start.webglVersion, 2, 'the GPU evaluation needs WebGL2');
     console.log(`WebGL ${start.webglVersion} context created`);
 
     await waitUntil(page, 'no frame was rendered', () => window.skinstreamViewer.framesRendered > 0);
@@ -335,25 +300,58 @@ async function main() {
     assert.deepEqual([...fs.readFileSync(screenshot).subarray(0, 4)], [0x89, 0x50, 0x4e, 0x47], 'screenshot is not a PNG');
     console.log(`screenshot ${screenshot}`);
 
-    // The float encoding on a second page (the viewer asks for the quantised one by default).
-    assert.ok(after.quantised, 'the viewer did not ask for the quantised encoding by default');
-    const floatPage = await browser.newPage({ viewport: { width: 480, height: 360 } });
-    floatPage.on('pageerror', (error) => pageErrors.push(`float page: ${error.message}`));
-    await floatPage.goto(`${url}?quantised=0`);
-    await waitUntil(floatPage, 'the float page rendered no frame', () => window.skinstreamViewer && window.skinstreamViewer.framesRendered > 2);
-    const float = await viewer(floatPage);
-    assert.equal(float.quantised, false);
-    assert.equal(float.vertexCount, after.vertexCount);
-    assert.ok(float.samplePositions.every(Number.isFinite), 'float sample positions not finite');
-    await floatPage.close();
+    // Parameters by default, evaluated on the GPU: against the daemon's float buffers.
+    assert.equal(after.encoding, 'parameters', 'the viewer did not ask for parameters by default');
+    assert.ok(after.gpuEvaluation, 'parameters arrived but the GPU evaluation was not set up');
+    const reference = new ReferenceSubscriber(`ws://127.0.0.1:${ports.http}/stream`);
+    await reference.opened;
+    const accuracy = { parameters: await compareWithDaemon(page, reference) };
+    // The other encodings, each on a page of its own.
+    for (const encoding of ['float', 'quantised', 'compressed']) {
+      const other = await browser.newPage({ viewport: { width: 480, height: 360 } });
+      other.on('pageerror', (error) => pageErrors.push(`${encoding} page: ${error.message}`));
+      await other.goto(`${url}?encoding=${encoding}`);
+      await waitUntil(other, `the ${encoding} page rendered no frame`, () => window.skinstreamViewer && window.skinstreamViewer.framesRendered > 2, null, 60000);
+      assert.equal((await viewer(other)).encoding, encoding);
+      accuracy[encoding] = await compareWithDaemon(other, reference);
+      await other.close();
+    }
+    reference.close();
+    for (const [encoding, a] of Object.entries(accuracy)) {
+      console.log(`${encoding}: frames ${a.frames.join(', ')} within ${a.worstMm.toExponential(2)} mm and ${a.worstNormalDegrees.toFixed(3)} degrees of the daemon's float buffers`);
+    }
+    // The GPU evaluates in float as the daemon does; 0.1 mm is the issue's bound.
+    assert.ok(accuracy.parameters.worstMm < 0.1, `GPU positions ${accuracy.parameters.worstMm} mm from the daemon's`);
+    assert.ok(accuracy.parameters.worstNormalDegrees < 0.5, `GPU normals ${accuracy.parameters.worstNormalDegrees} degrees from the daemon's`);
+    assert.equal(accuracy.float.worstMm, 0, 'float vertices are drawn as they were sent');
+    assert.equal(accuracy.float.worstNormalDifference, 0, 'float normals are drawn as they were sent');
+    // Half a grid step: 2,300 mm over 65,535 steps for the compressed key grid, the body's
+    // extent for quantised; normals within the spec's 1.5 degrees (octahedral, 8 bits).
+    assert.ok(accuracy.compressed.worstMm < 0.025, `compressed positions ${accuracy.compressed.worstMm} mm off`);
+    assert.ok(accuracy.compressed.worstNormalDegrees < 1.5, `compressed normals ${accuracy.compressed.worstNormalDegrees} degrees off`);
+    assert.ok(accuracy.quantised.worstMm < 0.025, `quantised positions ${accuracy.quantised.worstMm} mm off`);
 
-    // A page naming the subject speaks version 2 and shows its subject in the menu; a name the
-    // daemon does not serve is refused, and the page says so.
+    // What each encoding costs the page, one page at a time (the default page closed first).
+    const bytes = await bytesPerFrame(ports.http);
+    await page.screenshot({ path: path.join(options.out, 'viewer_parameters.png') });
+    await page.close();
+    const costs = [];
+    for (const encoding of ['parameters', 'float', 'compressed']) costs.push(await measureFrameCost(browser, url, encoding));
+    console.log(JSON.stringify({
+      benchmark: 'web_viewer_frame_cost',
+      renderer: 'headless Chromium, WebGL2 on SwiftShader (the CPU): GPU work is CPU time in the GPU process',
+      viewport: '800x600', bytes_per_frame: bytes, model_message_bytes: bytes.model_message,
+      gpu_evaluation: after.gpuEvaluation, accuracy, modes: costs,
+    }));
+
+    // A page naming the subject is served it and shows it in the menu; a name the daemon does not
+    // serve is refused, and the page says so.
     const named = await browser.newPage({ viewport: { width: 480, height: 360 } });
     named.on('pageerror', (error) => pageErrors.push(`named page: ${error.message}`));
     await named.goto(`${url}?subject=${encodeURIComponent(options.subjectName)}`);
-    await waitUntil(named, 'the page naming its subject rendered no frame', () => window.skinstreamViewer && window.skinstreamViewer.framesRendered > 2);
+    await waitUntil(named, 'the page naming its subject rendered no frame', () => window.skinstreamViewer && window.skinstreamViewer.framesRendered > 2, null, 60000);
     assert.equal(await named.evaluate(() => window.skinstreamViewer.subject), options.subjectName);
+    await waitUntil(named, 'no subject menu', () => document.getElementById('subject') !== null);
     assert.equal(await named.evaluate(() => document.getElementById('subject').value), options.subjectName);
     await named.goto(`${url}?subject=Nobody`);
     await waitUntil(named, 'no refusal shown for an unknown subject', () => /refused/.test(window.skinstreamViewer.bannerText));
@@ -363,6 +361,9 @@ async function main() {
     assert.deepEqual(pageErrors, [], 'errors on the page');
 
     // Stop the daemon: the page must say the connection (or source) is gone.
+    page = await browser.newPage({ viewport: { width: 800, height: 600 } });
+    await page.goto(url);
+    await waitUntil(page, 'the page opened again rendered no frame', () => window.skinstreamViewer && window.skinstreamViewer.framesRendered > 0, null, 60000);
     daemon.kill('SIGTERM');
     const exit = await daemonExit;
     assert.equal(exit.code, 0, `skinstreamd did not exit cleanly on SIGTERM (${exit.code ?? exit.signal})`);

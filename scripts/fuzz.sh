@@ -1,0 +1,60 @@
+#!/usr/bin/env bash
+# Fuzzes every parser: builds the libFuzzer targets of tests/fuzz/ with clang, AddressSanitizer
+# and UndefinedBehaviorSanitizer into build-fuzz/, then runs each for SECONDS (default 10) on its
+# corpus (build-fuzz/fuzz/corpus/TARGET, seeded from the real files the first time and kept
+# between runs, so coverage grows run after run). One JSON line per target:
+#   {"target":"c3d","seconds":10,"executions":123456,"findings":0,"corpus":321}
+# A finding is a crash, a sanitizer report, an input over 10 s or over 2 GB of memory; its input
+# is kept in build-fuzz/fuzz/findings/TARGET/ (replay it: build-fuzz/bin/fuzz_TARGET FILE).
+# Exits non-zero when any target found anything. Usage: scripts/fuzz.sh [SECONDS] [TARGET...]
+set -euo pipefail
+cd "$(dirname "$0")/.."
+seconds=${1:-10}
+shift || true
+bash scripts/install-deps.sh >&2
+launcher=()
+if command -v ccache >/dev/null 2>&1; then launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache); fi
+cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++ "${launcher[@]}" \
+  -DSKINSTREAM_FUZZ=ON -DSKINSTREAM_BUILD_TESTS=OFF -DSKINSTREAM_BUILD_BENCHMARKS=OFF >&2
+cmake --build build-fuzz -j "$(nproc)" --target skinstream_fuzz >&2
+
+fuzz=$PWD/build-fuzz/fuzz
+if [ ! -f "$fuzz/seeds/done" ]; then
+  build-fuzz/bin/fuzz_make_seeds "$fuzz/seeds" >&2
+  touch "$fuzz/seeds/done"
+fi
+mkdir -p "$fuzz/tmp"
+export TMPDIR=$fuzz/tmp  # where the file readers' targets write each input
+targets=("$@")
+if [ ${#targets[@]} -eq 0 ]; then mapfile -t targets < "$fuzz/targets.txt"; fi
+
+failed=0
+for target in "${targets[@]}"; do
+  corpus=$fuzz/corpus/$target
+  findings=$fuzz/findings/$target
+  mkdir -p "$corpus"
+  rm -rf "$findings"
+  mkdir -p "$findings"
+  if [ -z "$(ls -A "$corpus")" ]; then  # first run: the real files and the made seeds
+    while IFS= read -r seed; do
+      [ -n "$seed" ] && cp "$seed" "$corpus/$(basename "$seed")"
+    done < "$fuzz/$target.seeds"
+    if [ -d "$fuzz/seeds/$target" ]; then cp "$fuzz/seeds/$target"/* "$corpus/"; fi
+  fi
+  log=$fuzz/$target.log
+  status=0
+  build-fuzz/bin/fuzz_"$target" -max_total_time="$seconds" -print_final_stats=1 -timeout=10 -rss_limit_mb=2048 \
+    -artifact_prefix="$findings/" "$corpus" > "$log" 2>&1 || status=$?
+  executions=$(sed -n 's/^stat::number_of_executed_units: *\([0-9]*\).*/\1/p' "$log" | tail -1)
+  found=$(find "$findings" -type f | wc -l)
+  if [ "$status" -ne 0 ] && [ "$found" -eq 0 ]; then found=1; fi  # stopped by something that left no input
+  printf '{"target":"%s","seconds":%s,"executions":%s,"findings":%s,"corpus":%s}\n' \
+    "$target" "$seconds" "${executions:-0}" "$found" "$(find "$corpus" -type f | wc -l)"
+  if [ "$found" -ne 0 ]; then
+    failed=1
+    echo "fuzz: $target: see $log and $findings/" >&2
+    grep -m 3 -E "ERROR|runtime error|deadly signal|Abort" "$log" >&2 || true
+  fi
+done
+rm -rf "$fuzz/tmp"
+exit $failed

@@ -1,0 +1,188 @@
+"""The Python package against the real skinstreamd replaying the demo subject over loopback:
+every encoding's vertices and normals against the daemon's own float buffer of the same frame
+number, and the bad paths (no daemon, a refused Hello, bytes that break the protocol) as
+one-line errors."""
+import os
+import socket
+import struct
+import sys
+import threading
+import time
+import unittest
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', '..'))
+from support.python_clients import demo_daemon, fixture  # noqa: E402
+import numpy as np  # noqa: E402
+import skinstream  # noqa: E402
+from skinstream.evaluation import vertex_normals  # noqa: E402
+
+
+def receive(port, encoding, count, results):
+    frames = {}
+    with skinstream.Subscriber(port=port, encoding=encoding, normals=True, markers=True) as sub:
+        deadline = time.monotonic() + 120
+        while len(frames) < count and time.monotonic() < deadline:
+            frame = sub.next_frame(1.0)
+            if frame is not None:
+                frames[frame.frame_number] = frame
+        results[encoding] = (frames, sub.encoding, sub.mesh, sub.model)
+
+
+def angles_degrees(a, b):
+    """Angle between unit vectors row by row, as atan2(|a x b|, a . b): exact near 0."""
+    a, b = a.astype(np.float64), b.astype(np.float64)
+    return np.degrees(np.arctan2(np.linalg.norm(np.cross(a, b), axis=1), (a * b).sum(axis=1)))
+
+
+class DemoSubject(unittest.TestCase):
+    def test_every_encoding_gives_the_daemons_vertices(self):
+        count = 30
+        results = {}
+        with demo_daemon() as daemon:
+            threads = [threading.Thread(target=receive, args=(daemon.sub_port, e, count, results)) for e in skinstream.ENCODINGS]
+            for t in threads:
+                t.start()
+            for t in threads:
+                t.join()
+            self.assertEqual(daemon.stop(), 0, daemon.log())
+        reference, _, mesh, _ = results['float']
+        self.assertEqual(len(reference), count)
+        first = next(iter(reference.values()))
+        self.assertEqual(first.vertices.shape, (53514, 3))
+        self.assertEqual(first.vertices.dtype, np.float32)
+        self.assertEqual(first.markers.shape, (len(mesh.marker_names), 3))
+        self.assertEqual(first.marker_status.shape, (len(mesh.marker_names),))
+        self.assertLessEqual(int(first.marker_status.max()), 4)
+        self.assertGreater(first.receive_time_ns, 0)
+        self.assertGreaterEqual(first.publish_time_ns, first.receive_time_ns)
+        self.assertEqual(mesh.faces.shape[1], 3)
+        # The normals the package computes for the parameter encoding, from the daemon's own
+        # positions: the daemon's normals.
+        computed = vertex_normals(first.vertices, mesh.faces)
+        self.assertLess(angles_degrees(computed, first.normals).max(), 0.001)
+        # Position tolerance (mm) and normal tolerance (degrees) of each encoding: parameters
+        # evaluated here as the protocol writes it out, in float64 (the daemon's float32 buffer
+        # is within a few 0.0001 mm of it; the demo body has triangles with 0.2 mm edges, whose
+        # normals that moves by up to 0.1 degree: from the same positions the normals agree to
+        # 0.0001 degree); quantised within half a step of the frame's box; compressed within half
+        # a step of the key's grid and 8-bit octahedral normals.
+        for encoding, mm, degrees in (('parameters', 0.01, 0.5), ('quantised', 0.02, 0.01), ('compressed', 0.025, 1.5)):
+            frames, served, _, model = results[encoding]
+            self.assertEqual(served, encoding)
+            common = sorted(set(frames) & set(reference))
+            self.assertGreaterEqual(len(common), count // 2, encoding)
+            worst_mm = max(np.abs(frames[n].vertices.astype(np.float64) - reference[n].vertices).max() for n in common)
+            worst_degrees = max(angles_degrees(frames[n].normals, reference[n].normals).max() for n in common)
+            print(f'{encoding}: {len(common)} frames, largest differences {worst_mm:.4g} mm, {worst_degrees:.3g} degrees')
+            self.assertLessEqual(worst_mm, mm, encoding)
+            self.assertLessEqual(worst_degrees, degrees, encoding)
+            for n in common:
+                np.testing.assert_array_equal(frames[n].markers, reference[n].markers)
+                np.testing.assert_array_equal(frames[n].marker_status, reference[n].marker_status)
+            if encoding == 'parameters':
+                self.assertEqual(model.vertex_count, 53514)
+
+    def test_an_unknown_subject_is_refused_with_the_reason(self):
+        with demo_daemon() as daemon:
+            with skinstream.Subscriber(port=daemon.sub_port, subject='Actor9') as sub:
+                with self.assertRaisesRegex(skinstream.Refused, 'refused.*Actor9') as raised:
+                    while True:
+                        sub.next_frame(10)
+        self.assertNotIn('\n', str(raised.exception))
+
+
+class FakeDaemon:
+    """Answers the Hello with the bytes given, then closes."""
+
+    def __init__(self, reply):
+        self.listener = socket.create_server(('127.0.0.1', 0))
+        self.port = self.listener.getsockname()[1]
+        self.thread = threading.Thread(target=self._serve, args=(reply,))
+        self.thread.start()
+
+    def _serve(self, reply):
+        peer, _ = self.listener.accept()
+        with peer:
+            peer.recv(1024)
+            peer.sendall(reply)
+            time.sleep(0.2)
+
+    def error(self, encoding='parameters'):
+        try:
+            with skinstream.Subscriber(port=self.port, encoding=encoding) as sub:
+                while sub.next_frame(5) is None:
+                    pass
+            return 'no error'
+        except skinstream.Error as e:
+            return str(e)
+        finally:
+            self.thread.join()
+            self.listener.close()
+
+
+def error_for(reply):
+    return FakeDaemon(reply).error()
+
+
+class BadDaemons(unittest.TestCase):
+    def test_no_daemon_is_a_one_line_error(self):
+        with socket.create_server(('127.0.0.1', 0)) as s:
+            port = s.getsockname()[1]
+        with self.assertRaisesRegex(skinstream.ConnectionLost, f'127.0.0.1:{port}: .*refused') as raised:
+            skinstream.Subscriber(port=port)
+        self.assertNotIn('\n', str(raised.exception))
+        with self.assertRaises(ValueError):
+            skinstream.Subscriber(encoding='parameters', protocol_version=1)
+
+    def test_bytes_that_break_the_protocol_are_one_line_errors(self):
+        mesh_info = fixture('mesh_info_v2.bin')
+        model = fixture('model.bin')  # 3 vertices; the MeshInfo has 4
+        cases = {
+            'bad magic': b'X' + mesh_info[1:],
+            'version 1, not 2': fixture('mesh_info.bin'),  # a version 1 answer to a version 2 Hello
+            'unsupported protocol version 7': mesh_info[:4] + struct.pack('<H', 7) + mesh_info[6:],
+            'exceeds the limit': mesh_info[:8] + struct.pack('<I', 100 << 20),
+            'Model message before MeshInfo': model,
+            'the Model has 3 vertices, MeshInfo 4': mesh_info + model,
+            'closed the connection': mesh_info + model[:-10],  # truncated: the connection ends inside it
+            'before the Model': mesh_info + fixture('frame_v2_parameters.bin'),
+        }
+        for what, reply in cases.items():
+            with self.subTest(what):
+                error = error_for(reply)
+                self.assertIn(what, error)
+                self.assertNotIn('\n', error)
+
+
+class Paced(unittest.TestCase):
+    def test_skipped_compressed_deltas_are_acknowledged_too(self):
+        # A delta of a key the subscriber never saw (it gave way in the daemon's queue) is
+        # skipped, and acknowledged like the frames shown: the daemon waits while two are not.
+        delta = bytearray(fixture('frame_v2_compressed.bin'))
+        delta[16] &= ~0x40  # the flags after the header and the frame number: no longer a key
+        delta[44:48] = struct.pack('<I', 4)  # the vertex count: the MeshInfo's 4 (the coded bytes are never read)
+        listener = socket.create_server(('127.0.0.1', 0))
+        received = bytearray()
+
+        def serve():
+            peer, _ = listener.accept()
+            with peer:
+                peer.recv(1024)  # the Hello
+                peer.sendall(fixture('mesh_info_v2.bin') + bytes(delta) * 3)
+                while chunk := peer.recv(1024):
+                    received.extend(chunk)
+
+        thread = threading.Thread(target=serve)
+        thread.start()
+        with skinstream.Subscriber(port=listener.getsockname()[1], encoding='compressed', paced=True) as sub:
+            self.assertIsNone(sub.next_frame(1.5))
+            self.assertEqual(sub.frames_skipped, 3)
+        thread.join()
+        listener.close()
+        acks = [struct.unpack_from('<IHHII', received, 16 * i) for i in range(len(received) // 16)]
+        self.assertEqual(len(received), 3 * 16)
+        self.assertEqual(acks, [(0x46534B53, 2, 5, 4, 1234)] * 3)
+
+
+if __name__ == '__main__':
+    unittest.main(verbosity=2)
