@@ -24,11 +24,35 @@ void take(const nlohmann::json& json, const char* key, T& out, const std::string
   }
 }
 
+nlohmann::json to_json(const SubjectConfig& subject) { return {{"name", subject.name}, {"file", subject.file}}; }
+
+SubjectConfig subject_from_json(const nlohmann::json& json, const std::string& origin) {
+  SubjectConfig subject;
+  if (json.is_object()) {
+    for (const auto& [key, value] : json.items())
+      if (key != "name" && key != "file") throw ConfigError(origin + ": unknown key \"" + key + "\" in a subject (name, file)");
+    take(json, "name", subject.name, origin);
+    take(json, "file", subject.file, origin);
+  } else if (json.is_string()) {
+    subject = parse_subject(json.get<std::string>());
+  } else {
+    throw ConfigError(origin + ": a subject is {\"name\": NAME, \"file\": FILE} or \"NAME=FILE\"");
+  }
+  return subject;
+}
+
 }  // namespace
+
+SubjectConfig parse_subject(const std::string& text) {
+  const size_t equals = text.find('=');
+  if (equals == std::string::npos || equals == 0 || text.find('/') < equals) return {"", text};
+  return {text.substr(0, equals), text.substr(equals + 1)};
+}
 
 void apply_json(const nlohmann::json& json, DaemonConfig& c, const std::string& origin) {
   if (!json.is_object()) throw ConfigError(origin + ": the configuration must be a JSON object");
-  static const char* const kKeys[] = {"subject", "replay", "loop", "speed", "vicon", "vicon_pull", "vicon_multicast", "qtm", "natnet", "natnet_interface", "bind_address",
+  static const char* const kKeys[] = {"subject", "subjects", "replay", "replay_subject", "loop", "speed", "vicon", "vicon_pull",
+                                      "vicon_multicast", "qtm", "natnet", "natnet_interface", "bind_address",
                                       "http_port", "sub_port", "web_root", "lookahead", "max_frame_wait_ms", "deform_threads",
                                       "deform_cpus", "deform_spin_lead_us",
                                       "continuity_seconds", "use_pca", "ports_file", "log_level", "hello_timeout_ms",
@@ -40,8 +64,19 @@ void apply_json(const nlohmann::json& json, DaemonConfig& c, const std::string& 
     for (const char* k : kKeys) known = known || key == k;
     if (!known) throw ConfigError(origin + ": unknown key \"" + key + "\"");
   }
-  take(json, "subject", c.subject, origin);
+  if (json.contains("subject") && json.contains("subjects"))
+    throw ConfigError(origin + ": give \"subject\" (one) or \"subjects\" (a list), not both");
+  if (const auto it = json.find("subject"); it != json.end()) {
+    if (!it->is_string()) throw ConfigError(origin + ": key \"subject\" has the wrong type (" + it->type_name() + ")");
+    c.subjects = {parse_subject(it->get<std::string>())};
+  }
+  if (const auto it = json.find("subjects"); it != json.end()) {
+    if (!it->is_array()) throw ConfigError(origin + ": key \"subjects\" must be a list of {\"name\": NAME, \"file\": FILE}");
+    c.subjects.clear();
+    for (const nlohmann::json& subject : *it) c.subjects.push_back(subject_from_json(subject, origin));
+  }
   take(json, "replay", c.replay, origin);
+  take(json, "replay_subject", c.replay_subject, origin);
   take(json, "loop", c.loop, origin);
   take(json, "speed", c.speed, origin);
   take(json, "vicon", c.vicon, origin);
@@ -92,8 +127,11 @@ DaemonConfig load_config_file(const std::string& path) {
 }
 
 nlohmann::json to_json(const DaemonConfig& c) {
-  return {{"subject", c.subject},
+  nlohmann::json subjects = nlohmann::json::array();
+  for (const SubjectConfig& subject : c.subjects) subjects.push_back(to_json(subject));
+  return {{"subjects", subjects},
           {"replay", c.replay},
+          {"replay_subject", c.replay_subject},
           {"loop", c.loop},
           {"speed", c.speed},
           {"vicon", c.vicon},
@@ -132,6 +170,15 @@ void validate(const DaemonConfig& c) {
   if (!c.replay.empty() + !c.vicon.empty() + !c.vicon_multicast.empty() + !c.qtm.empty() + !c.natnet.empty() > 1)
     fail("give one source: a replay file, a Vicon server, a Vicon multicast address, a QTM or a NatNet server");
   if (!(c.speed > 0 && c.speed <= 100)) fail("speed must be in (0, 100]");
+  for (size_t i = 0; i < c.subjects.size(); ++i) {
+    const SubjectConfig& subject = c.subjects[i];
+    if (subject.file.empty()) fail("subject \"" + subject.name + "\" has no file");
+    if (subject.name.size() > kMaxSubjectNameBytes) fail("a subject name is at most 256 bytes");
+    if (subject.name.empty() && c.subjects.size() > 1)
+      fail("with several subjects each follows a named one: --subject NAME=FILE (" + subject.file + " has no name)");
+    for (size_t j = 0; j < i; ++j)
+      if (c.subjects[j].name == subject.name) fail("subject \"" + subject.name + "\" is given twice");
+  }
   if (c.http_port < 0 || c.http_port > 65535) fail("http_port must be 0-65535");
   if (c.sub_port < 0 || c.sub_port > 65535) fail("sub_port must be 0-65535");
   if (c.lookahead < 0 || c.lookahead > 240) fail("lookahead must be 0-240 frames");
@@ -191,8 +238,15 @@ std::optional<CommandLine> parse_command_line(int argc, const char* const* argv,
   DaemonConfig flags;  // values of the flags; only those given are applied
   CommandLine result;
   app.add_option("--config", config_path, "JSON configuration file (see config/skinstreamd.reference.json)");
-  auto* subject = app.add_option("--subject", flags.subject, "subject file (skinstream build-subject)");
+  std::vector<std::string> subject_specs;
+  auto* subject = app.add_option("--subject", subject_specs,
+                                 "subject file (skinstream build-subject), or NAME=FILE to follow the capture system's subject NAME; "
+                                 "repeat for several subjects")
+                      ->expected(1)
+                      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   auto* replay = app.add_option("--replay", flags.replay, "replay a capture file (C3D/TRC) as the source");
+  auto* replay_subject = app.add_option("--replay-subject", flags.replay_subject,
+                                        "replay: the name of the file's subject (default: the file's stem)");
   auto* loop = app.add_flag("--loop", flags.loop, "replay: start again at the end");
   auto* speed = app.add_option("--speed", flags.speed, "replay: multiple of the capture rate");
   auto* vicon = app.add_option("--vicon", flags.vicon, "Vicon DataStream server HOST:PORT as the source");
@@ -231,7 +285,11 @@ std::optional<CommandLine> parse_command_line(int argc, const char* const* argv,
   DaemonConfig& c = result.config;
   if (!config_path.empty()) c = load_config_file(config_path);
   auto given = [](const CLI::Option* o) { return o->count() > 0; };
-  if (given(subject)) c.subject = flags.subject;
+  if (given(subject)) {
+    c.subjects.clear();
+    for (const std::string& spec : subject_specs) c.subjects.push_back(parse_subject(spec));
+  }
+  if (given(replay_subject)) c.replay_subject = flags.replay_subject;
   // A source given on the command line replaces the file's (several on the command line: validate() refuses).
   if (given(replay) || given(vicon) || given(vicon_multicast) || given(qtm) || given(natnet)) {
     c.replay = given(replay) ? flags.replay : std::string();

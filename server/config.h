@@ -12,9 +12,24 @@
 
 namespace skinstream::server {
 
+// A subject's name is at most this long (as in a subscriber's Hello, docs/subscriber-protocol.md).
+inline constexpr size_t kMaxSubjectNameBytes = 256;
+
+// One subject the daemon serves: its subject file, and the capture system's subject it follows.
+struct SubjectConfig {
+  std::string name;  // the source subject (Vicon subject name); empty: one actor, found by its labels
+  std::string file;  // subject file (skinstream build-subject)
+  bool operator==(const SubjectConfig&) const = default;
+};
+
+// "NAME=FILE" or "FILE": the form of --subject and of the "subject" key. A NAME has no '/' (so
+// "dir/a=b.sks" is a file).
+SubjectConfig parse_subject(const std::string& text);
+
 struct DaemonConfig {
-  std::string subject;            // subject file; empty = none
+  std::vector<SubjectConfig> subjects;  // none = nothing to serve (an error at start)
   std::string replay;             // capture file to replay (C3D/TRC); empty = none
+  std::string replay_subject;     // replay: the name of the file's one subject; empty = the file's stem
   bool loop = false;              // replay: start again at the end
   double speed = 1.0;             // replay: multiple of the capture rate
   std::string vicon;              // HOST:PORT of a Vicon DataStream server; empty = none

@@ -76,7 +76,7 @@ Difference compare(const std::map<uint32_t, Received>& reference, const std::map
 TEST(ClientSubscriberDemo, EveryEncodingGivesTheDaemonsVertices) {
   const std::string demo = SKINSTREAM_DEMO_DIR;
   // A fifth of real time: every subscriber takes every frame on this shared machine.
-  test::DaemonProcess daemon(SKINSTREAMD, "--subject " + demo + "/subject.sksubj --replay " + demo + "/live.c3d --loop --speed 0.2");
+  test::DaemonProcess daemon("--subject " + demo + "/subject.sksubj --replay " + demo + "/live.c3d --loop --speed 0.2");
   ASSERT_GT(daemon.sub_port, 0);
   const uint16_t port = static_cast<uint16_t>(daemon.sub_port);
   constexpr int kFrames = 40;
@@ -121,7 +121,7 @@ TEST(ClientSubscriberDemo, EveryEncodingGivesTheDaemonsVertices) {
 
 TEST(ClientSubscriberDemo, AnUnknownSubjectIsRefusedWithTheReason) {
   const std::string demo = SKINSTREAM_DEMO_DIR;
-  test::DaemonProcess daemon(SKINSTREAMD, "--subject " + demo + "/subject.sksubj");
+  test::DaemonProcess daemon("--subject " + demo + "/subject.sksubj");
   client::Options options;
   options.port = static_cast<uint16_t>(daemon.sub_port);
   options.subject = "Actor9";
