@@ -56,7 +56,7 @@ void apply_json(const nlohmann::json& json, DaemonConfig& c, const std::string& 
                                       "http_port", "sub_port", "web_root", "lookahead", "max_frame_wait_ms", "deform_threads",
                                       "deform_cpus", "deform_spin_lead_us",
                                       "continuity_seconds", "use_pca", "ports_file", "log_level", "hello_timeout_ms",
-                                      "subscriber_queue_frames", "subscriber_tcp_congestion", "publish_threads", "status_interval_ms", "default_rate_hz",
+                                      "subscriber_queue_frames", "subscriber_tcp_congestion", "publish_threads", "status_interval_ms", "status_log_seconds", "default_rate_hz",
                                       "compressed_key_interval", "source_max_subjects", "source_max_markers_per_subject",
                                       "source_max_name_bytes"};
   for (const auto& [key, value] : json.items()) {
@@ -104,6 +104,7 @@ void apply_json(const nlohmann::json& json, DaemonConfig& c, const std::string& 
   take(json, "subscriber_tcp_congestion", c.subscriber_tcp_congestion, origin);
   take(json, "publish_threads", c.publish_threads, origin);
   take(json, "status_interval_ms", c.status_interval_ms, origin);
+  take(json, "status_log_seconds", c.status_log_seconds, origin);
   take(json, "default_rate_hz", c.default_rate_hz, origin);
   take(json, "source_max_subjects", c.source_max_subjects, origin);
   take(json, "source_max_markers_per_subject", c.source_max_markers_per_subject, origin);
@@ -159,6 +160,7 @@ nlohmann::json to_json(const DaemonConfig& c) {
           {"subscriber_tcp_congestion", c.subscriber_tcp_congestion},
           {"publish_threads", c.publish_threads},
           {"status_interval_ms", c.status_interval_ms},
+          {"status_log_seconds", c.status_log_seconds},
           {"default_rate_hz", c.default_rate_hz},
           {"source_max_subjects", c.source_max_subjects},
           {"source_max_markers_per_subject", c.source_max_markers_per_subject},
@@ -195,6 +197,7 @@ void validate(const DaemonConfig& c) {
     fail("subscriber_tcp_congestion must be empty (the system's) or a Linux congestion control name such as reno, not \"" +
          c.subscriber_tcp_congestion + "\"");
   if (c.status_interval_ms < 10) fail("status_interval_ms must be >= 10");
+  if (c.status_log_seconds < 0 || c.status_log_seconds > 3600) fail("status_log_seconds must be 0 (none) to 3600");
   if (!(c.default_rate_hz > 0)) fail("default_rate_hz must be > 0");
   if (c.source_max_subjects < 1 || c.source_max_subjects > 4096) fail("source_max_subjects must be 1-4096");
   if (c.source_max_markers_per_subject < 1 || c.source_max_markers_per_subject > 65536)

@@ -57,6 +57,7 @@ struct DaemonConfig {
   int subscriber_queue_frames = 32;  // per subscriber at most; max_frame_wait_ms bounds their age
   int compressed_key_interval = 10;  // frames between key frames of the compressed encoding
   int status_interval_ms = 1000;
+  int status_log_seconds = 5;  // a status line per subject in the log this often (0: none)
   double default_rate_hz = 120.0;  // until the source says its rate
   // What one source message may describe (vicon::DescriptionLimits); more is a malformed packet.
   int source_max_subjects = 128;

@@ -122,7 +122,8 @@ Daemon::Daemon(const DaemonConfig& config)
       router_(targets_of(subjects_), static_cast<SubjectRouter::Observer&>(*this)),
       routed_(subjects_.size(), nullptr),
       publish_(config.publish_threads),
-      status_timer_(io_) {
+      status_timer_(io_),
+      status_log_timer_(io_) {
   for (auto& s : subjects_) {
     directory_.add(s->name(), s->hub());
     s->hub().set_directory(&directory_);
@@ -239,6 +240,7 @@ void Daemon::start_serving() {
   sub_listener_->start();
   http_->start();
   schedule_status();
+  if (config_.status_log_seconds > 0) schedule_status_log();
   write_ports_file();
   for (const auto& s : subjects_)
     spdlog::info("skinstreamd: subject {} ({}, {} markers, {} vertices)", s->name(), s->config().file, s->model().marker_count(),
@@ -259,6 +261,7 @@ void Daemon::request_stop() {
     sub_listener_->stop();
     http_->stop();
     status_timer_.cancel();
+    status_log_timer_.cancel();
     for (auto& s : subjects_) s->stop();  // no more frames published after this
     for (auto& s : subjects_) s->hub().close_all();  // posted to each TCP subscriber's thread
     publish_.stop();  // after those closes
@@ -299,15 +302,20 @@ void Daemon::on_frame(const SourceFrame& frame) {
 }
 
 void Daemon::on_source_state(SourceState state, std::string_view detail) {
+  SourceState previous;
   {
     std::lock_guard lock(state_mutex_);
+    previous = state_;
     state_ = state;
     state_detail_ = std::string(detail);
   }
   // Every start of streaming (first connect, reconnect, replay loop) is a new take for the fillers.
   if (state == SourceState::Streaming)
     for (auto& s : subjects_) s->new_take();
-  spdlog::info("source: {} ({})", to_string(state), detail);
+  // A change of state is news; streaming again (a replay's loop) is not: the status line says
+  // that the frames keep coming.
+  if (state != previous) spdlog::info("source: {} ({})", to_string(state), detail);
+  else spdlog::debug("source: {} ({})", to_string(state), detail);
   broadcast_status();
 }
 
@@ -364,6 +372,15 @@ void Daemon::schedule_status() {
     if (ec || stopping_.load()) return;
     broadcast_status();
     schedule_status();
+  });
+}
+
+void Daemon::schedule_status_log() {
+  status_log_timer_.expires_after(std::chrono::seconds(config_.status_log_seconds));
+  status_log_timer_.async_wait([this](const boost::system::error_code& ec) {
+    if (ec || stopping_.load()) return;
+    for (auto& s : subjects_) spdlog::info("{}", s->status_line(StatusLine::Clock::now()));
+    schedule_status_log();
   });
 }
 

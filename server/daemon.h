@@ -70,6 +70,7 @@ class Daemon : private SourceSink, private SubjectRouter::Observer {
 
   void broadcast_status();
   void schedule_status();
+  void schedule_status_log();
   void write_ports_file() const;
 
   DaemonConfig config_;
@@ -91,6 +92,7 @@ class Daemon : private SourceSink, private SubjectRouter::Observer {
   std::unique_ptr<HttpServer> http_;
   std::unique_ptr<FrameSource> source_;
   asio::steady_timer status_timer_;
+  asio::steady_timer status_log_timer_;
 
   mutable std::mutex state_mutex_;
   SourceState state_ = SourceState::Connecting;

@@ -152,6 +152,12 @@ void SubjectStream::broadcast_status(SourceState state, std::string_view source_
   hub_->broadcast_status(status);
 }
 
+std::string SubjectStream::status_line(StatusLine::Clock::time_point now) {
+  uint64_t subscriber_drops = 0;
+  for (const SubscriberMetrics& m : hub_->subscriber_metrics()) subscriber_drops += m.dropped;
+  return status_line_.next(name_, metrics_, hub_->subscriber_count(), subscriber_drops, now);
+}
+
 nlohmann::json SubjectStream::health() const {
   nlohmann::json out;
   {

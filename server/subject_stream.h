@@ -19,6 +19,7 @@
 #include "server/ingest/subject_router.h"
 #include "server/logging.h"
 #include "server/metrics/metrics.h"
+#include "server/metrics/status_line.h"
 #include "server/pipeline/frame_mailbox.h"
 #include "server/pipeline/pipeline.h"
 #include "server/publish/subscriber_hub.h"
@@ -66,6 +67,8 @@ class SubjectStream {
 
   bool present() const;
   nlohmann::json health() const;  // /health's entry for this subject
+  // The io thread: the log's status line for the interval since the previous one.
+  std::string status_line(StatusLine::Clock::time_point now);
 
  private:
   SubjectConfig config_;
@@ -74,6 +77,7 @@ class SubjectStream {
   Metrics metrics_;
   RateLimitedLog bad_input_log_;
   RateLimitedLog drop_log_;  // frames that gave way in the mailbox, with the reason
+  StatusLine status_line_;
   FrameMailbox mailbox_;
   std::unique_ptr<SubscriberHub> hub_;
   std::unique_ptr<Pipeline> pipeline_;

@@ -254,6 +254,22 @@ long count_lines_with(const std::string& text, const std::string& needle) {
   return count;
 }
 
+// A person watching the log: a status line per subject every status_log_seconds, and the
+// replay's loops (each a new take for the filler) not announced each time.
+TEST_F(DaemonProgram, LogsAStatusLineAndNotEveryLoopOfAReplay) {
+  const std::string config = test::scratch_path("status_" + std::to_string(getpid()) + ".json");
+  { std::ofstream(config) << R"({"status_log_seconds": 1})"; }
+  DaemonProcess daemon("--config " + config + " --subject " + subject_ + " --replay " + take_ + " --loop --speed 4");
+  ASSERT_GT(daemon.http_port, 0);
+  ASSERT_TRUE(eventually([&] { return count_lines_with(daemon.log(), "frames in") >= 3; })) << daemon.log();
+  EXPECT_EQ(daemon.stop(), 0);
+  const std::string log = daemon.log();
+  EXPECT_EQ(count_lines_with(log, "source: streaming"), 1) << log;
+  // The take lasts 0.5 s at 4x: several loops in the run, one "streaming" line.
+  EXPECT_NE(log.find(" out ("), std::string::npos) << log;
+  EXPECT_NE(log.find("0 subscribers; dropped"), std::string::npos) << log;
+}
+
 // Out of file descriptors (the daemon limited to 64) with subscriber connections still waiting in
 // the kernel's queue, every accept fails at once: the daemon pauses its accepts instead of
 // retrying (it spun, logging every failure), counts the failures, answers /health on the
