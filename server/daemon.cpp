@@ -20,6 +20,7 @@
 #include "server/ingest/vicon_source.h"
 #include "server/listener.h"
 #include "server/pipeline/deform_cpus.h"
+#include "server/publish/multicast_sender.h"
 #include "server/publish/subscriber_hub.h"
 #include "server/publish/tcp_subscriber.h"
 #include "server/thread_name.h"
@@ -87,6 +88,11 @@ vicon::DescriptionLimits description_limits_of(const DaemonConfig& config) {
   return limits;
 }
 
+MulticastSenderOptions multicast_options_of(const DaemonConfig& config) {
+  const HostPort group = host_port_of("--multicast", config.multicast);
+  return {group.host, group.port, config.multicast_interface, config.multicast_ttl, 0};
+}
+
 subscriber::SourceStateCode code_of(SourceState s) { return static_cast<subscriber::SourceStateCode>(static_cast<uint32_t>(s)); }
 
 // The /metrics histograms condensed for scripts, over the daemon's life: per stage its count,
@@ -147,9 +153,15 @@ Daemon::Daemon(const DaemonConfig& config)
   pipeline_options.filler.continuity_seconds = config.continuity_seconds;
   pipeline_options.filler.use_pca = config.use_pca;
   pipeline_options.compressed_key_interval = config.compressed_key_interval;
+  FrameConsumer* consumer = hub_.get();
+  if (!config.multicast.empty()) {
+    if (!subject_.deformation) throw ConfigError("multicast sends the parameters of the mesh: " + config.subject + " has none (built without --mesh)");
+    multicast_ = std::make_unique<MulticastSender>(*hub_, multicast_options_of(config));
+    consumer = multicast_.get();
+  }
   try {
     pipeline_ = std::make_unique<Pipeline>(model, subject_.deformation ? &*subject_.deformation : nullptr, pipeline_options,
-                                           mailbox_, *hub_, metrics_);
+                                           mailbox_, *consumer, metrics_);
   } catch (const std::invalid_argument& e) {
     throw FileError(config.subject, std::string("deformation model unusable: ") + e.what());
   }
@@ -160,6 +172,12 @@ Daemon::Daemon(const DaemonConfig& config)
     hub_->set_model_message(std::make_shared<const std::vector<unsigned char>>(subscriber::encode_model(*evaluation)));
     spdlog::info("parameter encoding: Model message of {} bytes ({} parts, {} RBF centres, {} influences)",
                  hub_->model_message()->size(), evaluation->part_count(), evaluation->member_count(), evaluation->influence_count());
+    if (multicast_) {
+      multicast_->set_model(std::span<const unsigned char>(*hub_->model_message()).subspan(subscriber::kHeaderBytes));
+      pipeline_->prepare_encoding(MulticastSender::sent_key());
+      spdlog::info("multicast: every frame's parameters to {} from {} (TTL {}), model id {:08x}", config.multicast,
+                   config.multicast_interface, config.multicast_ttl, multicast_->model_id());
+    }
   }
 
   if (!config.replay.empty()) {
@@ -231,7 +249,11 @@ Daemon::Daemon(const DaemonConfig& config)
   }, ListenerOptions{config.subscriber_tcp_congestion, &metrics_, &descriptor_reserve_, false});
   HttpRoutes routes;
   routes.health_json = [this] { return health_json(); };
-  routes.metrics_text = [this] { return metrics_.render_prometheus(hub_->subscriber_metrics()); };
+  routes.metrics_text = [this] {
+    std::string text = metrics_.render_prometheus(hub_->subscriber_metrics());
+    if (multicast_) multicast_->render_prometheus(text);
+    return text;
+  };
   routes.web_root = config.web_root;
   if (!config.web_root.empty() && !std::filesystem::is_directory(config.web_root))
     throw FileError(config.web_root, "web root is not a directory");
@@ -442,6 +464,7 @@ std::string Daemon::health_json() const {
        {{"max_subjects", config_.source_max_subjects},
         {"max_markers_per_subject", config_.source_max_markers_per_subject},
         {"max_name_bytes", config_.source_max_name_bytes}}},
+      {"multicast", multicast_ ? multicast_->health() : nlohmann::json()},
       {"latency_ms", latency_summaries(metrics_)}};
   return health.dump();
 }

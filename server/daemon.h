@@ -28,6 +28,7 @@
 namespace skinstream::server {
 
 class SubscriberHub;
+class MulticastSender;
 class HttpServer;
 class Listener;
 
@@ -77,6 +78,7 @@ class Daemon : private SourceSink, private SubjectRouter::Observer {
   FrameMailbox mailbox_;
   SubjectRouter router_;
   std::unique_ptr<SubscriberHub> hub_;
+  std::unique_ptr<MulticastSender> multicast_;  // the pipeline's consumer in front of the hub, when on
   std::unique_ptr<Pipeline> pipeline_;
   // After the pipeline and the hub: the io_context is destroyed first, and with it the handlers
   // still holding sessions whose queues hold frames of the pipeline's pool.
