@@ -1,6 +1,7 @@
 #pragma once
 // The real skinstreamd in the background, as a user starts it, on ephemeral loopback ports (read
 // back from its ports file); stopped with SIGTERM. `arguments` go on its command line as given.
+// `launcher` goes before it (e.g. "ip netns exec NAME"), and `bind` is the address it listens on.
 #include <string>
 #include <sys/types.h>
 
@@ -10,7 +11,8 @@ class DaemonProcess {
  public:
   // Waits until the daemon listens; a daemon that exits at startup fails the test (ADD_FAILURE)
   // with its log, and leaves the ports at 0.
-  DaemonProcess(const std::string& skinstreamd, const std::string& arguments);
+  DaemonProcess(const std::string& skinstreamd, const std::string& arguments, const std::string& launcher = "",
+                const std::string& bind = "127.0.0.1");
   ~DaemonProcess();
   DaemonProcess(const DaemonProcess&) = delete;
   DaemonProcess& operator=(const DaemonProcess&) = delete;

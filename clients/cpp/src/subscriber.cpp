@@ -3,7 +3,9 @@
 #include <optional>
 
 #include "core/deform/mesh_evaluator.h"
+#include "multicast_socket.h"
 #include "protocol/compressed_vertices.h"
+#include "protocol/datagram_reassembler.h"
 #include "protocol/frame_parameters.h"
 #include "protocol/subscriber_model.h"
 #include "protocol/subscriber_stream.h"
@@ -21,6 +23,8 @@ int64_t wall_clock_ns() {
 
 // Up to 1 MiB a read: a 53,500-vertex float frame (640 kB) in one or two reads.
 constexpr size_t kReadBytes = 1 << 20;
+// The largest UDP datagram: one that breaks the protocol's 1,400 is read whole and rejected.
+constexpr size_t kDatagramReadBytes = 65536;
 
 }  // namespace
 
@@ -51,6 +55,13 @@ struct Subscriber::State {
   std::vector<unsigned char> parameter_block;
   // Compressed.
   std::unique_ptr<wire::CompressedVertexDecoder> compressed;
+  // Multicast: frames from the group once the Model came over TCP (then the connection closes).
+  std::optional<MulticastSocket> group;
+  std::optional<wire::DatagramReassembler> reassembler;
+  std::vector<unsigned char> datagram;
+  uint32_t model_id = 0;
+  uint64_t messages_rejected = 0;
+  std::string last_error;
 
   std::vector<float> positions, normals, markers;
   std::vector<uint8_t> marker_status;
@@ -60,6 +71,12 @@ struct Subscriber::State {
   void on_status(std::span<const unsigned char> payload);
   // False when the frame cannot be shown (a compressed delta without its key).
   bool on_frame(std::span<const unsigned char> payload, Frame& frame);
+  // Reads the TCP stream until a frame is ready (true), the deadline passes, or, with multicast,
+  // the Model came and the connection was closed (false).
+  bool read_connection(Frame& frame, std::chrono::steady_clock::time_point deadline);
+  // Reads the group's datagrams until a frame is ready (true) or the deadline passes.
+  bool read_group(Frame& frame, std::chrono::steady_clock::time_point deadline);
+  void reject(const std::string& what);
 };
 
 Subscriber::Subscriber(Options options) : state_(std::make_unique<State>()) {
@@ -81,6 +98,15 @@ Subscriber::Subscriber(Options options) : state_(std::make_unique<State>()) {
   hello.encoding = static_cast<uint32_t>(o.encoding);
   hello.subject = o.subject;
   hello.token = o.token;
+  if (!o.multicast.group.empty()) {
+    if (s.version != wire::kVersion2 || o.encoding != Encoding::Parameters || o.paced || !o.evaluate || !o.mesh)
+      throw std::invalid_argument("multicast carries evaluated parameters only: encoding parameters, protocol 2, not paced");
+    // Joined first, so the group's datagrams wait in the socket while the Model comes.
+    s.group.emplace(o.multicast.group, o.multicast.port, o.multicast.interface_address);
+    s.reassembler.emplace(wire::DatagramReassembler::Options{o.multicast.stream_id, o.multicast.window});
+    s.datagram.resize(kDatagramReadBytes);
+    hello.wants &= ~(wire::kWantMarkers);  // the group's frames carry none
+  }
   s.connection.emplace(o.host, o.port, o.connect_timeout);
   s.connection->send_all(wire::encode_hello(hello));
 }
@@ -90,6 +116,12 @@ Subscriber::~Subscriber() = default;
 bool Subscriber::next(Frame& frame, std::chrono::milliseconds timeout) {
   State& s = *state_;
   const auto deadline = std::chrono::steady_clock::now() + timeout;
+  if (s.connection && s.read_connection(frame, deadline)) return true;
+  return s.group && !s.connection && s.read_group(frame, deadline);
+}
+
+bool Subscriber::State::read_connection(Frame& frame, std::chrono::steady_clock::time_point deadline) {
+  State& s = *this;
   for (;;) {
     try {
       while (const std::optional<wire::RawMessage> message = s.decoder.next()) {
@@ -97,7 +129,14 @@ bool Subscriber::next(Frame& frame, std::chrono::milliseconds timeout) {
           throw Error("the daemon answered in protocol version " + std::to_string(message->version) + ", not " + std::to_string(s.version));
         switch (message->type) {
           case wire::MessageType::MeshInfo: s.on_mesh_info(message->payload); break;
-          case wire::MessageType::Model: s.on_model(message->payload); break;
+          case wire::MessageType::Model:
+            s.on_model(message->payload);
+            if (s.group) {  // the frames come from the group from now on
+              s.model_id = wire::model_id_of(s.model_payload);
+              s.connection.reset();
+              return false;
+            }
+            break;
           case wire::MessageType::Status: s.on_status(message->payload); break;
           case wire::MessageType::Frame: {
             const bool ready = s.on_frame(message->payload, frame);
@@ -126,6 +165,57 @@ bool Subscriber::next(Frame& frame, std::chrono::milliseconds timeout) {
     s.bytes += n;
     s.arrival_ns = wall_clock_ns();
   }
+}
+
+bool Subscriber::State::read_group(Frame& frame, std::chrono::steady_clock::time_point deadline) {
+  for (;;) {
+    const auto now = std::chrono::steady_clock::now();
+    reassembler->expire(now);
+    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - now);
+    const size_t n = group->receive(datagram, std::max(left, std::chrono::milliseconds(0)));
+    if (n == 0) {
+      if (std::chrono::steady_clock::now() >= deadline) return false;
+      continue;
+    }
+    bytes += n;
+    arrival_ns = wall_clock_ns();
+    std::optional<wire::DatagramReassembler::Message> message;
+    try {
+      message = reassembler->add(std::span<const unsigned char>(datagram).first(n), std::chrono::steady_clock::now());
+    } catch (const wire::DecodeError& e) {
+      last_error = std::string("bad datagram: ") + e.what();  // counted by the reassembler
+      continue;
+    }
+    if (!message) continue;
+    if (message->header.model_id != model_id) {
+      char text[160];
+      std::snprintf(text, sizeof text, "the multicast frames fit another Model (id %08x, this receiver holds %08x): the daemon's subject changed",
+                    message->header.model_id, model_id);
+      throw Error(text);
+    }
+    // Anyone on the LAN can send to the group: a message that breaks the protocol is counted,
+    // never the end of the stream.
+    try {
+      const wire::MessageHeader header = wire::decode_header(message->bytes);
+      if (header.type != wire::MessageType::Frame || header.version != wire::kVersion2 ||
+          header.payload_bytes != message->bytes.size() - wire::kHeaderBytes)
+        throw wire::DecodeError(std::string("a ") + wire::to_string(header.type) + " message of version " + std::to_string(header.version) +
+                                " and " + std::to_string(header.payload_bytes) + " bytes, not a version 2 Frame filling the datagrams");
+      const std::span<const unsigned char> payload = message->bytes.subspan(wire::kHeaderBytes);
+      if (!(wire::decode_frame_info(payload, version).flags & wire::kFrameParameters))
+        throw wire::DecodeError("a Frame without parameters");
+      if (on_frame(payload, frame)) return true;
+    } catch (const wire::DecodeError& e) {
+      reject(std::string("bad multicast frame: ") + e.what());
+    } catch (const Error& e) {
+      reject(std::string("bad multicast frame: ") + e.what());
+    }
+  }
+}
+
+void Subscriber::State::reject(const std::string& what) {
+  ++messages_rejected;
+  last_error = what;
 }
 
 void Subscriber::State::on_mesh_info(std::span<const unsigned char> payload) {
@@ -277,5 +367,13 @@ uint64_t Subscriber::bytes_received() const { return state_->bytes; }
 size_t Subscriber::model_bytes() const { return state_->model_payload.empty() ? 0 : wire::kHeaderBytes + state_->model_payload.size(); }
 std::span<const unsigned char> Subscriber::parameter_block() const { return state_->parameter_block; }
 std::span<const unsigned char> Subscriber::model_payload() const { return state_->model_payload; }
+
+MulticastStats Subscriber::multicast_stats() const {
+  const State& s = *state_;
+  if (!s.reassembler) return {};
+  const wire::DatagramReassembler::Stats& r = s.reassembler->stats();
+  return {r.datagrams,          r.frames_completed, r.frames_lost,         r.frames_incomplete, r.datagrams_rejected,
+          r.datagrams_other_stream, r.datagrams_late, r.datagrams_duplicate, s.messages_rejected, s.last_error};
+}
 
 }  // namespace skinstream::client

@@ -1,0 +1,182 @@
+// The client library's multicast receiver against the real skinstreamd between network
+// namespaces on one bridge (multicast does not loop back on these machines): the daemon in one,
+// replaying the demo subject and sending its parameters to a group; receivers in the others,
+// each fetching the Model over TCP and evaluating the group's frames, compared with the daemon's
+// float vertex buffer of the same frames; and one receiver that loses a tenth of its datagrams.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <memory>
+#include <regex>
+#include <thread>
+
+#include "skinstream/client.h"
+#include "support/bridged_namespaces.h"
+#include "support/daemon_process.h"
+#include "support/program_run.h"
+#include "support/received_vertices.h"
+
+namespace skinstream {
+namespace {
+
+using test::compare;
+using test::Difference;
+using test::Received;
+
+constexpr const char* kGroup = "239.255.77.1";
+constexpr uint16_t kGroupPort = 9577;
+constexpr int kDaemonHost = 0, kReferenceHost = 1, kClean = 2, kLossy = 4;  // hosts kClean..kLossy-1 lose nothing
+constexpr int kHosts = 5;
+
+class MulticastDemo : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    skip_reason_ = test::BridgedNamespaces::unavailable_reason();
+    if (!skip_reason_.empty()) return;
+    lan_ = std::make_unique<test::BridgedNamespaces>(kHosts);
+    const std::string demo = SKINSTREAM_DEMO_DIR;
+    // A fifth of real time, as the TCP test: the float reference takes every frame on this shared machine.
+    daemon_ = std::make_unique<test::DaemonProcess>(
+        SKINSTREAMD,
+        "--subject " + demo + "/subject.sksubj --replay " + demo + "/live.c3d --loop --speed 0.2 --multicast " + kGroup + ":" +
+            std::to_string(kGroupPort) + " --multicast-interface " + lan_->address(kDaemonHost),
+        lan_->exec_prefix(kDaemonHost), "0.0.0.0");
+  }
+  static void TearDownTestSuite() {
+    if (daemon_) {
+      EXPECT_EQ(daemon_->stop(), 0) << daemon_->log();
+    }
+    daemon_.reset();
+    lan_.reset();  // removes the namespaces, the veth pairs and the bridge, whatever happened above
+  }
+  void SetUp() override {
+    if (!skip_reason_.empty()) GTEST_SKIP() << skip_reason_;
+    ASSERT_GT(daemon_->sub_port, 0);
+  }
+
+  static client::Options options_on(int host) {
+    client::Options o;
+    o.host = lan_->address(kDaemonHost);
+    o.port = static_cast<uint16_t>(daemon_->sub_port);
+    o.connect_timeout = std::chrono::seconds(10);
+    o.multicast = {kGroup, kGroupPort, lan_->address(host), 0, std::chrono::milliseconds(50)};
+    return o;
+  }
+
+  // The daemon's float vertex buffer, over TCP, on the reference host, until `stop` or `count` frames.
+  static std::map<uint32_t, Received> reference(int count) {
+    lan_->enter(kReferenceHost);
+    client::Options o;
+    o.host = lan_->address(kDaemonHost);
+    o.port = static_cast<uint16_t>(daemon_->sub_port);
+    o.encoding = client::Encoding::Float;
+    client::Subscriber sub(o);
+    return test::collect_frames(sub, count, std::chrono::seconds(120));
+  }
+
+  static inline std::string skip_reason_;
+  static inline std::unique_ptr<test::BridgedNamespaces> lan_;
+  static inline std::unique_ptr<test::DaemonProcess> daemon_;
+};
+
+TEST_F(MulticastDemo, EveryReceiverEvaluatesTheDaemonsVertices) {
+  constexpr int kFrames = 40;
+  std::map<uint32_t, Received> truth;
+  std::vector<std::map<uint32_t, Received>> received(kLossy - kClean);
+  std::vector<client::MulticastStats> stats(received.size());
+  std::vector<std::string> errors(received.size());
+  std::vector<std::thread> threads;
+  for (int r = 0; r < static_cast<int>(received.size()); ++r)
+    threads.emplace_back([&, r] {
+      try {
+        lan_->enter(kClean + r);
+        client::Subscriber sub(options_on(kClean + r));
+        received[r] = test::collect_frames(sub, kFrames, std::chrono::seconds(120));
+        stats[r] = sub.multicast_stats();
+      } catch (const std::exception& e) {
+        errors[r] = e.what();
+      }
+    });
+  threads.emplace_back([&] { truth = reference(kFrames + 20); });
+  for (std::thread& t : threads) t.join();
+  ASSERT_GE(truth.size(), size_t{kFrames});
+  for (size_t r = 0; r < received.size(); ++r) {
+    ASSERT_EQ(errors[r], "") << "receiver " << r;
+    EXPECT_EQ(received[r].size(), size_t{kFrames}) << "receiver " << r;
+    const Difference d = compare(truth, received[r]);
+    // The same frames as the float subscriber: two threads joined at about the same time.
+    EXPECT_GE(d.frames, kFrames / 2) << "receiver " << r;
+    EXPECT_LE(d.position_mm, 0.01) << "receiver " << r;
+    EXPECT_LE(d.normal_degrees, 0.01) << "receiver " << r;
+    EXPECT_EQ(stats[r].datagrams_rejected + stats[r].messages_rejected, 0u) << stats[r].last_error;
+    std::printf("receiver %zu: %d frames compared, largest difference %.3g mm %.3g deg; %llu datagrams, %llu frames, %llu lost\n", r,
+                d.frames, d.position_mm, d.normal_degrees, static_cast<unsigned long long>(stats[r].datagrams),
+                static_cast<unsigned long long>(stats[r].frames_completed), static_cast<unsigned long long>(stats[r].frames_lost));
+  }
+}
+
+// A tenth of the datagrams to one receiver are dropped on their way in (nftables in its
+// namespace; this kernel has no netem): it loses only frames one of whose datagrams was dropped,
+// never waits long for a frame, and the frames it completes are still the daemon's.
+TEST_F(MulticastDemo, ALossyReceiverLosesOnlyTheFramesItsDatagramsCarried) {
+  if (test::run_program("nft --version").exit_code != 0) GTEST_SKIP() << "needs nftables' nft to drop datagrams (Debian: apt-get install nftables)";
+  lan_->run_in(kLossy, "nft add table inet loss");
+  lan_->run_in(kLossy, "nft add chain inet loss input '{ type filter hook input priority 0; }'");
+  lan_->run_in(kLossy, "nft add rule inet loss input udp dport " + std::to_string(kGroupPort) + " numgen random mod 10 '<' 1 counter drop");
+  constexpr auto kListen = std::chrono::seconds(5);
+  std::map<uint32_t, Received> truth, received;
+  client::MulticastStats stats;
+  std::string error;
+  double longest_wait_s = 0;
+  std::thread lossy([&] {
+    try {
+      lan_->enter(kLossy);
+      client::Subscriber sub(options_on(kLossy));
+      client::Frame frame;
+      // The first frame, then kListen of the stream.
+      while (!sub.next(frame, std::chrono::seconds(1))) {
+      }
+      auto last = std::chrono::steady_clock::now();
+      const auto end = last + kListen;
+      while (std::chrono::steady_clock::now() < end) {
+        if (!sub.next(frame, std::chrono::milliseconds(200))) continue;
+        const auto now = std::chrono::steady_clock::now();
+        longest_wait_s = std::max(longest_wait_s, std::chrono::duration<double>(now - last).count());
+        last = now;
+        Received& r = received[frame.frame_number];
+        r.positions.assign(frame.positions.begin(), frame.positions.end());
+        r.normals.assign(frame.normals.begin(), frame.normals.end());
+      }
+      stats = sub.multicast_stats();
+    } catch (const std::exception& e) {
+      error = e.what();
+    }
+  });
+  std::thread reference_thread([&] { truth = reference(40); });
+  lossy.join();
+  reference_thread.join();
+  const std::string counters = lan_->run_in(kLossy, "nft list table inet loss");
+  lan_->run_in(kLossy, "nft delete table inet loss");
+  ASSERT_EQ(error, "");
+  std::smatch match;
+  ASSERT_TRUE(std::regex_search(counters, match, std::regex("counter packets ([0-9]+)"))) << counters;
+  const uint64_t dropped = std::stoull(match[1]);
+  // About 24 frames a second of 6 datagrams: over 100 datagrams dropped in 5 s, about half the frames lost.
+  EXPECT_GT(dropped, 20u);
+  EXPECT_GT(stats.frames_lost, 0u);
+  EXPECT_LE(stats.frames_lost, dropped);  // each dropped datagram costs at most its own frame
+  EXPECT_GT(stats.frames_completed, 0u);
+  EXPECT_LT(longest_wait_s, 1.0);  // never stalls: 24 frames in a row lost is a chance of 1e-8
+  EXPECT_EQ(stats.datagrams_rejected + stats.messages_rejected, 0u) << stats.last_error;
+  const Difference d = compare(truth, received);
+  EXPECT_GE(d.frames, 5);
+  EXPECT_LE(d.position_mm, 0.01);
+  std::printf("lossy receiver: %llu datagrams dropped on the way, %llu frames completed, %llu lost (%llu incomplete), longest wait "
+              "%.3f s; %d frames compared, largest difference %.3g mm\n",
+              static_cast<unsigned long long>(dropped), static_cast<unsigned long long>(stats.frames_completed),
+              static_cast<unsigned long long>(stats.frames_lost), static_cast<unsigned long long>(stats.frames_incomplete), longest_wait_s,
+              d.frames, d.position_mm);
+}
+
+}  // namespace
+}  // namespace skinstream
