@@ -14,8 +14,9 @@ packages=(
   python3 python3-numpy python3-pip python3-venv python3-setuptools python3-wheel
   # The Blender add-on's headless test (clients/blender): Blender 3.4, about a minute to install.
   blender
-  # The multicast test between network namespaces (ip: namespaces, veth pairs, a bridge; tc: netem loss).
-  iproute2
+  # The multicast test between network namespaces (ip: namespaces, veth pairs, a bridge; nft:
+  # dropping a tenth of one receiver's datagrams).
+  iproute2 nftables
 )
 # The web viewer's build (npm) and its browser test (node + playwright-core + chromium). A
 # machine with Node.js from elsewhere (e.g. NodeSource, which bundles npm) keeps it.

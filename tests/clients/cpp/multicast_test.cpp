@@ -3,9 +3,15 @@
 // replaying the demo subject and sending its parameters to a group; receivers in the others,
 // each fetching the Model over TCP and evaluating the group's frames, compared with the daemon's
 // float vertex buffer of the same frames; and one receiver that loses a tenth of its datagrams.
+#include <arpa/inet.h>
 #include <gtest/gtest.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
+#include <cstring>
 #include <memory>
 #include <regex>
 #include <thread>
@@ -176,6 +182,82 @@ TEST_F(MulticastDemo, ALossyReceiverLosesOnlyTheFramesItsDatagramsCarried) {
               static_cast<unsigned long long>(dropped), static_cast<unsigned long long>(stats.frames_completed),
               static_cast<unsigned long long>(stats.frames_lost), static_cast<unsigned long long>(stats.frames_incomplete), longest_wait_s,
               d.frames, d.position_mm);
+}
+
+}  // namespace
+}  // namespace skinstream
+
+namespace skinstream {
+namespace {
+
+// Anyone on the LAN can send to the group: datagrams that break the protocol, from another
+// host, are counted by the receiver, which goes on with the daemon's frames.
+TEST_F(MulticastDemo, BadDatagramsOnTheGroupAreCountedAndTheStreamGoesOn) {
+  std::atomic<bool> receiving{true};
+  std::thread vandal([&] {
+    lan_->enter(kClean + 1);
+    const int fd = socket(AF_INET, SOCK_DGRAM, 0);
+    in_addr interface{};
+    inet_pton(AF_INET, lan_->address(kClean + 1).c_str(), &interface);
+    setsockopt(fd, IPPROTO_IP, IP_MULTICAST_IF, &interface, sizeof interface);
+    sockaddr_in to{};
+    to.sin_family = AF_INET;
+    inet_pton(AF_INET, kGroup, &to.sin_addr);
+    to.sin_port = htons(kGroupPort);
+    // Foreign bytes; a header whose fragment is too short; one over 1,400 bytes; another stream's.
+    std::vector<std::vector<unsigned char>> bad = {{1, 2, 3}};
+    // A datagram header as the spec lays it out: magic SKSM, version 1, reserved, stream, model,
+    // sequence, fragment index and count, message bytes.
+    auto header = [](uint32_t stream, uint16_t count, uint32_t message_bytes) {
+      std::vector<unsigned char> h(28);
+      const uint32_t magic = 0x4D534B53, model = 1, sequence = 5;
+      const uint16_t version = 1, reserved = 0, index = 0;
+      unsigned char* p = h.data();
+      for (const auto& [value, bytes] : std::initializer_list<std::pair<const void*, size_t>>{
+               {&magic, 4}, {&version, 2}, {&reserved, 2}, {&stream, 4}, {&model, 4}, {&sequence, 4}, {&index, 2}, {&count, 2}, {&message_bytes, 4}}) {
+        std::memcpy(p, value, bytes);
+        p += bytes;
+      }
+      return h;
+    };
+    bad.push_back(header(0, 2, 2000));  // fragment 0 of 1,000 bytes, with none
+    bad.push_back(std::vector<unsigned char>(1401, 0));
+    std::vector<unsigned char> other_stream = header(7, 1, 10);
+    other_stream.resize(other_stream.size() + 10);
+    bad.push_back(other_stream);
+    while (receiving.load())
+      for (const auto& d : bad) {
+        sendto(fd, d.data(), d.size(), 0, reinterpret_cast<const sockaddr*>(&to), sizeof to);
+        std::this_thread::sleep_for(std::chrono::milliseconds(2));
+      }
+    close(fd);
+  });
+  std::map<uint32_t, Received> received;
+  client::MulticastStats stats;
+  std::string error;
+  std::thread receiver([&] {
+    try {
+      lan_->enter(kClean);
+      client::Subscriber sub(options_on(kClean));
+      received = test::collect_frames(sub, 30, std::chrono::seconds(60));
+      stats = sub.multicast_stats();
+    } catch (const std::exception& e) {
+      error = e.what();
+    }
+    receiving.store(false);
+  });
+  receiver.join();
+  vandal.join();
+  ASSERT_EQ(error, "");
+  EXPECT_EQ(received.size(), 30u);
+  EXPECT_GT(stats.datagrams_rejected, 10u);
+  EXPECT_GT(stats.datagrams_other_stream, 3u);
+  EXPECT_EQ(stats.frames_lost, 0u);
+  EXPECT_NE(stats.last_error.find("bad datagram"), std::string::npos) << stats.last_error;
+  EXPECT_EQ(stats.last_error.find('\n'), std::string::npos) << stats.last_error;
+  std::printf("%llu bad datagrams rejected (last: %s), %llu of another stream; %zu frames\n",
+              static_cast<unsigned long long>(stats.datagrams_rejected), stats.last_error.c_str(),
+              static_cast<unsigned long long>(stats.datagrams_other_stream), received.size());
 }
 
 }  // namespace
