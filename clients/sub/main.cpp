@@ -69,8 +69,8 @@ int main(int argc, char** argv) {
   app.add_option("--token", token, "the daemon's shared token, when it has one");
   app.add_option("--protocol", protocol, "subscriber protocol version: 2 (default) or 1 (float and quantised only)")->check(CLI::Range(1, 2));
   app.add_option("--multicast", multicast,
-                 "GROUP:PORT: the frames from the daemon's multicast group (its --multicast), evaluated here; MeshInfo and the Model "
-                 "still come from ADDRESS over TCP");
+                 "GROUP:PORT: the parameters of every frame from the daemon's multicast group (its --multicast; --evaluate "
+                 "turns them into vertices); MeshInfo and the Model still come from ADDRESS over TCP");
   app.add_option("--multicast-interface", multicast_interface, "multicast: this host's IPv4 address to join the group on");
   app.add_option("--multicast-stream", multicast_stream, "multicast: the subject's stream id (0: the daemon's first)");
   app.add_option("--frames", frames_wanted, "exit after this many frames (0 = run until the daemon closes)");
@@ -115,7 +115,6 @@ int main(int argc, char** argv) {
       options.multicast.interface_address = multicast_interface;
       options.multicast.stream_id = multicast_stream;
       options.encoding = client::Encoding::Parameters;
-      options.evaluate = true;
     }
     if (save_every > 0) std::filesystem::create_directories(save_dir);
     client::Subscriber sub(options);
@@ -244,6 +243,7 @@ int main(int argc, char** argv) {
                               {"datagrams_other_stream", m.datagrams_other_stream},
                               {"datagrams_late", m.datagrams_late},
                               {"datagrams_duplicate", m.datagrams_duplicate},
+                              {"frames_superseded", m.frames_superseded},
                               {"messages_rejected", m.messages_rejected},
                               {"last_error", m.last_error}};
     }

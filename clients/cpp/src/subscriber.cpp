@@ -60,6 +60,9 @@ struct Subscriber::State {
   std::optional<wire::DatagramReassembler> reassembler;
   std::vector<unsigned char> datagram;
   uint32_t model_id = 0;
+  std::vector<unsigned char> ready_message;  // the newest complete frame, not yet handed out
+  int64_t ready_arrival_ns = 0;
+  uint64_t superseded = 0;
   uint64_t messages_rejected = 0;
   std::string last_error;
 
@@ -76,6 +79,8 @@ struct Subscriber::State {
   bool read_connection(Frame& frame, std::chrono::steady_clock::time_point deadline);
   // Reads the group's datagrams until a frame is ready (true) or the deadline passes.
   bool read_group(Frame& frame, std::chrono::steady_clock::time_point deadline);
+  // Decodes and evaluates ready_message into `frame` (false: it broke the protocol; counted).
+  bool take_ready_message(Frame& frame);
   void reject(const std::string& what);
 };
 
@@ -99,12 +104,13 @@ Subscriber::Subscriber(Options options) : state_(std::make_unique<State>()) {
   hello.subject = o.subject;
   hello.token = o.token;
   if (!o.multicast.group.empty()) {
-    if (s.version != wire::kVersion2 || o.encoding != Encoding::Parameters || o.paced || !o.evaluate || !o.mesh)
-      throw std::invalid_argument("multicast carries evaluated parameters only: encoding parameters, protocol 2, not paced");
+    if (s.version != wire::kVersion2 || o.encoding != Encoding::Parameters || o.paced || !o.mesh)
+      throw std::invalid_argument("multicast carries the parameters of the mesh only: encoding parameters, protocol 2, not paced");
     // Joined first, so the group's datagrams wait in the socket while the Model comes.
     s.group.emplace(o.multicast.group, o.multicast.port, o.multicast.interface_address);
     s.reassembler.emplace(wire::DatagramReassembler::Options{o.multicast.stream_id, o.multicast.window});
     s.datagram.resize(kDatagramReadBytes);
+    s.ready_message.reserve(wire::kMaxDatagramMessageBytes);
     hello.wants &= ~(wire::kWantMarkers);  // the group's frames carry none
   }
   s.connection.emplace(o.host, o.port, o.connect_timeout);
@@ -169,11 +175,20 @@ bool Subscriber::State::read_connection(Frame& frame, std::chrono::steady_clock:
 
 bool Subscriber::State::read_group(Frame& frame, std::chrono::steady_clock::time_point deadline) {
   for (;;) {
+    // The newest complete frame wins: once one is complete, the datagrams already waiting are
+    // read too (without waiting), and a newer frame among them replaces it. A reader slower than
+    // the stream so skips frames instead of falling behind by what the socket buffer holds.
+    const bool have_one = !ready_message.empty();
     const auto now = std::chrono::steady_clock::now();
     reassembler->expire(now);
-    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - now);
-    const size_t n = group->receive(datagram, std::max(left, std::chrono::milliseconds(0)));
+    const auto left = have_one ? std::chrono::milliseconds(0)
+                               : std::max(std::chrono::duration_cast<std::chrono::milliseconds>(deadline - now), std::chrono::milliseconds(0));
+    const size_t n = group->receive(datagram, left);
     if (n == 0) {
+      if (have_one) {
+        if (take_ready_message(frame)) return true;
+        continue;
+      }
       if (std::chrono::steady_clock::now() >= deadline) return false;
       continue;
     }
@@ -193,24 +208,33 @@ bool Subscriber::State::read_group(Frame& frame, std::chrono::steady_clock::time
                     message->header.model_id, model_id);
       throw Error(text);
     }
-    // Anyone on the LAN can send to the group: a message that breaks the protocol is counted,
-    // never the end of the stream.
-    try {
-      const wire::MessageHeader header = wire::decode_header(message->bytes);
-      if (header.type != wire::MessageType::Frame || header.version != wire::kVersion2 ||
-          header.payload_bytes != message->bytes.size() - wire::kHeaderBytes)
-        throw wire::DecodeError(std::string("a ") + wire::to_string(header.type) + " message of version " + std::to_string(header.version) +
-                                " and " + std::to_string(header.payload_bytes) + " bytes, not a version 2 Frame filling the datagrams");
-      const std::span<const unsigned char> payload = message->bytes.subspan(wire::kHeaderBytes);
-      if (!(wire::decode_frame_info(payload, version).flags & wire::kFrameParameters))
-        throw wire::DecodeError("a Frame without parameters");
-      if (on_frame(payload, frame)) return true;
-    } catch (const wire::DecodeError& e) {
-      reject(std::string("bad multicast frame: ") + e.what());
-    } catch (const Error& e) {
-      reject(std::string("bad multicast frame: ") + e.what());
-    }
+    if (have_one) ++superseded;
+    ready_message.assign(message->bytes.begin(), message->bytes.end());  // within its capacity: allocates once
+    ready_arrival_ns = arrival_ns;
   }
+}
+
+bool Subscriber::State::take_ready_message(Frame& frame) {
+  const std::span<const unsigned char> bytes = ready_message;
+  arrival_ns = ready_arrival_ns;
+  bool ready = false;
+  // Anyone on the LAN can send to the group: a message that breaks the protocol is counted,
+  // never the end of the stream.
+  try {
+    const wire::MessageHeader header = wire::decode_header(bytes);
+    if (header.type != wire::MessageType::Frame || header.version != wire::kVersion2 || header.payload_bytes != bytes.size() - wire::kHeaderBytes)
+      throw wire::DecodeError(std::string("a ") + wire::to_string(header.type) + " message of version " + std::to_string(header.version) +
+                              " and " + std::to_string(header.payload_bytes) + " bytes, not a version 2 Frame filling the datagrams");
+    const std::span<const unsigned char> payload = bytes.subspan(wire::kHeaderBytes);
+    if (!(wire::decode_frame_info(payload, version).flags & wire::kFrameParameters)) throw wire::DecodeError("a Frame without parameters");
+    ready = on_frame(payload, frame);
+  } catch (const wire::DecodeError& e) {
+    reject(std::string("bad multicast frame: ") + e.what());
+  } catch (const Error& e) {
+    reject(std::string("bad multicast frame: ") + e.what());
+  }
+  ready_message.clear();
+  return ready;
 }
 
 void Subscriber::State::reject(const std::string& what) {
@@ -372,8 +396,8 @@ MulticastStats Subscriber::multicast_stats() const {
   const State& s = *state_;
   if (!s.reassembler) return {};
   const wire::DatagramReassembler::Stats& r = s.reassembler->stats();
-  return {r.datagrams,          r.frames_completed, r.frames_lost,         r.frames_incomplete, r.datagrams_rejected,
-          r.datagrams_other_stream, r.datagrams_late, r.datagrams_duplicate, s.messages_rejected, s.last_error};
+  return {r.datagrams,          r.frames_completed,    r.frames_lost,    r.frames_incomplete,   r.datagrams_rejected,
+          r.datagrams_other_stream, r.datagrams_late, r.datagrams_duplicate, s.superseded, s.messages_rejected, s.last_error};
 }
 
 }  // namespace skinstream::client

@@ -33,7 +33,9 @@ Encoding encoding_from_string(const std::string& name);
 // Frames from the daemon's multicast group instead of the TCP connection (the daemon's
 // --multicast; docs/subscriber-protocol.md, "Multicast"): the Subscriber fetches MeshInfo and the
 // Model over TCP from host:port, closes that connection, and then reads the parameters of every
-// frame from the group. A lost datagram costs the frame it carried; next() never waits for it.
+// frame from the group. A lost datagram costs the frame it carried; next() never waits for it,
+// and gives the newest complete frame (a reader slower than the stream skips frames instead of
+// falling behind by what the socket buffer holds).
 struct MulticastOptions {
   std::string group{};                       // IPv4 multicast address; empty: frames over TCP
   uint16_t port = 0;
@@ -52,6 +54,7 @@ struct MulticastStats {
   uint64_t datagrams_other_stream = 0;
   uint64_t datagrams_late = 0;      // for a frame already complete or given up
   uint64_t datagrams_duplicate = 0;
+  uint64_t frames_superseded = 0;   // complete, and a newer one was complete before next() took it
   uint64_t messages_rejected = 0;   // whole messages that broke the protocol
   std::string last_error{};         // one line, of the last datagram or message rejected
 };
