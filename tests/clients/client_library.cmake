@@ -5,7 +5,8 @@ if(TARGET skinstreamd AND TARGET skinstream_client)
     ${PROJECT_SOURCE_DIR}/tests/support/test_data.cpp ${PROJECT_SOURCE_DIR}/tests/support/daemon_process.cpp
     ${PROJECT_SOURCE_DIR}/tests/support/bridged_namespaces.cpp ${PROJECT_SOURCE_DIR}/tests/support/program_run.cpp)
   target_include_directories(client_library_tests PRIVATE ${PROJECT_SOURCE_DIR}/tests)
-  target_link_libraries(client_library_tests PRIVATE skinstream_client nlohmann_json::nlohmann_json GTest::gtest_main)
+  # skinstream_server for the daemon process harness the bench shares (server/client/daemon_process.h).
+  target_link_libraries(client_library_tests PRIVATE skinstream_client skinstream_server nlohmann_json::nlohmann_json GTest::gtest_main)
   target_compile_definitions(client_library_tests PRIVATE
     SKINSTREAMD="$<TARGET_FILE:skinstreamd>"
     SKINSTREAM_DEMO_DIR="${CMAKE_BINARY_DIR}/demo"

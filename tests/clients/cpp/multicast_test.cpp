@@ -18,7 +18,8 @@
 
 #include "skinstream/client.h"
 #include "support/bridged_namespaces.h"
-#include "support/daemon_process.h"
+#include "server/client/daemon_process.h"
+#include "support/test_data.h"
 #include "support/program_run.h"
 #include "support/received_vertices.h"
 
@@ -42,11 +43,18 @@ class MulticastDemo : public ::testing::Test {
     lan_ = std::make_unique<test::BridgedNamespaces>(kHosts);
     const std::string demo = SKINSTREAM_DEMO_DIR;
     // A fifth of real time, as the TCP test: the float reference takes every frame on this shared machine.
-    daemon_ = std::make_unique<test::DaemonProcess>(
-        SKINSTREAMD,
-        "--subject " + demo + "/subject.sksubj --replay " + demo + "/live.c3d --loop --speed 0.2 --multicast " + kGroup + ":" +
-            std::to_string(kGroupPort) + " --multicast-interface " + lan_->address(kDaemonHost),
-        lan_->exec_prefix(kDaemonHost), "0.0.0.0");
+    server::DaemonLaunch launch;
+    launch.program = SKINSTREAMD;
+    launch.arguments = "--subject " + demo + "/subject.sksubj --replay " + demo + "/live.c3d --loop --speed 0.2 --multicast " + kGroup + ":" +
+                       std::to_string(kGroupPort) + " --multicast-interface " + lan_->address(kDaemonHost);
+    launch.exec_prefix = lan_->exec_prefix(kDaemonHost);
+    launch.bind = "0.0.0.0";  // the receivers reach it over the bridge
+    launch.files_stem = test::scratch_path("multicast_daemon_" + std::to_string(getpid()));
+    try {
+      daemon_ = std::make_unique<server::DaemonProcess>(launch);
+    } catch (const std::exception& e) {
+      startup_error_ = e.what();
+    }
   }
   static void TearDownTestSuite() {
     if (daemon_) {
@@ -57,13 +65,13 @@ class MulticastDemo : public ::testing::Test {
   }
   void SetUp() override {
     if (!skip_reason_.empty()) GTEST_SKIP() << skip_reason_;
-    ASSERT_GT(daemon_->sub_port, 0);
+    ASSERT_TRUE(daemon_) << startup_error_;
   }
 
   static client::Options options_on(int host) {
     client::Options o;
     o.host = lan_->address(kDaemonHost);
-    o.port = static_cast<uint16_t>(daemon_->sub_port);
+    o.port = static_cast<uint16_t>(daemon_->sub_port());
     o.connect_timeout = std::chrono::seconds(10);
     o.multicast = {kGroup, kGroupPort, lan_->address(host), 0, std::chrono::milliseconds(50)};
     return o;
@@ -74,7 +82,7 @@ class MulticastDemo : public ::testing::Test {
     lan_->enter(kReferenceHost);
     client::Options o;
     o.host = lan_->address(kDaemonHost);
-    o.port = static_cast<uint16_t>(daemon_->sub_port);
+    o.port = static_cast<uint16_t>(daemon_->sub_port());
     o.encoding = client::Encoding::Float;
     client::Subscriber sub(o);
     return test::collect_frames(sub, count, std::chrono::seconds(120));
@@ -82,7 +90,8 @@ class MulticastDemo : public ::testing::Test {
 
   static inline std::string skip_reason_;
   static inline std::unique_ptr<test::BridgedNamespaces> lan_;
-  static inline std::unique_ptr<test::DaemonProcess> daemon_;
+  static inline std::unique_ptr<server::DaemonProcess> daemon_;
+  static inline std::string startup_error_;
 };
 
 TEST_F(MulticastDemo, EveryReceiverEvaluatesTheDaemonsVertices) {
