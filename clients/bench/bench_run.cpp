@@ -20,6 +20,7 @@
 
 #include "clients/bench/latency_samples.h"
 #include "clients/bench/process_usage.h"
+#include "clients/bench/replay_engine.h"
 #include "clients/bench/send_times.h"
 #include "clients/bench/shaped_link.h"
 #include "clients/bench/stall_log.h"
@@ -27,7 +28,6 @@
 #include "protocol/file_error.h"
 #include "server/client/daemon_process.h"
 #include "server/tcp_congestion.h"
-#include "server/vicon/vicon_server.h"
 
 namespace skinstream::bench {
 namespace {
@@ -41,8 +41,8 @@ int64_t wall_clock_ns() {
   return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch()).count();
 }
 
-std::string daemon_arguments(const BenchOptions& o, const std::string& vicon_address) {
-  std::string a = "--subject " + server::shell_word(o.subject) + " --vicon " + vicon_address + " --deform-threads " +
+std::string daemon_arguments(const BenchOptions& o, const std::string& source_option) {
+  std::string a = "--subject " + server::shell_word(o.subject) + " " + source_option + " --deform-threads " +
                   std::to_string(o.deform_threads) + " --log-level warn";
   if (!o.deform_cpus.empty()) a += " --deform-cpus " + server::shell_word(o.deform_cpus);
   if (o.deform_spin_lead_us >= 0) a += " --deform-spin-lead-us " + std::to_string(o.deform_spin_lead_us);
@@ -119,9 +119,17 @@ void subscribe(const BenchOptions& o, const std::string& host, int port, int ind
   tally.model_bytes = subscriber.model_bytes();
 }
 
+// Sleeps until `until`, in short steps, throwing once `stop` is set.
+void sleep_until_or_stop(Clock::time_point until, const std::atomic<bool>& stop) {
+  while (Clock::now() < until) {
+    if (stop.load()) throw std::runtime_error("interrupted");
+    std::this_thread::sleep_until(std::min(until, Clock::now() + std::chrono::milliseconds(50)));
+  }
+}
+
 }  // namespace
 
-nlohmann::json run_bench(const BenchOptions& o) {
+nlohmann::json run_bench(const BenchOptions& o, const std::atomic<bool>& stop) {
   const fs::path daemon_path = own_folder() / "skinstreamd";
   if (!fs::exists(daemon_path)) throw std::runtime_error(daemon_path.string() + ": skinstreamd not found next to skinstream-bench");
   const Capture capture = read_capture(o.recording);
@@ -145,13 +153,12 @@ nlohmann::json run_bench(const BenchOptions& o) {
 
   // The replay server: looping, its timeline from the daemon's first frame request.
   server::asio::io_context replay_io;
-  server::ViconServerOptions replay_options;
+  ReplayEngineOptions replay_options;
+  replay_options.protocol = o.protocol;
   replay_options.bind_address = replay_address;
-  replay_options.port = 0;
-  replay_options.loop = true;
   replay_options.tcp_congestion = o.replay_tcp_congestion;
   replay_options.subject_name = o.vicon_subject_name.empty() ? fs::path(o.recording).stem().string() : o.vicon_subject_name;
-  server::ViconServer replay(replay_io, capture, replay_options);
+  ReplayEngine replay(replay_io, capture, replay_options);
   StallLog stalls;  // before send_times, which writes to it until the replay stops
   SendTimes send_times;
   replay.set_frame_hook([&send_times](uint32_t frame_number, int64_t send_ns) { send_times.record(frame_number, send_ns); });
@@ -172,7 +179,7 @@ nlohmann::json run_bench(const BenchOptions& o) {
 
   server::DaemonLaunch launch;
   launch.program = daemon_path.string();
-  launch.arguments = daemon_arguments(o, replay_address + ":" + std::to_string(replay.port()));
+  launch.arguments = daemon_arguments(o, replay.daemon_source_option());
   launch.bind = daemon_address;
   launch.files_stem = (work / "skinstreamd").string();
   if (link)
@@ -208,29 +215,29 @@ nlohmann::json run_bench(const BenchOptions& o) {
   while (window.subscribers_ready.load() < o.subscribers) {
     if (Clock::now() > ready_deadline) throw std::runtime_error("the subscribers did not all get a frame within 120 s");
     if (!daemon.running()) throw std::runtime_error("skinstreamd exited:\n" + daemon.log());
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    sleep_until_or_stop(Clock::now() + std::chrono::milliseconds(10), stop);
   }
   const double seconds_to_first_frames = std::chrono::duration<double>(Clock::now() - connect_started).count();
-  std::this_thread::sleep_for(std::chrono::milliseconds(500));  // let the joins' backlog drain
+  sleep_until_or_stop(Clock::now() + std::chrono::milliseconds(500), stop);  // let the joins' backlog drain
 
   const nlohmann::json health_before = daemon.health();
   const int64_t period_ns = static_cast<int64_t>(1e9 / capture.rate_hz);
   const int64_t window_start_ns = wall_clock_ns();
   stalls.start(window_start_ns);
   send_times.start_counting(period_ns, &stalls);
-  const uint64_t sent_before = replay.stats().frame_packets_sent.load();
-  const uint64_t replay_dropped_before = replay.stats().frames_dropped.load();
+  const uint64_t sent_before = replay.frames_sent();
+  const uint64_t replay_dropped_before = replay.frames_dropped();
   const double cpu_before = cpu_seconds(daemon.pid());
   const double own_cpu_before = cpu_seconds(getpid());
   window.start_ns = window_start_ns;
-  const auto deadline = Clock::now() + std::chrono::duration<double>(o.seconds);
+  const Clock::time_point deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(o.seconds));
 
   // RSS once a second: the first sample after warm-up against the last.
   std::vector<long> rss_samples;
   nlohmann::json rss_steps = nlohmann::json::array();
   uint64_t buffers_after_1s = 0;  // the daemon's encoded frame buffers: RSS steps when they grow
   for (auto next = Clock::now() + std::chrono::seconds(1); next < deadline; next += std::chrono::seconds(1)) {
-    std::this_thread::sleep_until(next);
+    sleep_until_or_stop(next, stop);
     rss_samples.push_back(resident_kb(daemon.pid()));
     // Every step of RSS, with its time on the stall log's clock: a leak climbs steadily, memory
     // touched for the first time (a backlog reaching buffers never used before) steps once.
@@ -238,12 +245,12 @@ nlohmann::json run_bench(const BenchOptions& o) {
       rss_steps.push_back({{"at_s", (wall_clock_ns() - window_start_ns) * 1e-9}, {"kb", rss_samples.back() - rss_samples[rss_samples.size() - 2]}});
     if (rss_samples.size() == 1) buffers_after_1s = daemon.health().value("frame_buffers_allocated", 0);
   }
-  std::this_thread::sleep_until(deadline);
+  sleep_until_or_stop(deadline, stop);
   const int64_t window_end_ns = wall_clock_ns();
   window.end_ns = window_end_ns;
   const nlohmann::json health = daemon.health();
-  const uint64_t sent = replay.stats().frame_packets_sent.load() - sent_before;
-  const uint64_t replay_dropped = replay.stats().frames_dropped.load() - replay_dropped_before;
+  const uint64_t sent = replay.frames_sent() - sent_before;
+  const uint64_t replay_dropped = replay.frames_dropped() - replay_dropped_before;
   const double cpu = cpu_seconds(daemon.pid()) - cpu_before;
   const long peak_rss_kb = peak_resident_kb(daemon.pid());
   const double own_cpu = cpu_seconds(getpid()) - own_cpu_before;
@@ -283,12 +290,13 @@ nlohmann::json run_bench(const BenchOptions& o) {
   auto delta = [&](const char* key) { return health["frames"][key].get<uint64_t>() - health_before["frames"][key].get<uint64_t>(); };
   const double bytes_per_frame = all.received > 0 ? static_cast<double>(all.message_bytes) / all.received : 0.0;
   nlohmann::json report = {
-      {"mode", std::string("Vicon DataStream replay (in-process) -> skinstreamd --vicon -> subscribers, ") +
+      {"mode", std::string(to_string(o.protocol)) + " replay (in-process) -> skinstreamd -> subscribers, " +
                    (link ? "over a " + std::to_string(o.link_mbit) + " Mbit/s shaped link" : std::string("on loopback"))},
       {"seconds", o.seconds},
       {"window_seconds", window_s},
       {"subscribers", o.subscribers},
       {"encoding", client::to_string(o.encoding)},
+      {"protocol", to_string(o.protocol)},
       {"link_mbit", o.link_mbit},
       {"subscribers_want", {{"normals", o.normals}, {"quantised", o.encoding == client::Encoding::Quantised}, {"decode", o.decode}, {"paced", o.paced}}},
       {"seconds_until_every_subscriber_had_a_frame", seconds_to_first_frames},

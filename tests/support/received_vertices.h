@@ -4,7 +4,6 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <map>
@@ -24,18 +23,10 @@ struct Difference {
   int frames = 0;               // frames both received
 };
 
-// Frames by number from a subscriber of the client library, until it has `count` (or gives up).
-inline std::map<uint32_t, Received> collect_frames(client::Subscriber& sub, int count, std::chrono::seconds give_up) {
-  std::map<uint32_t, Received> frames;
-  client::Frame frame;
-  const auto end = std::chrono::steady_clock::now() + give_up;
-  while (static_cast<int>(frames.size()) < count && std::chrono::steady_clock::now() < end) {
-    if (!sub.next(frame, std::chrono::seconds(1))) continue;
-    Received& r = frames[frame.frame_number];
-    r.positions.assign(frame.positions.begin(), frame.positions.end());
-    r.normals.assign(frame.normals.begin(), frame.normals.end());
-  }
-  return frames;
+// What receive_frames() (support/client_frames.h) keeps of each frame for compare().
+inline void keep_vertices(const client::Frame& frame, Received& r) {
+  r.positions.assign(frame.positions.begin(), frame.positions.end());
+  r.normals.assign(frame.normals.begin(), frame.normals.end());
 }
 
 inline Difference compare(const std::map<uint32_t, Received>& reference, const std::map<uint32_t, Received>& other) {

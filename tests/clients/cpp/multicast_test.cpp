@@ -18,6 +18,7 @@
 
 #include "skinstream/client.h"
 #include "support/bridged_namespaces.h"
+#include "support/client_frames.h"
 #include "server/client/daemon_process.h"
 #include "support/test_data.h"
 #include "support/program_run.h"
@@ -85,7 +86,7 @@ class MulticastDemo : public ::testing::Test {
     o.port = static_cast<uint16_t>(daemon_->sub_port());
     o.encoding = client::Encoding::Float;
     client::Subscriber sub(o);
-    return test::collect_frames(sub, count, std::chrono::seconds(120));
+    return test::receive_frames<Received>(sub, count, test::keep_vertices);
   }
 
   static inline std::string skip_reason_;
@@ -106,7 +107,7 @@ TEST_F(MulticastDemo, EveryReceiverEvaluatesTheDaemonsVertices) {
       try {
         lan_->enter(kClean + r);
         client::Subscriber sub(options_on(kClean + r));
-        received[r] = test::collect_frames(sub, kFrames, std::chrono::seconds(120));
+        received[r] = test::receive_frames<Received>(sub, kFrames, test::keep_vertices);
         stats[r] = sub.multicast_stats();
       } catch (const std::exception& e) {
         errors[r] = e.what();
@@ -158,9 +159,7 @@ TEST_F(MulticastDemo, ALossyReceiverLosesOnlyTheFramesItsDatagramsCarried) {
         const auto now = std::chrono::steady_clock::now();
         longest_wait_s = std::max(longest_wait_s, std::chrono::duration<double>(now - last).count());
         last = now;
-        Received& r = received[frame.frame_number];
-        r.positions.assign(frame.positions.begin(), frame.positions.end());
-        r.normals.assign(frame.normals.begin(), frame.normals.end());
+        test::keep_vertices(frame, received[frame.frame_number]);
       }
       stats = sub.multicast_stats();
     } catch (const std::exception& e) {
@@ -248,7 +247,7 @@ TEST_F(MulticastDemo, BadDatagramsOnTheGroupAreCountedAndTheStreamGoesOn) {
     try {
       lan_->enter(kClean);
       client::Subscriber sub(options_on(kClean));
-      received = test::collect_frames(sub, 30, std::chrono::seconds(60));
+      received = test::receive_frames<Received>(sub, 30, test::keep_vertices);
       stats = sub.multicast_stats();
     } catch (const std::exception& e) {
       error = e.what();

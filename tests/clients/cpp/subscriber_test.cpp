@@ -13,6 +13,7 @@
 #include <mutex>
 #include <thread>
 
+#include "support/client_frames.h"
 #include "support/daemon_process.h"
 #include "support/received_vertices.h"
 #include "support/test_data.h"
@@ -32,7 +33,7 @@ std::map<uint32_t, Received> receive(uint16_t port, Encoding encoding, bool norm
   options.encoding = encoding;
   options.normals = normals;
   client::Subscriber sub(options);
-  std::map<uint32_t, Received> frames = test::collect_frames(sub, count, std::chrono::seconds(120));
+  auto frames = test::receive_frames<Received>(sub, count, test::keep_vertices);
   EXPECT_EQ(sub.mesh().encoding, encoding);
   if (model_bytes) *model_bytes = sub.model_bytes();
   return frames;
