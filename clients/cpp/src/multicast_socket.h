@@ -20,8 +20,10 @@ class MulticastSocket {
   MulticastSocket& operator=(const MulticastSocket&) = delete;
 
   // Waits up to `timeout` for a datagram and reads it into `into`: its size (cut to `into`'s
-  // size when longer, which the protocol then rejects), 0 on timeout. Throws Error when the read fails.
-  size_t receive(std::span<unsigned char> into, std::chrono::milliseconds timeout);
+  // size when longer, which the protocol then rejects), 0 on timeout. `out_arrival` is when the
+  // kernel received it (on the steady clock), not when it was read: a reader busy with the last
+  // frame must not think the next one's datagrams came late. Throws Error when the read fails.
+  size_t receive(std::span<unsigned char> into, std::chrono::milliseconds timeout, std::chrono::steady_clock::time_point& out_arrival);
 
  private:
   int fd_ = -1;

@@ -180,11 +180,13 @@ bool Subscriber::State::read_group(Frame& frame, std::chrono::steady_clock::time
     // the stream so skips frames instead of falling behind by what the socket buffer holds.
     const bool have_one = !ready_message.empty();
     const auto now = std::chrono::steady_clock::now();
-    reassembler->expire(now);
     const auto left = have_one ? std::chrono::milliseconds(0)
                                : std::max(std::chrono::duration_cast<std::chrono::milliseconds>(deadline - now), std::chrono::milliseconds(0));
-    const size_t n = group->receive(datagram, left);
+    std::chrono::steady_clock::time_point arrival;
+    const size_t n = group->receive(datagram, left, arrival);
     if (n == 0) {
+      // Nothing waiting: a frame begun longer than the window ago will not complete.
+      reassembler->expire(std::chrono::steady_clock::now());
       if (have_one) {
         if (take_ready_message(frame)) return true;
         continue;
@@ -196,7 +198,7 @@ bool Subscriber::State::read_group(Frame& frame, std::chrono::steady_clock::time
     arrival_ns = wall_clock_ns();
     std::optional<wire::DatagramReassembler::Message> message;
     try {
-      message = reassembler->add(std::span<const unsigned char>(datagram).first(n), std::chrono::steady_clock::now());
+      message = reassembler->add(std::span<const unsigned char>(datagram).first(n), arrival);
     } catch (const wire::DecodeError& e) {
       last_error = std::string("bad datagram: ") + e.what();  // counted by the reassembler
       continue;
