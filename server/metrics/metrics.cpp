@@ -55,6 +55,12 @@ double LatencyHistogram::quantile_upper_bound_ms(double q, uint64_t total, int64
   return max_ms;  // beyond the last bound
 }
 
+LatencyHistogram::Buckets LatencyHistogram::bucket_counts() const {
+  Buckets counts;
+  for (size_t b = 0; b < kBounds.size(); ++b) counts[b] = buckets_[b].load(std::memory_order_relaxed);
+  return counts;
+}
+
 LatencyHistogram::Summary LatencyHistogram::summary() const {
   Summary s;
   s.count = count_.load(std::memory_order_relaxed);

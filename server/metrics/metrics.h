@@ -32,6 +32,9 @@ class LatencyHistogram {
     double p50_le_ms = 0, p99_le_ms = 0, p99_9_le_ms = 0, max_ms = 0;
   };
   Summary summary() const;
+  // Each bucket's count now (not cumulative): the difference of two gives an interval's histogram.
+  using Buckets = std::array<uint64_t, kBounds.size()>;
+  Buckets bucket_counts() const;
 
  private:
   double quantile_upper_bound_ms(double q, uint64_t total, int64_t max_ns) const;
