@@ -57,7 +57,7 @@ void apply_json(const nlohmann::json& json, DaemonConfig& c, const std::string& 
                                       "deform_cpus", "deform_spin_lead_us",
                                       "continuity_seconds", "use_pca", "ports_file", "log_level", "hello_timeout_ms",
                                       "subscriber_queue_frames", "subscriber_tcp_congestion", "publish_threads", "status_interval_ms", "status_log_seconds", "default_rate_hz",
-                                      "compressed_key_interval", "source_max_subjects", "source_max_markers_per_subject",
+                                      "compressed_key_interval", "multicast", "multicast_interface", "multicast_ttl", "source_max_subjects", "source_max_markers_per_subject",
                                       "source_max_name_bytes"};
   for (const auto& [key, value] : json.items()) {
     bool known = false;
@@ -106,6 +106,9 @@ void apply_json(const nlohmann::json& json, DaemonConfig& c, const std::string& 
   take(json, "status_interval_ms", c.status_interval_ms, origin);
   take(json, "status_log_seconds", c.status_log_seconds, origin);
   take(json, "default_rate_hz", c.default_rate_hz, origin);
+  take(json, "multicast", c.multicast, origin);
+  take(json, "multicast_interface", c.multicast_interface, origin);
+  take(json, "multicast_ttl", c.multicast_ttl, origin);
   take(json, "source_max_subjects", c.source_max_subjects, origin);
   take(json, "source_max_markers_per_subject", c.source_max_markers_per_subject, origin);
   take(json, "source_max_name_bytes", c.source_max_name_bytes, origin);
@@ -162,6 +165,9 @@ nlohmann::json to_json(const DaemonConfig& c) {
           {"status_interval_ms", c.status_interval_ms},
           {"status_log_seconds", c.status_log_seconds},
           {"default_rate_hz", c.default_rate_hz},
+          {"multicast", c.multicast},
+          {"multicast_interface", c.multicast_interface},
+          {"multicast_ttl", c.multicast_ttl},
           {"source_max_subjects", c.source_max_subjects},
           {"source_max_markers_per_subject", c.source_max_markers_per_subject},
           {"source_max_name_bytes", c.source_max_name_bytes}};
@@ -216,6 +222,15 @@ void validate(const DaemonConfig& c) {
   if (!c.natnet.empty() && !parse_host_with_port(c.natnet, 1510))
     fail("natnet must be HOST or HOST:PORT with a port of 1-65535 (the command port is 1510), not \"" + c.natnet + "\"");
   in_addr address{};
+  if (!c.multicast.empty()) {
+    const std::optional<HostPort> group = parse_host_port(c.multicast);
+    if (!group || inet_pton(AF_INET, group->host.c_str(), &address) != 1 || !IN_MULTICAST(ntohl(address.s_addr)))
+      fail("multicast must be GROUP:PORT with an IPv4 multicast group (224.0.0.0-239.255.255.255; 239.x.x.x is for a site's own use) "
+           "and a port of 1-65535, not \"" + c.multicast + "\"");
+  }
+  if (inet_pton(AF_INET, c.multicast_interface.c_str(), &address) != 1)
+    fail("multicast_interface must be an IPv4 address of this host (0.0.0.0: the system's route), not \"" + c.multicast_interface + "\"");
+  if (c.multicast_ttl < 0 || c.multicast_ttl > 255) fail("multicast_ttl must be 0-255");
   if (inet_pton(AF_INET, c.natnet_interface.c_str(), &address) != 1) fail("natnet_interface must be an IPv4 address of this host, not \"" + c.natnet_interface + "\"");
 }
 
@@ -260,6 +275,11 @@ std::optional<CommandLine> parse_command_line(int argc, const char* const* argv,
   auto* natnet = app.add_option("--natnet", flags.natnet, "OptiTrack NatNet server HOST[:PORT] as the source (command port, 1510)");
   auto* natnet_interface = app.add_option("--natnet-interface", flags.natnet_interface,
                                           "NatNet: this host's IPv4 address to join the multicast group on");
+  auto* multicast = app.add_option("--multicast", flags.multicast,
+                                   "also send every frame's parameters to this IPv4 multicast GROUP:PORT (docs/subscriber-protocol.md)");
+  auto* multicast_interface = app.add_option("--multicast-interface", flags.multicast_interface,
+                                             "multicast: this host's IPv4 address to send from (default: the system's route)");
+  auto* multicast_ttl = app.add_option("--multicast-ttl", flags.multicast_ttl, "multicast: hops the datagrams may cross (default 1: this link)");
   auto* bind = app.add_option("--bind", flags.bind_address, "address to listen on");
   auto* http_port = app.add_option("--http-port", flags.http_port, "HTTP/WebSocket port (0 = ephemeral)");
   auto* sub_port = app.add_option("--sub-port", flags.sub_port, "TCP subscriber port (0 = ephemeral)");
@@ -302,6 +322,9 @@ std::optional<CommandLine> parse_command_line(int argc, const char* const* argv,
     c.natnet = given(natnet) ? flags.natnet : std::string();
   }
   if (given(natnet_interface)) c.natnet_interface = flags.natnet_interface;
+  if (given(multicast)) c.multicast = flags.multicast;
+  if (given(multicast_interface)) c.multicast_interface = flags.multicast_interface;
+  if (given(multicast_ttl)) c.multicast_ttl = flags.multicast_ttl;
   if (given(loop)) c.loop = flags.loop;
   if (given(speed)) c.speed = flags.speed;
   if (given(vicon_pull)) c.vicon_pull = flags.vicon_pull;

@@ -58,6 +58,9 @@ struct DaemonConfig {
   int compressed_key_interval = 10;  // frames between key frames of the compressed encoding
   int status_interval_ms = 1000;
   int status_log_seconds = 5;  // a status line per subject in the log this often (0: none)
+  std::string multicast;          // GROUP:PORT: also send every frame's parameters to this IPv4 multicast group; empty = off
+  std::string multicast_interface = "0.0.0.0";  // multicast: this host's address to send from; 0.0.0.0 = the system's route
+  int multicast_ttl = 1;          // multicast: hops the datagrams may cross (1: this link)
   double default_rate_hz = 120.0;  // until the source says its rate
   // What one source message may describe (vicon::DescriptionLimits); more is a malformed packet.
   int source_max_subjects = 128;

@@ -19,6 +19,7 @@
 #include "server/ingest/vicon_source.h"
 #include "server/listener.h"
 #include "server/pipeline/deform_cpus.h"
+#include "server/publish/multicast_sender.h"
 #include "server/publish/subscriber_hub.h"
 #include "server/publish/tcp_subscriber.h"
 #include "server/thread_name.h"
@@ -38,6 +39,8 @@ std::vector<int> deform_cpus_of(const DaemonConfig& config) {
                       (subjects > 1 ? " (deform_threads for each of the " + std::to_string(subjects) + " subjects)" : ""));
   }
 }
+
+MulticastSenderOptions multicast_options_of(const DaemonConfig& config, uint32_t stream_id);
 
 std::vector<std::unique_ptr<SubjectStream>> load_subjects(const DaemonConfig& config, const std::vector<int>& cpus) {
   SubjectStreamOptions options;
@@ -64,6 +67,8 @@ std::vector<std::unique_ptr<SubjectStream>> load_subjects(const DaemonConfig& co
       const auto first = cpus.begin() + static_cast<long>(k) * config.deform_threads;
       pipeline.deform_cpus.assign(first, first + config.deform_threads);
     }
+    // Every subject's parameters to the one group, told apart by the stream id (its index).
+    if (!config.multicast.empty()) options.multicast = multicast_options_of(config, static_cast<uint32_t>(k));
     subjects.push_back(std::make_unique<SubjectStream>(config.subjects[k], options));
     const SubjectStream& s = *subjects.back();
     if (pipeline.deform_cpus.empty())
@@ -111,6 +116,11 @@ vicon::DescriptionLimits description_limits_of(const DaemonConfig& config) {
   limits.max_markers_per_subject = static_cast<uint32_t>(config.source_max_markers_per_subject);
   limits.max_name_bytes = static_cast<uint32_t>(config.source_max_name_bytes);
   return limits;
+}
+
+MulticastSenderOptions multicast_options_of(const DaemonConfig& config, uint32_t stream_id) {
+  const HostPort group = host_port_of("--multicast", config.multicast);
+  return {group.host, group.port, config.multicast_interface, config.multicast_ttl, stream_id};
 }
 
 }  // namespace
@@ -423,7 +433,10 @@ std::string Daemon::health_json() const {
 std::string Daemon::metrics_text() const {
   std::vector<SubjectMetricsView> views;
   for (const auto& s : subjects_) views.push_back({s->name(), &s->metrics(), s->hub().subscriber_metrics()});
-  return render_prometheus(source_metrics_, views);
+  std::string text = render_prometheus(source_metrics_, views);
+  // The sender's series carry no subject label: with several subjects they are in /health only.
+  if (subjects_.size() == 1) subjects_.front()->render_multicast_metrics(text);
+  return text;
 }
 
 void Daemon::write_ports_file() const {

@@ -30,6 +30,7 @@
 namespace skinstream::server {
 
 class SubscriberHub;
+class MulticastSender;
 class HttpServer;
 class Listener;
 

@@ -71,9 +71,16 @@ SubjectStream::SubjectStream(SubjectConfig config, const SubjectStreamOptions& o
   subscriber::MeshInfo mesh_info = mesh_info_of(subject_);
   mesh_info.subject = name_;
   hub_ = std::make_unique<SubscriberHub>(metrics_, options.hub, std::move(mesh_info), subject_.deformation.has_value());
+  FrameConsumer* consumer = hub_.get();
+  if (options.multicast) {
+    if (!subject_.deformation)
+      throw ConfigError("multicast sends the parameters of the mesh: subject " + name_ + " (" + config_.file + ") has none (built without --mesh)");
+    multicast_ = std::make_unique<MulticastSender>(*hub_, *options.multicast);
+    consumer = multicast_.get();
+  }
   try {
     pipeline_ = std::make_unique<Pipeline>(subject_.model, subject_.deformation ? &*subject_.deformation : nullptr, options.pipeline,
-                                           mailbox_, *hub_, metrics_);
+                                           mailbox_, *consumer, metrics_);
   } catch (const std::invalid_argument& e) {
     throw FileError(config_.file, std::string("deformation model unusable: ") + e.what());
   }
@@ -83,7 +90,18 @@ SubjectStream::SubjectStream(SubjectConfig config, const SubjectStreamOptions& o
     hub_->set_model_message(std::make_shared<const std::vector<unsigned char>>(subscriber::encode_model(*evaluation)));
     spdlog::info("subject {}: parameter encoding: Model message of {} bytes ({} parts, {} RBF centres, {} influences)", name_,
                  hub_->model_message()->size(), evaluation->part_count(), evaluation->member_count(), evaluation->influence_count());
+    if (multicast_) {
+      multicast_->set_model(std::span<const unsigned char>(*hub_->model_message()).subspan(subscriber::kHeaderBytes));
+      pipeline_->prepare_encoding(MulticastSender::sent_key());
+      spdlog::info("subject {}: multicast: every frame's parameters to {}:{} from {} (TTL {}), stream {}, model id {:08x}", name_,
+                   options.multicast->group, options.multicast->port, options.multicast->interface_address, options.multicast->ttl,
+                   options.multicast->stream_id, multicast_->model_id());
+    }
   }
+}
+
+void SubjectStream::render_multicast_metrics(std::string& out) const {
+  if (multicast_) multicast_->render_prometheus(out);
 }
 
 SubjectStream::~SubjectStream() { stop(); }
@@ -179,6 +197,7 @@ nlohmann::json SubjectStream::health() const {
   out["subscribers"] = hub_->subscriber_count();
   out["deform"] = {{"threads", deform_threads_}, {"cpus", deform_cpus_}};
   out["latency_ms"] = latency_summaries(metrics_);
+  if (multicast_) out["multicast"] = multicast_->health();
   return out;
 }
 

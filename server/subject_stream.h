@@ -8,6 +8,7 @@
 
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <string_view>
 
@@ -22,6 +23,7 @@
 #include "server/metrics/status_line.h"
 #include "server/pipeline/frame_mailbox.h"
 #include "server/pipeline/pipeline.h"
+#include "server/publish/multicast_sender.h"
 #include "server/publish/subscriber_hub.h"
 
 namespace skinstream::server {
@@ -30,6 +32,7 @@ struct SubjectStreamOptions {
   PipelineOptions pipeline;  // deform_cpus: this subject's share (none, or one per deform thread)
   HubOptions hub;
   std::chrono::milliseconds max_frame_wait{25};
+  std::optional<MulticastSenderOptions> multicast;  // also every frame's parameters to a multicast group
 };
 
 class SubjectStream {
@@ -67,6 +70,7 @@ class SubjectStream {
 
   bool present() const;
   nlohmann::json health() const;  // /health's entry for this subject
+  void render_multicast_metrics(std::string& out) const;  // appended to /metrics when multicast is on
   // The io thread: the log's status line for the interval since the previous one.
   std::string status_line(StatusLine::Clock::time_point now);
 
@@ -80,6 +84,7 @@ class SubjectStream {
   StatusLine status_line_;
   FrameMailbox mailbox_;
   std::unique_ptr<SubscriberHub> hub_;
+  std::unique_ptr<MulticastSender> multicast_;  // the pipeline's consumer in front of the hub, when on
   std::unique_ptr<Pipeline> pipeline_;
   std::vector<int> deform_cpus_;
   int deform_threads_ = 0;

@@ -205,6 +205,25 @@ TEST(Config, QtmAndNatNetTakeAHostWithOrWithoutItsPort) {
   EXPECT_FALSE(parse_host_with_port("", 1510));
 }
 
+TEST(Config, MulticastIsOffByDefaultAndComesFromFileAndFlags) {
+  EXPECT_EQ(DaemonConfig{}.multicast, "");
+  EXPECT_EQ(DaemonConfig{}.multicast_ttl, 1);
+  const std::string path = write_file("multicast.json", R"({"multicast": "239.1.2.3:9500", "multicast_ttl": 4})");
+  const auto from_file = parse({"--config", path});
+  ASSERT_TRUE(from_file);
+  EXPECT_EQ(from_file->config.multicast, "239.1.2.3:9500");
+  EXPECT_EQ(from_file->config.multicast_ttl, 4);
+  const auto flags = parse({"--config", path, "--multicast", "239.9.9.9:9600", "--multicast-interface", "10.0.0.2", "--multicast-ttl", "2"});
+  ASSERT_TRUE(flags);
+  EXPECT_EQ(flags->config.multicast, "239.9.9.9:9600");
+  EXPECT_EQ(flags->config.multicast_interface, "10.0.0.2");
+  EXPECT_EQ(flags->config.multicast_ttl, 2);
+  for (const char* bad : {"10.0.0.1:9500", "239.1.2.3", "239.1.2.3:0", "stage-group:9500"})
+    EXPECT_NE(error_of([&] { parse({"--multicast", bad}); }).find("multicast must be GROUP:PORT"), std::string::npos) << bad;
+  EXPECT_NE(error_of([] { parse({"--multicast-interface", "eth0"}); }).find("multicast_interface"), std::string::npos);
+  EXPECT_NE(error_of([] { parse({"--multicast-ttl", "256"}); }).find("multicast_ttl"), std::string::npos);
+}
+
 TEST(Config, PrintConfigIsAFlag) {
   const auto parsed = parse({"--print-config", "--sub-port", "1234"});
   ASSERT_TRUE(parsed);
