@@ -11,6 +11,7 @@ std::optional<int> parse_bench_options(int argc, char** argv, BenchOptions& o) {
   o.replay_tcp_congestion = server::ViconServerOptions{}.tcp_congestion;
   std::string encoding = client::to_string(o.encoding);
   bool quantised = false;
+  std::string protocol = "vicon";
   app.add_option("--seconds", o.seconds, "how long to measure")->check(CLI::Range(0.5, 3600.0))->capture_default_str();
   app.add_option("--subscribers", o.subscribers, "subscribers connected in-process, one thread each")->check(CLI::Range(1, 256))->capture_default_str();
   app.add_option("--recording", o.recording, "capture the Vicon replay server streams, looped")->capture_default_str();
@@ -38,7 +39,14 @@ std::optional<int> parse_bench_options(int argc, char** argv, BenchOptions& o) {
   app.add_option("--replay-tcp-congestion", o.replay_tcp_congestion,
                  "TCP congestion control of the replay server's connection to the daemon (\"\" = the system's)")
       ->capture_default_str();
-  app.add_option("--vicon-subject-name", o.vicon_subject_name, "subject name the replay announces (default: the recording's file name)");
+  app.add_option("--protocol", protocol, "the capture system the replay plays to the daemon: vicon (DataStream, TCP), qtm (QTM RT, TCP) or natnet (NatNet, UDP unicast)")
+      ->check(CLI::IsMember({"vicon", "qtm", "natnet"}))
+      ->capture_default_str();
+  app.add_option("--vicon-subject-name", o.vicon_subject_name, "subject (marker set) name the replay announces (default: the recording's file name)");
+  app.add_option("--subjects", o.subjects, "actors on the stage: the recording streamed this many times, moved apart, as Actor1..ActorN; subscriber s follows ActorN with N = s mod subjects + 1")
+      ->check(CLI::Range(1, 16))
+      ->capture_default_str();
+  app.add_option("--subject-spacing-mm", o.subject_spacing_mm, "with --subjects: how far apart the actors stand along x")->capture_default_str();
   app.add_flag("--json", o.json, "print the report as JSON");
   try {
     app.parse(argc, argv);
@@ -46,6 +54,7 @@ std::optional<int> parse_bench_options(int argc, char** argv, BenchOptions& o) {
     return app.exit(e);
   }
   o.encoding = client::encoding_from_string(quantised ? "quantised" : encoding);
+  o.protocol = protocol == "qtm" ? CaptureProtocol::Qtm : protocol == "natnet" ? CaptureProtocol::NatNet : CaptureProtocol::Vicon;
   return std::nullopt;
 }
 

@@ -4,6 +4,7 @@
 #include <optional>
 #include <string>
 
+#include "clients/bench/replay_engine.h"
 #include "skinstream/client.h"
 
 namespace skinstream::bench {
@@ -14,6 +15,9 @@ struct BenchOptions {
   std::string recording = "replay_data/cmu/85_12.c3d";
   std::string subject;             // the subject file (required)
   std::string vicon_subject_name;  // the replay's subject name (default: the recording's file name)
+  CaptureProtocol protocol = CaptureProtocol::Vicon;  // what the replay speaks to the daemon
+  int subjects = 1;                  // actors: the recording streamed this many times, apart
+  double subject_spacing_mm = 3000;  // how far apart along x
   // What the subscribers ask for and do with it.
   client::Encoding encoding = client::Encoding::Float;
   bool normals = false;

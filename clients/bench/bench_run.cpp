@@ -15,19 +15,21 @@
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <memory>
 #include <thread>
 
 #include "clients/bench/latency_samples.h"
 #include "clients/bench/process_usage.h"
+#include "clients/bench/replay_engine.h"
 #include "clients/bench/send_times.h"
 #include "clients/bench/shaped_link.h"
 #include "clients/bench/stall_log.h"
+#include "clients/bench/subjects.h"
 #include "protocol/capture_file.h"
 #include "protocol/file_error.h"
 #include "server/client/daemon_process.h"
 #include "server/tcp_congestion.h"
-#include "server/vicon/vicon_server.h"
 
 namespace skinstream::bench {
 namespace {
@@ -41,9 +43,9 @@ int64_t wall_clock_ns() {
   return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch()).count();
 }
 
-std::string daemon_arguments(const BenchOptions& o, const std::string& vicon_address) {
-  std::string a = "--subject " + server::shell_word(o.subject) + " --vicon " + vicon_address + " --deform-threads " +
-                  std::to_string(o.deform_threads) + " --log-level warn";
+std::string daemon_arguments(const BenchOptions& o, const std::string& source_option) {
+  std::string a = source_option + " --deform-threads " + std::to_string(o.deform_threads) + " --log-level warn";
+  for (const std::string& word : daemon_subject_arguments(o.subject, o.subjects)) a += " " + server::shell_word(word);
   if (!o.deform_cpus.empty()) a += " --deform-cpus " + server::shell_word(o.deform_cpus);
   if (o.deform_spin_lead_us >= 0) a += " --deform-spin-lead-us " + std::to_string(o.deform_spin_lead_us);
   if (o.publish_threads >= 0) a += " --publish-threads " + std::to_string(o.publish_threads);
@@ -72,6 +74,7 @@ void subscribe(const BenchOptions& o, const std::string& host, int port, int ind
   options.paced = o.paced;
   options.decode = o.decode;
   options.evaluate = o.decode;
+  options.subject = subscriber_subject(index, o.subjects);
   client::Subscriber subscriber(options);
   tally.reserve(static_cast<size_t>(o.seconds * 130) + 16);
   const std::string who = "subscriber " + std::to_string(index);
@@ -119,9 +122,17 @@ void subscribe(const BenchOptions& o, const std::string& host, int port, int ind
   tally.model_bytes = subscriber.model_bytes();
 }
 
+// Sleeps until `until`, in short steps, throwing once `stop` is set.
+void sleep_until_or_stop(Clock::time_point until, const std::atomic<bool>& stop) {
+  while (Clock::now() < until) {
+    if (stop.load()) throw std::runtime_error("interrupted");
+    std::this_thread::sleep_until(std::min(until, Clock::now() + std::chrono::milliseconds(50)));
+  }
+}
+
 }  // namespace
 
-nlohmann::json run_bench(const BenchOptions& o) {
+nlohmann::json run_bench(const BenchOptions& o, const std::atomic<bool>& stop) {
   const fs::path daemon_path = own_folder() / "skinstreamd";
   if (!fs::exists(daemon_path)) throw std::runtime_error(daemon_path.string() + ": skinstreamd not found next to skinstream-bench");
   const Capture capture = read_capture(o.recording);
@@ -145,13 +156,13 @@ nlohmann::json run_bench(const BenchOptions& o) {
 
   // The replay server: looping, its timeline from the daemon's first frame request.
   server::asio::io_context replay_io;
-  server::ViconServerOptions replay_options;
+  ReplayEngineOptions replay_options;
+  replay_options.protocol = o.protocol;
   replay_options.bind_address = replay_address;
-  replay_options.port = 0;
-  replay_options.loop = true;
   replay_options.tcp_congestion = o.replay_tcp_congestion;
-  replay_options.subject_name = o.vicon_subject_name.empty() ? fs::path(o.recording).stem().string() : o.vicon_subject_name;
-  server::ViconServer replay(replay_io, capture, replay_options);
+  const ReplayStage stage = replay_stage(capture, o.subjects, o.subject_spacing_mm,
+                                         o.vicon_subject_name.empty() ? fs::path(o.recording).stem().string() : o.vicon_subject_name);
+  ReplayEngine replay(replay_io, stage.subjects, replay_options);
   StallLog stalls;  // before send_times, which writes to it until the replay stops
   SendTimes send_times;
   replay.set_frame_hook([&send_times](uint32_t frame_number, int64_t send_ns) { send_times.record(frame_number, send_ns); });
@@ -172,7 +183,7 @@ nlohmann::json run_bench(const BenchOptions& o) {
 
   server::DaemonLaunch launch;
   launch.program = daemon_path.string();
-  launch.arguments = daemon_arguments(o, replay_address + ":" + std::to_string(replay.port()));
+  launch.arguments = daemon_arguments(o, replay.daemon_source_option());
   launch.bind = daemon_address;
   launch.files_stem = (work / "skinstreamd").string();
   if (link)
@@ -208,29 +219,30 @@ nlohmann::json run_bench(const BenchOptions& o) {
   while (window.subscribers_ready.load() < o.subscribers) {
     if (Clock::now() > ready_deadline) throw std::runtime_error("the subscribers did not all get a frame within 120 s");
     if (!daemon.running()) throw std::runtime_error("skinstreamd exited:\n" + daemon.log());
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    sleep_until_or_stop(Clock::now() + std::chrono::milliseconds(10), stop);
   }
   const double seconds_to_first_frames = std::chrono::duration<double>(Clock::now() - connect_started).count();
-  std::this_thread::sleep_for(std::chrono::milliseconds(500));  // let the joins' backlog drain
+  sleep_until_or_stop(Clock::now() + std::chrono::milliseconds(500), stop);  // let the joins' backlog drain
 
   const nlohmann::json health_before = daemon.health();
   const int64_t period_ns = static_cast<int64_t>(1e9 / capture.rate_hz);
   const int64_t window_start_ns = wall_clock_ns();
   stalls.start(window_start_ns);
   send_times.start_counting(period_ns, &stalls);
-  const uint64_t sent_before = replay.stats().frame_packets_sent.load();
-  const uint64_t replay_dropped_before = replay.stats().frames_dropped.load();
+  const uint64_t sent_before = replay.frames_sent();
+  const uint64_t replay_dropped_before = replay.frames_dropped();
   const double cpu_before = cpu_seconds(daemon.pid());
+  const std::map<std::string, double> thread_cpu_before = thread_cpu_seconds(daemon.pid());
   const double own_cpu_before = cpu_seconds(getpid());
   window.start_ns = window_start_ns;
-  const auto deadline = Clock::now() + std::chrono::duration<double>(o.seconds);
+  const Clock::time_point deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(o.seconds));
 
   // RSS once a second: the first sample after warm-up against the last.
   std::vector<long> rss_samples;
   nlohmann::json rss_steps = nlohmann::json::array();
   uint64_t buffers_after_1s = 0;  // the daemon's encoded frame buffers: RSS steps when they grow
   for (auto next = Clock::now() + std::chrono::seconds(1); next < deadline; next += std::chrono::seconds(1)) {
-    std::this_thread::sleep_until(next);
+    sleep_until_or_stop(next, stop);
     rss_samples.push_back(resident_kb(daemon.pid()));
     // Every step of RSS, with its time on the stall log's clock: a leak climbs steadily, memory
     // touched for the first time (a backlog reaching buffers never used before) steps once.
@@ -238,13 +250,14 @@ nlohmann::json run_bench(const BenchOptions& o) {
       rss_steps.push_back({{"at_s", (wall_clock_ns() - window_start_ns) * 1e-9}, {"kb", rss_samples.back() - rss_samples[rss_samples.size() - 2]}});
     if (rss_samples.size() == 1) buffers_after_1s = daemon.health().value("frame_buffers_allocated", 0);
   }
-  std::this_thread::sleep_until(deadline);
+  sleep_until_or_stop(deadline, stop);
   const int64_t window_end_ns = wall_clock_ns();
   window.end_ns = window_end_ns;
   const nlohmann::json health = daemon.health();
-  const uint64_t sent = replay.stats().frame_packets_sent.load() - sent_before;
-  const uint64_t replay_dropped = replay.stats().frames_dropped.load() - replay_dropped_before;
+  const uint64_t sent = replay.frames_sent() - sent_before;
+  const uint64_t replay_dropped = replay.frames_dropped() - replay_dropped_before;
   const double cpu = cpu_seconds(daemon.pid()) - cpu_before;
+  const std::map<std::string, double> thread_cpu_after = thread_cpu_seconds(daemon.pid());
   const long peak_rss_kb = peak_resident_kb(daemon.pid());
   const double own_cpu = cpu_seconds(getpid()) - own_cpu_before;
   std::this_thread::sleep_for(std::chrono::milliseconds(500));  // the window's last frames still on their way
@@ -271,8 +284,11 @@ nlohmann::json run_bench(const BenchOptions& o) {
   std::vector<double> rates;
   nlohmann::json per_subscriber = nlohmann::json::array();
   const double window_s = (window_end_ns - window_start_ns) * 1e-9;
-  for (const SubscriberTally& tally : tallies) {
+  std::vector<SubscriberTally> by_subject(static_cast<size_t>(o.subjects));  // subscriber s follows subject s mod N
+  for (size_t s = 0; s < tallies.size(); ++s) {
+    const SubscriberTally& tally = tallies[s];
     all.add(tally);
+    by_subject[s % by_subject.size()].add(tally);
     total_dropped += tally.dropped();
     const double rate = tally.received / window_s;
     rates.push_back(rate);
@@ -280,15 +296,20 @@ nlohmann::json run_bench(const BenchOptions& o) {
         {{"received", tally.received}, {"dropped", tally.dropped()}, {"longest_gap_ms", tally.longest_gap_ms}, {"frames_per_second", rate}});
   }
   std::sort(rates.begin(), rates.end());
+  std::vector<nlohmann::json> subject_subscribers;
+  for (SubscriberTally& t : by_subject)
+    subject_subscribers.push_back({{"received", t.received}, {"end_to_end", t.end_to_end.summary()}, {"daemon_processing", t.processing.summary()}});
   auto delta = [&](const char* key) { return health["frames"][key].get<uint64_t>() - health_before["frames"][key].get<uint64_t>(); };
   const double bytes_per_frame = all.received > 0 ? static_cast<double>(all.message_bytes) / all.received : 0.0;
   nlohmann::json report = {
-      {"mode", std::string("Vicon DataStream replay (in-process) -> skinstreamd --vicon -> subscribers, ") +
+      {"mode", std::string(to_string(o.protocol)) + " replay (in-process) -> skinstreamd -> subscribers, " +
                    (link ? "over a " + std::to_string(o.link_mbit) + " Mbit/s shaped link" : std::string("on loopback"))},
       {"seconds", o.seconds},
       {"window_seconds", window_s},
       {"subscribers", o.subscribers},
+      {"subjects", o.subjects},
       {"encoding", client::to_string(o.encoding)},
+      {"protocol", to_string(o.protocol)},
       {"link_mbit", o.link_mbit},
       {"subscribers_want", {{"normals", o.normals}, {"quantised", o.encoding == client::Encoding::Quantised}, {"decode", o.decode}, {"paced", o.paced}}},
       {"seconds_until_every_subscriber_had_a_frame", seconds_to_first_frames},
@@ -326,6 +347,8 @@ nlohmann::json run_bench(const BenchOptions& o) {
                   {"out_of_order", all.out_of_order},
                   {"without_send_time", all.unmatched}}},
       {"per_subscriber", per_subscriber},
+      // Each actor's own threads' CPU and the daemon's figures for it; the threads they share.
+      {"per_subject", per_subject_report(o.subjects, thread_cpu_before, thread_cpu_after, health_before, health, subject_subscribers, window_s)},
       // Gaps over 3 frame periods (the replay's sends, each subscriber's arrivals), drops for a
       // subscriber and drops in the pipeline, in time order: a pause of the whole machine shows
       // at one moment in all.

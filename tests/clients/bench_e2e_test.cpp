@@ -110,9 +110,30 @@ TEST(BenchProgram, ParameterSubscribersReportTheModelAndBytesPerFrame) {
   EXPECT_GT(rates["slowest"].get<double>(), 0.0);
 }
 
+// The other two capture systems drive the daemon too, and their frames are timed end to end
+// (the replay's send time found by frame number for every frame but the window's edges).
+TEST(BenchProgram, QtmAndNatNetSourcesAreTimedEndToEnd) {
+  for (const std::string protocol : {"qtm", "natnet"}) {
+    SCOPED_TRACE(protocol);
+    const test::ProgramRun r = test::run_program(
+        bench("--subject " + kDemo + "/subject.sksubj --recording " + kDemo + "/live.c3d --seconds 2 --protocol " + protocol + " --json"),
+        /*stderr_too=*/false);
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    const auto j = nlohmann::json::parse(r.output);
+    EXPECT_EQ(j["protocol"], protocol);
+    const long received = j["frames"]["received_by_subscribers"].get<long>();
+    EXPECT_GT(received, 100);
+    EXPECT_LE(j["frames"]["without_send_time"].get<long>(), 2);
+    EXPECT_EQ(j["end_to_end"]["count"].get<long>(), received - j["frames"]["without_send_time"].get<long>());
+    EXPECT_GT(j["frames"]["sent_by_replay"].get<long>(), 200);
+  }
+}
+
 bool is_root() { return geteuid() == 0; }
 
-std::string network_namespaces() { return test::run_program("ip netns list").output; }
+// The bench's own namespaces (skbench<pid>); ctest runs these tests alone (RUN_SERIAL), so no
+// other run's namespace comes or goes meanwhile.
+std::string network_namespaces() { return test::run_program("ip netns list | grep '^skbench' || true").output; }
 
 // The shaped link: the daemon in a namespace of its own behind tc, reached through it, and
 // nothing of it left afterwards. Root only (CI runs as root); elsewhere the next test applies.
@@ -135,6 +156,19 @@ TEST(BenchProgram, ShapedLinkCarriesTheStreamAndIsRemovedAfterwards) {
   EXPECT_EQ(network_namespaces(), before);
 }
 
+// Ctrl-C in the middle of a run: the bench stops the daemon and removes the namespace on its way out.
+TEST(BenchProgram, InterruptedRunLeavesNoNamespaceBehind) {
+  if (!is_root()) GTEST_SKIP() << "needs root to make a network namespace";
+  const std::string before = network_namespaces();
+  const test::ProgramRun r = test::run_program("timeout --preserve-status -s INT 6 " +
+                                               bench("--subject " + kDemo + "/subject.sksubj --recording " + kDemo +
+                                                     "/live.c3d --seconds 60 --encoding parameters --link-mbit 100"));
+  EXPECT_EQ(r.exit_code, 130) << r.output;
+  EXPECT_NE(r.output.find("interrupted"), std::string::npos) << r.output;
+  EXPECT_EQ(network_namespaces(), before);
+  EXPECT_EQ(test::run_program("pgrep -f 'skinstreamd.*10\\.213\\.'").exit_code, 1) << "a daemon of the run is still running";
+}
+
 TEST(BenchProgram, ShapedLinkWithoutRootSaysWhatItNeeds) {
   if (!is_root() && test::run_program("command -v setpriv").exit_code != 0) GTEST_SKIP() << "needs setpriv to drop root";
   // As root, drop it for the run (util-linux's setpriv), as a user without it would run.
@@ -145,6 +179,36 @@ TEST(BenchProgram, ShapedLinkWithoutRootSaysWhatItNeeds) {
                                                                 "/live.c3d --seconds 1 --link-mbit 100"));
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.output.find("--link-mbit needs root"), std::string::npos) << r.output;
+// --subjects 2: two actors (the recording twice, apart), each followed by the daemon, with a
+// subscriber each, and reported with its own threads' CPU, frames and its subscriber's latency;
+// the io and publish threads are nobody's.
+TEST(BenchProgram, SeveralSubjectsAreEachReportedWithTheirOwnThreadsAndSubscribers) {
+  const test::ProgramRun r = test::run_program(
+      bench("--subject " + kDemo + "/subject.sksubj --recording " + kDemo + "/live.c3d --seconds 2 --subjects 2 --subscribers 2 --json"),
+      /*stderr_too=*/false);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto j = nlohmann::json::parse(r.output);
+  EXPECT_EQ(j["subjects"], 2);
+  const auto& rows = j["per_subject"]["subjects"];
+  ASSERT_EQ(rows.size(), 2u);
+  double total = 0.0;
+  for (int k = 0; k < 2; ++k) {
+    SCOPED_TRACE(k);
+    EXPECT_EQ(rows[k]["name"], "Actor" + std::to_string(k + 1));
+    EXPECT_GT(rows[k]["frames"]["received"].get<long>(), 0);
+    EXPECT_GT(rows[k]["cpu_share_of_one_core"].get<double>(), 0.0);
+    EXPECT_EQ(rows[k]["deform"]["threads"], 2);
+    EXPECT_GT(rows[k]["subscribers"]["received"].get<long>(), 0);
+    EXPECT_LE(rows[k]["subscribers"]["end_to_end"]["count"].get<long>(), rows[k]["subscribers"]["received"].get<long>());
+    EXPECT_LE(rows[k]["subscribers"]["end_to_end"]["p50_ms"].get<double>(), rows[k]["subscribers"]["end_to_end"]["p99_ms"].get<double>());
+    total += rows[k]["cpu_share_of_one_core"].get<double>();
+  }
+  EXPECT_DOUBLE_EQ(j["per_subject"]["mean_cpu_share_per_subject"].get<double>(), total / 2);
+  EXPECT_EQ(rows[0]["subscribers"]["received"].get<long>() + rows[1]["subscribers"]["received"].get<long>(),
+            j["frames"]["received_by_subscribers"].get<long>());
+  EXPECT_TRUE(j["per_subject"]["shared_threads_cpu_share"].contains("io")) << j["per_subject"].dump();
+  EXPECT_FALSE(j["per_subject"]["shared_threads_cpu_share"].contains("pipeline-0"));
+  EXPECT_EQ(j["daemon"]["exit_status"], 0);
 }
 
 TEST(BenchProgram, MissingRecordingFailsNamingIt) {
