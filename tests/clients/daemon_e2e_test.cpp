@@ -26,6 +26,7 @@
 #include "protocol/capture_file.h"
 #include "protocol/point_cache.h"
 #include "server/client/subscriber_client.h"
+#include "support/loopback_peer.h"
 #include "support/program_run.h"
 #include "support/test_data.h"
 
@@ -33,6 +34,9 @@ namespace skinstream {
 namespace {
 
 using test::ProgramRun;
+using test::connect_loopback;
+using test::eventually;
+using test::http_get_within;
 ProgramRun run(const std::string& command_line) { return test::run_program(command_line); }
 
 // A daemon in the background; stopped with SIGTERM. `shell_prefix` runs before it in the same
@@ -98,13 +102,14 @@ class DaemonProcess {
 // skinstream-replay in the background: a Vicon DataStream server looping a recording.
 class ReplayProcess {
  public:
-  // port 0: any free port (see port). `extra` goes on the command line as it is.
-  ReplayProcess(const std::string& recording, int port, const std::string& extra = "") {
+  // port 0: any free port (see port). `extra` goes on the command line as it is; `shell_prefix`
+  // runs before it in the same shell (e.g. "ulimit -n 32; ").
+  ReplayProcess(const std::string& recording, int port, const std::string& extra = "", const std::string& shell_prefix = "") {
     out_path_ = test::scratch_path("replay_" + std::to_string(getpid()) + "_" + std::to_string(counter_++) + ".out");
     std::remove(out_path_.c_str());
     pid_ = fork();
     if (pid_ == 0) {
-      const std::string command = "exec " + std::string(SKINSTREAM_REPLAY) + " " + recording + " --bind 127.0.0.1 --port " +
+      const std::string command = shell_prefix + "exec " + std::string(SKINSTREAM_REPLAY) + " " + recording + " --bind 127.0.0.1 --port " +
                                   std::to_string(port) + " --loop " + extra + " > " + out_path_ + " 2> " + out_path_ + ".log";
       execl("/bin/sh", "sh", "-c", command.c_str(), static_cast<char*>(nullptr));
       _exit(127);
@@ -132,6 +137,11 @@ class ReplayProcess {
     waitpid(pid_, nullptr, 0);
     pid_ = -1;
   }
+  pid_t pid() const { return pid_; }
+  std::string log() const {
+    std::ifstream in(out_path_ + ".log");
+    return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  }
   int port = 0;
 
  private:
@@ -140,16 +150,6 @@ class ReplayProcess {
   std::string out_path_;
 };
 
-
-// Polls `condition` every 20 ms for up to `limit`: a bound on a hang, not a timing assertion.
-bool eventually(const std::function<bool()>& condition, std::chrono::seconds limit = std::chrono::seconds(20)) {
-  const auto end = std::chrono::steady_clock::now() + limit;
-  while (std::chrono::steady_clock::now() < end) {
-    if (condition()) return true;
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
-  }
-  return condition();
-}
 
 // A subscriber on its own thread that keeps every Status and counts frames, until stopped.
 class BackgroundSubscriber {
@@ -373,42 +373,6 @@ TEST_F(DaemonProgram, SigtermStopsCleanlyWithMarkersOnly) {
   EXPECT_NE(daemon.log().find("no deformation model"), std::string::npos) << daemon.log();
 }
 
-// A loopback TCP connection to `port`, or -1. Connected even when the server has not accepted it
-// (the kernel completes the handshake into the listener's queue).
-int connect_loopback(int port) {
-  const int fd = socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in address{};
-  address.sin_family = AF_INET;
-  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  address.sin_port = htons(static_cast<uint16_t>(port));
-  if (fd >= 0 && connect(fd, reinterpret_cast<sockaddr*>(&address), sizeof address) == 0) return fd;
-  if (fd >= 0) close(fd);
-  return -1;
-}
-
-// GET `target` over a new connection, waiting at most `limit` for the whole reply; "" when none
-// came (a daemon that never accepts must fail the test, not hang it).
-std::string http_get_within(int port, const std::string& target, std::chrono::seconds limit) {
-  const int fd = connect_loopback(port);
-  if (fd < 0) return "";
-  const std::string request = "GET " + target + " HTTP/1.1\r\nHost: 127.0.0.1\r\nConnection: close\r\n\r\n";
-  std::string reply;
-  if (send(fd, request.data(), request.size(), MSG_NOSIGNAL) == static_cast<ssize_t>(request.size())) {
-    const auto end = std::chrono::steady_clock::now() + limit;
-    char buffer[4096];
-    for (;;) {
-      const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(end - std::chrono::steady_clock::now());
-      pollfd readable{fd, POLLIN, 0};
-      if (left.count() <= 0 || poll(&readable, 1, static_cast<int>(left.count())) <= 0) break;
-      const ssize_t n = recv(fd, buffer, sizeof buffer, 0);
-      if (n <= 0) break;
-      reply.append(buffer, static_cast<size_t>(n));
-    }
-  }
-  close(fd);
-  return reply;
-}
-
 // The CPU time a process has used so far (user + system), in seconds, from /proc/PID/stat.
 double cpu_seconds(pid_t pid) {
   std::ifstream in("/proc/" + std::to_string(pid) + "/stat");
@@ -475,6 +439,35 @@ TEST_F(DaemonProgram, OutOfDescriptorsPausesAcceptsAndHealthStillAnswers) {
   close(subscriber);
   EXPECT_TRUE(eventually([&] { return daemon.log().find("accepting again after") != std::string::npos; })) << daemon.log();
   EXPECT_EQ(daemon.stop(), 0) << daemon.log();
+}
+
+// The Vicon replay server out of file descriptors (limited to 32) with clients still waiting:
+// its accepts pause as the daemon's do (it retried at once, a core spinning), and it accepts
+// again once they leave.
+TEST_F(DaemonProgram, ViconReplayServerOutOfDescriptorsPausesAccepts) {
+  ReplayProcess replay(take_, 0, "", "ulimit -n 32; ");
+  ASSERT_GT(replay.pid(), 0);
+  std::vector<int> flood;
+  for (int i = 0; i < 100; ++i) {
+    const int fd = connect_loopback(replay.port);
+    ASSERT_GE(fd, 0) << "connection " << i;
+    flood.push_back(fd);
+  }
+  ASSERT_TRUE(eventually([&] { return replay.log().find("Too many open files") != std::string::npos; })) << replay.log();
+  const double cpu_before = cpu_seconds(replay.pid());
+  std::this_thread::sleep_for(std::chrono::seconds(2));
+  const double cpu_used = cpu_seconds(replay.pid()) - cpu_before;
+  std::printf("replay server CPU in 2 s out of descriptors: %.2f s\n", cpu_used);
+  EXPECT_LT(cpu_used, 0.2);
+  EXPECT_LE(count_lines_with(replay.log(), "accept failed"), 2) << replay.log().substr(0, 2000);
+
+  for (int fd : flood) close(fd);
+  EXPECT_TRUE(eventually([&] { return replay.log().find("accepting again after") != std::string::npos; })) << replay.log();
+  const int client = connect_loopback(replay.port);
+  ASSERT_GE(client, 0);
+  pollfd readable{client, POLLIN, 0};
+  EXPECT_EQ(poll(&readable, 1, 20'000), 1) << "no ObjectEnums to a client after the flood left: " << replay.log().substr(0, 2000);
+  close(client);
 }
 
 // skinstream-replay -> skinstreamd --vicon -> skinstream-sub, in both Vicon modes (and the same
