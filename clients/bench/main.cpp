@@ -31,6 +31,7 @@
 #include <thread>
 #include <unistd.h>
 
+#include "clients/bench/hostile_waves.h"
 #include "clients/bench/stall_log.h"
 #include "server/client/health_probe.h"
 #include "protocol/capture_file.h"
@@ -226,7 +227,8 @@ int main(int argc, char** argv) {
   int publish_threads = -1;      // -1: the daemon's default
   std::optional<std::string> tcp_congestion;  // unset: the daemon's default
   std::string replay_tcp_congestion = server::ViconServerOptions{}.tcp_congestion;
-  bool json = false, normals = false, quantised = false;
+  bool json = false, normals = false, quantised = false, hostile_waves = false;
+  int wave_seconds = 60, calm_seconds = 60;
   app.add_option("--seconds", seconds, "how long to measure")->check(CLI::Range(0.5, 3600.0))->capture_default_str();
   app.add_option("--subscribers", subscriber_count, "subscribers connected in-process, one thread each")->check(CLI::Range(1, 256))->capture_default_str();
   app.add_option("--recording", recording, "capture the Vicon replay server streams, looped")->capture_default_str();
@@ -245,6 +247,12 @@ int main(int argc, char** argv) {
   app.add_flag("--normals", normals, "subscribers ask for normals too");
   app.add_flag("--quantised", quantised, "subscribers ask for the quantised encoding (half the bytes)");
   app.add_flag("--json", json, "print the report as JSON");
+  app.add_flag("--hostile-waves", hostile_waves,
+               "the soak: hostile peers (stalled, flooding, churning) connect and leave in waves while the subscribers measure");
+  app.add_option("--wave-seconds", wave_seconds, "--hostile-waves: how long each wave stays")->check(CLI::Range(1, 3600))->capture_default_str();
+  app.add_option("--calm-seconds", calm_seconds, "--hostile-waves: the calm after each wave, at whose end RSS is noted")
+      ->check(CLI::Range(1, 3600))
+      ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
 
   const fs::path daemon_path = own_folder() / "skinstreamd";
@@ -357,6 +365,12 @@ int main(int argc, char** argv) {
           errors[s] = e.what();
         }
       });
+    std::optional<bench::HostileWaves> waves;
+    if (hostile_waves) {
+      waves.emplace(bench::HostileWaveOptions{sub_port, http_port, std::chrono::seconds(wave_seconds), std::chrono::seconds(calm_seconds)},
+                    [pid] { return resident_kb(pid); });
+      waves->start();
+    }
     // RSS once a second: the first sample after warm-up against the last.
     std::vector<long> rss_samples;
     nlohmann::json rss_steps = nlohmann::json::array();
@@ -372,6 +386,7 @@ int main(int argc, char** argv) {
                              {"kb", rss_samples.back() - rss_samples[rss_samples.size() - 2]}});
       if (rss_samples.size() == 1) buffers_after_1s = server::fetch_health(http_port).value("frame_buffers_allocated", 0);
     }
+    if (waves) waves->stop();
     for (std::thread& t : threads) t.join();
     // The growth over the run, at a glance: a leak climbs minute after minute, a warm-up does not.
     std::vector<long> every_minute;
@@ -444,6 +459,9 @@ int main(int argc, char** argv) {
                     {"out_of_order", all.out_of_order},
                     {"without_send_time", all.unmatched}}},
         {"per_subscriber", per_subscriber},
+        {"frames_per_second_per_subscriber", static_cast<double>(all.received) / seconds / subscriber_count},
+        {"hostile", waves ? waves->report() : nlohmann::json(nullptr)},
+        {"subscriber_limits", health.value("subscriber_limits", nlohmann::json(nullptr))},
         // Gaps over 3 frame periods (the replay's sends, each subscriber's arrivals), drops for a
         // subscriber and drops in the pipeline, in time order: a pause of the whole machine shows
         // at one moment in all.
