@@ -87,6 +87,19 @@ vicon::DescriptionLimits description_limits_of(const DaemonConfig& config) {
   return limits;
 }
 
+AdmissionOptions admission_options_of(const DaemonConfig& config) {
+  AdmissionOptions options;
+  for (const std::string& text : config.allow_subscribers) {
+    const std::optional<SubscriberNetwork> network = SubscriberNetwork::parse(text);
+    if (!network) throw ConfigError("allow_subscribers: \"" + text + "\" is not a network such as 10.0.0.0/8");
+    options.allow.push_back(*network);
+  }
+  options.max_total = config.max_subscribers;
+  options.max_per_address = config.max_subscribers_per_address;
+  options.token = config.subscriber_token;
+  return options;
+}
+
 subscriber::SourceStateCode code_of(SourceState s) { return static_cast<subscriber::SourceStateCode>(static_cast<uint32_t>(s)); }
 
 // The /metrics histograms condensed for scripts, over the daemon's life: per stage its count,
@@ -127,6 +140,7 @@ Daemon::Daemon(const DaemonConfig& config)
   hub_options.frame_max_wait = std::chrono::milliseconds(config.max_frame_wait_ms);
   hub_options.hello_timeout = std::chrono::milliseconds(config.hello_timeout_ms);
   hub_ = std::make_unique<SubscriberHub>(metrics_, hub_options, mesh_info_of(subject_, config.subject), subject_.deformation.has_value());
+  admission_ = std::make_shared<SubscriberAdmission>(admission_options_of(config), metrics_);
 
   PipelineOptions pipeline_options;
   pipeline_options.lookahead = config.lookahead;
@@ -205,7 +219,8 @@ Daemon::Daemon(const DaemonConfig& config)
   sub_listener_ = std::make_unique<Listener>(io_, config.bind_address, config.sub_port, "subscriber port", [this](tcp::socket socket) {
     boost::system::error_code ec;
     const auto endpoint = socket.remote_endpoint(ec);
-    const std::string remote = ec ? "?" : endpoint.address().to_string() + ":" + std::to_string(endpoint.port());
+    if (ec) return;  // gone before it was taken
+    const std::string remote = endpoint.address().to_string() + ":" + std::to_string(endpoint.port());
     // To the publish thread with the fewest subscribers: the socket moves to its io_context, and
     // the session starts there. (Accepting straight onto that context would leave the waiting
     // accept, and a socket of a publish context, in io_'s queue, which outlives the publish
@@ -226,10 +241,15 @@ Daemon::Daemon(const DaemonConfig& config)
       socket = std::move(own);
     }
     auto subscriber = std::make_shared<TcpSubscriber>(placed.io, *hub_, std::move(socket), remote, std::move(placed.token));
+    // Refused or not, the subscriber is answered after its Hello, in the version it speaks.
+    SubscriberAdmission::Decision admitted = admission_->admit(endpoint.address());
+    const bool ask_token = admitted.ticket && admission_->token_required();
+    subscriber->set_admission(std::move(admitted), ask_token ? admission_ : nullptr);
     hub_->add(subscriber);
     asio::post(placed.io, [subscriber] { subscriber->start(); });
   }, ListenerOptions{config.subscriber_tcp_congestion, &metrics_, &descriptor_reserve_, false});
   HttpRoutes routes;
+  routes.stream_admission = admission_;
   routes.health_json = [this] { return health_json(); };
   routes.metrics_text = [this] { return metrics_.render_prometheus(hub_->subscriber_metrics()); };
   routes.web_root = config.web_root;
@@ -410,6 +430,7 @@ void Daemon::schedule_status() {
   status_timer_.async_wait([this](const boost::system::error_code& ec) {
     if (ec || stopping_.load()) return;
     broadcast_status();
+    if (config_.subscriber_write_stall_ms > 0) hub_->drop_stalled_writers(std::chrono::milliseconds(config_.subscriber_write_stall_ms));
     schedule_status();
   });
 }
@@ -420,6 +441,8 @@ std::string Daemon::health_json() const {
     std::lock_guard lock(state_mutex_);
     source = {{"state", to_string(state_)}, {"detail", state_detail_}, {"rate_hz", source_rate_hz_}};
   }
+  nlohmann::json allowed = nlohmann::json::array();  // as understood: "10.1.2.3" is shown as 10.1.2.3/32
+  for (const SubscriberNetwork& network : admission_->options().allow) allowed.push_back(network.to_string());
   const nlohmann::json health = {
       {"status", "ok"},
       {"source", source},
@@ -434,6 +457,17 @@ std::string Daemon::health_json() const {
       {"frame_buffers_allocated", metrics_.frame_buffers_allocated.load()},
       {"frame_buffers_allocated_by_pipeline", metrics_.frame_buffers_allocated_by_pipeline.load()},
       {"subscribers", hub_->subscriber_count()},
+      {"subscriber_limits",
+       {{"max_subscribers", config_.max_subscribers},
+        {"max_subscribers_per_address", config_.max_subscribers_per_address},
+        {"write_stall_ms", config_.subscriber_write_stall_ms},
+        {"allow_subscribers", allowed},
+        {"token_required", admission_->token_required()},
+        {"admitted", admission_->admitted()},
+        {"refused_not_allowed", metrics_.subscribers_refused_not_allowed.load()},
+        {"refused_limit", metrics_.subscribers_refused_limit.load()},
+        {"refused_token", metrics_.subscribers_refused_token.load()},
+        {"dropped_write_stall", metrics_.subscribers_dropped_write_stall.load()}}},
       {"deform", {{"threads", config_.deform_threads}, {"cpus", deform_cpus_}, {"spin_lead_us", config_.deform_spin_lead_us}}},
       {"publish_threads", publish_.count()},
       {"subscriber_tcp_congestion", config_.subscriber_tcp_congestion},  // empty: the system's

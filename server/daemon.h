@@ -24,6 +24,7 @@
 #include "server/pipeline/frame_mailbox.h"
 #include "server/pipeline/pipeline.h"
 #include "server/publish/publish_threads.h"
+#include "server/publish/subscriber_admission.h"
 
 namespace skinstream::server {
 
@@ -77,6 +78,7 @@ class Daemon : private SourceSink, private SubjectRouter::Observer {
   FrameMailbox mailbox_;
   SubjectRouter router_;
   std::unique_ptr<SubscriberHub> hub_;
+  std::shared_ptr<SubscriberAdmission> admission_;  // who may subscribe, and how many
   std::unique_ptr<Pipeline> pipeline_;
   // After the pipeline and the hub: the io_context is destroyed first, and with it the handlers
   // still holding sessions whose queues hold frames of the pipeline's pool.

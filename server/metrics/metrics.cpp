@@ -107,6 +107,13 @@ std::string Metrics::render_prometheus(const std::vector<SubscriberMetrics>& sub
   counter(out, "bad_subscriber_messages_total", "Subscriber messages that broke the protocol.", bad_subscriber_messages);
   counter(out, "subscribers_accepted_total", "Subscriber connections accepted.", subscribers_connected);
   counter(out, "subscribers_refused_total", "Subscribers refused after their Hello (unknown subject, ...).", subscribers_refused);
+  counter(out, "subscribers_refused_not_allowed_total", "Subscribers refused as they connected: their address is in none of allow_subscribers.",
+          subscribers_refused_not_allowed);
+  counter(out, "subscribers_refused_limit_total",
+          "Subscribers refused as they connected: max_subscribers or max_subscribers_per_address reached.", subscribers_refused_limit);
+  counter(out, "subscribers_refused_token_total", "Subscribers refused for a missing or wrong subscriber_token.", subscribers_refused_token);
+  counter(out, "subscribers_dropped_write_stall_total",
+          "Subscribers closed because a write to them did not progress for subscriber_write_stall_ms.", subscribers_dropped_write_stall);
   counter(out, "accepts_failed_no_descriptor_total",
           "Accepts (HTTP and subscriber ports) that failed for lack of file descriptors; each pauses that port's accepts, 10 ms doubling to 1 s.",
           accepts_failed_no_descriptor);
