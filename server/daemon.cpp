@@ -168,7 +168,10 @@ Daemon::Daemon(const DaemonConfig& config)
     throw FileError(config.subject, std::string("deformation model unusable: ") + e.what());
   }
 
-  hub_->set_encoding_preparer([pipeline = pipeline_.get()](StreamKey key) { pipeline->prepare_encoding(key); });
+  hub_->set_encoding_preparer([pipeline = pipeline_.get(), hub = hub_.get()](StreamKey key) {
+    pipeline->prepare_encoding(key);
+    pipeline->size_pool_for(hub->active_count() + 1);  // this one is about to be active
+  });
   hub_->set_compressed_order(pipeline_->compressed_order());
   if (const EvaluationModel* evaluation = pipeline_->evaluation_model()) {
     hub_->set_model_message(std::make_shared<const std::vector<unsigned char>>(subscriber::encode_model(*evaluation)));
@@ -431,6 +434,7 @@ void Daemon::schedule_status() {
     if (ec || stopping_.load()) return;
     broadcast_status();
     if (config_.subscriber_write_stall_ms > 0) hub_->drop_stalled_writers(std::chrono::milliseconds(config_.subscriber_write_stall_ms));
+    pipeline_->size_pool_for(hub_->active_count());
     schedule_status();
   });
 }
@@ -456,6 +460,9 @@ std::string Daemon::health_json() const {
       // mark of frames in use (bounded by the subscribers' queues), so RSS steps with it.
       {"frame_buffers_allocated", metrics_.frame_buffers_allocated.load()},
       {"frame_buffers_allocated_by_pipeline", metrics_.frame_buffers_allocated_by_pipeline.load()},
+      // Frames in the pool and held by subscribers now: back to what the subscribers need within
+      // a second of stalled ones leaving.
+      {"frame_pool", {{"frames", pipeline_->pool_frames()}, {"in_use", pipeline_->pool_frames_in_use()}}},
       {"subscribers", hub_->subscriber_count()},
       {"subscriber_limits",
        {{"max_subscribers", config_.max_subscribers},

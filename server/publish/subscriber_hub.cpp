@@ -159,6 +159,11 @@ std::vector<SubscriberMetrics> SubscriberHub::subscriber_metrics() const {
   return out;
 }
 
+size_t SubscriberHub::active_count() const {
+  std::lock_guard lock(mutex_);
+  return active_.size();
+}
+
 size_t SubscriberHub::subscriber_count() const {
   std::lock_guard lock(mutex_);
   return sessions_.size();

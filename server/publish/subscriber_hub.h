@@ -78,6 +78,7 @@ class SubscriberHub : public FrameConsumer {
 
   std::vector<SubscriberMetrics> subscriber_metrics() const;
   size_t subscriber_count() const;
+  size_t active_count() const;  // subscribers receiving frames
 
  private:
   void update_wanted_locked();

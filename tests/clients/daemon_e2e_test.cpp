@@ -337,6 +337,26 @@ long count_lines_with(const std::string& text, const std::string& needle) {
   return count;
 }
 
+// `count` connections to `port` left waiting (kept in `out_flood`) until the program `pid`
+// runs out of descriptors, then two seconds of that episode: a paused listener uses next to no
+// CPU (one retrying at once takes what the scheduler gives it, a whole core on an idle machine)
+// and logs its start once.
+void expect_accepts_paused_when_flooded(int port, int count, pid_t pid, const std::function<std::string()>& log,
+                                        std::vector<int>& out_flood) {
+  for (int i = 0; i < count; ++i) {
+    const int fd = connect_loopback(port);
+    ASSERT_GE(fd, 0) << "connection " << i;
+    out_flood.push_back(fd);
+  }
+  ASSERT_TRUE(eventually([&] { return log().find("Too many open files") != std::string::npos; })) << log();
+  const double cpu_before = cpu_seconds(pid);
+  std::this_thread::sleep_for(std::chrono::seconds(2));
+  const double cpu_used = cpu_seconds(pid) - cpu_before;
+  std::printf("CPU in 2 s out of descriptors: %.2f s\n", cpu_used);
+  EXPECT_LT(cpu_used, 0.2);
+  EXPECT_LE(count_lines_with(log(), "accept failed"), 2) << log().substr(0, 2000);
+}
+
 // Out of file descriptors (the daemon limited to 64) with subscriber connections still waiting in
 // the kernel's queue, every accept fails at once: the daemon pauses its accepts instead of
 // retrying (it spun, logging every failure), counts the failures, answers /health on the
@@ -345,22 +365,7 @@ TEST_F(DaemonProgram, OutOfDescriptorsPausesAcceptsAndHealthStillAnswers) {
   DaemonProcess daemon("--subject " + subject_, "ulimit -n 64; ");
   ASSERT_GT(daemon.pid(), 0);
   std::vector<int> flood;
-  for (int i = 0; i < 200; ++i) {
-    const int fd = connect_loopback(daemon.sub_port);
-    ASSERT_GE(fd, 0) << "connection " << i;
-    flood.push_back(fd);
-  }
-  ASSERT_TRUE(eventually([&] { return daemon.log().find("Too many open files") != std::string::npos; })) << daemon.log();
-
-  // Two seconds of the episode: a paused listener uses next to no CPU (the spinning one, all of
-  // a core) and logs its start once.
-  const double cpu_before = cpu_seconds(daemon.pid());
-  std::this_thread::sleep_for(std::chrono::seconds(2));
-  const double cpu_used = cpu_seconds(daemon.pid()) - cpu_before;
-  std::printf("daemon CPU in 2 s out of descriptors: %.2f s\n", cpu_used);
-  // A spinning io thread takes what the scheduler gives it (a whole core on an idle machine).
-  EXPECT_LT(cpu_used, 0.2);
-  EXPECT_LE(count_lines_with(daemon.log(), "accept failed"), 2) << daemon.log().substr(0, 2000);
+  ASSERT_NO_FATAL_FAILURE(expect_accepts_paused_when_flooded(daemon.sub_port, 200, daemon.pid(), [&] { return daemon.log(); }, flood));
 
   const std::string health = http_get_within(daemon.http_port, "/health", std::chrono::seconds(10));
   ASSERT_NE(health.find("200 OK"), std::string::npos) << "no /health reply while out of descriptors: " << health;
@@ -395,18 +400,7 @@ TEST_F(DaemonProgram, ViconReplayServerOutOfDescriptorsPausesAccepts) {
   ReplayProcess replay(take_, 0, "", "ulimit -n 32; ");
   ASSERT_GT(replay.pid(), 0);
   std::vector<int> flood;
-  for (int i = 0; i < 100; ++i) {
-    const int fd = connect_loopback(replay.port);
-    ASSERT_GE(fd, 0) << "connection " << i;
-    flood.push_back(fd);
-  }
-  ASSERT_TRUE(eventually([&] { return replay.log().find("Too many open files") != std::string::npos; })) << replay.log();
-  const double cpu_before = cpu_seconds(replay.pid());
-  std::this_thread::sleep_for(std::chrono::seconds(2));
-  const double cpu_used = cpu_seconds(replay.pid()) - cpu_before;
-  std::printf("replay server CPU in 2 s out of descriptors: %.2f s\n", cpu_used);
-  EXPECT_LT(cpu_used, 0.2);
-  EXPECT_LE(count_lines_with(replay.log(), "accept failed"), 2) << replay.log().substr(0, 2000);
+  ASSERT_NO_FATAL_FAILURE(expect_accepts_paused_when_flooded(replay.port, 100, replay.pid(), [&] { return replay.log(); }, flood));
 
   for (int fd : flood) close(fd);
   EXPECT_TRUE(eventually([&] { return replay.log().find("accepting again after") != std::string::npos; })) << replay.log();

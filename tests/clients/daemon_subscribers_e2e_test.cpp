@@ -124,11 +124,29 @@ std::string upgrade_reply(int http_port, const std::string& target, const std::s
   return test::http_exchange_within(http_port, request, std::chrono::seconds(3), from);
 }
 
+long resident_kb(pid_t pid) {
+  std::ifstream status("/proc/" + std::to_string(pid) + "/status");
+  for (std::string line; std::getline(status, line);)
+    if (line.rfind("VmRSS:", 0) == 0) return std::stol(line.substr(6));
+  return 0;
+}
+
 nlohmann::json health_of(int http_port) {
   const std::string reply = test::http_get_within(http_port, "/health", std::chrono::seconds(10));
   const size_t body = reply.find("\r\n\r\n");
   if (body == std::string::npos) return {};
   return nlohmann::json::parse(reply.substr(body + 4), nullptr, false);
+}
+
+// The daemon replaying the demo body (53,500 vertices, frames of 640 kB) in a loop, with these
+// config keys on top of the defaults.
+std::unique_ptr<test::DaemonProcess> start_demo_daemon(const nlohmann::json& keys = nlohmann::json::object()) {
+  static int configs = 0;
+  const std::string demo = SKINSTREAM_DEMO_DIR;
+  const std::string config = test::scratch_path("demo_" + std::to_string(getpid()) + "_" + std::to_string(configs++) + ".json");
+  std::ofstream(config) << keys.dump();
+  return std::make_unique<test::DaemonProcess>(SKINSTREAMD, "--config " + config + " --subject " + demo + "/subject.sksubj --replay " +
+                                                                demo + "/live.c3d --loop");
 }
 
 class DaemonAdmission : public ::testing::Test {
@@ -239,11 +257,8 @@ TEST_F(DaemonAdmission, ASharedTokenIsAskedInHelloOrOnTheUrl) {
 // demo body is 640 kB), its write makes no progress, and after subscriber_write_stall_ms it is
 // closed and counted, while a subscriber that reads goes on.
 TEST(DaemonDemoSubscribers, ASubscriberWhoseWriteStallsIsDropped) {
-  const std::string demo = SKINSTREAM_DEMO_DIR;
-  const std::string config = test::scratch_path("stall_" + std::to_string(getpid()) + ".json");
-  std::ofstream(config) << nlohmann::json{{"subscriber_write_stall_ms", 500}}.dump();
-  test::DaemonProcess daemon(SKINSTREAMD, "--config " + config + " --subject " + demo + "/subject.sksubj --replay " + demo +
-                                               "/live.c3d --loop");
+  const auto started = start_demo_daemon({{"subscriber_write_stall_ms", 500}});
+  test::DaemonProcess& daemon = *started;
   ASSERT_GT(daemon.sub_port, 0);
   RawSubscriber stalled(daemon.sub_port, "", 4096);
   ASSERT_TRUE(stalled.say(subscriber::Hello{}));
@@ -255,11 +270,54 @@ TEST(DaemonDemoSubscribers, ASubscriberWhoseWriteStallsIsDropped) {
   EXPECT_EQ(daemon.stop(), 0) << daemon.log();
 }
 
+// 60 subscribers from 8 hosts that stop reading hold frames of the pool (the daemon grows it
+// for them off the pipeline thread: /health's promise of 0 frame buffers made there holds);
+// once they leave, the pool is back to what the one good subscriber needs, and RSS comes down
+// within a generous bound.
+TEST(DaemonDemoSubscribers, ThePoolComesBackAfterStalledSubscribersLeave) {
+  const auto started = start_demo_daemon();
+  test::DaemonProcess& daemon = *started;
+  ASSERT_GT(daemon.sub_port, 0);
+  RawSubscriber good(daemon.sub_port);
+  ASSERT_TRUE(good.say(subscriber::Hello{0}));
+  ASSERT_TRUE(served(good));
+  const nlohmann::json before = health_of(daemon.http_port)["frame_pool"];
+  ASSERT_TRUE(before.is_object()) << health_of(daemon.http_port).dump();
+  const long rss_before = resident_kb(daemon.pid());
+  {
+    std::vector<std::unique_ptr<RawSubscriber>> stalled;
+    for (int i = 0; i < 60; ++i) {
+      stalled.push_back(std::make_unique<RawSubscriber>(daemon.sub_port, "127.0.0." + std::to_string(2 + i % 8), 4096));
+      ASSERT_TRUE(stalled.back()->say(subscriber::Hello{0}));
+    }
+    // They stall within a frame or two; the good one reads on meanwhile.
+    const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(3);
+    while (std::chrono::steady_clock::now() < until) ASSERT_TRUE(good.next());
+    const nlohmann::json during = health_of(daemon.http_port);
+    std::printf("pool before %s, with 60 stalled %s; RSS %ld kB before, %ld kB with them\n", before.dump().c_str(),
+                during["frame_pool"].dump().c_str(), rss_before, resident_kb(daemon.pid()));
+    EXPECT_GT(during["frame_pool"]["frames"].get<int>(), before["frames"].get<int>());
+  }
+  // Gone: within a few seconds the pool is as before (the good subscriber's share and the
+  // pipeline's own frames), its frames freed.
+  auto pool_back = [&] {
+    for (int i = 0; i < 10; ++i) good.next(std::chrono::seconds(1));  // keep reading
+    return health_of(daemon.http_port)["frame_pool"]["frames"] == before["frames"];
+  };
+  EXPECT_TRUE(eventually(pool_back)) << health_of(daemon.http_port)["frame_pool"].dump();
+  const nlohmann::json after = health_of(daemon.http_port);
+  EXPECT_EQ(after["frame_buffers_allocated_by_pipeline"], 0) << after.dump();
+  const long rss_after = resident_kb(daemon.pid());
+  std::printf("RSS %ld kB after they left\n", rss_after);
+  EXPECT_LT(rss_after, rss_before + 64 * 1024) << "the stalled subscribers' memory did not come back";
+  EXPECT_EQ(daemon.stop(), 0) << daemon.log();
+}
+
 // MeshInfo (1.35 MB for the demo body) comes again after a Hello only when what it describes
 // changes: not for normals or markers, but for positions no longer wanted.
 TEST(DaemonDemoSubscribers, MeshInfoIsSentAgainOnlyWhenWhatItDescribesChanges) {
-  const std::string demo = SKINSTREAM_DEMO_DIR;
-  test::DaemonProcess daemon(SKINSTREAMD, "--subject " + demo + "/subject.sksubj --replay " + demo + "/live.c3d --loop");
+  const auto started = start_demo_daemon();
+  test::DaemonProcess& daemon = *started;
   ASSERT_GT(daemon.sub_port, 0);
   RawSubscriber peer(daemon.sub_port);
   // MeshInfo messages (and their vertex counts) until `frames` Frames have come after it.
