@@ -1,6 +1,8 @@
 #include "server/config.h"
 
+#include "protocol/subscriber_stream.h"
 #include "server/pipeline/deform_cpus.h"
+#include "server/publish/subscriber_network.h"
 #include "server/tcp_congestion.h"
 
 #include <arpa/inet.h>
@@ -58,7 +60,8 @@ void apply_json(const nlohmann::json& json, DaemonConfig& c, const std::string& 
                                       "continuity_seconds", "use_pca", "ports_file", "log_level", "hello_timeout_ms",
                                       "subscriber_queue_frames", "subscriber_tcp_congestion", "publish_threads", "status_interval_ms", "status_log_seconds", "default_rate_hz",
                                       "compressed_key_interval", "multicast", "multicast_interface", "multicast_ttl", "source_max_subjects", "source_max_markers_per_subject",
-                                      "source_max_name_bytes"};
+                                      "source_max_name_bytes", "max_subscribers", "max_subscribers_per_address",
+                                      "subscriber_write_stall_ms", "allow_subscribers", "subscriber_token"};
   for (const auto& [key, value] : json.items()) {
     bool known = false;
     for (const char* k : kKeys) known = known || key == k;
@@ -112,6 +115,11 @@ void apply_json(const nlohmann::json& json, DaemonConfig& c, const std::string& 
   take(json, "source_max_subjects", c.source_max_subjects, origin);
   take(json, "source_max_markers_per_subject", c.source_max_markers_per_subject, origin);
   take(json, "source_max_name_bytes", c.source_max_name_bytes, origin);
+  take(json, "max_subscribers", c.max_subscribers, origin);
+  take(json, "max_subscribers_per_address", c.max_subscribers_per_address, origin);
+  take(json, "subscriber_write_stall_ms", c.subscriber_write_stall_ms, origin);
+  take(json, "allow_subscribers", c.allow_subscribers, origin);
+  take(json, "subscriber_token", c.subscriber_token, origin);
 }
 
 DaemonConfig load_config_file(const std::string& path) {
@@ -170,7 +178,12 @@ nlohmann::json to_json(const DaemonConfig& c) {
           {"multicast_ttl", c.multicast_ttl},
           {"source_max_subjects", c.source_max_subjects},
           {"source_max_markers_per_subject", c.source_max_markers_per_subject},
-          {"source_max_name_bytes", c.source_max_name_bytes}};
+          {"source_max_name_bytes", c.source_max_name_bytes},
+          {"max_subscribers", c.max_subscribers},
+          {"max_subscribers_per_address", c.max_subscribers_per_address},
+          {"subscriber_write_stall_ms", c.subscriber_write_stall_ms},
+          {"allow_subscribers", c.allow_subscribers},
+          {"subscriber_token", c.subscriber_token}};
 }
 
 void validate(const DaemonConfig& c) {
@@ -209,6 +222,14 @@ void validate(const DaemonConfig& c) {
   if (c.source_max_markers_per_subject < 1 || c.source_max_markers_per_subject > 65536)
     fail("source_max_markers_per_subject must be 1-65536");
   if (c.source_max_name_bytes < 1 || c.source_max_name_bytes > 4096) fail("source_max_name_bytes must be 1-4096");
+  if (c.max_subscribers < 0) fail("max_subscribers must be >= 0 (0 = no limit)");
+  if (c.max_subscribers_per_address < 0) fail("max_subscribers_per_address must be >= 0 (0 = no limit)");
+  if (c.subscriber_write_stall_ms < 0) fail("subscriber_write_stall_ms must be >= 0 (0 = never)");
+  for (const std::string& network : c.allow_subscribers)
+    if (!SubscriberNetwork::parse(network))
+      fail("allow_subscribers: \"" + network + "\" is not a network such as 10.0.0.0/8, 192.168.1.20 or fd00::/8");
+  if (c.subscriber_token.size() > subscriber::kMaxHelloString)
+    fail("subscriber_token must be at most " + std::to_string(subscriber::kMaxHelloString) + " bytes (Hello's token field)");
   static const char* const kLevels[] = {"trace", "debug", "info", "warn", "error", "critical", "off"};
   bool level_ok = false;
   for (const char* l : kLevels) level_ok = level_ok || c.log_level == l;

@@ -66,6 +66,12 @@ struct DaemonConfig {
   int source_max_subjects = 128;
   int source_max_markers_per_subject = 1024;
   int source_max_name_bytes = 256;
+  // Who may subscribe, and how many (server/publish/subscriber_admission.h).
+  int max_subscribers = 256;              // TCP and WebSocket together; 0 = no limit
+  int max_subscribers_per_address = 64;   // from one remote address; 0 = no limit
+  int subscriber_write_stall_ms = 10000;  // a write without progress this long closes the subscriber; 0 = never
+  std::vector<std::string> allow_subscribers;  // CIDR networks subscribers may connect from; empty = any
+  std::string subscriber_token;           // asked of every subscriber (Hello version 2, ?token=); empty = none
 };
 
 // Thrown for a bad config file, a bad key or value, or conflicting flags: one line, says which.

@@ -123,6 +123,19 @@ MulticastSenderOptions multicast_options_of(const DaemonConfig& config, uint32_t
   return {group.host, group.port, config.multicast_interface, config.multicast_ttl, stream_id};
 }
 
+AdmissionOptions admission_options_of(const DaemonConfig& config) {
+  AdmissionOptions options;
+  for (const std::string& text : config.allow_subscribers) {
+    const std::optional<SubscriberNetwork> network = SubscriberNetwork::parse(text);
+    if (!network) throw ConfigError("allow_subscribers: \"" + text + "\" is not a network such as 10.0.0.0/8");
+    options.allow.push_back(*network);
+  }
+  options.max_total = config.max_subscribers;
+  options.max_per_address = config.max_subscribers_per_address;
+  options.token = config.subscriber_token;
+  return options;
+}
+
 }  // namespace
 
 Daemon::Daemon(const DaemonConfig& config)
@@ -138,6 +151,7 @@ Daemon::Daemon(const DaemonConfig& config)
     directory_.add(s->name(), s->hub());
     s->hub().set_directory(&directory_);
   }
+  admission_ = std::make_shared<SubscriberAdmission>(admission_options_of(config), source_metrics_);
   if (!config.replay.empty()) {
     auto replay = std::make_unique<FileReplaySource>(io_, config.replay, static_cast<SourceSink&>(*this),
                                                      ReplayOptions{config.loop, config.speed, config.replay_subject});
@@ -188,7 +202,8 @@ Daemon::Daemon(const DaemonConfig& config)
   sub_listener_ = std::make_unique<Listener>(io_, config.bind_address, config.sub_port, "subscriber port", [this](tcp::socket socket) {
     boost::system::error_code ec;
     const auto endpoint = socket.remote_endpoint(ec);
-    const std::string remote = ec ? "?" : endpoint.address().to_string() + ":" + std::to_string(endpoint.port());
+    if (ec) return;  // gone before it was taken
+    const std::string remote = endpoint.address().to_string() + ":" + std::to_string(endpoint.port());
     // To the publish thread with the fewest subscribers: the socket moves to its io_context, and
     // the session starts there. (Accepting straight onto that context would leave the waiting
     // accept, and a socket of a publish context, in io_'s queue, which outlives the publish
@@ -210,10 +225,15 @@ Daemon::Daemon(const DaemonConfig& config)
     }
     SubscriberHub& hub = subject(0).hub();  // until a version 2 Hello names another
     auto subscriber = std::make_shared<TcpSubscriber>(placed.io, hub, std::move(socket), remote, std::move(placed.token));
+    // Refused or not, the subscriber is answered after its Hello, in the version it speaks.
+    SubscriberAdmission::Decision admitted = admission_->admit(endpoint.address());
+    const bool ask_token = admitted.ticket && admission_->token_required();
+    subscriber->set_admission(std::move(admitted), ask_token ? admission_ : nullptr);
     hub.add(subscriber);
     asio::post(placed.io, [subscriber] { subscriber->start(); });
   }, ListenerOptions{config.subscriber_tcp_congestion, &source_metrics_, &descriptor_reserve_, false});
   HttpRoutes routes;
+  routes.stream_admission = admission_;
   routes.health_json = [this] { return health_json(); };
   routes.metrics_text = [this] { return metrics_text(); };
   routes.web_root = config.web_root;
@@ -381,6 +401,7 @@ void Daemon::schedule_status() {
   status_timer_.async_wait([this](const boost::system::error_code& ec) {
     if (ec || stopping_.load()) return;
     broadcast_status();
+    for (auto& s : subjects_) s->tend_subscribers(std::chrono::milliseconds(config_.subscriber_write_stall_ms));
     schedule_status();
   });
 }
@@ -403,10 +424,14 @@ std::string Daemon::health_json() const {
   }
   nlohmann::json subjects = nlohmann::json::array();
   size_t subscribers = 0;
+  uint64_t dropped_write_stall = 0;
   for (const auto& s : subjects_) {
     subjects.push_back(s->health());
     subscribers += subjects.back()["subscribers"].get<size_t>();
+    dropped_write_stall += s->metrics().subscribers_dropped_write_stall.load();
   }
+  nlohmann::json allowed = nlohmann::json::array();  // as understood: "10.1.2.3" is shown as 10.1.2.3/32
+  for (const SubscriberNetwork& network : admission_->options().allow) allowed.push_back(network.to_string());
   // The first subject's figures also at the top level, where they were when a daemon had one.
   const nlohmann::json& first = subjects.front();
   const nlohmann::json health = {
@@ -414,6 +439,17 @@ std::string Daemon::health_json() const {
       {"source", source},
       {"subjects", subjects},
       {"subscribers", subscribers},
+      {"subscriber_limits",
+       {{"max_subscribers", config_.max_subscribers},
+        {"max_subscribers_per_address", config_.max_subscribers_per_address},
+        {"write_stall_ms", config_.subscriber_write_stall_ms},
+        {"allow_subscribers", allowed},
+        {"token_required", admission_->token_required()},
+        {"admitted", admission_->admitted()},
+        {"refused_not_allowed", source_metrics_.subscribers_refused_not_allowed.load()},
+        {"refused_limit", source_metrics_.subscribers_refused_limit.load()},
+        {"refused_token", source_metrics_.subscribers_refused_token.load()},
+        {"dropped_write_stall", dropped_write_stall}}},
       {"deform", {{"threads", config_.deform_threads}, {"cpus", deform_cpus_}, {"spin_lead_us", config_.deform_spin_lead_us}}},
       {"publish_threads", publish_.count()},
       {"subscriber_tcp_congestion", config_.subscriber_tcp_congestion},  // empty: the system's

@@ -25,6 +25,7 @@
 #include "server/metrics/metrics.h"
 #include "server/publish/publish_threads.h"
 #include "server/publish/subject_directory.h"
+#include "server/publish/subscriber_admission.h"
 #include "server/subject_stream.h"
 
 namespace skinstream::server {
@@ -84,6 +85,7 @@ class Daemon : private SourceSink, private SubjectRouter::Observer {
   std::vector<std::unique_ptr<SubjectStream>> subjects_;
   SubjectRouter router_;
   std::vector<MarkerFrame*> routed_;  // per subject, its mailbox slot being filled (one frame)
+  std::shared_ptr<SubscriberAdmission> admission_;  // who may subscribe, and how many: every subject's subscribers together
   asio::io_context io_;
   // The TCP subscribers' threads: destroyed before io_ and after the listeners (declared
   // between), once every session was closed on its own thread.

@@ -71,6 +71,9 @@ class SubjectStream {
   bool present() const;
   nlohmann::json health() const;  // /health's entry for this subject
   void render_multicast_metrics(std::string& out) const;  // appended to /metrics when multicast is on
+  // The io thread, every Status tick: drops subscribers whose write made no progress for
+  // `write_stall` (0: never), and gives the frame pool back down to what the active ones need.
+  void tend_subscribers(std::chrono::milliseconds write_stall);
   // The io thread: the log's status line for the interval since the previous one.
   std::string status_line(StatusLine::Clock::time_point now);
 

@@ -33,6 +33,9 @@ struct BenchOptions {
   // 0: loopback. Otherwise the daemon runs in a network namespace behind a veth pair shaped to
   // this rate, its subscribers and the replay outside.
   int link_mbit = 0;
+  // The soak: hostile peers connect and leave in waves while the subscribers measure (loopback only).
+  bool hostile_waves = false;
+  int wave_seconds = 60, calm_seconds = 60;
   bool json = false;
 };
 

@@ -17,8 +17,10 @@
 #include <fstream>
 #include <map>
 #include <memory>
+#include <optional>
 #include <thread>
 
+#include "clients/bench/hostile_waves.h"
 #include "clients/bench/latency_samples.h"
 #include "clients/bench/process_usage.h"
 #include "clients/bench/replay_engine.h"
@@ -150,6 +152,8 @@ nlohmann::json run_bench(const BenchOptions& o, const std::atomic<bool>& stop) {
 
   // The stage network, when asked for: made first, removed last.
   std::unique_ptr<ShapedLink> link;
+  // The hostile peers play hosts 127.0.0.2-9: they reach a daemon on loopback only.
+  if (o.hostile_waves && o.link_mbit > 0) throw std::runtime_error("--hostile-waves runs on loopback only, not with --link-mbit");
   if (o.link_mbit > 0) link = std::make_unique<ShapedLink>(ShapedLinkOptions{.rate_mbit = o.link_mbit});
   const std::string replay_address = link ? link->host_address() : "127.0.0.1";
   const std::string daemon_address = link ? link->inner_address() : "127.0.0.1";
@@ -237,6 +241,13 @@ nlohmann::json run_bench(const BenchOptions& o, const std::atomic<bool>& stop) {
   window.start_ns = window_start_ns;
   const Clock::time_point deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(o.seconds));
 
+  std::optional<HostileWaves> waves;
+  if (o.hostile_waves) {
+    waves.emplace(HostileWaveOptions{daemon.sub_port(), daemon.http_port(), std::chrono::seconds(o.wave_seconds),
+                                     std::chrono::seconds(o.calm_seconds)},
+                  [pid = daemon.pid()] { return resident_kb(pid); });
+    waves->start();
+  }
   // RSS once a second: the first sample after warm-up against the last.
   std::vector<long> rss_samples;
   nlohmann::json rss_steps = nlohmann::json::array();
@@ -251,6 +262,7 @@ nlohmann::json run_bench(const BenchOptions& o, const std::atomic<bool>& stop) {
     if (rss_samples.size() == 1) buffers_after_1s = daemon.health().value("frame_buffers_allocated", 0);
   }
   sleep_until_or_stop(deadline, stop);
+  if (waves) waves->stop();
   const int64_t window_end_ns = wall_clock_ns();
   window.end_ns = window_end_ns;
   const nlohmann::json health = daemon.health();
@@ -349,6 +361,8 @@ nlohmann::json run_bench(const BenchOptions& o, const std::atomic<bool>& stop) {
       {"per_subscriber", per_subscriber},
       // Each actor's own threads' CPU and the daemon's figures for it; the threads they share.
       {"per_subject", per_subject_report(o.subjects, thread_cpu_before, thread_cpu_after, health_before, health, subject_subscribers, window_s)},
+      {"hostile", waves ? waves->report() : nlohmann::json(nullptr)},
+      {"subscriber_limits", health.value("subscriber_limits", nlohmann::json(nullptr))},
       // Gaps over 3 frame periods (the replay's sends, each subscriber's arrivals), drops for a
       // subscriber and drops in the pipeline, in time order: a pause of the whole machine shows
       // at one moment in all.

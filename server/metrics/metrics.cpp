@@ -127,6 +127,16 @@ std::string render_prometheus(const Metrics& source, const std::vector<SubjectMe
          "Accepts (HTTP and subscriber ports) that failed for lack of file descriptors; each pauses that port's accepts, 10 ms doubling to 1 s.",
          "counter");
   out += "skinstream_accepts_failed_no_descriptor_total " + std::to_string(source.accepts_failed_no_descriptor.load()) + "\n";
+  // Who may subscribe is decided for the whole daemon, as a subscriber connects (before it names a subject).
+  auto daemon_counter = [&](const char* name, const char* help, const std::atomic<uint64_t>& value) {
+    header(out, name, help, "counter");
+    out += "skinstream_" + std::string(name) + " " + std::to_string(value.load()) + "\n";
+  };
+  daemon_counter("subscribers_refused_not_allowed_total", "Subscribers refused as they connected: their address is in none of allow_subscribers.",
+                 source.subscribers_refused_not_allowed);
+  daemon_counter("subscribers_refused_limit_total", "Subscribers refused as they connected: max_subscribers or max_subscribers_per_address reached.",
+                 source.subscribers_refused_limit);
+  daemon_counter("subscribers_refused_token_total", "Subscribers refused for a missing or wrong subscriber_token.", source.subscribers_refused_token);
   per_subject("frames_received_total", "Marker frames of the subject received from the source.", &Metrics::frames_received);
   per_subject("frames_processed_total", "Frames through the gap filler.", &Metrics::frames_processed);
   per_subject("frames_published_total", "Frames handed to the publishers.", &Metrics::frames_published);
@@ -138,6 +148,8 @@ std::string render_prometheus(const Metrics& source, const std::vector<SubjectMe
   per_subject("bad_subscriber_messages_total", "Subscriber messages that broke the protocol.", &Metrics::bad_subscriber_messages);
   per_subject("subscribers_accepted_total", "Subscriber connections accepted.", &Metrics::subscribers_connected);
   per_subject("subscribers_refused_total", "Subscribers refused after their Hello (unknown subject, ...).", &Metrics::subscribers_refused);
+  per_subject("subscribers_dropped_write_stall_total", "Subscribers closed because a write to them did not progress for subscriber_write_stall_ms.",
+              &Metrics::subscribers_dropped_write_stall);
   per_subject("frame_buffers_allocated_total", "Encoded frame buffers created (steady state: constant).", &Metrics::frame_buffers_allocated);
   per_subject("frame_buffers_allocated_by_pipeline_total",
               "Of those, created on the pipeline thread because none was prepared when the subscriber asked (expected: 0).",

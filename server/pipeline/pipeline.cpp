@@ -189,6 +189,11 @@ void Pipeline::prepare_encoding(StreamKey key) {
   if ((stream_flags(key) & subscriber::kFrameCompressed) && compressed_) compressed_->request_key();
 }
 
+void Pipeline::size_pool_for(size_t subscribers) {
+  const size_t made = pool_.resize(kPooledFrames + kFramesPerSubscriber * subscribers);
+  metrics_.frame_buffers_allocated.fetch_add(made, std::memory_order_relaxed);
+}
+
 void Pipeline::publish(const Released& meta, std::span<const Vec3> positions, std::span<const MarkerStatus> status) {
   const StreamKeySet wanted = consumer_.wanted_encodings();
   const FrameNeeds needs = needs_of(wanted);

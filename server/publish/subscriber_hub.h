@@ -54,6 +54,10 @@ class SubscriberHub : public FrameConsumer {
   void activate(SubscriberSession& session, StreamKey key);
   void remove(SubscriberSession& session);
   void close_all();
+  // Any thread (the daemon's 1 Hz timer): closes and counts each subscriber whose write has made
+  // no progress for `limit`; a subscriber that stopped reading would otherwise hold its
+  // socket, its queue and the frames in it for as long as it stays connected.
+  void drop_stalled_writers(std::chrono::nanoseconds limit);
 
   ControlMessage mesh_info_message(StreamKey key);
   // The compressed encoding's vertex order, sent in its MeshInfo. Set before any subscriber connects.
@@ -80,6 +84,7 @@ class SubscriberHub : public FrameConsumer {
 
   std::vector<SubscriberMetrics> subscriber_metrics() const;
   size_t subscriber_count() const;
+  size_t active_count() const;  // subscribers receiving frames
 
  private:
   void update_wanted_locked();

@@ -6,6 +6,7 @@
 #include <cstring>
 
 #include "protocol/subscriber_stream.h"
+#include "server/logging.h"
 #include "server/publish/subscriber_hub.h"
 
 namespace skinstream::server {
@@ -37,6 +38,31 @@ void SubscriberSession::offer_control(ControlMessage message) {
 void SubscriberSession::close_from_any_thread() {
   if (io_.get_executor().running_in_this_thread()) close();
   else asio::post(io_, [self = shared_from_this()] { self->close(); });
+}
+
+void SubscriberSession::set_admission(SubscriberAdmission::Decision decision,
+                                      std::shared_ptr<const SubscriberAdmission> token_check) {
+  admission_ = std::move(decision.ticket);
+  refusal_ = std::move(decision.reason);
+  token_check_ = std::move(token_check);
+}
+
+std::chrono::nanoseconds SubscriberSession::write_stalled_for(std::chrono::steady_clock::time_point now) const {
+  const int64_t since = write_progress_ns_.load(std::memory_order_relaxed);
+  if (since == 0) return std::chrono::nanoseconds(0);
+  return std::max(std::chrono::nanoseconds(0), now.time_since_epoch() - std::chrono::nanoseconds(since));
+}
+
+void SubscriberSession::drop_for_write_stall(std::chrono::nanoseconds stalled) {
+  if (dropped_for_stall_.exchange(true)) return;
+  hub_->metrics().subscribers_dropped_write_stall.fetch_add(1, std::memory_order_relaxed);
+  spdlog::warn("subscriber {} ({} {}): a write made no progress for {:.1f} s; closing", id_, transport_, remote_,
+               std::chrono::duration<double>(stalled).count());
+  close_from_any_thread();
+}
+
+void SubscriberSession::note_write_progress() {
+  write_progress_ns_.store(std::chrono::steady_clock::now().time_since_epoch().count(), std::memory_order_relaxed);
 }
 
 SubscriberMetrics SubscriberSession::stats() const {
@@ -79,8 +105,17 @@ void SubscriberSession::on_ack() {
 }
 
 void SubscriberSession::on_hello(const subscriber::Hello& hello) {
-  if (closed_) return;
+  if (closed_ || close_after_write_) return;
   version_ = hello.version;
+  if (!refusal_.empty()) return refuse(refusal_);
+  if (token_check_) {
+    if (!token_check_->token_matches(hello.token)) {
+      hub_->metrics().subscribers_refused_token.fetch_add(1, std::memory_order_relaxed);
+      return refuse(hello.token.empty() ? "this daemon asks for a token (Hello version 2's token field, or ?token= on the WebSocket URL)"
+                                        : "wrong token");
+    }
+    token_check_.reset();  // a later Hello changes what the subscriber wants, not who it is
+  }
   paced_ = (hello.wants & subscriber::kWantPaced) != 0;
   // Version 2: the encoding asked for, or what can be served instead, and why.
   std::string notice;
@@ -109,8 +144,16 @@ void SubscriberSession::on_hello(const subscriber::Hello& hello) {
   hello_timer_.cancel();
   if (!changed) return;
   key_.store(key);
-  offer_control(hub_->mesh_info_message(key));
-  if ((flags & subscriber::kFrameParameters) && hub_->model_message()) offer_control(hub_->model_message());
+  // Sent again only when what it describes changed (MeshInfo is 1.35 MB for the 53,500-vertex
+  // body; a Hello that changes normals or markers must not cost that), the Model only once.
+  if (ControlMessage mesh_info = hub_->mesh_info_message(key); mesh_info != mesh_info_sent_) {
+    offer_control(mesh_info);
+    mesh_info_sent_ = std::move(mesh_info);
+  }
+  if ((flags & subscriber::kFrameParameters) && hub_->model_message() && !model_sent_) {
+    offer_control(hub_->model_message());
+    model_sent_ = true;
+  }
   offer_control(hub_->status_message(key));
   if (!notice.empty()) {
     offer_control(hub_->status_message(key, notice, subscriber::SourceStateCode::Streaming));
@@ -134,6 +177,8 @@ bool SubscriberSession::join_subject(const std::string& subject) {
     std::shared_ptr<SubscriberSession> self = shared_from_this();  // the old hub held it
     hub_->remove(*this);
     hub_ = chosen;
+    mesh_info_sent_ = {};  // another subject: its own MeshInfo and Model
+    model_sent_ = false;
     hub_->add(self, /*accepted=*/false);
   }
   return true;
@@ -141,7 +186,9 @@ bool SubscriberSession::join_subject(const std::string& subject) {
 
 void SubscriberSession::refuse(const std::string& reason) {
   hub_->metrics().subscribers_refused.fetch_add(1, std::memory_order_relaxed);
-  spdlog::warn("subscriber {} ({} {}): refused: {}", id_, transport_, remote_, reason);
+  // Rate-limited: refusals come in floods (a subscriber reconnecting in a loop, too many at once).
+  static RateLimitedLog refusals;
+  refusals.warn("subscriber_refused", fmt::format("subscriber {} ({} {}): refused: {}", id_, transport_, remote_, reason));
   greeted_ = true;
   hello_timer_.cancel();
   // The Status goes out first; the session closes once its queue has been written.
@@ -151,7 +198,9 @@ void SubscriberSession::refuse(const std::string& reason) {
 
 void SubscriberSession::on_protocol_error(const std::string& reason) {
   hub_->metrics().bad_subscriber_messages.fetch_add(1, std::memory_order_relaxed);
-  spdlog::warn("subscriber {} ({} {}): {}; closing", id_, transport_, remote_, reason);
+  // Rate-limited: a peer that is no subscriber may reconnect and send the same bytes again and again.
+  static RateLimitedLog protocol_errors;
+  protocol_errors.warn("subscriber_protocol_error", fmt::format("subscriber {} ({} {}): {}; closing", id_, transport_, remote_, reason));
   close();
 }
 
@@ -161,6 +210,8 @@ void SubscriberSession::on_disconnected(const std::string& reason) {
   hello_timer_.cancel();
   spdlog::info("subscriber {} ({} {}) gone: {} (sent {}, dropped {})", id_, transport_, remote_, reason, sent_.load(),
                queue_.frames_dropped());
+  write_progress_ns_.store(0, std::memory_order_relaxed);
+  admission_.reset();
   hub_->remove(*this);
 }
 
@@ -189,6 +240,7 @@ void SubscriberSession::pump() {
     in_flight_.frame.reset();  // encoded for this subscriber's previous wants
   }
   writing_ = true;
+  note_write_progress();
   if (in_flight_.control) {
     start_write({asio::buffer(*in_flight_.control), asio::const_buffer()});
     return;
@@ -206,6 +258,7 @@ void SubscriberSession::pump() {
 
 void SubscriberSession::write_done(const boost::system::error_code& ec) {
   writing_ = false;
+  write_progress_ns_.store(0, std::memory_order_relaxed);
   const bool was_frame = static_cast<bool>(in_flight_.frame);
   in_flight_.frame.reset();
   in_flight_.control.reset();

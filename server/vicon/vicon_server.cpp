@@ -13,7 +13,7 @@
 #include "protocol/vicon_packet_framer.h"
 #include "protocol/vicon_packet_reader.h"
 #include "protocol/vicon_packet_writer.h"
-#include "server/tcp_congestion.h"
+#include "server/listener.h"
 
 namespace skinstream::server {
 namespace {
@@ -55,18 +55,15 @@ struct ViconServer::State : std::enable_shared_from_this<ViconServer::State> {
   State(asio::io_context& io_context, std::vector<ReplaySubject> subjects, ViconServerOptions opts)
       : io(io_context),
         options(std::move(opts)),
-        congestion("vicon server", options.tcp_congestion),
         encoder(subjects, options.rate_hz, options.loop),
-        acceptor(io),
         timer(io),
         multicast_socket(io) {}
 
   asio::io_context& io;
   ViconServerOptions options;
-  AcceptedSocketCongestion congestion;  // options.tcp_congestion on each client
   vicon::CaptureFrameEncoder encoder;
   vicon::PacketWriter writer;
-  tcp::acceptor acceptor;
+  std::unique_ptr<Listener> listener;  // from start() until stop()
   asio::steady_timer timer;
   udp::socket multicast_socket;
   std::vector<udp::endpoint> multicast_destinations;
@@ -259,48 +256,38 @@ struct ViconServer::State : std::enable_shared_from_this<ViconServer::State> {
   }
 
   void start() {
-    const auto address = asio::ip::make_address(options.bind_address);
-    const tcp::endpoint endpoint(address, options.port);
-    boost::system::error_code ec;
-    acceptor.open(endpoint.protocol(), ec);
-    if (!ec) acceptor.set_option(tcp::acceptor::reuse_address(true), ec);
-    if (!ec) acceptor.bind(endpoint, ec);
-    if (!ec) acceptor.listen(asio::socket_base::max_listen_connections, ec);
-    if (ec)
-      throw std::runtime_error("cannot listen on " + options.bind_address + ":" + std::to_string(options.port) + ": " +
-                               ec.message());
+    // The daemon's listener: out of descriptors it pauses its accepts instead of retrying at once.
+    listener = std::make_unique<Listener>(
+        io, options.bind_address, options.port, "vicon server",
+        [weak = weak_from_this()](tcp::socket socket) {
+          if (const auto self = weak.lock()) self->on_accept(std::move(socket));
+        },
+        ListenerOptions{options.tcp_congestion});
     object_enums_packet = copy_packet(vicon::encode_packet(vicon::CaptureFrameEncoder::offered_types()));
     running = true;
-    accept();
+    listener->start();
     if (!options.start_on_first_request) start_timeline();
   }
 
-  void accept() {
-    acceptor.async_accept([self = shared_from_this()](const boost::system::error_code& ec, tcp::socket socket) {
-      if (!self->running) return;
-      if (!ec) {
-        boost::system::error_code ignored;
-        socket.set_option(tcp::no_delay(true), ignored);
-        if (self->options.socket_send_buffer_bytes > 0)
-          socket.set_option(asio::socket_base::send_buffer_size(self->options.socket_send_buffer_bytes), ignored);
-        self->congestion.apply(socket.native_handle());
-        auto session = std::make_shared<Session>(*self, std::move(socket));
-        self->sessions.push_back(session);
-        ++self->stats.clients_accepted;
-        ++self->stats.clients_open;
-        session->begin();
-      } else if (ec == asio::error::operation_aborted) {
-        return;
-      }
-      self->accept();
-    });
+  void on_accept(tcp::socket socket) {
+    if (!running) return;
+    boost::system::error_code ignored;
+    if (options.socket_send_buffer_bytes > 0)
+      socket.set_option(asio::socket_base::send_buffer_size(options.socket_send_buffer_bytes), ignored);
+    auto session = std::make_shared<Session>(*this, std::move(socket));
+    sessions.push_back(session);
+    ++stats.clients_accepted;
+    ++stats.clients_open;
+    session->begin();
   }
 
   void stop() {
     if (!running) return;
     running = false;
     boost::system::error_code ignored;
-    acceptor.close(ignored);
+    listener->stop();
+    // Its cancelled handlers are queued and use it: freed after them.
+    asio::post(io, [done = std::move(listener)] {});
     timer.cancel();
     multicast_socket.close(ignored);
     for (auto& session : std::vector<std::shared_ptr<Session>>(sessions)) session->close();
@@ -435,9 +422,7 @@ ViconServer::~ViconServer() { stop(); }
 void ViconServer::start() { state_->start(); }
 void ViconServer::stop() { state_->stop(); }
 uint16_t ViconServer::port() const {
-  boost::system::error_code ec;
-  const auto endpoint = state_->acceptor.local_endpoint(ec);
-  return ec ? 0 : endpoint.port();
+  return state_->listener ? static_cast<uint16_t>(state_->listener->port()) : 0;
 }
 void ViconServer::set_frame_hook(FrameHook hook) { state_->frame_hook = std::move(hook); }
 void ViconServer::set_on_finished(std::function<void()> on_finished) { state_->on_finished = std::move(on_finished); }

@@ -24,6 +24,7 @@
 // Each client has a bounded queue: when it is full the oldest waiting frame is dropped (the
 // newest wins) and counted, so a slow client never delays the others. A client sending malformed
 // input is closed and counted; the others go on.
+// Out of file descriptors, accepts pause and resume as the daemon's do (server/listener.h).
 //
 // Threading: all member functions run on the io_context's thread (or before it runs); stats()
 // may be read from any thread.

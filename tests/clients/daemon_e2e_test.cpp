@@ -26,6 +26,7 @@
 #include "protocol/capture_file.h"
 #include "protocol/point_cache.h"
 #include "server/client/subscriber_client.h"
+#include "support/loopback_peer.h"
 #include "support/program_processes.h"
 #include "support/program_run.h"
 #include "support/recording_match.h"
@@ -39,6 +40,8 @@ using test::DaemonProcess;
 using test::eventually;
 using test::ProgramRun;
 using test::ReplayProcess;
+using test::connect_loopback;
+using test::http_get_within;
 ProgramRun run(const std::string& command_line) { return test::run_program(command_line); }
 
 class DaemonProgram : public ::testing::Test {
@@ -201,42 +204,6 @@ TEST_F(DaemonProgram, SigtermStopsCleanlyWithMarkersOnly) {
   EXPECT_NE(daemon.log().find("no deformation model"), std::string::npos) << daemon.log();
 }
 
-// A loopback TCP connection to `port`, or -1. Connected even when the server has not accepted it
-// (the kernel completes the handshake into the listener's queue).
-int connect_loopback(int port) {
-  const int fd = socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in address{};
-  address.sin_family = AF_INET;
-  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  address.sin_port = htons(static_cast<uint16_t>(port));
-  if (fd >= 0 && connect(fd, reinterpret_cast<sockaddr*>(&address), sizeof address) == 0) return fd;
-  if (fd >= 0) close(fd);
-  return -1;
-}
-
-// GET `target` over a new connection, waiting at most `limit` for the whole reply; "" when none
-// came (a daemon that never accepts must fail the test, not hang it).
-std::string http_get_within(int port, const std::string& target, std::chrono::seconds limit) {
-  const int fd = connect_loopback(port);
-  if (fd < 0) return "";
-  const std::string request = "GET " + target + " HTTP/1.1\r\nHost: 127.0.0.1\r\nConnection: close\r\n\r\n";
-  std::string reply;
-  if (send(fd, request.data(), request.size(), MSG_NOSIGNAL) == static_cast<ssize_t>(request.size())) {
-    const auto end = std::chrono::steady_clock::now() + limit;
-    char buffer[4096];
-    for (;;) {
-      const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(end - std::chrono::steady_clock::now());
-      pollfd readable{fd, POLLIN, 0};
-      if (left.count() <= 0 || poll(&readable, 1, static_cast<int>(left.count())) <= 0) break;
-      const ssize_t n = recv(fd, buffer, sizeof buffer, 0);
-      if (n <= 0) break;
-      reply.append(buffer, static_cast<size_t>(n));
-    }
-  }
-  close(fd);
-  return reply;
-}
-
 // The CPU time a process has used so far (user + system), in seconds, from /proc/PID/stat.
 double cpu_seconds(pid_t pid) {
   std::ifstream in("/proc/" + std::to_string(pid) + "/stat");
@@ -270,6 +237,26 @@ TEST_F(DaemonProgram, LogsAStatusLineAndNotEveryLoopOfAReplay) {
   EXPECT_NE(log.find("0 subscribers; dropped"), std::string::npos) << log;
 }
 
+// `count` connections to `port` left waiting (kept in `out_flood`) until the program `pid`
+// runs out of descriptors, then two seconds of that episode: a paused listener uses next to no
+// CPU (one retrying at once takes what the scheduler gives it, a whole core on an idle machine)
+// and logs its start once.
+void expect_accepts_paused_when_flooded(int port, int count, pid_t pid, const std::function<std::string()>& log,
+                                        std::vector<int>& out_flood) {
+  for (int i = 0; i < count; ++i) {
+    const int fd = connect_loopback(port);
+    ASSERT_GE(fd, 0) << "connection " << i;
+    out_flood.push_back(fd);
+  }
+  ASSERT_TRUE(eventually([&] { return log().find("Too many open files") != std::string::npos; })) << log();
+  const double cpu_before = cpu_seconds(pid);
+  std::this_thread::sleep_for(std::chrono::seconds(2));
+  const double cpu_used = cpu_seconds(pid) - cpu_before;
+  std::printf("CPU in 2 s out of descriptors: %.2f s\n", cpu_used);
+  EXPECT_LT(cpu_used, 0.2);
+  EXPECT_LE(count_lines_with(log(), "accept failed"), 2) << log().substr(0, 2000);
+}
+
 // Out of file descriptors (the daemon limited to 64) with subscriber connections still waiting in
 // the kernel's queue, every accept fails at once: the daemon pauses its accepts instead of
 // retrying (it spun, logging every failure), counts the failures, answers /health on the
@@ -278,22 +265,7 @@ TEST_F(DaemonProgram, OutOfDescriptorsPausesAcceptsAndHealthStillAnswers) {
   DaemonProcess daemon("--subject " + subject_, "ulimit -n 64; ");
   ASSERT_GT(daemon.pid(), 0);
   std::vector<int> flood;
-  for (int i = 0; i < 200; ++i) {
-    const int fd = connect_loopback(daemon.sub_port);
-    ASSERT_GE(fd, 0) << "connection " << i;
-    flood.push_back(fd);
-  }
-  ASSERT_TRUE(eventually([&] { return daemon.log().find("Too many open files") != std::string::npos; })) << daemon.log();
-
-  // Two seconds of the episode: a paused listener uses next to no CPU (the spinning one, all of
-  // a core) and logs its start once.
-  const double cpu_before = cpu_seconds(daemon.pid());
-  std::this_thread::sleep_for(std::chrono::seconds(2));
-  const double cpu_used = cpu_seconds(daemon.pid()) - cpu_before;
-  std::printf("daemon CPU in 2 s out of descriptors: %.2f s\n", cpu_used);
-  // A spinning io thread takes what the scheduler gives it (a whole core on an idle machine).
-  EXPECT_LT(cpu_used, 0.2);
-  EXPECT_LE(count_lines_with(daemon.log(), "accept failed"), 2) << daemon.log().substr(0, 2000);
+  ASSERT_NO_FATAL_FAILURE(expect_accepts_paused_when_flooded(daemon.sub_port, 200, daemon.pid(), [&] { return daemon.log(); }, flood));
 
   const std::string health = http_get_within(daemon.http_port, "/health", std::chrono::seconds(10));
   ASSERT_NE(health.find("200 OK"), std::string::npos) << "no /health reply while out of descriptors: " << health;
@@ -319,6 +291,24 @@ TEST_F(DaemonProgram, OutOfDescriptorsPausesAcceptsAndHealthStillAnswers) {
   close(subscriber);
   EXPECT_TRUE(eventually([&] { return daemon.log().find("accepting again after") != std::string::npos; })) << daemon.log();
   EXPECT_EQ(daemon.stop(), 0) << daemon.log();
+}
+
+// The Vicon replay server out of file descriptors (limited to 32) with clients still waiting:
+// its accepts pause as the daemon's do (it retried at once, a core spinning), and it accepts
+// again once they leave.
+TEST_F(DaemonProgram, ViconReplayServerOutOfDescriptorsPausesAccepts) {
+  ReplayProcess replay(take_, 0, "", "ulimit -n 32; ");
+  ASSERT_GT(replay.pid(), 0);
+  std::vector<int> flood;
+  ASSERT_NO_FATAL_FAILURE(expect_accepts_paused_when_flooded(replay.port, 100, replay.pid(), [&] { return replay.log(); }, flood));
+
+  for (int fd : flood) close(fd);
+  EXPECT_TRUE(eventually([&] { return replay.log().find("accepting again after") != std::string::npos; })) << replay.log();
+  const int client = connect_loopback(replay.port);
+  ASSERT_GE(client, 0);
+  pollfd readable{client, POLLIN, 0};
+  EXPECT_EQ(poll(&readable, 1, 20'000), 1) << "no ObjectEnums to a client after the flood left: " << replay.log().substr(0, 2000);
+  close(client);
 }
 
 // skinstream-replay -> skinstreamd --vicon -> skinstream-sub, in both Vicon modes (and the same

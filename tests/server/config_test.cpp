@@ -173,6 +173,30 @@ TEST(Config, SourceLimitsDefaultToTheDecodersAndComeFromTheFile) {
   }
 }
 
+TEST(Config, SubscriberAdmissionComesFromTheFileAndBadNetworksAreNamed) {
+  const DaemonConfig defaults;
+  EXPECT_TRUE(defaults.allow_subscribers.empty());
+  EXPECT_TRUE(defaults.subscriber_token.empty());
+  const std::string path = write_file("admission.json", R"({"max_subscribers": 8, "max_subscribers_per_address": 2,
+      "subscriber_write_stall_ms": 3000, "allow_subscribers": ["10.0.0.0/8", "fd00::/8"], "subscriber_token": "t"})");
+  const auto parsed = parse({"--config", path});
+  ASSERT_TRUE(parsed);
+  EXPECT_EQ(parsed->config.max_subscribers, 8);
+  EXPECT_EQ(parsed->config.max_subscribers_per_address, 2);
+  EXPECT_EQ(parsed->config.subscriber_write_stall_ms, 3000);
+  EXPECT_EQ(parsed->config.allow_subscribers, (std::vector<std::string>{"10.0.0.0/8", "fd00::/8"}));
+  EXPECT_EQ(parsed->config.subscriber_token, "t");
+  const std::pair<const char*, const char*> bad[] = {
+      {R"({"allow_subscribers": ["10.0.0.0/40"]})", "allow_subscribers: \"10.0.0.0/40\" is not a network"},
+      {R"({"allow_subscribers": "10.0.0.0/8"})", "\"allow_subscribers\" has the wrong type"},
+      {R"({"max_subscribers": -1})", "max_subscribers must be >= 0"},
+      {R"({"subscriber_write_stall_ms": -5})", "subscriber_write_stall_ms must be >= 0"}};
+  for (const auto& [json, message] : bad) {
+    const std::string bad_path = write_file("bad_admission.json", json);
+    EXPECT_NE(error_of([&] { parse({"--config", bad_path}); }).find(message), std::string::npos) << json;
+  }
+}
+
 TEST(Config, OutOfRangeValuesAndConflictsAreErrors) {
   EXPECT_NE(error_of([] { parse({"--deform-threads", "0"}); }).find("deform_threads"), std::string::npos);
   EXPECT_NE(error_of([] { parse({"--deform-cpus", "1;2"}); }).find("deform_cpus must be"), std::string::npos);

@@ -32,13 +32,14 @@ namespace skinstream::test {
 // several: `recording` goes on the command line as it is).
 class ReplayProcess {
  public:
-  // port 0: any free port (see port). `extra` goes on the command line as it is.
-  ReplayProcess(const std::string& recording, int port, const std::string& extra = "") {
+  // port 0: any free port (see port). `extra` goes on the command line as it is; `shell_prefix`
+  // runs before it in the same shell (e.g. "ulimit -n 32; ").
+  ReplayProcess(const std::string& recording, int port, const std::string& extra = "", const std::string& shell_prefix = "") {
     out_path_ = scratch_path("replay_" + std::to_string(getpid()) + "_" + std::to_string(counter_++) + ".out");
     std::remove(out_path_.c_str());
     pid_ = fork();
     if (pid_ == 0) {
-      const std::string command = "exec " + std::string(SKINSTREAM_REPLAY) + " " + recording + " --bind 127.0.0.1 --port " +
+      const std::string command = shell_prefix + "exec " + std::string(SKINSTREAM_REPLAY) + " " + recording + " --bind 127.0.0.1 --port " +
                                   std::to_string(port) + " --loop " + extra + " > " + out_path_ + " 2> " + out_path_ + ".log";
       execl("/bin/sh", "sh", "-c", command.c_str(), static_cast<char*>(nullptr));
       _exit(127);
@@ -65,6 +66,11 @@ class ReplayProcess {
     kill(pid_, SIGKILL);
     waitpid(pid_, nullptr, 0);
     pid_ = -1;
+  }
+  pid_t pid() const { return pid_; }
+  std::string log() const {
+    std::ifstream in(out_path_ + ".log");
+    return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   }
   int port = 0;
 
