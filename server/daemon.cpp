@@ -96,21 +96,22 @@ HostPort host_port_of(const std::string& flag, const std::string& text, uint16_t
   return *parsed;
 }
 
-ViconSourceOptions vicon_options_of(const DaemonConfig& config) {
-  const HostPort address = host_port_of("--vicon", config.vicon);
-  ViconSourceOptions options;
-  options.host = address.host;
-  options.port = address.port;
-  options.mode = config.vicon_pull ? ViconSourceOptions::Mode::ClientPull : ViconSourceOptions::Mode::ServerPush;
-  return options;
-}
-
 vicon::DescriptionLimits description_limits_of(const DaemonConfig& config) {
   vicon::DescriptionLimits limits;
   limits.max_subjects = static_cast<uint32_t>(config.source_max_subjects);
   limits.max_markers_per_subject = static_cast<uint32_t>(config.source_max_markers_per_subject);
   limits.max_name_bytes = static_cast<uint32_t>(config.source_max_name_bytes);
   return limits;
+}
+
+ViconSourceOptions vicon_options_of(const DaemonConfig& config) {
+  const HostPort address = host_port_of("--vicon", config.vicon);
+  ViconSourceOptions options;
+  options.host = address.host;
+  options.port = address.port;
+  options.mode = config.vicon_pull ? ViconSourceOptions::Mode::ClientPull : ViconSourceOptions::Mode::ServerPush;
+  options.limits = description_limits_of(config);
+  return options;
 }
 
 }  // namespace
