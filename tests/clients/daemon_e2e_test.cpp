@@ -35,7 +35,7 @@ namespace skinstream {
 namespace {
 
 using test::BackgroundSubscriber;
-using test::DaemonProcess;
+using DaemonProcess = test::SkinstreamdProcess;
 using test::eventually;
 using test::ProgramRun;
 using test::ReplayProcess;

@@ -16,7 +16,7 @@
 namespace skinstream {
 namespace {
 
-using test::DaemonProcess;
+using DaemonProcess = test::SkinstreamdProcess;
 using test::ProgramRun;
 using test::ReplayProcess;
 

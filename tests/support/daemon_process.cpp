@@ -17,7 +17,7 @@
 
 namespace skinstream::test {
 
-DaemonProcess::DaemonProcess(const std::string& skinstreamd, const std::string& arguments) {
+DaemonProcess::DaemonProcess(const std::string& skinstreamd, const std::string& arguments, const std::string& shell_prefix) {
   static std::atomic<int> counter{0};
   // The process id too: ctest runs each test as its own process, several at once.
   ports_path_ = scratch_path("ports_" + std::to_string(getpid()) + "_" + std::to_string(counter++) + ".json");
@@ -25,7 +25,7 @@ DaemonProcess::DaemonProcess(const std::string& skinstreamd, const std::string& 
   log_path_ = ports_path_ + ".log";
   pid_ = fork();
   if (pid_ == 0) {
-    const std::string command = "exec " + skinstreamd + " --bind 127.0.0.1 --http-port 0 --sub-port 0 --ports-file " + ports_path_ + " " +
+    const std::string command = shell_prefix + "exec " + skinstreamd + " --bind 127.0.0.1 --http-port 0 --sub-port 0 --ports-file " + ports_path_ + " " +
                                 arguments + " > " + log_path_ + " 2>&1";
     execl("/bin/sh", "sh", "-c", command.c_str(), static_cast<char*>(nullptr));
     _exit(127);

@@ -174,6 +174,14 @@ struct Loopback {
       port = server->port();
     });
   }
+  // Two recordings as the subjects Actor1 and Actor2 of one stream.
+  void start_stage(const Capture& actor1, const Capture& actor2, ViconServerOptions options) {
+    server_io.call([&] {
+      server = std::make_unique<ViconServer>(server_io.io, std::vector<ReplaySubject>{{"Actor1", &actor1}, {"Actor2", &actor2}}, options);
+      server->start();
+      port = server->port();
+    });
+  }
   void stop_server() {
     server_io.call([&] { server.reset(); });
   }
@@ -294,12 +302,7 @@ TEST(ViconStream, TwoRecordingsAreTwoSubjectsThatNeverMixAndOneLeavesAndReturns)
       if (f >= 30 && f < 50 && two.is_labelled(p)) two.at(f, p) = missing_point();
     }
   Loopback net;
-  net.server_io.call([&] {
-    net.server = std::make_unique<ViconServer>(net.server_io.io, std::vector<ReplaySubject>{{"Actor1", &one}, {"Actor2", &two}},
-                                               fast_options(4.0));
-    net.server->start();
-    net.port = net.server->port();
-  });
+  net.start_stage(one, two, fast_options(4.0));
   const std::vector<std::string> markers = {"A", "B", "C"};
   RecordingSink sink({{"Actor1", markers}, {"Actor2", markers}});
   ViconSource source(net.client_io.io, {.host = "127.0.0.1", .port = net.port}, sink);
@@ -420,12 +423,7 @@ TEST(ViconStream, TcpSourceRefusesDescriptionsBeyondItsLimits) {
   for (const Case& c : cases) {
     SCOPED_TRACE(c.what);
     Loopback net;
-    net.server_io.call([&] {
-      net.server = std::make_unique<ViconServer>(net.server_io.io, std::vector<ReplaySubject>{{"Actor1", &one}, {"Actor2", &two}},
-                                                 fast_options(4.0));
-      net.server->start();
-      net.port = net.server->port();
-    });
+    net.start_stage(one, two, fast_options(4.0));
     RecordingSink sink({"A", "B", "C"});
     ViconSourceOptions options{.host = "127.0.0.1", .port = net.port};
     options.limits = c.limits;
