@@ -101,15 +101,6 @@ HostPort host_port_of(const std::string& flag, const std::string& text, uint16_t
   return *parsed;
 }
 
-ViconSourceOptions vicon_options_of(const DaemonConfig& config) {
-  const HostPort address = host_port_of("--vicon", config.vicon);
-  ViconSourceOptions options;
-  options.host = address.host;
-  options.port = address.port;
-  options.mode = config.vicon_pull ? ViconSourceOptions::Mode::ClientPull : ViconSourceOptions::Mode::ServerPush;
-  return options;
-}
-
 vicon::DescriptionLimits description_limits_of(const DaemonConfig& config) {
   vicon::DescriptionLimits limits;
   limits.max_subjects = static_cast<uint32_t>(config.source_max_subjects);
@@ -133,6 +124,16 @@ AdmissionOptions admission_options_of(const DaemonConfig& config) {
   options.max_total = config.max_subscribers;
   options.max_per_address = config.max_subscribers_per_address;
   options.token = config.subscriber_token;
+  return options;
+}
+
+ViconSourceOptions vicon_options_of(const DaemonConfig& config) {
+  const HostPort address = host_port_of("--vicon", config.vicon);
+  ViconSourceOptions options;
+  options.host = address.host;
+  options.port = address.port;
+  options.mode = config.vicon_pull ? ViconSourceOptions::Mode::ClientPull : ViconSourceOptions::Mode::ServerPush;
+  options.limits = description_limits_of(config);
   return options;
 }
 

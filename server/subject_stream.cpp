@@ -165,6 +165,13 @@ void SubjectStream::broadcast_status(SourceState state, std::string_view source_
   status.frames_published = metrics_.frames_published.load();
   {
     std::lock_guard lock(mutex_);
+    const auto now = std::chrono::steady_clock::now();
+    const double seconds = std::chrono::duration<double>(now - sampled_at_).count();
+    if (seconds >= 0.5) {
+      published_fps_ = static_cast<double>(status.frames_published - published_at_sample_) / seconds;
+      published_at_sample_ = status.frames_published;
+      sampled_at_ = now;
+    }
     status.subject_present = present_;
     status.detail = present_ || state != SourceState::Streaming
                         ? std::string(source_detail)
@@ -189,7 +196,7 @@ nlohmann::json SubjectStream::health() const {
   {
     std::lock_guard lock(mutex_);
     // present: in the source's latest frames (the daemon waits for an absent one).
-    out = {{"name", name_}, {"file", config_.file}, {"present", present_}, {"detail", presence_detail_}};
+    out = {{"name", name_}, {"file", config_.file}, {"present", present_}, {"detail", presence_detail_}, {"fps", published_fps_}};
   }
   out["markers"] = subject_.model.marker_count();
   out["vertices"] = pipeline_->vertex_count();

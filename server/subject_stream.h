@@ -6,6 +6,7 @@
 // present in it; a stream's work never waits for another's (each has its own threads: see
 // SubjectStreamOptions::pipeline for how the CPUs are shared).
 
+#include <chrono>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -65,7 +66,8 @@ class SubjectStream {
   void new_take() { ++generation_; }
   // The io thread: the router's verdict on this subject (logged; a return is a new take).
   void set_presence(bool present, std::string_view detail);
-  // Sends a Status to this subject's subscribers: the source's state, and this subject's.
+  // Sends a Status to this subject's subscribers: the source's state, and this subject's. Called
+  // about once a second, it also samples the rate of published frames /health reports.
   void broadcast_status(SourceState state, std::string_view source_detail);
 
   bool present() const;
@@ -97,6 +99,10 @@ class SubjectStream {
   mutable std::mutex mutex_;  // what /health reads from another thread
   bool present_ = false;
   std::string presence_detail_ = "no frame from the source yet";
+  // Frames published per second between the last two samples at least half a second apart.
+  double published_fps_ = 0.0;
+  uint64_t published_at_sample_ = 0;
+  std::chrono::steady_clock::time_point sampled_at_ = std::chrono::steady_clock::now();
 };
 
 }  // namespace skinstream::server

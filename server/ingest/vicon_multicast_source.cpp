@@ -21,7 +21,7 @@ struct ViconMulticastSource::State : std::enable_shared_from_this<ViconMulticast
       : io(io_context),
         options(std::move(opts)),
         sink(frame_sink),
-        assembler(frame_sink),
+        assembler(frame_sink, options.limits),
         socket(io),
         silence_timer(io),
         datagram(64 * 1024) {

@@ -62,7 +62,7 @@ SourceTimecode timecode_of(const vicon::Timecode& in) {
 
 // ---------------------------------------------------------------- ViconFrameAssembler
 
-ViconFrameAssembler::ViconFrameAssembler(SourceSink& sink) : sink_(sink) {
+ViconFrameAssembler::ViconFrameAssembler(SourceSink& sink, const vicon::DescriptionLimits& limits) : sink_(sink), limits_(limits) {
   labeled_.reserve(512);
   unlabeled_.reserve(256);
   frame_.unlabelled.reserve(256);
@@ -102,7 +102,7 @@ bool ViconFrameAssembler::update_subjects(const std::vector<vicon::ObjectView>& 
   for (const vicon::ObjectView& o : objects) {
     if (o.type != type::SubjectInfo) continue;
     vicon::SubjectInfo info;
-    if (!vicon::decode(o.payload, info, out_error)) return false;
+    if (!vicon::decode(o.payload, info, out_error, limits_)) return false;
     SourceSubject& subject = subjects.emplace_back();
     subject.name = std::move(info.name);
     for (const vicon::SubjectMarker& m : info.markers) {
@@ -212,10 +212,11 @@ struct ViconSource::State : std::enable_shared_from_this<ViconSource::State> {
       : io(io_context),
         options(std::move(opts)),
         sink(frame_sink),
-        assembler(frame_sink),
+        assembler(frame_sink, options.limits),
         socket(io),
         resolver(io),
         timer(io),
+        framer(vicon::kMaxPacketLength, options.limits),
         backoff(options.initial_backoff_seconds) {
     pull_request = vicon::encode_packet(vicon::RequestFrame{false});
     out_pending.reserve(256);

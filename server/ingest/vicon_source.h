@@ -39,7 +39,8 @@ namespace skinstream::server {
 // Packet objects -> SourceFrame, shared by the TCP and the multicast sources.
 class ViconFrameAssembler {
  public:
-  explicit ViconFrameAssembler(SourceSink& sink);
+  // `limits` bound what a SubjectInfo may describe (its markers, its names).
+  explicit ViconFrameAssembler(SourceSink& sink, const vicon::DescriptionLimits& limits = {});
 
   enum class Result { NoFrame, Frame, Malformed };
   // One packet's objects. On Frame, frame() holds it (receive_time_ns as given). Unknown object
@@ -56,6 +57,7 @@ class ViconFrameAssembler {
   void add_unlabelled(const std::array<double, 3>& position, uint32_t trajectory_id);
 
   SourceSink& sink_;
+  vicon::DescriptionLimits limits_;
   SourceFrame frame_;
   int64_t frame_period_ticks_ = 0;
   bool saw_object_enums_ = false;
@@ -77,6 +79,7 @@ struct ViconSourceOptions {
   Mode mode = Mode::ServerPush;
   double initial_backoff_seconds = 0.25;
   double max_backoff_seconds = 5.0;
+  vicon::DescriptionLimits limits{};  // the subjects a packet may describe (beyond them: malformed)
 };
 
 class ViconSource : public FrameSource {

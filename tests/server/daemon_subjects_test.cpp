@@ -151,7 +151,12 @@ TEST(DaemonSubjects, TwoActorsWithOneTemplateNeverMixAndEachSubscriberGetsTheSub
   version1 = subscribe(daemon, {.wants = subscriber::kWantMarkers}, frames_at_least(kWanted));
   t1.join();
   t2.join();
-  const nlohmann::json health = nlohmann::json::parse(daemon.health_json());
+  // Each subject's rate of published frames, sampled about once a second while frames flow.
+  nlohmann::json health;
+  wait_until([&] {
+    health = nlohmann::json::parse(daemon.health_json());
+    return health["subjects"][0]["fps"].get<double>() > 0.0 && health["subjects"][1]["fps"].get<double>() > 0.0;
+  });
   daemon.stop();
 
   // Each got its own subject's MeshInfo and Status, in its version.

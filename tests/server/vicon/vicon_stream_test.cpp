@@ -174,6 +174,14 @@ struct Loopback {
       port = server->port();
     });
   }
+  // Two recordings as the subjects Actor1 and Actor2 of one stream.
+  void start_stage(const Capture& actor1, const Capture& actor2, ViconServerOptions options) {
+    server_io.call([&] {
+      server = std::make_unique<ViconServer>(server_io.io, std::vector<ReplaySubject>{{"Actor1", &actor1}, {"Actor2", &actor2}}, options);
+      server->start();
+      port = server->port();
+    });
+  }
   void stop_server() {
     server_io.call([&] { server.reset(); });
   }
@@ -294,12 +302,7 @@ TEST(ViconStream, TwoRecordingsAreTwoSubjectsThatNeverMixAndOneLeavesAndReturns)
       if (f >= 30 && f < 50 && two.is_labelled(p)) two.at(f, p) = missing_point();
     }
   Loopback net;
-  net.server_io.call([&] {
-    net.server = std::make_unique<ViconServer>(net.server_io.io, std::vector<ReplaySubject>{{"Actor1", &one}, {"Actor2", &two}},
-                                               fast_options(4.0));
-    net.server->start();
-    net.port = net.server->port();
-  });
+  net.start_stage(one, two, fast_options(4.0));
   const std::vector<std::string> markers = {"A", "B", "C"};
   RecordingSink sink({{"Actor1", markers}, {"Actor2", markers}});
   ViconSource source(net.client_io.io, {.host = "127.0.0.1", .port = net.port}, sink);
@@ -400,6 +403,43 @@ TEST(ViconStream, GarbageFromTheServerIsCountedNotFatal) {
     EXPECT_NE(sink.states_[1].second.find("bad packet magic"), std::string::npos) << sink.states_[1].second;
   });
   EXPECT_GE(served.load(), 2);
+}
+
+// The daemon's source limits (DescriptionLimits) hold on the TCP source as on the multicast one:
+// a stream describing more subjects, more markers or longer names than allowed is refused with
+// the reason, and no frame of it is handed on.
+TEST(ViconStream, TcpSourceRefusesDescriptionsBeyondItsLimits) {
+  const Capture one = synthetic_capture(30), two = synthetic_capture(30);  // subjects of 3 labelled markers
+  struct Case {
+    const char* what;
+    vicon::DescriptionLimits limits;
+    const char* reason;
+  };
+  const Case cases[] = {
+      {"subjects", {.max_subjects = 1}, "more than 1 SubjectInfo objects in one packet"},
+      {"markers", {.max_markers_per_subject = 2}, "marker count 3 exceeds the limit of 2"},
+      {"names", {.max_name_bytes = 5}, "subject name of 6 bytes exceeds the limit of 5"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.what);
+    Loopback net;
+    net.start_stage(one, two, fast_options(4.0));
+    RecordingSink sink({"A", "B", "C"});
+    ViconSourceOptions options{.host = "127.0.0.1", .port = net.port};
+    options.limits = c.limits;
+    ViconSource source(net.client_io.io, options, sink);
+    source.start();
+    ASSERT_TRUE(sink.wait([&] { return sink.count_state(SourceState::Disconnected) >= 1; }));
+    source.stop();
+    sink.with_lock([&] {
+      ASSERT_FALSE(sink.bad_inputs_.empty());
+      EXPECT_EQ(sink.bad_inputs_[0], "malformed_packet");
+      EXPECT_TRUE(sink.frames_.empty());
+      bool said = false;
+      for (const auto& [state, detail] : sink.states_) said = said || (state == SourceState::Disconnected && detail.find(c.reason) != std::string::npos);
+      EXPECT_TRUE(said) << sink.states_.back().second;
+    });
+  }
 }
 
 // A raw client that asks for frames and then never reads.
