@@ -110,7 +110,7 @@ TEST(MeshFile, ReadsTheSharedAsciiPlyOfTheSameBody) {
 }
 
 TEST(MeshFile, ReadsFromMemoryAsFromTheFile) {
-  for (const std::string file : {std::string(kBody), std::string("data/meshes/makehuman/makehuman_hm08_body_only_tri.ply")}) {
+  for (const std::string& file : {std::string(kBody), std::string("data/meshes/makehuman/makehuman_hm08_body_only_tri.ply")}) {
     SCOPED_TRACE(file);
     const TriangleMesh from_file = read_mesh(test::shared_path(file));
     const TriangleMesh from_memory = read_mesh_bytes(read_bytes(test::shared_path(file)), file);
