@@ -5,6 +5,7 @@
 #include "protocol/qtm_packet_reader.h"
 #include "protocol/qtm_parameters.h"
 #include "support/fixture_bytes.h"
+#include "support/test_data.h"
 
 namespace skinstream::qtm {
 namespace {
@@ -95,6 +96,15 @@ TEST(QtmParameters, MalformedOrInconsistentIsRefused) {
   }
   bomb += "]><R><The_3D><AxisUpwards>&e9;</AxisUpwards></The_3D></R>";
   EXPECT_FALSE(parse_error(bomb).empty());
+}
+
+// Found by fuzzing (tests/fuzz/qtm_parameters_fuzz.cpp): a Labels count that is not one was
+// quoted into the error with its line break. The error is now one printable line.
+TEST(QtmParameters, TextQuotedInAnErrorIsMadePrintable) {
+  const std::string xml = test::read_bytes(test::source_path("tests/protocol/fixtures/fuzz/qtm_parameters_labels_line_break.xml"));
+  EXPECT_EQ(parse_error(xml), "The_3D/Labels is not a count: '1meters_Ver_1.19>\\x0a'");
+  EXPECT_EQ(parse_error("<R><General><Frequency>fast&#9;</Frequency></General></R>"),
+            "General/Frequency is not a frequency: 'fast\\x09'");
 }
 
 }  // namespace
