@@ -81,6 +81,8 @@ void XMLCALL on_end(void* user, const XML_Char* name) {
       double count = 0;
       if (!parse_number(s.text, count) || count < 0 || count != std::floor(count))
         s.error = "The_3D/Labels is not a count: " + quoted_text(s.text);
+      else if (count > static_cast<double>(kMaxLabels))  // and beyond a long's range, not converted
+        s.error = "The_3D/Labels says " + quoted_text(s.text) + ", more than " + std::to_string(kMaxLabels) + " labels";
       else
         s.declared_labels = static_cast<long>(count);
     }

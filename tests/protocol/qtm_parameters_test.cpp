@@ -107,5 +107,18 @@ TEST(QtmParameters, TextQuotedInAnErrorIsMadePrintable) {
             "General/Frequency is not a frequency: 'fast\\x09'");
 }
 
+// Found by fuzzing (tests/fuzz/qtm_parameters_fuzz.cpp): a Labels count of 129 digits was
+// converted to a long (undefined behaviour, reported by UBSan, before expat found the
+// document malformed further on). A count over the parser's limit
+// of labels is refused before it is converted.
+TEST(QtmParameters, ALabelsCountBeyondTheLimitIsRefused) {
+  const std::string xml = test::read_bytes(test::source_path("tests/protocol/fixtures/fuzz/qtm_parameters_labels_count_overflow.xml"));
+  EXPECT_FALSE(parse_error(xml).empty());  // the document is not well-formed further on, which expat says
+  EXPECT_EQ(parse_error("<R><The_3D><Labels>1" + std::string(128, '5') + "</Labels></The_3D></R>"),
+            "The_3D/Labels says '1555555555555555555555555555555555555555... (129 bytes)', more than 100000 labels");
+  EXPECT_NE(parse_error("<R><The_3D><Labels>100001</Labels></The_3D></R>").find("more than 100000 labels"), std::string::npos);
+  EXPECT_NE(parse_error("<R><The_3D><Labels>100000</Labels></The_3D></R>").find("says 100000 labels but names 0"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace skinstream::qtm
