@@ -43,7 +43,18 @@ std::optional<int> parse_bench_options(int argc, char** argv, BenchOptions& o) {
       ->check(CLI::IsMember({"vicon", "qtm", "natnet"}))
       ->capture_default_str();
   app.add_option("--vicon-subject-name", o.vicon_subject_name, "subject (marker set) name the replay announces (default: the recording's file name)");
+  app.add_option("--subjects", o.subjects, "actors on the stage: the recording streamed this many times, moved apart, as Actor1..ActorN; subscriber s follows ActorN with N = s mod subjects + 1")
+      ->check(CLI::Range(1, 16))
+      ->capture_default_str();
+  app.add_option("--subject-spacing-mm", o.subject_spacing_mm, "with --subjects: how far apart the actors stand along x")->capture_default_str();
   app.add_flag("--json", o.json, "print the report as JSON");
+  app.add_flag("--hostile-waves", o.hostile_waves,
+               "the soak: hostile peers (stalled, flooding, churning) connect and leave in waves while the subscribers measure "
+               "(loopback only)");
+  app.add_option("--wave-seconds", o.wave_seconds, "--hostile-waves: how long each wave stays")->check(CLI::Range(1, 3600))->capture_default_str();
+  app.add_option("--calm-seconds", o.calm_seconds, "--hostile-waves: the calm after each wave, at whose end RSS is noted")
+      ->check(CLI::Range(1, 3600))
+      ->capture_default_str();
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -4,11 +4,15 @@
 #include <sstream>
 
 #include "server/beast.h"
+#include "server/http/query_parameter.h"
 #include "server/http/static_files.h"
 #include "server/http/websocket_subscriber.h"
 
 namespace skinstream::server {
 namespace {
+
+// Refused WebSocket subscribers, all connections together: a flood logs once a second.
+RateLimitedLog websocket_refusals;
 
 std::string remote_of(const tcp::socket& socket) {
   boost::system::error_code ec;
@@ -34,19 +38,13 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
  private:
   void handle() {
     const std::string target(request_.target());
+    const std::string path = target.substr(0, target.find('?'));
     if (websocket::is_upgrade(request_)) {
-      if (target != "/stream") return respond(error(http::status::not_found, "WebSocket subscribers connect to /stream\n"));
-      stream_.expires_never();
-      tcp::socket socket = stream_.release_socket();
-      const std::string remote = remote_of(socket);
-      auto subscriber = std::make_shared<WebSocketSubscriber>(io_, hub_, std::move(socket), remote);
-      hub_.add(subscriber);
-      subscriber->accept(std::move(request_));
-      return;
+      if (path != "/stream") return respond(error(http::status::not_found, "WebSocket subscribers connect to /stream\n"));
+      return upgrade();
     }
     if (request_.method() != http::verb::get && request_.method() != http::verb::head)
       return respond(error(http::status::method_not_allowed, "only GET and HEAD\n"));
-    const std::string path = target.substr(0, target.find('?'));
     if (path == "/health") return respond(text(routes_->health_json(), "application/json"));
     if (path == "/metrics") return respond(text(routes_->metrics_text(), "text/plain; version=0.0.4; charset=utf-8"));
     if (const auto file = resolve_static_file(routes_->web_root, target)) {
@@ -56,6 +54,45 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
       if (in) return respond(text(body.str(), content_type_for(*file)));
     }
     respond(error(http::status::not_found, "not found\n"));
+  }
+
+  // A WebSocket subscriber: admitted (allow-list, limits, the token on the URL) or told why not
+  // in the HTTP status and a one-line body, and the connection closed.
+  void upgrade() {
+    SubscriberAdmission::Decision decision;
+    std::shared_ptr<const SubscriberAdmission> token_check;
+    if (SubscriberAdmission* admission = routes_->stream_admission.get()) {
+      boost::system::error_code ec;
+      const tcp::endpoint peer = stream_.socket().remote_endpoint(ec);
+      if (ec) return shutdown();
+      decision = admission->admit(peer.address());
+      if (decision.refusal != SubscriberAdmission::Refusal::None) {
+        const bool not_allowed = decision.refusal == SubscriberAdmission::Refusal::NotAllowed;
+        return refuse(not_allowed ? http::status::forbidden : http::status::service_unavailable, decision.reason);
+      }
+      if (admission->token_required()) {
+        const std::optional<std::string> token = query_parameter(std::string_view(request_.target().data(), request_.target().size()), "token");
+        if (token && !admission->token_matches(*token)) {
+          hub_.metrics().subscribers_refused_token.fetch_add(1, std::memory_order_relaxed);
+          return refuse(http::status::forbidden, "wrong token");
+        }
+        if (!token) token_check = routes_->stream_admission;  // then Hello version 2 must carry it
+      }
+    }
+    stream_.expires_never();
+    tcp::socket socket = stream_.release_socket();
+    const std::string remote = remote_of(socket);
+    auto subscriber = std::make_shared<WebSocketSubscriber>(io_, hub_, std::move(socket), remote);
+    subscriber->set_admission(std::move(decision), std::move(token_check));
+    hub_.add(subscriber);
+    subscriber->accept(std::move(request_));
+  }
+
+  void refuse(http::status status, const std::string& reason) {
+    websocket_refusals.warn("websocket_refused", "WebSocket subscriber " + remote_of(stream_.socket()) + " refused: " + reason);
+    auto res = error(status, reason + "\n");
+    request_.keep_alive(false);
+    respond(std::move(res));
   }
 
   http::response<http::string_body> text(std::string body, std::string_view type) {

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "server/listener.h"
+#include "server/publish/subscriber_admission.h"
 #include "server/publish/subscriber_hub.h"
 
 namespace skinstream::server {
@@ -16,6 +17,8 @@ struct HttpRoutes {
   std::function<std::string()> health_json;
   std::function<std::string()> metrics_text;
   std::filesystem::path web_root;  // empty: no static files
+  // Who may open /stream (refused: 403 or 503 with the reason); null: anyone.
+  std::shared_ptr<SubscriberAdmission> stream_admission;
 };
 
 class HttpServer {

@@ -1,5 +1,8 @@
 #include "server/pipeline/encoded_frame.h"
 
+#include <malloc.h>
+
+#include <algorithm>
 #include <utility>
 
 namespace skinstream::server {
@@ -65,6 +68,7 @@ size_t FramePool::prepare(StreamKey key, size_t bytes) {
   size_t missing = 0;
   {
     std::lock_guard lock(mutex_);
+    prepared_bytes_[key] = bytes;
     const size_t covered = sized_[key] + ready_[key].size();
     missing = all_.size() > covered ? all_.size() - covered : 0;
   }
@@ -96,6 +100,64 @@ bool FramePool::size_message(EncodedFrame& frame, StreamKey key, size_t bytes) {
   }
   message.resize(bytes);
   return true;
+}
+
+size_t FramePool::in_use() const {
+  std::lock_guard lock(mutex_);
+  return all_.size() - free_.size();
+}
+
+size_t FramePool::resize(size_t frames) {
+  std::lock_guard serial(prepare_mutex_);
+  std::array<size_t, EncodedFrame::kEncodings> bytes{};
+  size_t missing = 0;
+  {
+    std::lock_guard lock(mutex_);
+    bytes = prepared_bytes_;
+    missing = frames > all_.size() ? frames - all_.size() : 0;
+  }
+  // Made outside the lock, every page touched here (value-initialised), as prepare() does.
+  std::vector<EncodedFrame*> made(missing);
+  size_t buffers = 0;
+  for (EncodedFrame*& frame : made) {
+    frame = new EncodedFrame();
+    frame->pool_ = this;
+    for (size_t key = 0; key < bytes.size(); ++key)
+      if (bytes[key] > 0) {
+        frame->messages[key].resize(bytes[key]);
+        ++buffers;
+      }
+  }
+  std::vector<EncodedFrame*> doomed;
+  {
+    std::lock_guard lock(mutex_);
+    if (!made.empty()) {
+      // The ring grows to hold every frame, its free frames kept in order.
+      std::vector<EncodedFrame*> free_frames;
+      while (!free_.empty()) free_frames.push_back(free_.pop());
+      free_.reset(all_.size() + made.size());
+      for (EncodedFrame* frame : free_frames) free_.push(frame);
+      for (EncodedFrame* frame : made) {
+        all_.push_back(frame);
+        free_.push(frame);
+        for (size_t key = 0; key < bytes.size(); ++key) sized_[key] += bytes[key] > 0;
+      }
+    }
+    // The oldest free frames go first; their prepared buffers beyond the frames left go too.
+    while (all_.size() > frames && !free_.empty()) {
+      EncodedFrame* frame = free_.pop();
+      all_.erase(std::find(all_.begin(), all_.end(), frame));
+      for (size_t key = 0; key < frame->messages.size(); ++key) sized_[key] -= frame->messages[key].capacity() > 0;
+      doomed.push_back(frame);
+    }
+    for (size_t key = 0; key < ready_.size(); ++key)
+      while (!ready_[key].empty() && sized_[key] + ready_[key].size() > all_.size()) ready_[key].pop_back();
+  }
+  for (EncodedFrame* frame : doomed) delete frame;
+  // Buffers of 640 kB may sit in malloc's heap rather than in mappings of their own (its
+  // threshold rises as it frees them): hand the freed pages back to the system too.
+  if (!doomed.empty()) malloc_trim(0);
+  return buffers;
 }
 
 void FramePool::release(EncodedFrame* frame) {

@@ -89,6 +89,13 @@ class FramePool {
   // Pipeline thread: gives frame.messages[key] `bytes` bytes, within its capacity, or from a
   // prepared buffer when one is ready. Returns true when it had to allocate here instead.
   bool size_message(EncodedFrame& frame, StreamKey key, size_t bytes);
+  // Any thread but the pipeline's: brings the pool to `frames` frames. New frames get a buffer
+  // of every encoding prepared so far, made here, so the pipeline does not make them when
+  // subscribers hold more frames; free frames beyond `frames` are freed, so the memory that
+  // stalled subscribers held comes back once they leave (frames in use are kept). Returns the
+  // number of buffers it made.
+  size_t resize(size_t frames);
+  size_t in_use() const;
 
  private:
   friend class FrameRef;
@@ -103,6 +110,7 @@ class FramePool {
   // hold a buffer of that encoding (so prepare() knows how many are missing).
   std::array<std::vector<std::vector<unsigned char>>, EncodedFrame::kEncodings> ready_;
   std::array<size_t, EncodedFrame::kEncodings> sized_{};
+  std::array<size_t, EncodedFrame::kEncodings> prepared_bytes_{};  // per encoding, from prepare()
   std::mutex prepare_mutex_;  // one prepare() at a time, so two cannot both make the missing ones
 };
 

@@ -10,6 +10,7 @@
 #include <atomic>
 #include <memory>
 #include <optional>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -46,6 +47,8 @@ struct PipelineOptions {
   double default_rate_hz = 120.0;
   GapFillerOptions filler;
   int compressed_key_interval = 10;  // frames; the compressed encoding's key frames (protocol/compressed_vertices.h)
+  std::string thread_name = "pipeline";  // its deform workers: DeformWorkerOptions::thread_name
+  std::string deform_thread_name = "deform";
 };
 
 class Pipeline {
@@ -71,6 +74,14 @@ class Pipeline {
   // 640 kB each) on the pipeline thread. For the compressed encoding, the next frame becomes a
   // key frame, so the new subscriber need not wait for one.
   void prepare_encoding(StreamKey key);
+  // Any thread but the pipeline's: sizes the frame pool for this many subscribers, each of which
+  // may hold kFramesPerSubscriber frames (the one it is writing, the newest in its queue) beyond
+  // the kPooledFrames the pipeline itself cycles through. Called as subscribers come (so the
+  // pipeline does not make frames because they hold some) and once a second (so the frames that
+  // stalled subscribers held are freed once they leave).
+  void size_pool_for(size_t subscribers);
+  size_t pool_frames() const { return pool_.allocated(); }
+  size_t pool_frames_in_use() const { return pool_.in_use(); }
 
  private:
   // A Frame message of this key: its size, or for the compressed encoding the most it can take.
@@ -99,6 +110,7 @@ class Pipeline {
   // subscribers (one or two in steady state; more after a burst or behind a slow subscriber, and
   // then the pool grows). Made up front; their buffers come from prepare_encoding().
   static constexpr int kPooledFrames = 8;
+  static constexpr int kFramesPerSubscriber = 2;
   FramePool pool_{kPooledFrames};
 
   std::optional<GapFiller> filler_;

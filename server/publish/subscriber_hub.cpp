@@ -34,10 +34,10 @@ SubscriberHub::SubscriberHub(Metrics& metrics, const HubOptions& options, subscr
   broadcast_status(status_);
 }
 
-void SubscriberHub::add(const std::shared_ptr<SubscriberSession>& session) {
+void SubscriberHub::add(const std::shared_ptr<SubscriberSession>& session, bool accepted) {
   std::lock_guard lock(mutex_);
   sessions_.push_back(session);
-  metrics_.subscribers_connected.fetch_add(1, std::memory_order_relaxed);
+  if (accepted) metrics_.subscribers_connected.fetch_add(1, std::memory_order_relaxed);
 }
 
 void SubscriberHub::activate(SubscriberSession& session, StreamKey key) {
@@ -68,6 +68,17 @@ void SubscriberHub::close_all() {
   for (const auto& s : sessions) s->close_from_any_thread();
 }
 
+void SubscriberHub::drop_stalled_writers(std::chrono::nanoseconds limit) {
+  const auto now = std::chrono::steady_clock::now();
+  std::vector<std::pair<std::shared_ptr<SubscriberSession>, std::chrono::nanoseconds>> stalled;
+  {
+    std::lock_guard lock(mutex_);
+    for (const auto& s : sessions_)
+      if (const auto for_how_long = s->write_stalled_for(now); for_how_long > limit) stalled.emplace_back(s, for_how_long);
+  }
+  for (const auto& [session, for_how_long] : stalled) session->drop_for_write_stall(for_how_long);
+}
+
 void SubscriberHub::update_wanted_locked() {
   StreamKeySet set;
   for (const SubscriberSession* s : active_) set.add(s->stream_key());
@@ -76,16 +87,22 @@ void SubscriberHub::update_wanted_locked() {
 }
 
 ControlMessage SubscriberHub::mesh_info_message(StreamKey key) {
+  // What MeshInfo describes: whether positions come, and in version 2 their encoding; not
+  // normals, markers or pacing. Keys that differ only in those share one message, so a
+  // subscriber whose new Hello changes only them is not sent the 1.35 MB again.
+  const uint32_t encoding_flags = subscriber::kFrameQuantised | subscriber::kFrameCompressed | subscriber::kFrameParameters;
+  const uint32_t described_flags = subscriber::kFrameNoPositions | (stream_version(key) >= subscriber::kVersion2 ? encoding_flags : 0u);
+  const StreamKey described = stream_key(stream_flags(key) & described_flags, stream_version(key));
   std::lock_guard lock(mesh_info_mutex_);
-  ControlMessage& cached = mesh_info_messages_[key % kStreamKeys];
+  ControlMessage& cached = mesh_info_messages_[described % kStreamKeys];
   if (!cached) {
     subscriber::MeshInfo info = mesh_info_;
-    if (stream_flags(key) & subscriber::kFrameNoPositions) {
+    if (stream_flags(described) & subscriber::kFrameNoPositions) {
       info.vertex_count = 0;
       info.faces.clear();
       info.dominant_part.clear();
     }
-    info.encoding = encoding_of(key);
+    info.encoding = encoding_of(described);
     if (info.encoding == subscriber::Encoding::Compressed) info.compressed_order = compressed_order_;
     cached = std::make_shared<const std::vector<unsigned char>>(subscriber::encode_mesh_info(info, stream_version(key)));
   }
@@ -140,6 +157,11 @@ std::vector<SubscriberMetrics> SubscriberHub::subscriber_metrics() const {
   std::vector<SubscriberMetrics> out;
   for (const auto& s : sessions_) out.push_back(s->stats());
   return out;
+}
+
+size_t SubscriberHub::active_count() const {
+  std::lock_guard lock(mutex_);
+  return active_.size();
 }
 
 size_t SubscriberHub::subscriber_count() const {

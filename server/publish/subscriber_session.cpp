@@ -6,6 +6,7 @@
 #include <cstring>
 
 #include "protocol/subscriber_stream.h"
+#include "server/logging.h"
 #include "server/publish/subscriber_hub.h"
 
 namespace skinstream::server {
@@ -15,7 +16,7 @@ std::atomic<uint64_t> next_id{1};
 
 SubscriberSession::SubscriberSession(asio::io_context& io, SubscriberHub& hub, std::string transport, std::string remote)
     : io_(io),
-      hub_(hub),
+      hub_(&hub),
       id_(next_id.fetch_add(1)),
       transport_(std::move(transport)),
       remote_(std::move(remote)),
@@ -37,6 +38,31 @@ void SubscriberSession::offer_control(ControlMessage message) {
 void SubscriberSession::close_from_any_thread() {
   if (io_.get_executor().running_in_this_thread()) close();
   else asio::post(io_, [self = shared_from_this()] { self->close(); });
+}
+
+void SubscriberSession::set_admission(SubscriberAdmission::Decision decision,
+                                      std::shared_ptr<const SubscriberAdmission> token_check) {
+  admission_ = std::move(decision.ticket);
+  refusal_ = std::move(decision.reason);
+  token_check_ = std::move(token_check);
+}
+
+std::chrono::nanoseconds SubscriberSession::write_stalled_for(std::chrono::steady_clock::time_point now) const {
+  const int64_t since = write_progress_ns_.load(std::memory_order_relaxed);
+  if (since == 0) return std::chrono::nanoseconds(0);
+  return std::max(std::chrono::nanoseconds(0), now.time_since_epoch() - std::chrono::nanoseconds(since));
+}
+
+void SubscriberSession::drop_for_write_stall(std::chrono::nanoseconds stalled) {
+  if (dropped_for_stall_.exchange(true)) return;
+  hub_->metrics().subscribers_dropped_write_stall.fetch_add(1, std::memory_order_relaxed);
+  spdlog::warn("subscriber {} ({} {}): a write made no progress for {:.1f} s; closing", id_, transport_, remote_,
+               std::chrono::duration<double>(stalled).count());
+  close_from_any_thread();
+}
+
+void SubscriberSession::note_write_progress() {
+  write_progress_ns_.store(std::chrono::steady_clock::now().time_since_epoch().count(), std::memory_order_relaxed);
 }
 
 SubscriberMetrics SubscriberSession::stats() const {
@@ -79,15 +105,26 @@ void SubscriberSession::on_ack() {
 }
 
 void SubscriberSession::on_hello(const subscriber::Hello& hello) {
-  if (closed_) return;
+  if (closed_ || close_after_write_) return;
   version_ = hello.version;
+  if (!refusal_.empty()) return refuse(refusal_);
+  if (token_check_) {
+    if (!token_check_->token_matches(hello.token)) {
+      hub_->metrics().subscribers_refused_token.fetch_add(1, std::memory_order_relaxed);
+      return refuse(hello.token.empty() ? "this daemon asks for a token (Hello version 2's token field, or ?token= on the WebSocket URL)"
+                                        : "wrong token");
+    }
+    token_check_.reset();  // a later Hello changes what the subscriber wants, not who it is
+  }
   paced_ = (hello.wants & subscriber::kWantPaced) != 0;
   // Version 2: the encoding asked for, or what can be served instead, and why.
   std::string notice;
-  uint32_t flags = subscriber::frame_flags_for(hello.wants, hub_.has_mesh());
+  uint32_t flags = subscriber::frame_flags_for(hello.wants, hub_->has_mesh());
   if (hello.version >= subscriber::kVersion2) {
-    if (!hello.subject.empty() && hello.subject != hub_.subject_name()) {
-      refuse("no subject \"" + hello.subject + "\" here (this daemon serves \"" + hub_.subject_name() + "\")");
+    // The first Hello chooses the subject; a later one may not name another.
+    if (!greeted_ && !join_subject(hello.subject)) return;
+    if (greeted_ && !hello.subject.empty() && hello.subject != hub_->subject_name()) {
+      refuse("a Hello naming subject \"" + hello.subject + "\" after one naming \"" + hub_->subject_name() + "\"");
       return;
     }
     subscriber::Encoding served = subscriber::Encoding::Float;
@@ -97,9 +134,9 @@ void SubscriberSession::on_hello(const subscriber::Hello& hello) {
       notice = "encoding " + std::to_string(hello.encoding) + " is not one this daemon serves: positions in float";
     }
     const bool needs_mesh = served == subscriber::Encoding::Parameters || served == subscriber::Encoding::Compressed;
-    if (needs_mesh && !hub_.has_mesh())
+    if (needs_mesh && !hub_->has_mesh())
       notice = std::string("no ") + subscriber::to_string(served) + " encoding for a subject without a mesh: markers only";
-    flags = subscriber::frame_flags_for(hello.wants, served, hub_.has_mesh());
+    flags = subscriber::frame_flags_for(hello.wants, served, hub_->has_mesh());
   }
   const StreamKey key = server::stream_key(flags, hello.version);
   const bool changed = !greeted_ || key != key_.load();
@@ -107,31 +144,63 @@ void SubscriberSession::on_hello(const subscriber::Hello& hello) {
   hello_timer_.cancel();
   if (!changed) return;
   key_.store(key);
-  offer_control(hub_.mesh_info_message(key));
-  if ((flags & subscriber::kFrameParameters) && hub_.model_message()) offer_control(hub_.model_message());
-  offer_control(hub_.status_message(key));
+  // Sent again only when what it describes changed (MeshInfo is 1.35 MB for the 53,500-vertex
+  // body; a Hello that changes normals or markers must not cost that), the Model only once.
+  if (ControlMessage mesh_info = hub_->mesh_info_message(key); mesh_info != mesh_info_sent_) {
+    offer_control(mesh_info);
+    mesh_info_sent_ = std::move(mesh_info);
+  }
+  if ((flags & subscriber::kFrameParameters) && hub_->model_message() && !model_sent_) {
+    offer_control(hub_->model_message());
+    model_sent_ = true;
+  }
+  offer_control(hub_->status_message(key));
   if (!notice.empty()) {
-    offer_control(hub_.status_message(key, notice, subscriber::SourceStateCode::Streaming));
+    offer_control(hub_->status_message(key, notice, subscriber::SourceStateCode::Streaming));
     spdlog::info("subscriber {} ({} {}): {}", id_, transport_, remote_, notice);
   }
-  hub_.activate(*this, key);
+  hub_->activate(*this, key);
   spdlog::info("subscriber {} ({} {}): protocol {}, wants {:#x}, frame flags {:#x}", id_, transport_, remote_, hello.version,
                hello.wants, flags);
 }
 
+bool SubscriberSession::join_subject(const std::string& subject) {
+  const SubjectDirectory* directory = hub_->directory();
+  SubscriberHub* chosen =
+      directory ? directory->find(subject) : (subject.empty() || subject == hub_->subject_name() ? hub_ : nullptr);
+  if (!chosen) {
+    refuse("no subject \"" + subject + "\" here (this daemon serves " +
+           (directory ? directory->names() : "\"" + hub_->subject_name() + "\"") + ")");
+    return false;
+  }
+  if (chosen != hub_) {
+    std::shared_ptr<SubscriberSession> self = shared_from_this();  // the old hub held it
+    hub_->remove(*this);
+    hub_ = chosen;
+    mesh_info_sent_ = {};  // another subject: its own MeshInfo and Model
+    model_sent_ = false;
+    hub_->add(self, /*accepted=*/false);
+  }
+  return true;
+}
+
 void SubscriberSession::refuse(const std::string& reason) {
-  hub_.metrics().subscribers_refused.fetch_add(1, std::memory_order_relaxed);
-  spdlog::warn("subscriber {} ({} {}): refused: {}", id_, transport_, remote_, reason);
+  hub_->metrics().subscribers_refused.fetch_add(1, std::memory_order_relaxed);
+  // Rate-limited: refusals come in floods (a subscriber reconnecting in a loop, too many at once).
+  static RateLimitedLog refusals;
+  refusals.warn("subscriber_refused", fmt::format("subscriber {} ({} {}): refused: {}", id_, transport_, remote_, reason));
   greeted_ = true;
   hello_timer_.cancel();
   // The Status goes out first; the session closes once its queue has been written.
   close_after_write_ = true;
-  offer_control(hub_.status_message(server::stream_key(0, version_), reason, subscriber::SourceStateCode::Refused));
+  offer_control(hub_->status_message(server::stream_key(0, version_), reason, subscriber::SourceStateCode::Refused));
 }
 
 void SubscriberSession::on_protocol_error(const std::string& reason) {
-  hub_.metrics().bad_subscriber_messages.fetch_add(1, std::memory_order_relaxed);
-  spdlog::warn("subscriber {} ({} {}): {}; closing", id_, transport_, remote_, reason);
+  hub_->metrics().bad_subscriber_messages.fetch_add(1, std::memory_order_relaxed);
+  // Rate-limited: a peer that is no subscriber may reconnect and send the same bytes again and again.
+  static RateLimitedLog protocol_errors;
+  protocol_errors.warn("subscriber_protocol_error", fmt::format("subscriber {} ({} {}): {}; closing", id_, transport_, remote_, reason));
   close();
 }
 
@@ -141,7 +210,9 @@ void SubscriberSession::on_disconnected(const std::string& reason) {
   hello_timer_.cancel();
   spdlog::info("subscriber {} ({} {}) gone: {} (sent {}, dropped {})", id_, transport_, remote_, reason, sent_.load(),
                queue_.frames_dropped());
-  hub_.remove(*this);
+  write_progress_ns_.store(0, std::memory_order_relaxed);
+  admission_.reset();
+  hub_->remove(*this);
 }
 
 void SubscriberSession::kick() {
@@ -169,13 +240,14 @@ void SubscriberSession::pump() {
     in_flight_.frame.reset();  // encoded for this subscriber's previous wants
   }
   writing_ = true;
+  note_write_progress();
   if (in_flight_.control) {
     start_write({asio::buffer(*in_flight_.control), asio::const_buffer()});
     return;
   }
   if (paced_) ++unacked_;
   write_started_ = std::chrono::steady_clock::now();
-  hub_.metrics().subscriber_queue_wait.observe_ns(
+  hub_->metrics().subscriber_queue_wait.observe_ns(
       std::chrono::duration_cast<std::chrono::nanoseconds>(write_started_ - in_flight_.frame->published).count());
   const std::span<const unsigned char> message = in_flight_.frame->message(key_.load());
   const size_t prefix = std::min(frame_prefix_.size(), message.size());
@@ -186,6 +258,7 @@ void SubscriberSession::pump() {
 
 void SubscriberSession::write_done(const boost::system::error_code& ec) {
   writing_ = false;
+  write_progress_ns_.store(0, std::memory_order_relaxed);
   const bool was_frame = static_cast<bool>(in_flight_.frame);
   in_flight_.frame.reset();
   in_flight_.control.reset();
@@ -195,7 +268,7 @@ void SubscriberSession::write_done(const boost::system::error_code& ec) {
   }
   if (was_frame) {
     sent_.fetch_add(1, std::memory_order_relaxed);
-    hub_.metrics().subscriber_write.observe_ns(
+    hub_->metrics().subscriber_write.observe_ns(
         std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - write_started_).count());
   }
   pump();

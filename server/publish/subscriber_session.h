@@ -16,6 +16,7 @@
 #include "server/metrics/metrics.h"
 #include "protocol/subscriber_stream.h"
 #include "server/publish/handler_slot.h"
+#include "server/publish/subscriber_admission.h"
 #include "server/pipeline/stream_key.h"
 #include "server/publish/subscriber_queue.h"
 
@@ -40,6 +41,16 @@ class SubscriberSession : public std::enable_shared_from_this<SubscriberSession>
   // whatever is already posted to it).
   void close_from_any_thread();
 
+  // Before the session starts (the accepting thread): what admission decided. A refused
+  // subscriber gets a Status saying why, in the version of its Hello (version 1 after the Hello
+  // timeout), and is closed. `token_check` (null: no token asked, or it came on the URL) checks
+  // the token of its first Hello.
+  void set_admission(SubscriberAdmission::Decision decision, std::shared_ptr<const SubscriberAdmission> token_check);
+  // Any thread: how long the write under way has made no progress (zero when none is under way).
+  std::chrono::nanoseconds write_stalled_for(std::chrono::steady_clock::time_point now) const;
+  // Any thread, once: closes the subscriber whose write stalled, and counts it.
+  void drop_for_write_stall(std::chrono::nanoseconds stalled);
+
  protected:
   // For the transports (io thread).
   void start_hello_timer(std::chrono::milliseconds timeout);
@@ -55,13 +66,18 @@ class SubscriberSession : public std::enable_shared_from_this<SubscriberSession>
   // Writes the buffers as one protocol message, then calls write_done().
   virtual void start_write(const std::array<asio::const_buffer, 2>& buffers) = 0;
   void write_done(const boost::system::error_code& ec);
+  // From the transport while a write is under way: some bytes went out.
+  void note_write_progress();
 
   asio::io_context& io_;
-  SubscriberHub& hub_;
+  SubscriberHub* hub_;  // the subject's; changes only at the first version 2 Hello, before frames flow
 
  private:
   void kick();
   void pump();
+  // Version 2's first Hello: into the hub of the subject it names (SubjectDirectory); false when
+  // refused (no such subject).
+  bool join_subject(const std::string& subject);
 
   uint64_t id_;
   std::string transport_, remote_;
@@ -73,6 +89,8 @@ class SubscriberSession : public std::enable_shared_from_this<SubscriberSession>
   bool close_after_write_ = false;  // refused: close once the Status is written
   bool paced_ = false;  // Hello asked for kWantPaced
   uint16_t version_ = 0;  // of the first Hello; 0 before it
+  ControlMessage mesh_info_sent_;  // the last MeshInfo queued for it
+  bool model_sent_ = false;
   int unacked_ = 0;     // Frames sent (or being sent) and not acknowledged yet
   std::atomic<bool> pump_scheduled_{false};
   std::shared_ptr<HandlerSlot> pump_slot_;  // the posted pump's memory: the pipeline thread posts it
@@ -81,6 +99,12 @@ class SubscriberSession : public std::enable_shared_from_this<SubscriberSession>
   SubscriberQueue::Item in_flight_;
   std::chrono::steady_clock::time_point write_started_;  // of the frame in flight
   std::array<unsigned char, 64> frame_prefix_{};  // the frame's first bytes with this subscriber's drop count
+  // steady_clock ns of the write's start or its last progress; 0 while no write is under way.
+  std::atomic<int64_t> write_progress_ns_{0};
+  std::atomic<bool> dropped_for_stall_{false};
+  SubscriberAdmission::Ticket admission_;  // its place among the subscribers, freed when it goes
+  std::string refusal_;                    // refused as it connected: said after its Hello
+  std::shared_ptr<const SubscriberAdmission> token_check_;
 };
 
 }  // namespace skinstream::server

@@ -9,7 +9,7 @@ TcpSubscriber::TcpSubscriber(asio::io_context& io, SubscriberHub& hub, tcp::sock
     : SubscriberSession(io, hub, "tcp", std::move(remote)), socket_(std::move(socket)), placement_(std::move(placement)) {}
 
 void TcpSubscriber::start() {
-  start_hello_timer(hub_.options().hello_timeout);
+  start_hello_timer(hub_->options().hello_timeout);
   read_next();
 }
 
@@ -41,9 +41,15 @@ void TcpSubscriber::read_next() {
 }
 
 void TcpSubscriber::start_write(const std::array<asio::const_buffer, 2>& buffers) {
-  asio::async_write(socket_, buffers, [self = shared_from_this(), this](const boost::system::error_code& ec, size_t) {
-    write_done(ec);
-  });
+  // The completion condition runs after each piece the socket took: the write's progress, by
+  // which a subscriber that stopped reading is told from a slow one.
+  asio::async_write(
+      socket_, buffers,
+      [this](const boost::system::error_code& ec, size_t transferred) {
+        note_write_progress();
+        return asio::transfer_all()(ec, transferred);
+      },
+      [self = shared_from_this(), this](const boost::system::error_code& ec, size_t) { write_done(ec); });
 }
 
 }  // namespace skinstream::server

@@ -13,7 +13,7 @@
 #include "protocol/vicon_packet_framer.h"
 #include "protocol/vicon_packet_reader.h"
 #include "protocol/vicon_packet_writer.h"
-#include "server/tcp_congestion.h"
+#include "server/listener.h"
 
 namespace skinstream::server {
 namespace {
@@ -52,23 +52,18 @@ Packet filter_packet(const Packet& packet, const std::vector<uint32_t>& wanted) 
 struct ViconServer::State : std::enable_shared_from_this<ViconServer::State> {
   struct Session;
 
-  State(asio::io_context& io_context, const Capture& capture_in, ViconServerOptions opts)
+  State(asio::io_context& io_context, std::vector<ReplaySubject> subjects, ViconServerOptions opts)
       : io(io_context),
-        capture(capture_in),
         options(std::move(opts)),
-        congestion("vicon server", options.tcp_congestion),
-        encoder(capture, options.subject_name, options.rate_hz),
-        acceptor(io),
+        encoder(subjects, options.rate_hz, options.loop),
         timer(io),
         multicast_socket(io) {}
 
   asio::io_context& io;
-  const Capture& capture;
   ViconServerOptions options;
-  AcceptedSocketCongestion congestion;  // options.tcp_congestion on each client
   vicon::CaptureFrameEncoder encoder;
   vicon::PacketWriter writer;
-  tcp::acceptor acceptor;
+  std::unique_ptr<Listener> listener;  // from start() until stop()
   asio::steady_timer timer;
   udp::socket multicast_socket;
   std::vector<udp::endpoint> multicast_destinations;
@@ -81,6 +76,7 @@ struct ViconServer::State : std::enable_shared_from_this<ViconServer::State> {
   Clock::time_point timeline_start;
   uint64_t next_sequence = 0;      // k of the next frame to produce
   uint64_t latest_sequence = 0;    // k of the newest produced frame (valid when produced > 0)
+  uint64_t latest_listed = 0;      // the subjects the newest frame lists (CaptureFrameEncoder::listed)
   Packet latest_plain;             // the newest frame without static objects
   Packet latest_with_static;       // ... and with them (made when a client first needs it)
 
@@ -105,6 +101,7 @@ struct ViconServer::State : std::enable_shared_from_this<ViconServer::State> {
     bool push = false;
     int pull_requests = 0;
     bool sent_any_frame = false;
+    uint64_t listed_sent = 0;  // the subjects listed in the SubjectInfo it was sent last
     bool has_last_sent = false;
     uint64_t last_sent_sequence = 0;
     std::vector<uint32_t> wanted;  // empty: everything offered
@@ -259,48 +256,38 @@ struct ViconServer::State : std::enable_shared_from_this<ViconServer::State> {
   }
 
   void start() {
-    const auto address = asio::ip::make_address(options.bind_address);
-    const tcp::endpoint endpoint(address, options.port);
-    boost::system::error_code ec;
-    acceptor.open(endpoint.protocol(), ec);
-    if (!ec) acceptor.set_option(tcp::acceptor::reuse_address(true), ec);
-    if (!ec) acceptor.bind(endpoint, ec);
-    if (!ec) acceptor.listen(asio::socket_base::max_listen_connections, ec);
-    if (ec)
-      throw std::runtime_error("cannot listen on " + options.bind_address + ":" + std::to_string(options.port) + ": " +
-                               ec.message());
+    // The daemon's listener: out of descriptors it pauses its accepts instead of retrying at once.
+    listener = std::make_unique<Listener>(
+        io, options.bind_address, options.port, "vicon server",
+        [weak = weak_from_this()](tcp::socket socket) {
+          if (const auto self = weak.lock()) self->on_accept(std::move(socket));
+        },
+        ListenerOptions{options.tcp_congestion});
     object_enums_packet = copy_packet(vicon::encode_packet(vicon::CaptureFrameEncoder::offered_types()));
     running = true;
-    accept();
+    listener->start();
     if (!options.start_on_first_request) start_timeline();
   }
 
-  void accept() {
-    acceptor.async_accept([self = shared_from_this()](const boost::system::error_code& ec, tcp::socket socket) {
-      if (!self->running) return;
-      if (!ec) {
-        boost::system::error_code ignored;
-        socket.set_option(tcp::no_delay(true), ignored);
-        if (self->options.socket_send_buffer_bytes > 0)
-          socket.set_option(asio::socket_base::send_buffer_size(self->options.socket_send_buffer_bytes), ignored);
-        self->congestion.apply(socket.native_handle());
-        auto session = std::make_shared<Session>(*self, std::move(socket));
-        self->sessions.push_back(session);
-        ++self->stats.clients_accepted;
-        ++self->stats.clients_open;
-        session->begin();
-      } else if (ec == asio::error::operation_aborted) {
-        return;
-      }
-      self->accept();
-    });
+  void on_accept(tcp::socket socket) {
+    if (!running) return;
+    boost::system::error_code ignored;
+    if (options.socket_send_buffer_bytes > 0)
+      socket.set_option(asio::socket_base::send_buffer_size(options.socket_send_buffer_bytes), ignored);
+    auto session = std::make_shared<Session>(*this, std::move(socket));
+    sessions.push_back(session);
+    ++stats.clients_accepted;
+    ++stats.clients_open;
+    session->begin();
   }
 
   void stop() {
     if (!running) return;
     running = false;
     boost::system::error_code ignored;
-    acceptor.close(ignored);
+    listener->stop();
+    // Its cancelled handlers are queued and use it: freed after them.
+    asio::post(io, [done = std::move(listener)] {});
     timer.cancel();
     multicast_socket.close(ignored);
     for (auto& session : std::vector<std::shared_ptr<Session>>(sessions)) session->close();
@@ -316,7 +303,7 @@ struct ViconServer::State : std::enable_shared_from_this<ViconServer::State> {
   }
 
   void start_timeline() {
-    if (timeline_started || !running || capture.frame_count <= 0) return;
+    if (timeline_started || !running || encoder.frame_count() <= 0) return;
     timeline_started = true;
     timeline_start = Clock::now();
     schedule();
@@ -338,13 +325,12 @@ struct ViconServer::State : std::enable_shared_from_this<ViconServer::State> {
 
   void produce() {
     const uint64_t sequence = next_sequence++;
-    const int index = static_cast<int>(sequence % static_cast<uint64_t>(capture.frame_count));
-    const auto frame_number = static_cast<uint32_t>(static_cast<int64_t>(capture.first_frame) + static_cast<int64_t>(sequence));
-    encoder.encode_frame(index, frame_number, false, writer);
+    const auto frame_number = static_cast<uint32_t>(static_cast<int64_t>(encoder.first_frame()) + static_cast<int64_t>(sequence));
+    encoder.encode_frame(sequence, frame_number, false, writer);
     latest_plain = copy_packet(writer.finish());
     latest_with_static.reset();
     latest_sequence = sequence;
-    latest_index = index;
+    latest_listed = encoder.listed(sequence);
     latest_frame_number = frame_number;
     ++stats.frames_produced;
 
@@ -356,7 +342,7 @@ struct ViconServer::State : std::enable_shared_from_this<ViconServer::State> {
     for (auto& session : std::vector<std::shared_ptr<Session>>(sessions)) serve(*session);
     send_multicast();
 
-    if (!options.loop && next_sequence >= static_cast<uint64_t>(capture.frame_count)) {
+    if (!options.loop && next_sequence >= static_cast<uint64_t>(encoder.frame_count())) {
       done = true;
       if (on_finished) on_finished();
       return;
@@ -366,7 +352,7 @@ struct ViconServer::State : std::enable_shared_from_this<ViconServer::State> {
 
   const Packet& with_static() {
     if (!latest_with_static) {
-      encoder.encode_frame(latest_index, latest_frame_number, true, writer);
+      encoder.encode_frame(latest_sequence, latest_frame_number, true, writer);
       latest_with_static = copy_packet(writer.finish());
     }
     return latest_with_static;
@@ -377,9 +363,12 @@ struct ViconServer::State : std::enable_shared_from_this<ViconServer::State> {
     if (!session.open || stats.frames_produced == 0) return;
     if (!session.push && session.pull_requests <= 0) return;
     if (session.has_last_sent && session.last_sent_sequence >= latest_sequence) return;
-    Packet packet = session.sent_any_frame ? latest_plain : with_static();
+    // Static objects in a client's first frame and whenever the subjects listed changed.
+    const bool needs_static = !session.sent_any_frame || session.listed_sent != latest_listed;
+    Packet packet = needs_static ? with_static() : latest_plain;
     if (!session.wanted.empty()) packet = filter_packet(packet, session.wanted);
     session.sent_any_frame = true;
+    session.listed_sent = latest_listed;
     session.has_last_sent = true;
     session.last_sent_sequence = latest_sequence;
     if (!session.push) --session.pull_requests;
@@ -419,21 +408,21 @@ struct ViconServer::State : std::enable_shared_from_this<ViconServer::State> {
     }
   }
 
-  int latest_index = 0;
   uint32_t latest_frame_number = 0;
 };
 
+ViconServer::ViconServer(asio::io_context& io, std::vector<ReplaySubject> subjects, ViconServerOptions options)
+    : state_(std::make_shared<State>(io, std::move(subjects), std::move(options))) {}
+
 ViconServer::ViconServer(asio::io_context& io, const Capture& capture, ViconServerOptions options)
-    : state_(std::make_shared<State>(io, capture, std::move(options))) {}
+    : ViconServer(io, {{options.subject_name, &capture}}, options) {}
 
 ViconServer::~ViconServer() { stop(); }
 
 void ViconServer::start() { state_->start(); }
 void ViconServer::stop() { state_->stop(); }
 uint16_t ViconServer::port() const {
-  boost::system::error_code ec;
-  const auto endpoint = state_->acceptor.local_endpoint(ec);
-  return ec ? 0 : endpoint.port();
+  return state_->listener ? static_cast<uint16_t>(state_->listener->port()) : 0;
 }
 void ViconServer::set_frame_hook(FrameHook hook) { state_->frame_hook = std::move(hook); }
 void ViconServer::set_on_finished(std::function<void()> on_finished) { state_->on_finished = std::move(on_finished); }

@@ -3,8 +3,10 @@
 # `skinstream fill`; a Vicon DataStream source (skinstream-replay) going away and coming back;
 # the demo subject's vertex buffers against `skinstream fill` + `deform`; bad paths fail clearly.
 if(TARGET skinstreamd AND TARGET skinstream-sub AND TARGET skinstream-replay)
-  add_executable(daemon_tests ${CMAKE_CURRENT_LIST_DIR}/daemon_e2e_test.cpp ${PROJECT_SOURCE_DIR}/tests/support/test_data.cpp
-  ${PROJECT_SOURCE_DIR}/tests/support/program_run.cpp ${PROJECT_SOURCE_DIR}/tests/support/daemon_process.cpp)
+  add_executable(daemon_tests ${CMAKE_CURRENT_LIST_DIR}/daemon_e2e_test.cpp ${CMAKE_CURRENT_LIST_DIR}/daemon_subjects_e2e_test.cpp
+    ${CMAKE_CURRENT_LIST_DIR}/daemon_subscribers_e2e_test.cpp
+    ${PROJECT_SOURCE_DIR}/tests/support/test_data.cpp ${PROJECT_SOURCE_DIR}/tests/support/program_run.cpp
+    ${PROJECT_SOURCE_DIR}/tests/support/loopback_peer.cpp ${PROJECT_SOURCE_DIR}/tests/support/daemon_process.cpp)
   target_include_directories(daemon_tests PRIVATE ${PROJECT_SOURCE_DIR}/tests)
   # skinstream_server for the blocking subscriber client (server/client/) the tests subscribe with.
   target_link_libraries(daemon_tests PRIVATE skinstream_server skinstream_protocol skinstream_core nlohmann_json::nlohmann_json GTest::gtest_main)
@@ -18,9 +20,9 @@ if(TARGET skinstreamd AND TARGET skinstream-sub AND TARGET skinstream-replay)
     SKINSTREAM_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
     SKINSTREAM_TEST_TMP_DIR="${CMAKE_BINARY_DIR}/test_tmp/daemon")
   add_dependencies(daemon_tests skinstreamd skinstream-sub skinstream-replay skinstream)
-  gtest_discover_tests(daemon_tests TEST_FILTER "-DaemonDemo.*" DISCOVERY_TIMEOUT 60 PROPERTIES LABELS clients TIMEOUT 120)
+  gtest_discover_tests(daemon_tests TEST_FILTER "-DaemonDemo*" DISCOVERY_TIMEOUT 60 PROPERTIES LABELS clients TIMEOUT 120)
   # The demo subject's tests need the demo_subject fixture (tests/clients/CMakeLists.txt).
-  gtest_discover_tests(daemon_tests TEST_FILTER "DaemonDemo.*" DISCOVERY_TIMEOUT 60
+  gtest_discover_tests(daemon_tests TEST_FILTER "DaemonDemo*" DISCOVERY_TIMEOUT 60
     PROPERTIES LABELS clients TIMEOUT 300 FIXTURES_REQUIRED demo_subject)
 
   # Usage errors of the programs themselves.

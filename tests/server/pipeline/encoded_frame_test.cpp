@@ -57,5 +57,41 @@ TEST(FramePool, PreparedBuffersAreTakenWithoutAllocating) {
   EXPECT_EQ(pool.prepare(EncodedFrame::kEncodings, 1000), 0u) << "no such encoding";
 }
 
+// Frames held by subscribers that stalled (the pool grew on the pipeline thread to 40) are
+// freed once they come back, down to what the subscribers left need; frames still held stay.
+TEST(FramePool, ResizeFreesTheFramesStalledSubscribersHeldOnceTheyAreBack) {
+  FramePool pool(8);
+  pool.prepare(3, 1000);
+  std::vector<FrameRef> held;
+  for (int i = 0; i < 40; ++i) held.push_back(pool.acquire());
+  ASSERT_EQ(pool.allocated(), 40u);
+  held.resize(12);  // 28 come back
+  EXPECT_EQ(pool.resize(8), 0u);
+  EXPECT_EQ(pool.allocated(), 12u) << "frames in use were freed, or free ones kept";
+  EXPECT_EQ(pool.in_use(), 12u);
+  held.clear();
+  pool.resize(8);
+  EXPECT_EQ(pool.allocated(), 8u);
+  EXPECT_EQ(pool.in_use(), 0u);
+}
+
+// Grown ahead of the subscribers off the pipeline thread, the pool's new frames carry every
+// prepared encoding: taking them allocates nothing there.
+TEST(FramePool, ResizeGrowsWithThePreparedEncodingsSoThePipelineMakesNone) {
+  FramePool pool(2);
+  pool.prepare(3, 1000);
+  pool.prepare(5, 2000);
+  EXPECT_EQ(pool.resize(6), 8u);  // 4 new frames, 2 buffers each
+  ASSERT_EQ(pool.allocated(), 6u);
+  std::vector<FrameRef> frames;
+  for (int i = 0; i < 6; ++i) frames.push_back(pool.acquire());
+  const test::CountAllocations allocations;
+  for (FrameRef& frame : frames) {
+    EXPECT_FALSE(pool.size_message(*frame.mutable_frame(), 3, 1000));
+    EXPECT_FALSE(pool.size_message(*frame.mutable_frame(), 5, 2000));
+  }
+  EXPECT_EQ(allocations.count(), 0u);
+}
+
 }  // namespace
 }  // namespace skinstream::server
