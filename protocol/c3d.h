@@ -1,6 +1,8 @@
 #pragma once
 // C3D motion capture files (c3d.org): 3D points only; analog channels are skipped on read
 // and never written. Positions come back in millimetres whatever POINT:UNITS says.
+#include <cstdint>
+#include <span>
 #include <string>
 
 #include "core/capture.h"
@@ -23,6 +25,8 @@ struct C3dWriteOptions {
 
 // Missing samples (negative residual, NaN or exactly (0,0,0)) come back as missing_point().
 Capture read_c3d(const std::string& path);  // throws FileError
+// The same from a whole file's bytes in memory; `name` stands for the path in errors.
+Capture read_c3d_bytes(std::span<const uint8_t> bytes, const std::string& name);
 void write_c3d(const Capture& capture, const std::string& path,
                const C3dWriteOptions& options = {});  // throws FileError
 

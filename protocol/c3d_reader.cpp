@@ -17,6 +17,7 @@
 #include <limits>
 #include <map>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -451,34 +452,47 @@ Vec3 decode_sample(const Word (&word)[4], const Layout& layout) {
   return p;
 }
 
+// Frames [first, first + count) of the data section, `count` whole frames at `frames`.
+void decode_frames(const uint8_t* frames, uint64_t first, uint64_t count, const Layout& layout, Capture& capture) {
+  const uint64_t frame_bytes = layout.frame_bytes();
+  const WordFormat& f = layout.format;
+  for (uint64_t i = 0; i < count; ++i) {
+    const uint8_t* frame = frames + i * frame_bytes;
+    for (uint64_t p = 0; p < layout.points; ++p) {
+      Vec3& out = capture.at(static_cast<int>(first + i), static_cast<int>(p));
+      if (layout.float_storage) {
+        const uint8_t* b = frame + p * 16;
+        const float word[4] = {f.f32(b), f.f32(b + 4), f.f32(b + 8), f.f32(b + 12)};
+        out = decode_sample(word, layout);
+      } else {
+        const uint8_t* b = frame + p * 8;
+        const int16_t word[4] = {f.i16(b), f.i16(b + 2), f.i16(b + 4), f.i16(b + 6)};
+        out = decode_sample(word, layout);
+      }
+    }
+  }
+}
+
+// The data section read from the file a few megabytes at a time (a take can be gigabytes).
 void read_data(const std::string& path, std::ifstream& in, const Layout& layout, Capture& capture) {
   const uint64_t frame_bytes = layout.frame_bytes();
   if (layout.points == 0 || layout.frames == 0) return;
   in.seekg(static_cast<std::streamoff>(layout.data_offset));
   const uint64_t frames_per_chunk = std::max<uint64_t>(1, (4u << 20) / frame_bytes);
   std::vector<uint8_t> chunk;
-  const WordFormat& f = layout.format;
   for (uint64_t first = 0; first < layout.frames; first += frames_per_chunk) {
     const uint64_t count = std::min(frames_per_chunk, layout.frames - first);
     chunk.resize(count * frame_bytes);
     if (!in.read(reinterpret_cast<char*>(chunk.data()), static_cast<std::streamsize>(chunk.size())))
       throw FileError(path, "read error in the data section at frame " + std::to_string(first));
-    for (uint64_t i = 0; i < count; ++i) {
-      const uint8_t* frame = chunk.data() + i * frame_bytes;
-      for (uint64_t p = 0; p < layout.points; ++p) {
-        Vec3& out = capture.at(static_cast<int>(first + i), static_cast<int>(p));
-        if (layout.float_storage) {
-          const uint8_t* b = frame + p * 16;
-          const float word[4] = {f.f32(b), f.f32(b + 4), f.f32(b + 8), f.f32(b + 12)};
-          out = decode_sample(word, layout);
-        } else {
-          const uint8_t* b = frame + p * 8;
-          const int16_t word[4] = {f.i16(b), f.i16(b + 2), f.i16(b + 4), f.i16(b + 6)};
-          out = decode_sample(word, layout);
-        }
-      }
-    }
+    decode_frames(chunk.data(), first, count, layout, capture);
   }
+}
+
+Capture make_capture(const Layout& layout) {
+  Capture capture(layout.labels, static_cast<int>(layout.frames), layout.rate);
+  capture.first_frame = static_cast<int>(layout.first_frame);
+  return capture;
 }
 
 }  // namespace
@@ -501,10 +515,21 @@ Capture read_c3d(const std::string& path) {
     throw FileError(path, "read error in the header or parameter section");
   const FilePrefix prefix(path, std::move(bytes));
   const Layout layout = read_layout(path, prefix, file_size);
-
-  Capture capture(layout.labels, static_cast<int>(layout.frames), layout.rate);
-  capture.first_frame = static_cast<int>(layout.first_frame);
+  Capture capture = make_capture(layout);
   read_data(path, in, layout, capture);
+  return capture;
+}
+
+Capture read_c3d_bytes(std::span<const uint8_t> bytes, const std::string& name) {
+  if (bytes.size() < kBlockBytes)
+    throw FileError(
+        name, "truncated: " + std::to_string(bytes.size()) + " bytes, shorter than the 512-byte C3D header");
+  const std::span<const uint8_t> kept = bytes.first(std::min<uint64_t>(bytes.size(), kMaxPrefixBytes));
+  const FilePrefix prefix(name, std::vector<uint8_t>(kept.begin(), kept.end()));
+  const Layout layout = read_layout(name, prefix, bytes.size());
+  Capture capture = make_capture(layout);
+  if (layout.points > 0 && layout.frames > 0)  // read_layout checked that the frames are all there
+    decode_frames(bytes.data() + layout.data_offset, 0, layout.frames, layout, capture);
   return capture;
 }
 

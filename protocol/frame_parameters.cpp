@@ -54,7 +54,8 @@ void encode_parameter_block(const FrameParameters& parameters, std::span<unsigne
     at += sizeof(part.translation);
     put<uint32_t>(at, part.rbf ? 1u : 0u);
   }
-  std::memcpy(at, parameters.weights.data(), parameters.weights.size() * sizeof(float));
+  // A model of no members has no weights (and an empty vector's data() may be null).
+  if (!parameters.weights.empty()) std::memcpy(at, parameters.weights.data(), parameters.weights.size() * sizeof(float));
 }
 
 void decode_parameter_block(std::span<const unsigned char> block, FrameParameters& out) {
@@ -76,7 +77,7 @@ void decode_parameter_block(std::span<const unsigned char> block, FrameParameter
     if (flags > 1) throw DecodeError("parameters: part " + std::to_string(p) + " has reserved flag bits set (" + std::to_string(flags) + ")");
     part.rbf = flags == 1;
   }
-  std::memcpy(out.weights.data(), at, out.weights.size() * sizeof(float));
+  if (!out.weights.empty()) std::memcpy(out.weights.data(), at, out.weights.size() * sizeof(float));
   for (float w : out.weights)
     if (!std::isfinite(w)) throw DecodeError("parameters: an RBF weight is not finite");
 }

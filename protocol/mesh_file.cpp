@@ -428,17 +428,30 @@ TriangleMesh read_ply_file(const std::string& path, const std::string& bytes) {
   return mesh;
 }
 
-}  // namespace
-
-TriangleMesh read_mesh(const std::string& path) {
+// The path's extension when it names a mesh format (.obj or .ply); a FileError otherwise.
+std::string mesh_extension(const std::string& path) {
   const std::string ext = lower_extension(path);
   if (ext != ".obj" && ext != ".ply")
     throw FileError(path, "unknown mesh extension '" + ext + "' (expected .obj or .ply)");
-  const std::string bytes = read_bytes(path);
+  return ext;
+}
+
+TriangleMesh parse_mesh(const std::string& path, const std::string& ext, const std::string& bytes) {
   if (bytes.empty()) throw FileError(path, "empty file");
   TriangleMesh mesh = ext == ".obj" ? read_obj_file(path, bytes) : read_ply_file(path, bytes);
   check_mesh(mesh, path);
   return mesh;
+}
+
+}  // namespace
+
+TriangleMesh read_mesh(const std::string& path) {
+  const std::string ext = mesh_extension(path);
+  return parse_mesh(path, ext, read_bytes(path));
+}
+
+TriangleMesh read_mesh_bytes(std::string_view bytes, const std::string& name) {
+  return parse_mesh(name, mesh_extension(name), std::string(bytes));
 }
 
 namespace {

@@ -12,6 +12,7 @@
 // trailing bytes and wrong list counts in binary ones.)
 #include <array>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "core/capture.h"
@@ -25,6 +26,9 @@ struct TriangleMesh {
 
 // Reads .obj or .ply (extension, case-insensitive). Throws FileError.
 TriangleMesh read_mesh(const std::string& path);
+// The same from a whole file's bytes in memory; `name`'s extension says the format, and it stands
+// for the path in errors.
+TriangleMesh read_mesh_bytes(std::string_view bytes, const std::string& name);
 
 // Wavefront OBJ with one "v" line per vertex (full double precision) and 1-based "f" lines.
 // With normals (one per vertex), "vn" lines are written and faces reference them (f a//a ...).

@@ -55,9 +55,9 @@ void write_ply(const std::string& path, const std::vector<Vec3>& vertices,
   if (!out) throw FileError(path, "write failed");
 }
 
-PlyMesh read_ply(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw FileError(path, "cannot open");
+namespace {
+
+PlyMesh parse_ply(const std::string& path, std::istream& in) {
   std::string line;
   size_t nv = 0, nf = 0;
   if (!std::getline(in, line) || line != "ply") throw FileError(path, "not a PLY file");
@@ -101,6 +101,19 @@ PlyMesh read_ply(const std::string& path) {
     mesh.faces.push_back({idx[0], idx[1], idx[2], k == 4 ? idx[3] : -1});
   }
   return mesh;
+}
+
+}  // namespace
+
+PlyMesh read_ply(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw FileError(path, "cannot open");
+  return parse_ply(path, in);
+}
+
+PlyMesh read_ply_bytes(std::string_view bytes, const std::string& name) {
+  std::istringstream in{std::string(bytes)};
+  return parse_ply(name, in);
 }
 
 }  // namespace skinstream

@@ -2,6 +2,7 @@
 // Binary little-endian PLY for meshes (the generator's per-frame truth meshes): float x y z per
 // vertex, faces as polygons (uchar count, int indices). Millimetres, as given.
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "core/capture.h"
@@ -19,5 +20,7 @@ struct PlyMesh {
   std::vector<synth::Face> faces;
 };
 PlyMesh read_ply(const std::string& path);
+// The same from a whole file's bytes in memory; `name` stands for the path in errors.
+PlyMesh read_ply_bytes(std::string_view bytes, const std::string& name);
 
 }  // namespace skinstream

@@ -2,6 +2,8 @@
 
 #include <charconv>
 
+#include "protocol/printable_text.h"
+
 namespace skinstream::qtm {
 namespace {
 
@@ -38,7 +40,7 @@ bool parse_udp(std::string_view word, Command& out, std::string& out_error) {
   const std::string_view port = colon == std::string_view::npos ? rest : rest.substr(colon + 1);
   uint32_t value = 0;
   if (!parse_uint(port, value) || value == 0 || value > 65535)
-    return fail(out_error, "StreamFrames: bad UDP port in '" + std::string(word) + "'");
+    return fail(out_error, "StreamFrames: bad UDP port in " + quoted_text(word));
   out.udp = true;
   out.udp_port = static_cast<uint16_t>(value);
   out.udp_address = colon == std::string_view::npos ? std::string() : std::string(rest.substr(0, colon));
@@ -59,7 +61,7 @@ bool parse_stream_frames(const std::vector<std::string_view>& words, Command& ou
     const bool frequency = !divisor && starts_with_word(rate, "Frequency:");
     const size_t colon = rate.find(':');
     if ((!divisor && !frequency) || !parse_uint(rate.substr(colon + 1), out.rate_value) || out.rate_value == 0)
-      return fail(out_error, "StreamFrames: bad rate '" + std::string(rate) + "'");
+      return fail(out_error, "StreamFrames: bad rate " + quoted_text(rate));
     out.rate = divisor ? Command::Rate::FrequencyDivisor : Command::Rate::Frequency;
   }
   for (size_t i = 2; i < words.size(); ++i) {
@@ -99,7 +101,7 @@ bool parse_command(std::string_view text, Command& out, std::string& out_error) 
     uint32_t major = 0, minor = 0;
     if (words.size() != 2 || dot == std::string_view::npos || !parse_uint(v.substr(0, dot), major) ||
         !parse_uint(v.substr(dot + 1), minor) || major > 99 || minor > 99)
-      return fail(out_error, "Version: bad version '" + std::string(text.substr(0, 40)) + "'");
+      return fail(out_error, "Version: bad version " + quoted_text(text));
     out.major = static_cast<int>(major);
     out.minor = static_cast<int>(minor);
     return true;

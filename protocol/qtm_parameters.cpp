@@ -7,6 +7,8 @@
 #include <cstring>
 #include <memory>
 
+#include "protocol/printable_text.h"
+
 namespace skinstream::qtm {
 namespace {
 
@@ -70,7 +72,7 @@ void XMLCALL on_end(void* user, const XML_Char* name) {
   auto& s = *static_cast<ParseState*>(user);
   if (s.general_depth == 2 && s.depth == 3) {
     if (is(name, "Frequency") && (!parse_number(s.text, s.out->frequency_hz) || s.out->frequency_hz < 0.0))
-      s.error = "General/Frequency is not a frequency: '" + s.text.substr(0, 40) + "'";
+      s.error = "General/Frequency is not a frequency: " + quoted_text(s.text);
     if (is(name, "Capture_Time")) parse_number(s.text, s.out->capture_time_s);
   }
   if (s.the_3d_depth == 2 && s.depth == 3) {
@@ -78,7 +80,9 @@ void XMLCALL on_end(void* user, const XML_Char* name) {
     if (is(name, "Labels")) {
       double count = 0;
       if (!parse_number(s.text, count) || count < 0 || count != std::floor(count))
-        s.error = "The_3D/Labels is not a count: '" + s.text.substr(0, 40) + "'";
+        s.error = "The_3D/Labels is not a count: " + quoted_text(s.text);
+      else if (count > static_cast<double>(kMaxLabels))  // and beyond a long's range, not converted
+        s.error = "The_3D/Labels says " + quoted_text(s.text) + ", more than " + std::to_string(kMaxLabels) + " labels";
       else
         s.declared_labels = static_cast<long>(count);
     }

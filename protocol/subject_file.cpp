@@ -199,6 +199,10 @@ SubjectFile read_subject_file(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw FileError(path, "cannot open subject file");
   const std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  return read_subject_bytes(bytes, path);
+}
+
+SubjectFile read_subject_bytes(std::span<const unsigned char> bytes, const std::string& path) {
   if (bytes.size() < 24 || std::memcmp(bytes.data(), kMagic, sizeof kMagic) != 0)
     throw FileError(path, "not a skinstream subject file (bad magic)");
   ByteReader header(bytes.data() + 8, 12);

@@ -15,6 +15,7 @@
 // with a FileError that says which.
 
 #include <optional>
+#include <span>
 #include <string>
 
 #include "core/deform/deformation_model.h"
@@ -33,6 +34,8 @@ struct SubjectFile {
 void write_subject(const SubjectModel& model, const std::string& path);
 void write_subject(const SubjectModel& model, const DeformationModel* deformation, const std::string& path);
 SubjectFile read_subject_file(const std::string& path);
+// The same from a whole file's bytes in memory; `name` stands for the path in errors.
+SubjectFile read_subject_bytes(std::span<const unsigned char> bytes, const std::string& name);
 SubjectModel read_subject(const std::string& path);  // the marker model only
 
 }  // namespace skinstream

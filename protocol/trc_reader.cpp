@@ -186,17 +186,8 @@ std::vector<std::string> read_names(const std::string& path, const TextLines& li
 
 bool blank(std::string_view line) { return trim(line).empty(); }
 
-}  // namespace
-
-Capture read_trc(const std::string& path) {
-  std::error_code error;
-  if (!std::filesystem::exists(path, error)) throw FileError(path, "no such file");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw FileError(path, "cannot open for reading");
-  std::ostringstream buffer;
-  buffer << in.rdbuf();
-  if (in.bad()) throw FileError(path, "read error");
-  const TextLines lines(path, std::move(buffer).str());
+Capture parse_trc(const std::string& path, std::string text) {
+  const TextLines lines(path, std::move(text));
   const CellParser parse(path);
 
   const TrcHeader header = read_header(path, lines, parse);
@@ -256,5 +247,20 @@ Capture read_trc(const std::string& path) {
   }
   return capture;
 }
+
+}  // namespace
+
+Capture read_trc(const std::string& path) {
+  std::error_code error;
+  if (!std::filesystem::exists(path, error)) throw FileError(path, "no such file");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw FileError(path, "cannot open for reading");
+  std::ostringstream buffer;
+  buffer << in.rdbuf();
+  if (in.bad()) throw FileError(path, "read error");
+  return parse_trc(path, std::move(buffer).str());
+}
+
+Capture read_trc_bytes(std::string_view text, const std::string& name) { return parse_trc(name, std::string(text)); }
 
 }  // namespace skinstream

@@ -7,10 +7,14 @@
 # A finding is a crash, a sanitizer report, an input over 10 s or over 2 GB of memory; its input
 # is kept in build-fuzz/fuzz/findings/TARGET/ (replay it: build-fuzz/bin/fuzz_TARGET FILE).
 # Exits non-zero when any target found anything. Usage: scripts/fuzz.sh [SECONDS] [TARGET...]
+# FUZZ_RUNS=N also stops each target after N executions (a long run: FUZZ_RUNS=10000000 with
+# SECONDS as the cap on each target).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds=${1:-10}
 shift || true
+runs=()
+if [ -n "${FUZZ_RUNS:-}" ]; then runs=(-runs="$FUZZ_RUNS"); fi
 bash scripts/install-deps.sh >&2
 launcher=()
 if command -v ccache >/dev/null 2>&1; then launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache); fi
@@ -19,7 +23,7 @@ cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_
 cmake --build build-fuzz -j "$(nproc)" --target skinstream_fuzz >&2
 
 fuzz=$PWD/build-fuzz/fuzz
-if [ ! -f "$fuzz/seeds/done" ]; then
+if [ ! -f "$fuzz/seeds/done" ] || [ build-fuzz/bin/fuzz_make_seeds -nt "$fuzz/seeds/done" ]; then
   build-fuzz/bin/fuzz_make_seeds "$fuzz/seeds" >&2
   touch "$fuzz/seeds/done"
 fi
@@ -43,13 +47,14 @@ for target in "${targets[@]}"; do
   fi
   log=$fuzz/$target.log
   status=0
-  build-fuzz/bin/fuzz_"$target" -max_total_time="$seconds" -print_final_stats=1 -timeout=10 -rss_limit_mb=2048 \
+  started=$(date +%s)
+  build-fuzz/bin/fuzz_"$target" -max_total_time="$seconds" "${runs[@]}" -print_final_stats=1 -timeout=10 -rss_limit_mb=2048 \
     -artifact_prefix="$findings/" "$corpus" > "$log" 2>&1 || status=$?
   executions=$(sed -n 's/^stat::number_of_executed_units: *\([0-9]*\).*/\1/p' "$log" | tail -1)
   found=$(find "$findings" -type f | wc -l)
   if [ "$status" -ne 0 ] && [ "$found" -eq 0 ]; then found=1; fi  # stopped by something that left no input
   printf '{"target":"%s","seconds":%s,"executions":%s,"findings":%s,"corpus":%s}\n' \
-    "$target" "$seconds" "${executions:-0}" "$found" "$(find "$corpus" -type f | wc -l)"
+    "$target" "$(( $(date +%s) - started ))" "${executions:-0}" "$found" "$(find "$corpus" -type f | wc -l)"
   if [ "$found" -ne 0 ]; then
     failed=1
     echo "fuzz: $target: see $log and $findings/" >&2

@@ -3,7 +3,9 @@
 # with -DSKINSTREAM_SANITIZE=address,undefined into build-asan/ (benchmarks left out) and runs
 # every ctest test; the first report stops the test it happened in, which then fails. Extra
 # arguments go to ctest (e.g. -R protocol). SANITIZE=thread builds build-tsan/ under
-# ThreadSanitizer instead. Takes longer than scripts/test.sh: the sanitized programs run slower.
+# ThreadSanitizer instead. TARGETS="server_tests daemon_tests" builds only those targets (and
+# what they need) instead of everything. Takes longer than scripts/test.sh: the sanitized
+# programs run slower.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
@@ -14,7 +16,9 @@ dir=build-asan
 if [ "${SANITIZE:-}" = thread ]; then sanitizers=thread; dir=build-tsan; fi
 cmake -S . -B "$dir" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo "${launcher[@]}" \
   -DSKINSTREAM_SANITIZE="$sanitizers" -DSKINSTREAM_BUILD_TESTS=ON -DSKINSTREAM_BUILD_BENCHMARKS=OFF
-cmake --build "$dir" -j "$(nproc)"
+targets=()
+for t in ${TARGETS:-}; do targets+=(--target "$t"); done
+cmake --build "$dir" -j "$(nproc)" "${targets[@]}"
 export ASAN_OPTIONS=detect_leaks=1:strict_string_checks=1:check_initialization_order=1
 export UBSAN_OPTIONS=print_stacktrace=1
 export TSAN_OPTIONS=halt_on_error=1:second_deadlock_stack=1

@@ -417,6 +417,9 @@ void MeshEvaluator::State::build_fans(const std::vector<std::array<int, 3>>& fac
         lane_vertex[l] = order[std::min(q + l, order.size() - 1)];
         rows = std::max(rows, fan_length(lane_vertex[l]));
       }
+      // block_normals reads two rows at least: four vertices in no face get a row of themselves
+      // (a zero normal).
+      rows = std::max(rows, 1);
       bool reads_last = false;
       for (int k = -1; k < rows; ++k)  // -1: the block's own vertices
         for (int v : lane_vertex) {

@@ -12,6 +12,7 @@
 #include <iterator>
 #include <map>
 #include <random>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -252,6 +253,32 @@ TEST(C3dInvalid, RandomDamageEndsInFileErrorOrAValidCapture) {
     }
   }
   EXPECT_GT(refused, 0);
+}
+
+// ---------------------------------------------------------------- from memory
+
+std::span<const uint8_t> as_span(const Bytes& bytes) { return {reinterpret_cast<const uint8_t*>(bytes.data()), bytes.size()}; }
+
+TEST(C3dFromMemory, ReadsEveryEncodingAsTheFileReaderDoes) {
+  // Integer and float storage, Intel, DEC and MIPS (sample01), analog samples between frames
+  // (Sample_Jump2), metres and gaps (basket sprint) and a long take (CMU 85_02).
+  for (const std::string file : {"c3d-org/sample01/Eb015pi.c3d", "c3d-org/sample01/Eb015pr.c3d", "c3d-org/sample01/Eb015vi.c3d",
+                                 "c3d-org/sample01/Eb015vr.c3d", "c3d-org/sample01/Eb015si.c3d", "c3d-org/sample01/Eb015sr.c3d",
+                                 "c3d-org/Sample_Jump2.c3d", "kineticstoolkit/kinematics_basket_sprint.c3d", "cmu/85_02.c3d"}) {
+    SCOPED_TRACE(file);
+    const Capture from_file = read_c3d(capture_path(file));
+    ASSERT_GT(from_file.frame_count, 0);
+    expect_same_capture(from_file, read_c3d_bytes(as_span(read_bytes(capture_path(file))), file), 0.0);
+  }
+}
+
+TEST(C3dFromMemory, TruncatedBytesAreRefusedUnderTheGivenName) {
+  const Bytes whole = read_bytes(capture_path(kSample01));
+  for (size_t size : {0, 511, 5119, 80000, 156319}) {
+    SCOPED_TRACE(size);
+    EXPECT_TRUE(throws_file_error([&] { read_c3d_bytes(as_span(whole).first(size), "take.c3d"); }, "take.c3d", "truncated"));
+  }
+  EXPECT_EQ(read_c3d_bytes(as_span(whole).first(156320), "take.c3d").frame_count, 450);
 }
 
 // ---------------------------------------------------------------- the shared captures

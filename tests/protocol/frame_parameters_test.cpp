@@ -72,5 +72,21 @@ TEST(FrameParameters, BlocksThatDoNotFitTheModelAreRejected) {
   EXPECT_THROW(decode_parameter_block(bad, fits), DecodeError);
 }
 
+// Found by fuzzing (tests/fuzz/frame_parameters_fuzz.cpp): the block of a model with no parts and
+// no members (8 zero bytes) copied its weights with memcpy from an empty vector's null data()
+// (undefined behaviour, reported by UBSan). It decodes to nothing, and encodes back the same.
+TEST(FrameParameters, NoPartsAndNoMembersDecodeAndEncode) {
+  std::ifstream in(test::source_path("tests/protocol/fixtures/fuzz/frame_parameters_no_parts_no_members.bin"), std::ios::binary);
+  const std::vector<unsigned char> block{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  ASSERT_EQ(block, std::vector<unsigned char>(8, 0));
+  FrameParameters none;
+  decode_parameter_block(block, none);
+  EXPECT_TRUE(none.parts.empty());
+  EXPECT_TRUE(none.weights.empty());
+  std::vector<unsigned char> again(parameter_block_bytes(0, 0), 0xff);
+  encode_parameter_block(none, again);
+  EXPECT_EQ(again, block);
+}
+
 }  // namespace
 }  // namespace skinstream::subscriber

@@ -109,6 +109,21 @@ TEST(MeshFile, ReadsTheSharedAsciiPlyOfTheSameBody) {
   EXPECT_EQ(ply.faces, obj.faces);
 }
 
+TEST(MeshFile, ReadsFromMemoryAsFromTheFile) {
+  for (const std::string& file : {std::string(kBody), std::string("data/meshes/makehuman/makehuman_hm08_body_only_tri.ply")}) {
+    SCOPED_TRACE(file);
+    const TriangleMesh from_file = read_mesh(test::shared_path(file));
+    const TriangleMesh from_memory = read_mesh_bytes(read_bytes(test::shared_path(file)), file);
+    EXPECT_EQ(from_memory.vertices, from_file.vertices);
+    EXPECT_EQ(from_memory.faces, from_file.faces);
+  }
+  // The name's extension says the format, and the name stands for the path in errors.
+  EXPECT_EQ(read_mesh_bytes(kAsciiTetra, "tetra.PLY").faces.size(), 4u);
+  EXPECT_TRUE(test::throws_file_error([] { read_mesh_bytes(kAsciiTetra, "tetra.obj"); }, "tetra.obj", "line 1"));
+  EXPECT_TRUE(test::throws_file_error([] { read_mesh_bytes(kAsciiTetra, "tetra.stl"); }, "tetra.stl", "unknown mesh extension"));
+  EXPECT_TRUE(test::throws_file_error([] { read_mesh_bytes("", "empty.ply"); }, "empty.ply", "empty file"));
+}
+
 TEST(MeshFile, PlyFromTheGeneratorRoundTripsWithQuadsFanned) {
   const std::vector<Vec3> v = {{0, 0, 0}, {1000.5, 0, 0}, {1000.5, 2000.25, 0}, {0, 2000.25, -3.5}};
   const std::vector<synth::Face> f = {{0, 1, 2, 3}, {3, 2, 1, -1}};

@@ -54,6 +54,19 @@ TEST(MeshPly, CountsBeyondTheFileAreRefused) {
   EXPECT_TRUE(test::throws_file_error([&] { read_ply(no_end); }, no_end, "no end_header"));
 }
 
+TEST(MeshPly, ReadsFromMemoryAsFromTheFile) {
+  const std::vector<Vec3> v = {{0, 0, 0}, {1000.5, 0, 0}, {1000.5, 2000.25, 0}, {0, 2000.25, -3.5}};
+  const std::vector<synth::Face> f = {{0, 1, 2, 3}, {0, 2, 3, -1}};
+  const std::string path = test::scratch_path("quad_memory.ply");
+  write_ply(path, v, f);
+  const std::string bytes = test::read_bytes(path);
+  const PlyMesh from_file = read_ply(path), from_memory = read_ply_bytes(bytes, "quad.ply");
+  EXPECT_EQ(from_memory.vertices, from_file.vertices);
+  EXPECT_EQ(from_memory.faces, from_file.faces);
+  EXPECT_TRUE(test::throws_file_error([&] { read_ply_bytes(bytes.substr(0, bytes.size() - 1), "quad.ply"); }, "quad.ply",
+                                      "truncated"));
+}
+
 TEST(MeshPly, QuadsAndTrianglesRoundTrip) {
   const std::vector<Vec3> v = {{0, 0, 0}, {1000.5, 0, 0}, {1000.5, 2000.25, 0}, {0, 2000.25, -3.5}};
   const std::vector<synth::Face> f = {{0, 1, 2, 3}, {0, 2, 3, -1}};

@@ -1,8 +1,12 @@
 // QTM RT commands (protocol/qtm_command) and the actor prefixes of labels (protocol/qtm_labels).
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "protocol/qtm_command.h"
 #include "protocol/qtm_labels.h"
+#include "protocol/qtm_packet_reader.h"
+#include "support/test_data.h"
 
 namespace skinstream::qtm {
 namespace {
@@ -86,6 +90,27 @@ TEST(QtmLabels, PrefixesSplitAtTheFirstUnderscore) {
   EXPECT_EQ(b.subject, "");
   EXPECT_EQ(b.marker, "LFHD");
   EXPECT_EQ(split_label("_X").marker, "_X");
+}
+
+// Found by fuzzing (tests/fuzz/qtm_command_fuzz.cpp and qtm_packets_fuzz.cpp): a bad rate or
+// version was quoted into the error as it came, control bytes and all. The error is now one
+// printable line, the peer's bytes escaped.
+TEST(QtmCommand, ControlBytesInARefusedCommandAreEscapedInTheError) {
+  const auto printable = [](const std::string& text) {
+    return std::all_of(text.begin(), text.end(), [](char c) { return c >= 0x20 && c < 0x7f; });
+  };
+  const std::string stream_frames = test::read_bytes(test::source_path("tests/protocol/fixtures/fuzz/qtm_command_control_bytes.txt"));
+  const std::string rate_error = error_of(stream_frames);
+  EXPECT_TRUE(printable(rate_error)) << rate_error;
+  EXPECT_EQ(rate_error, "StreamFrames: bad rate 'AllFra\\x89es'");
+
+  const std::string packet = test::read_bytes(test::source_path("tests/protocol/fixtures/fuzz/qtm_version_command_control_bytes.bin"));
+  Packet decoded;
+  std::string error;
+  ASSERT_TRUE(decode_packet({reinterpret_cast<const unsigned char*>(packet.data()), packet.size()}, decoded, error)) << error;
+  const std::string version_error = error_of(decoded.text);
+  EXPECT_TRUE(printable(version_error)) << version_error;
+  EXPECT_EQ(version_error.rfind("Version: bad version 'Version 1.1\\xba", 0), 0u) << version_error;
 }
 
 }  // namespace

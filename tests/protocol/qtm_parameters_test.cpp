@@ -5,6 +5,7 @@
 #include "protocol/qtm_packet_reader.h"
 #include "protocol/qtm_parameters.h"
 #include "support/fixture_bytes.h"
+#include "support/test_data.h"
 
 namespace skinstream::qtm {
 namespace {
@@ -95,6 +96,28 @@ TEST(QtmParameters, MalformedOrInconsistentIsRefused) {
   }
   bomb += "]><R><The_3D><AxisUpwards>&e9;</AxisUpwards></The_3D></R>";
   EXPECT_FALSE(parse_error(bomb).empty());
+}
+
+// Found by fuzzing (tests/fuzz/qtm_parameters_fuzz.cpp): a Labels count that is not one was
+// quoted into the error with its line break. The error is now one printable line.
+TEST(QtmParameters, TextQuotedInAnErrorIsMadePrintable) {
+  const std::string xml = test::read_bytes(test::source_path("tests/protocol/fixtures/fuzz/qtm_parameters_labels_line_break.xml"));
+  EXPECT_EQ(parse_error(xml), "The_3D/Labels is not a count: '1meters_Ver_1.19>\\x0a'");
+  EXPECT_EQ(parse_error("<R><General><Frequency>fast&#9;</Frequency></General></R>"),
+            "General/Frequency is not a frequency: 'fast\\x09'");
+}
+
+// Found by fuzzing (tests/fuzz/qtm_parameters_fuzz.cpp): a Labels count of 129 digits was
+// converted to a long (undefined behaviour, reported by UBSan, before expat found the
+// document malformed further on). A count over the parser's limit
+// of labels is refused before it is converted.
+TEST(QtmParameters, ALabelsCountBeyondTheLimitIsRefused) {
+  const std::string xml = test::read_bytes(test::source_path("tests/protocol/fixtures/fuzz/qtm_parameters_labels_count_overflow.xml"));
+  EXPECT_FALSE(parse_error(xml).empty());  // the document is not well-formed further on, which expat says
+  EXPECT_EQ(parse_error("<R><The_3D><Labels>1" + std::string(128, '5') + "</Labels></The_3D></R>"),
+            "The_3D/Labels says '1555555555555555555555555555555555555555... (129 bytes)', more than 100000 labels");
+  EXPECT_NE(parse_error("<R><The_3D><Labels>100001</Labels></The_3D></R>").find("more than 100000 labels"), std::string::npos);
+  EXPECT_NE(parse_error("<R><The_3D><Labels>100000</Labels></The_3D></R>").find("says 100000 labels but names 0"), std::string::npos);
 }
 
 }  // namespace

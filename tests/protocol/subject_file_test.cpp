@@ -5,6 +5,7 @@
 #include <cstring>
 #include <fstream>
 #include <iterator>
+#include <span>
 
 #include "core/offline/subject_builder.h"
 #include "protocol/byte_buffer.h"
@@ -92,6 +93,21 @@ TEST_F(SubjectFile, RingOffsetsFarApartAreRefusedWithoutOverflow) {
   const std::string message = message_of(path);
   EXPECT_NE(message.find("inconsistent subject model: marker"), std::string::npos) << message;
   EXPECT_NE(message.find("ring size -1335885824"), std::string::npos) << message;
+}
+
+TEST_F(SubjectFile, ReadsFromMemoryAsFromTheFile) {
+  const std::vector<char> bytes = slurp(path_);
+  const std::span<const unsigned char> view(reinterpret_cast<const unsigned char*>(bytes.data()), bytes.size());
+  const auto from_memory = read_subject_bytes(view, "limb.subject");
+  EXPECT_EQ(from_memory.model.marker_names, model_.marker_names);
+  EXPECT_EQ(from_memory.model.reference_positions, model_.reference_positions);
+  EXPECT_EQ(from_memory.model.ring_offsets, model_.ring_offsets);
+  try {
+    read_subject_bytes(view.first(view.size() / 2), "limb.subject");
+    ADD_FAILURE() << "half a file was read";
+  } catch (const FileError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("limb.subject: truncated", 0), 0u) << e.what();
+  }
 }
 
 TEST_F(SubjectFile, RefusesToWriteAnInconsistentModel) {

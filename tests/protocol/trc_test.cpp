@@ -190,6 +190,22 @@ TEST(TrcRead, CentimetresAndWindowsLineEnds) {
   EXPECT_EQ(c.labels[1], "LASI");
 }
 
+TEST(TrcFromMemory, ReadsAsTheFileReaderDoes) {
+  const Capture c = read_c3d(test::shared_path("data/captures/cmu/85_02.c3d"));
+  const std::string path = scratch_path("trc_cmu_memory.trc");
+  write_trc(c, path);
+  test::expect_same_capture(read_trc(path), read_trc_bytes(read_text(path), "cmu.trc"));
+  const std::string small = small_trc(kValues);
+  test::expect_same_capture(read_trc(write_text("trc_small_memory.trc", small)), read_trc_bytes(small, "small.trc"));
+}
+
+TEST(TrcFromMemory, RefusesUnderTheGivenName) {
+  const std::string text = small_trc(kValues);
+  EXPECT_TRUE(throws_file_error([&] { read_trc_bytes(text.substr(0, text.size() - 3), "walk.trc"); }, "walk.trc",
+                                "truncated: line 9 has no line end"));
+  EXPECT_TRUE(throws_file_error([&] { read_trc_bytes("", "empty.trc"); }, "empty.trc", "truncated: file ends at line 0"));
+}
+
 TEST(TrcWrite, HeaderLines) {
   Capture c({"A", "B"}, 2, 60.0);
   c.first_frame = 1;

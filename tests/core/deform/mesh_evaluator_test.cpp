@@ -125,6 +125,36 @@ TEST(MeshEvaluator, EvaluatesWithoutAllocatingAndRefusesParametersThatDoNotFit) 
   EXPECT_EQ(positions, good);  // refused frames leave the previous result
 }
 
+// Found by fuzzing (tests/fuzz/subscriber_model_fuzz.cpp, a decoded Model evaluated before its
+// MeshInfo gave it faces): four vertices of a block of lanes in no face made a block of one row,
+// and the normals read the next row past the end (AddressSanitizer: heap-buffer-overflow). A
+// vertex in no face now gets a zero normal, one in a face a unit one.
+TEST(MeshEvaluator, VerticesInNoFaceGetAZeroNormal) {
+  WavySheet sheet;
+  MeshDeformer deformer(sheet.model, sheet.subject);
+  const EvaluationModel& whole = deformer.evaluation_model();
+  std::vector<float> positions(whole.reference_vertices.size());
+
+  EvaluationModel one_face = whole;
+  one_face.faces.resize(1);
+  EvaluationModel no_faces = whole;
+  no_faces.faces.clear();
+  for (const EvaluationModel* model : {&one_face, &no_faces}) {
+    MeshEvaluator evaluator(*model);
+    std::vector<float> normals(positions.size(), 7.0f);
+    ASSERT_TRUE(evaluator.evaluate(rest_parameters(*model), positions, normals));
+    for (int v = 0; v < model->vertex_count(); ++v) {
+      const std::array<int, 3>* face = model->faces.empty() ? nullptr : &model->faces[0];
+      const bool in_face = face && ((*face)[0] == v || (*face)[1] == v || (*face)[2] == v);
+      const float length = std::hypot(normals[3 * v], normals[3 * v + 1], normals[3 * v + 2]);
+      if (in_face)
+        EXPECT_NEAR(length, 1.0f, 1e-5f) << v;
+      else
+        EXPECT_EQ(length, 0.0f) << v;
+    }
+  }
+}
+
 TEST(EvaluationModel, ValidateNamesWhatIsInconsistent) {
   WavySheet sheet;
   MeshDeformer deformer(sheet.model, sheet.subject);
