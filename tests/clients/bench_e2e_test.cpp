@@ -179,6 +179,8 @@ TEST(BenchProgram, ShapedLinkWithoutRootSaysWhatItNeeds) {
                                                                 "/live.c3d --seconds 1 --link-mbit 100"));
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.output.find("--link-mbit needs root"), std::string::npos) << r.output;
+}
+
 // --subjects 2: two actors (the recording twice, apart), each followed by the daemon, with a
 // subscriber each, and reported with its own threads' CPU, frames and its subscriber's latency;
 // the io and publish threads are nobody's.
