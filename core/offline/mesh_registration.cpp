@@ -11,6 +11,7 @@
 
 #include "core/absolute_orientation.h"
 #include "core/offline/mesh_edges.h"
+#include "core/precondition.h"
 #include "core/synth/body.h"
 #include "core/synth/bvh.h"
 
@@ -19,9 +20,7 @@ namespace {
 
 using Triangles = std::span<const std::array<int, 3>>;
 
-void require(bool ok, const std::string& what) {
-  if (!ok) throw std::invalid_argument("mesh registration: " + what);
-}
+constexpr Precondition require{"mesh registration"};
 
 void check_points(std::span<const Vec3> points, const char* what) {
   for (size_t i = 0; i < points.size(); ++i)

@@ -3,19 +3,17 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
-#include <stdexcept>
 #include <string>
 #include <utility>
 
+#include "core/precondition.h"
 #include "core/synth/body.h"
 #include "core/synth/bvh.h"
 
 namespace skinstream {
 namespace {
 
-void require(bool ok, const std::string& what) {
-  if (!ok) throw std::invalid_argument("vertex part weights: " + what);
-}
+constexpr Precondition require{"vertex part weights"};
 
 // Below this, an interpolated weight counts as zero (a vertex on an edge or a vertex of the
 // triangle gets exactly what its markers have, not a trace of the opposite marker).
