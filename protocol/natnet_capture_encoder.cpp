@@ -36,10 +36,14 @@ CaptureEncoder::CaptureEncoder(std::vector<ReplaySubject> subjects, double rate_
   frame_.labelled_markers.reserve(labelled + unlabelled);
 }
 
+uint32_t CaptureEncoder::frame_number(uint64_t stream_index) const {
+  const int first = subjects_.empty() ? 1 : subjects_[0].capture->first_frame;
+  return static_cast<uint32_t>(static_cast<int64_t>(first) + static_cast<int64_t>(stream_index));
+}
+
 const FrameOfData& CaptureEncoder::frame(uint64_t stream_index) {
   const int index = frame_count_ > 0 ? static_cast<int>(stream_index % static_cast<uint64_t>(frame_count_)) : 0;
-  const int first = subjects_.empty() ? 1 : subjects_[0].capture->first_frame;
-  const auto frame_number = static_cast<uint32_t>(static_cast<int64_t>(first) + static_cast<int64_t>(stream_index));
+  const uint32_t frame_number = this->frame_number(stream_index);
   frame_.frame_number = static_cast<int32_t>(frame_number);
   frame_.other_markers.clear();
   frame_.labelled_markers.clear();

@@ -31,6 +31,8 @@ class CaptureEncoder {
   double rate_hz() const { return rate_hz_; }
   int frame_count() const { return frame_count_; }
 
+  // Stream index k's frame number: the first recording's first frame + k.
+  uint32_t frame_number(uint64_t stream_index) const;
   // The frame of stream index k, then its bytes in `version`'s layout (no allocation once warm).
   const FrameOfData& frame(uint64_t stream_index);
   void encode(uint64_t stream_index, Version version, ByteVector& out);

@@ -10,10 +10,13 @@ packages=(
   chromium
   clang libclang-rt-14-dev  # scripts/fuzz.sh: libFuzzer and clang's sanitizer runtimes
   # The Python package (clients/python): Debian's python3 and numpy; pip, venv, setuptools and
-  # wheel for its offline `pip install` test.
-  python3 python3-numpy python3-pip python3-venv python3-setuptools python3-wheel
+  # wheel for its offline `pip install` test; libmeshoptimizer2d (the .so.2d it decodes the
+  # compressed encoding with, also pulled in by libmeshoptimizer-dev).
+  python3 python3-numpy python3-pip python3-venv python3-setuptools python3-wheel libmeshoptimizer2d
   # The Blender add-on's headless test (clients/blender): Blender 3.4, about a minute to install.
   blender
+  # skinstream-bench --link-mbit: a network namespace and tc's shaper (ip, tc).
+  iproute2
 )
 # The web viewer's build (npm) and its browser test (node + playwright-core + chromium). A
 # machine with Node.js from elsewhere (e.g. NodeSource, which bundles npm) keeps it.

@@ -11,11 +11,11 @@ bash scripts/make-demo.sh build/bin/skinstream build/demo
 http_port=${HTTP_PORT:-8480}
 sub_port=${SUB_PORT:-8481}
 echo
-echo "== skinstreamd: replaying build/demo/live.c3d (350 markers, 120 Hz, looped)"
+echo "== skinstreamd: replaying build/demo/medley.c3d (350 markers, 120 Hz, 25 s: punch, golf, jump rope, flex, breathing; looped)"
 echo "== open http://localhost:${http_port}/ in a browser (TCP subscribers: port ${sub_port};"
 echo "   metrics: http://localhost:${http_port}/metrics)"
 echo
-cmd=(build/bin/skinstreamd --subject build/demo/subject.sksubj --replay build/demo/live.c3d --loop
+cmd=(build/bin/skinstreamd --subject build/demo/subject.sksubj --replay build/demo/medley.c3d --loop
      --web-root build/web --http-port "$http_port" --sub-port "$sub_port")
 if [ -n "${RUN_SECONDS:-}" ]; then
   exec timeout --signal=INT --preserve-status "$RUN_SECONDS" "${cmd[@]}"

@@ -88,8 +88,7 @@ Pose build_pose(const Skeleton& skeleton, const Anatomy& anatomy, const JointAng
 }
 
 const std::vector<std::string>& motion_names() {
-  static const std::vector<std::string> names = {"rom",   "breathe",  "flex",  "golf",
-                                                 "punch", "jumprope", "static"};
+  static const std::vector<std::string> names = {"rom", "breathe", "flex", "golf", "punch", "jumprope", "medley", "static"};
   return names;
 }
 
@@ -98,29 +97,24 @@ bool is_motion(const std::string& name) {
   return std::find(n.begin(), n.end(), name) != n.end();
 }
 
-JointAngles motion_angles(const std::string& name, const Anatomy& anatomy, double t, double duration) {
-  JointAngles target;
-  if (name == "rom")
-    target = rom_motion(anatomy, t, duration);
-  else if (name == "breathe")
-    target = breathe_motion(anatomy, t);
-  else if (name == "flex")
-    target = flex_motion(anatomy, t);
-  else if (name == "golf")
-    target = golf_motion(anatomy, t);
-  else if (name == "punch")
-    target = punch_motion(anatomy, t);
-  else if (name == "jumprope")
-    target = jumprope_motion(anatomy, t);
-  else if (name == "static") {
-    target = rest_angles(anatomy);
+JointAngles motion_target_angles(const std::string& name, const Anatomy& anatomy, double t, double duration) {
+  if (name == "rom") return rom_motion(anatomy, t, duration);
+  if (name == "breathe") return breathe_motion(anatomy, t);
+  if (name == "flex") return flex_motion(anatomy, t);
+  if (name == "golf") return golf_motion(anatomy, t);
+  if (name == "punch") return punch_motion(anatomy, t);
+  if (name == "jumprope") return jumprope_motion(anatomy, t);
+  if (name == "medley") return medley_motion(anatomy, t, duration);
+  if (name == "static") {
+    JointAngles target = rest_angles(anatomy);
     target.breath = tidal_breath(t);
-  } else
-    throw std::invalid_argument("unknown motion '" + name +
-                                "' (known: rom, breathe, flex, golf, punch, jumprope, static)");
-  const double w = smooth(t / kBlendIn);
-  JointAngles out = blend(rest_angles(anatomy), target, w);
-  return out;
+    return target;
+  }
+  throw std::invalid_argument("unknown motion '" + name + "' (known: rom, breathe, flex, golf, punch, jumprope, medley, static)");
+}
+
+JointAngles motion_angles(const std::string& name, const Anatomy& anatomy, double t, double duration) {
+  return blend(rest_angles(anatomy), motion_target_angles(name, anatomy, t, duration), smooth(t / kBlendIn));
 }
 
 MotionSample sample_motion(const std::string& name, const Skeleton& skeleton, const Anatomy& anatomy,

@@ -11,6 +11,8 @@
 //   golf      address, backswing, fast downswing, follow-through, 4.2 s cycle
 //   punch     boxing guard with alternating jab and cross, 1.2 s cycle
 //   jumprope  hopping at 2.2 Hz with turning wrists: flight, landing impacts
+//   medley    punch, golf, jumprope, flex and breathe in turn, each a fifth of the take, each
+//             blending into the next over 1 s (the demo: several motions in one take)
 //   static    the rest pose with quiet breathing (for tests)
 #include <string>
 #include <vector>
@@ -57,6 +59,8 @@ bool is_motion(const std::string& name);
 // The angles of motion `name` at time t (s) of a take lasting `duration` s, before grounding.
 // Throws std::invalid_argument for an unknown motion.
 JointAngles motion_angles(const std::string& name, const Anatomy& anatomy, double t, double duration);
+// The same without the blend in from the rest pose at the start of the take.
+JointAngles motion_target_angles(const std::string& name, const Anatomy& anatomy, double t, double duration);
 
 // motion_angles posed and grounded (soles on the floor, or `clearance` above it).
 MotionSample sample_motion(const std::string& name, const Skeleton& skeleton, const Anatomy& anatomy,
@@ -77,6 +81,7 @@ JointAngles flex_motion(const Anatomy& anatomy, double t);
 JointAngles golf_motion(const Anatomy& anatomy, double t);
 JointAngles punch_motion(const Anatomy& anatomy, double t);
 JointAngles jumprope_motion(const Anatomy& anatomy, double t);
+JointAngles medley_motion(const Anatomy& anatomy, double t, double duration);
 
 // Quiet breathing (0..0.45) with the given period, for motions that do not breathe deeply.
 double tidal_breath(double t, double period_s = 4.0);

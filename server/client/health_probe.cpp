@@ -7,11 +7,11 @@
 
 namespace skinstream::server {
 
-nlohmann::json fetch_health(int http_port) {
+nlohmann::json fetch_health(const std::string& host, int http_port) {
   asio::io_context io;
   tcp::socket socket(io);
-  socket.connect({asio::ip::make_address("127.0.0.1"), static_cast<unsigned short>(http_port)});
-  const std::string request = "GET /health HTTP/1.1\r\nHost: 127.0.0.1\r\nConnection: close\r\n\r\n";
+  socket.connect({asio::ip::make_address(host), static_cast<unsigned short>(http_port)});
+  const std::string request = "GET /health HTTP/1.1\r\nHost: " + host + "\r\nConnection: close\r\n\r\n";
   asio::write(socket, asio::buffer(request));
   std::string response;
   boost::system::error_code ec;

@@ -47,6 +47,7 @@ struct NatNetServer::State : std::enable_shared_from_this<NatNetServer::State> {
   Packet latest;
   bool running = false;
   std::function<void()> on_finished;
+  NatNetServer::FrameHook frame_hook;
   NatNetServerStats stats;
   RateLimitedLog log;
 
@@ -177,6 +178,9 @@ struct NatNetServer::State : std::enable_shared_from_this<NatNetServer::State> {
       return;
     }
     latest = std::make_shared<const natnet::ByteVector>(frame_bytes);
+    if (frame_hook)
+      frame_hook(encoder.frame_number(k),
+                 std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch()).count());
     if (options.multicast) {
       send(latest, multicast_destination);
       return;
@@ -202,6 +206,7 @@ uint16_t NatNetServer::command_port() const {
   return ec ? 0 : endpoint.port();
 }
 void NatNetServer::set_on_finished(std::function<void()> on_finished) { state_->on_finished = std::move(on_finished); }
+void NatNetServer::set_frame_hook(FrameHook hook) { state_->frame_hook = std::move(hook); }
 bool NatNetServer::finished() const { return state_->timeline.finished(); }
 const NatNetServerStats& NatNetServer::stats() const { return state_->stats; }
 

@@ -71,6 +71,10 @@ class NatNetServer {
   uint16_t command_port() const;
 
   void set_on_finished(std::function<void()> on_finished);  // once, after the last frame
+  // Called on the io thread with each frame's number and the system clock (ns since the epoch)
+  // just before it goes out to the first client: the bench's send time.
+  using FrameHook = std::function<void(uint32_t frame_number, int64_t send_time_ns)>;
+  void set_frame_hook(FrameHook hook);
   bool finished() const;
   const NatNetServerStats& stats() const;
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <deque>
 #include <optional>
@@ -59,6 +60,7 @@ struct QtmServer::State : std::enable_shared_from_this<QtmServer::State> {
   uint64_t latest = 0;                  // stream index of the newest frame
   std::array<Packet, 3> latest_packets;  // 3D + no labels, 3D only, no labels only: made on demand
   std::function<void()> on_finished;
+  QtmServer::FrameHook frame_hook;
   QtmServerStats stats;
   RateLimitedLog log;
 
@@ -325,6 +327,9 @@ struct QtmServer::State : std::enable_shared_from_this<QtmServer::State> {
     latest = k;
     latest_packets = {};
     ++stats.frames_produced;
+    if (frame_hook)
+      frame_hook(encoder.frame_number(k),
+                 std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch()).count());
     for (auto& session : std::vector<std::shared_ptr<Session>>(sessions)) {
       if (!session->open || !session->streaming || k % session->divisor != 0) continue;
       Packet p = packet(session->labelled, session->unlabelled);
@@ -369,6 +374,7 @@ uint16_t QtmServer::port() const {
   return ec ? 0 : endpoint.port();
 }
 void QtmServer::set_on_finished(std::function<void()> on_finished) { state_->on_finished = std::move(on_finished); }
+void QtmServer::set_frame_hook(FrameHook hook) { state_->frame_hook = std::move(hook); }
 bool QtmServer::finished() const { return state_->timeline.finished(); }
 bool QtmServer::all_clients_idle() const {
   return std::all_of(state_->sessions.begin(), state_->sessions.end(),

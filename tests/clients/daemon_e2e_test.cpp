@@ -27,6 +27,7 @@
 #include "protocol/point_cache.h"
 #include "server/client/subscriber_client.h"
 #include "support/program_run.h"
+#include "support/daemon_process.h"
 #include "support/test_data.h"
 
 namespace skinstream {
@@ -35,65 +36,11 @@ namespace {
 using test::ProgramRun;
 ProgramRun run(const std::string& command_line) { return test::run_program(command_line); }
 
-// A daemon in the background; stopped with SIGTERM. `shell_prefix` runs before it in the same
-// shell (e.g. "ulimit -n 64; ").
-class DaemonProcess {
- public:
-  explicit DaemonProcess(const std::string& arguments, const std::string& shell_prefix = "") {
-    // The process id too: ctest runs each test as its own process, several at once.
-    ports_path_ = test::scratch_path("ports_" + std::to_string(getpid()) + "_" + std::to_string(counter_++) + ".json");
-    std::remove(ports_path_.c_str());
-    log_path_ = ports_path_ + ".log";
-    pid_ = fork();
-    if (pid_ == 0) {
-      const std::string command = shell_prefix + "exec " + std::string(SKINSTREAMD) + " --bind 127.0.0.1 --http-port 0 --sub-port 0 --ports-file " +
-                                  ports_path_ + " " + arguments + " > " + log_path_ + " 2>&1";
-      execl("/bin/sh", "sh", "-c", command.c_str(), static_cast<char*>(nullptr));
-      _exit(127);
-    }
-    for (;;) {
-      std::ifstream in(ports_path_);
-      if (in) {
-        const nlohmann::json ports = nlohmann::json::parse(in);
-        http_port = ports["http"];
-        sub_port = ports["sub"];
-        return;
-      }
-      int status = 0;
-      if (waitpid(pid_, &status, WNOHANG) == pid_) {
-        pid_ = -1;
-        ADD_FAILURE() << "skinstreamd exited at startup: " << log();
-        return;
-      }
-      std::this_thread::sleep_for(std::chrono::milliseconds(20));
-    }
-  }
-  ~DaemonProcess() { stop(); }
-  int stop() {
-    if (pid_ <= 0) return exit_code_;
-    kill(pid_, SIGTERM);
-    int status = 0;
-    waitpid(pid_, &status, 0);
-    pid_ = -1;
-    exit_code_ = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    return exit_code_;
-  }
-  std::string log() const {
-    std::ifstream in(log_path_);
-    std::stringstream text;
-    text << in.rdbuf();
-    return text.str();
-  }
-  pid_t pid() const { return pid_; }  // the daemon's own (the shell execs it)
-  int http_port = 0, sub_port = 0;
-
- private:
-  static inline int counter_ = 0;
-  pid_t pid_ = -1;
-  int exit_code_ = -1;
-  std::string ports_path_, log_path_;
+// A daemon in the background, through the harness the bench uses too.
+struct DaemonProcess : test::DaemonProcess {
+  explicit DaemonProcess(const std::string& arguments, const std::string& shell_prefix = "")
+      : test::DaemonProcess(SKINSTREAMD, arguments, shell_prefix) {}
 };
-
 
 // skinstream-replay in the background: a Vicon DataStream server looping a recording.
 class ReplayProcess {

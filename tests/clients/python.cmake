@@ -1,5 +1,7 @@
 # The Python package (clients/python) with Debian's python3 and python3-numpy: its codecs against
-# the golden fixtures and the real meshoptimizer library, pip install without the network, and
+# the golden fixtures and the real meshoptimizer library, its numpy evaluation of the parameters
+# against the spec's in float64, its ctypes paths through libmeshoptimizer and the C++ client
+# library against the numpy ones, pip install without the network, and
 # end to end against the real skinstreamd on the demo subject (tests/clients/python/).
 find_program(SKINSTREAM_PYTHON NAMES python3 PATHS /usr/bin NO_DEFAULT_PATH)
 if(NOT SKINSTREAM_PYTHON)
@@ -10,7 +12,12 @@ elseif(TARGET skinstreamd)
     SKINSTREAM_CLI=$<TARGET_FILE:skinstream>
     SKINSTREAM_DEMO_DIR=${CMAKE_BINARY_DIR}/demo
     SKINSTREAM_TEST_TMP_DIR=${CMAKE_BINARY_DIR}/test_tmp/python)
-  foreach(name vertex_codec protocol install subscriber receiver)
+  set(python_tests vertex_codec meshoptimizer_library protocol evaluation normals decoder_choice install subscriber receiver)
+  if(TARGET skinstream_client)  # the package's fast path for the parameters, through its C ABI
+    list(APPEND python_test_environment SKINSTREAM_CLIENT_LIBRARY=$<TARGET_FILE:skinstream_client>)
+    list(APPEND python_tests client_library)
+  endif()
+  foreach(name ${python_tests})
     add_test(NAME python.${name} COMMAND ${SKINSTREAM_PYTHON} ${CMAKE_CURRENT_LIST_DIR}/python/${name}_test.py)
     set_tests_properties(python.${name} PROPERTIES ENVIRONMENT "${python_test_environment}" LABELS clients TIMEOUT 300)
   endforeach()

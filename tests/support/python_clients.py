@@ -1,5 +1,6 @@
 """What the Python-driven client tests share: the package from the source tree on sys.path, and
-the programs, demo subject and scratch folder ctest hands them in the environment."""
+the programs, demo subject, scratch folder and C++ client library ctest hands them in the
+environment (by hand: the build tree's)."""
 import os
 import sys
 
@@ -12,6 +13,9 @@ SKINSTREAM_CLI = os.environ.get('SKINSTREAM_CLI', os.path.join(SOURCE, 'build', 
 DEMO = os.environ.get('SKINSTREAM_DEMO_DIR', os.path.join(SOURCE, 'build', 'demo'))
 SCRATCH = os.environ.get('SKINSTREAM_TEST_TMP_DIR', os.path.join(SOURCE, 'build', 'test_tmp', 'python'))
 FIXTURES = os.path.join(TESTS, 'protocol', 'fixtures', 'subscriber')
+# The package finds libskinstream_client by this variable (skinstream/client_library.py).
+CLIENT_LIBRARY = os.environ.setdefault('SKINSTREAM_CLIENT_LIBRARY',
+                                       os.path.join(SOURCE, 'build', 'clients', 'cpp', 'libskinstream_client.so.0'))
 
 
 def demo_daemon(*extra, port=0, speed='0.2'):

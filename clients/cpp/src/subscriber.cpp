@@ -194,7 +194,9 @@ bool Subscriber::State::on_frame(std::span<const unsigned char> payload, Frame& 
   const wire::FrameInfo& info = view.info;
   const size_t v3 = 3 * static_cast<size_t>(mesh.vertex_count);
   bool have_positions = false, have_normals = false;
-  if (info.flags & wire::kFrameParameters) {
+  if (!options.decode) {
+    // The header, markers and times below only.
+  } else if (info.flags & wire::kFrameParameters) {
     if (!evaluator) throw Error("a parameter Frame before the Model");
     wire::decode_parameter_block(view.positions, parameters);
     parameter_block.assign(view.positions.begin(), view.positions.end());

@@ -9,7 +9,11 @@ deformation parameters, evaluated here). Protocol: docs/subscriber-protocol.md.
 
 Receiver does the same on a background thread, keeps only the newest frame and reconnects with
 backoff when the daemon goes away (for renderers with their own loop, such as Blender).
+
+Compressed frames are decoded by the system's libmeshoptimizer and parameters evaluated by the
+C++ client library (libskinstream_client) when they load, else in numpy: decoders() says which.
 """
+from .decoder_choice import decoders
 from .protocol import ENCODINGS, MARKER_STATUS, Error, ProtocolError
 from .point_cache import PointCacheWriter, read_point_cache
 from .receiver import Receiver
@@ -18,4 +22,4 @@ from .vertex_codec import CodecError
 
 __version__ = '0.1.0'
 __all__ = ['Subscriber', 'Receiver', 'Frame', 'Error', 'ProtocolError', 'ConnectionLost', 'Refused', 'CodecError',
-           'PointCacheWriter', 'read_point_cache', 'ENCODINGS', 'MARKER_STATUS']
+           'PointCacheWriter', 'read_point_cache', 'ENCODINGS', 'MARKER_STATUS', 'decoders']

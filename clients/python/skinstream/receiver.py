@@ -21,6 +21,7 @@ class Receiver:
         self.frames_replaced = 0  # arrived and gave way to a newer one before take()
         self.connections = 0  # subscriptions that got their MeshInfo
         self.mesh = self.model = None  # of the current (or last) subscription
+        self.decoder = None  # what decodes its frames (Subscriber.decoder)
         self._state, self._detail, self._retry_at = 'stopped', '', None
         self._newest = None
         self._slot = threading.Lock()
@@ -66,7 +67,8 @@ class Receiver:
             left = max(0.0, self._retry_at - time.monotonic())
             return f'{where}: {self._detail}; retrying in {left:.1f} s'
         if self._state == 'streaming' and self.mesh is not None:
-            return f'{where}: streaming "{self.mesh.subject}", {self.frames_received} frames'
+            decoded = f' (decoded by {self.decoder})' if self.decoder else ''
+            return f'{where}: streaming "{self.mesh.subject}", {self.frames_received} frames{decoded}'
         return f'{where}: {self._state}'
 
     def start_recording(self, path, start_frame=0.0):
@@ -107,7 +109,7 @@ class Receiver:
                         self.connections += 1
                     if frame is None:
                         continue
-                    self.model = subscriber.model
+                    self.model, self.decoder = subscriber.model, subscriber.decoder
                     self._arrived(frame)
                     self._state = 'streaming'
                     wait = self.first_retry

@@ -7,8 +7,7 @@ import time
 import numpy as np
 
 from . import protocol as wire
-from .compressed import CompressedDecoder
-from .evaluation import Evaluator
+from .decoder_choice import compressed_decoder, parameter_evaluator
 from .protocol import Error, ProtocolError
 
 
@@ -42,10 +41,11 @@ class Frame:
 class Subscriber:
     """A subscription. Connects and sends Hello on construction (ConnectionLost when the daemon
     cannot be reached); next_frame() and frames() read. Every error is an Error subclass with a
-    one-line message; after one, make a new Subscriber (Receiver does that with backoff)."""
+    one-line message; after one, make a new Subscriber (Receiver does that with backoff).
+    libraries=False decodes in numpy even where libmeshoptimizer or libskinstream_client load."""
 
     def __init__(self, host='127.0.0.1', port=8481, encoding='parameters', normals=True, markers=False, mesh=True,
-                 paced=False, evaluate=True, subject='', token='', protocol_version=2, connect_timeout=5.0):
+                 paced=False, evaluate=True, subject='', token='', protocol_version=2, connect_timeout=5.0, libraries=True):
         if encoding not in wire.ENCODINGS:
             raise ValueError(f'unknown encoding "{encoding}" (float, quantised, compressed or parameters)')
         if protocol_version not in wire.VERSIONS:
@@ -55,6 +55,7 @@ class Subscriber:
             raise ValueError('the compressed and parameter encodings, a subject and a token need protocol version 2')
         self.version = protocol_version
         self.paced, self.evaluate, self.want_normals = paced, evaluate, normals
+        self.libraries = libraries  # decode with the system's libraries when they load (decoder_choice.py)
         wants = ((wire.WANT_NORMALS if normals else 0) | (wire.WANT_MARKERS if markers else 0) |
                  (0 if mesh else wire.WANT_NO_MESH) | (wire.WANT_PACED if paced else 0))
         if protocol_version == 1 and self.encoding_asked == wire.QUANTISED:
@@ -91,6 +92,17 @@ class Subscriber:
         if self.mesh is None:
             return wire.ENCODINGS[self.encoding_asked]
         return wire.ENCODINGS[self.mesh.encoding]
+
+    @property
+    def decoder(self):
+        """What turns the frames into vertices: 'libskinstream_client' or 'numpy' (parameters),
+        'libmeshoptimizer' or 'numpy' (compressed), 'numpy' (float, quantised); None before
+        MeshInfo (and for parameters before the Model)."""
+        if self.mesh is None:
+            return None
+        if self.mesh.encoding == wire.PARAMETERS:
+            return None if self._evaluator is None else self._evaluator.name
+        return self._compressed.name if self._compressed is not None else 'numpy'
 
     def frames(self, timeout=None):
         """Frames as they come; ends when the daemon closes the connection (then raises
@@ -136,7 +148,7 @@ class Subscriber:
             self.mesh.encoding = self.encoding_asked
         self.model = self._evaluator = self._compressed = None
         if self.mesh.encoding == wire.COMPRESSED:
-            self._compressed = CompressedDecoder(self.mesh.vertex_count, self.mesh.compressed_order)
+            self._compressed = compressed_decoder(self.mesh.vertex_count, self.mesh.compressed_order, self.libraries)
 
     def _on_model(self, payload):
         if self.mesh is None:
@@ -144,8 +156,8 @@ class Subscriber:
         model = wire.Model(payload)
         if model.vertex_count != self.mesh.vertex_count:
             raise ProtocolError(f'the Model has {model.vertex_count} vertices, MeshInfo {self.mesh.vertex_count}')
+        self._evaluator = parameter_evaluator(model, payload, self.mesh.faces, self.libraries)
         self.model = model
-        self._evaluator = Evaluator(model, self.mesh.faces)
 
     def _on_frame(self, payload):
         arrival = time.time_ns()

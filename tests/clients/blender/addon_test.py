@@ -4,7 +4,9 @@ skinstreamd on the demo subject. Background Blender runs no timers, so the test 
 add-on's timer function itself, as Blender's would.
 
 - the body mesh's vertices equal the daemon's (a float subscriber's frame of the same number)
-  within 0.1 mm, for the parameter and compressed encodings; markers as a point cloud;
+  within 0.1 mm, for the parameter and compressed encodings (bit for bit when the C++ client
+  library evaluates the parameters: the package carried finds it as outside Blender, and the
+  system's libmeshoptimizer, and the panel says which decodes); markers as a point cloud;
 - a daemon that stalls never holds the timer up; one that goes away is shown in the panel's
   status and reconnected to when it comes back;
 - a recording plays back through Blender's own Mesh Cache modifier, sample for sample;
@@ -21,7 +23,7 @@ import bpy
 import numpy as np
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', '..'))
-from support.python_clients import DEMO, SCRATCH, SKINSTREAM_CLI, demo_daemon  # noqa: E402
+from support.python_clients import CLIENT_LIBRARY, DEMO, SCRATCH, SKINSTREAM_CLI, demo_daemon  # noqa: E402
 import skinstream as source_package  # noqa: E402  (the source tree's, for the reference subscriber)
 
 ADDON_ZIP = sys.argv[sys.argv.index('--') + 1]
@@ -106,6 +108,8 @@ class Addon(unittest.TestCase):
                     self.assertTrue(self.pump(lambda: self.live.frames_applied() >= start + 10), self.live.status_lines())
                     body = self.live.body_object()
                     number = body['skinstream_frame']
+                    decoder = self.live._connection.receiver.decoder
+                    self.assertIn(f'(decoded by {decoder})', self.live.status_lines()[0])
                     shown = vertices_of(body.data)
                     self.assertTrue(self.pump(lambda: number in reference.frames, 30), f'frame {number} not seen by the float subscriber')
                 finally:
@@ -114,8 +118,12 @@ class Addon(unittest.TestCase):
                 self.assertEqual(len(body.data.polygons), len(truth.mesh.faces))
                 self.assertEqual(shown.shape, truth.vertices.shape)
                 worst = np.abs(shown.astype(np.float64) - truth.vertices).max()
-                print(f'{encoding}: frame {number}, largest difference from the daemon {worst:.4g} mm')
+                print(f'{encoding} by {decoder}: frame {number}, largest difference from the daemon {worst:.4g} mm')
                 self.assertLessEqual(worst, 0.1)
+                if encoding == 'parameters' and os.path.exists(CLIENT_LIBRARY):
+                    self.assertEqual((decoder, worst), ('libskinstream_client', 0.0))
+                if encoding == 'compressed' and self.live.skinstream.meshoptimizer_library.find_meshoptimizer()[0]:
+                    self.assertEqual(decoder, 'libmeshoptimizer')
                 self.assertAlmostEqual(body.scale[0], 0.001)
                 markers = bpy.data.objects[self.live._connection.markers]
                 self.assertEqual(markers.instance_type, 'VERTS')

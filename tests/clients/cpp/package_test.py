@@ -88,8 +88,14 @@ class InstalledPackage(unittest.TestCase):
     def test_installs_the_public_header_the_library_and_the_package(self):
         installed = sorted(os.path.relpath(os.path.join(d, f), self.prefix) for d, _, files in os.walk(self.prefix) for f in files)
         headers = [f for f in installed if f.startswith('include/')]
-        self.assertEqual(headers, ['include/skinstream/client.h'])  # the codecs and the evaluator stay inside
+        # The codecs and the evaluator stay inside; the evaluator is open through its C ABI.
+        self.assertEqual(headers, ['include/skinstream/client.h', 'include/skinstream/evaluator_c.h'])
         self.assertIn('lib/libskinstream_client.so.0', installed)
+        exported = subprocess.run(['nm', '-D', '--defined-only', os.path.join(self.prefix, 'lib', 'libskinstream_client.so.0')],
+                                  capture_output=True, text=True, check=True).stdout
+        c_functions = sorted(set(re.findall(r' T (skinstream_evaluator_\w+)', exported)))
+        self.assertEqual(c_functions, ['skinstream_evaluator_abi_version', 'skinstream_evaluator_create', 'skinstream_evaluator_destroy',
+                                       'skinstream_evaluator_evaluate', 'skinstream_evaluator_vertex_count'])
         self.assertIn('lib/cmake/skinstream_client/skinstream_clientConfig.cmake', installed)
         self.assertIn('lib/cmake/skinstream_client/skinstream_clientConfigVersion.cmake', installed)
         # Found in the prefix, not in the build tree.

@@ -13,6 +13,7 @@
 #include <mutex>
 #include <thread>
 
+#include "support/client_frames.h"
 #include "support/daemon_process.h"
 #include "support/test_data.h"
 
@@ -32,15 +33,10 @@ std::map<uint32_t, Received> receive(uint16_t port, Encoding encoding, bool norm
   options.encoding = encoding;
   options.normals = normals;
   client::Subscriber sub(options);
-  std::map<uint32_t, Received> frames;
-  client::Frame frame;
-  const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(120);
-  while (static_cast<int>(frames.size()) < count && std::chrono::steady_clock::now() < give_up) {
-    if (!sub.next(frame, std::chrono::seconds(1))) continue;
-    Received& r = frames[frame.frame_number];
+  auto frames = test::receive_frames<Received>(sub, count, [](const client::Frame& frame, Received& r) {
     r.positions.assign(frame.positions.begin(), frame.positions.end());
     r.normals.assign(frame.normals.begin(), frame.normals.end());
-  }
+  });
   EXPECT_EQ(sub.mesh().encoding, encoding);
   if (model_bytes) *model_bytes = sub.model_bytes();
   return frames;

@@ -1,7 +1,7 @@
 """`pip install ./clients/python` as CI does it on a clean Debian 12, without the network: a
 virtual environment that sees Debian's numpy, setuptools and wheel, pip told to build without
-isolation and fetch nothing; then the installed package (not the source tree) imports and
-decodes a message."""
+isolation and fetch nothing; then the installed package (not the source tree) imports, decodes
+a message and finds the C++ client library by SKINSTREAM_CLIENT_LIBRARY."""
 import os
 import shutil
 import subprocess
@@ -9,7 +9,7 @@ import sys
 import unittest
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', '..'))
-from support.python_clients import FIXTURES, SCRATCH, SOURCE  # noqa: E402
+from support.python_clients import CLIENT_LIBRARY, FIXTURES, SCRATCH, SOURCE  # noqa: E402
 
 
 class PipInstall(unittest.TestCase):
@@ -29,12 +29,15 @@ class PipInstall(unittest.TestCase):
         self.assertIn('Successfully installed skinstream-0.1.0', install.stdout)
         script = ('import skinstream, sys; from skinstream import protocol as wire; '
                   f'data = open({os.path.join(FIXTURES, "mesh_info_v2.bin")!r}, "rb").read(); '
-                  'info = wire.MeshInfo(data[12:], 2); print(skinstream.__file__); print(info.subject, info.marker_names)')
+                  'info = wire.MeshInfo(data[12:], 2); print(skinstream.__file__); print(info.subject, info.marker_names); '
+                  "print(skinstream.decoders()['parameters'])")
         run = subprocess.run([python, '-c', script], capture_output=True, text=True, cwd=root)
         self.assertEqual(run.returncode, 0, run.stderr)
-        where, decoded = run.stdout.splitlines()
+        where, decoded, parameters = run.stdout.splitlines()
         self.assertTrue(where.startswith(os.path.join(venv, 'lib')), where)
         self.assertEqual(decoded, "Actor2 ['LSHO', 'RSHO', 'C7']")
+        if os.path.exists(CLIENT_LIBRARY):  # built (the environment names it for the child too)
+            self.assertEqual(parameters, f'libskinstream_client ({CLIENT_LIBRARY})')
 
 
 if __name__ == '__main__':

@@ -46,6 +46,8 @@ class Receiver(unittest.TestCase):
                 for _ in range(100):
                     self.assertIsNone(receiver.take())
                 self.assertEqual(receiver.state(), 'streaming')
+                self.assertIn(receiver.decoder, ('libmeshoptimizer', 'numpy'))
+                self.assertIn(f'(decoded by {receiver.decoder})', receiver.describe())
                 daemon.resume()
                 self.assertTrue(wait_until(lambda: receiver.take() is not None))
             finally:
@@ -55,8 +57,9 @@ class Receiver(unittest.TestCase):
     def test_the_daemon_going_away_and_coming_back(self):
         daemon = demo_daemon()
         port = daemon.sub_port
-        # Paced: a reader slower than the stream (parameters are evaluated in numpy) has two frames
-        # in flight, not a socket's fill to read before it sees the daemon gone.
+        # Paced: a reader slower than the stream (parameters evaluated in numpy, where the client
+        # library is not found) has two frames in flight, not a socket's fill to read before it
+        # sees the daemon gone.
         receiver = skinstream.Receiver(port=port, encoding='parameters', markers=True, paced=True, first_retry=0.1,
                                        longest_retry=0.8)
         receiver.start()

@@ -1,7 +1,8 @@
 """The Python package against the real skinstreamd replaying the demo subject over loopback:
-every encoding's vertices and normals against the daemon's own float buffer of the same frame
-number, and the bad paths (no daemon, a refused Hello, bytes that break the protocol) as
-one-line errors."""
+every encoding's vertices and normals, by each of its decoders (numpy, and the system's
+libmeshoptimizer and the C++ client library, which ctest names in SKINSTREAM_CLIENT_LIBRARY),
+against the daemon's own float buffer of the same frame number; and the bad paths (no daemon, a
+refused Hello, bytes that break the protocol) as one-line errors."""
 import os
 import socket
 import struct
@@ -11,21 +12,30 @@ import time
 import unittest
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', '..'))
-from support.python_clients import demo_daemon, fixture  # noqa: E402
+from support.python_clients import CLIENT_LIBRARY, demo_daemon, fixture  # noqa: E402
 import numpy as np  # noqa: E402
 import skinstream  # noqa: E402
-from skinstream.evaluation import vertex_normals  # noqa: E402
+from skinstream.meshoptimizer_library import find_meshoptimizer  # noqa: E402
+from skinstream.normals import vertex_normals  # noqa: E402
+
+# (encoding, the system's libraries or numpy only, the decoder that must then decode it)
+SUBSCRIBERS = [('float', True, 'numpy'), ('quantised', True, 'numpy'), ('compressed', False, 'numpy'),
+               ('parameters', False, 'numpy')]
+if os.path.exists(CLIENT_LIBRARY):  # built: then it must load
+    SUBSCRIBERS.append(('parameters', True, 'libskinstream_client'))
+if find_meshoptimizer()[0] is not None:
+    SUBSCRIBERS.append(('compressed', True, 'libmeshoptimizer'))
 
 
-def receive(port, encoding, count, results):
+def receive(port, encoding, libraries, count, results):
     frames = {}
-    with skinstream.Subscriber(port=port, encoding=encoding, normals=True, markers=True) as sub:
+    with skinstream.Subscriber(port=port, encoding=encoding, normals=True, markers=True, libraries=libraries) as sub:
         deadline = time.monotonic() + 120
         while len(frames) < count and time.monotonic() < deadline:
             frame = sub.next_frame(1.0)
             if frame is not None:
                 frames[frame.frame_number] = frame
-        results[encoding] = (frames, sub.encoding, sub.mesh, sub.model)
+        results[encoding, libraries] = (frames, sub.encoding, sub.mesh, sub.model, sub.decoder)
 
 
 def angles_degrees(a, b):
@@ -39,13 +49,14 @@ class DemoSubject(unittest.TestCase):
         count = 30
         results = {}
         with demo_daemon() as daemon:
-            threads = [threading.Thread(target=receive, args=(daemon.sub_port, e, count, results)) for e in skinstream.ENCODINGS]
+            threads = [threading.Thread(target=receive, args=(daemon.sub_port, e, libraries, count, results))
+                       for e, libraries, _ in SUBSCRIBERS]
             for t in threads:
                 t.start()
             for t in threads:
                 t.join()
             self.assertEqual(daemon.stop(), 0, daemon.log())
-        reference, _, mesh, _ = results['float']
+        reference, _, mesh, _, _ = results['float', True]
         self.assertEqual(len(reference), count)
         first = next(iter(reference.values()))
         self.assertEqual(first.vertices.shape, (53514, 3))
@@ -60,23 +71,31 @@ class DemoSubject(unittest.TestCase):
         # positions: the daemon's normals.
         computed = vertex_normals(first.vertices, mesh.faces)
         self.assertLess(angles_degrees(computed, first.normals).max(), 0.001)
-        # Position tolerance (mm) and normal tolerance (degrees) of each encoding: parameters
-        # evaluated here as the protocol writes it out, in float64 (the daemon's float32 buffer
-        # is within a few 0.0001 mm of it; the demo body has triangles with 0.2 mm edges, whose
-        # normals that moves by up to 0.1 degree: from the same positions the normals agree to
-        # 0.0001 degree); quantised within half a step of the frame's box; compressed within half
-        # a step of the key's grid and 8-bit octahedral normals.
-        for encoding, mm, degrees in (('parameters', 0.01, 0.5), ('quantised', 0.02, 0.01), ('compressed', 0.025, 1.5)):
-            frames, served, _, model = results[encoding]
-            self.assertEqual(served, encoding)
+        # Position tolerance (mm) and normal tolerance (degrees) of each decoder: the client
+        # library is the daemon's evaluator on the same floats, so its buffers are the daemon's
+        # bit for bit; the numpy evaluation is float32 in another order (within 0.001 mm; the
+        # demo body has triangles with 0.2 mm edges, whose normals that moves by up to 0.1
+        # degree: from the same positions the normals agree to 0.0001 degree); quantised within
+        # half a step of the frame's box; compressed within half a step of the key's grid and
+        # 8-bit octahedral normals.
+        tolerances = {'parameters': (0.01, 0.5), 'quantised': (0.02, 0.01), 'compressed': (0.025, 1.5)}
+        for encoding, libraries, decoder in SUBSCRIBERS:
+            if encoding == 'float':
+                continue
+            mm, degrees = (0, 0) if decoder == 'libskinstream_client' else tolerances[encoding]
+            frames, served, _, model, decoded_by = results[encoding, libraries]
+            self.assertEqual((served, decoded_by), (encoding, decoder))
             common = sorted(set(frames) & set(reference))
             self.assertGreaterEqual(len(common), count // 2, encoding)
             worst_mm = max(np.abs(frames[n].vertices.astype(np.float64) - reference[n].vertices).max() for n in common)
             worst_degrees = max(angles_degrees(frames[n].normals, reference[n].normals).max() for n in common)
-            print(f'{encoding}: {len(common)} frames, largest differences {worst_mm:.4g} mm, {worst_degrees:.3g} degrees')
-            self.assertLessEqual(worst_mm, mm, encoding)
-            self.assertLessEqual(worst_degrees, degrees, encoding)
+            print(f'{encoding} by {decoder}: {len(common)} frames, largest differences {worst_mm:.4g} mm, {worst_degrees:.3g} degrees')
+            self.assertLessEqual(worst_mm, mm, decoder)
+            self.assertLessEqual(worst_degrees, degrees, decoder)
             for n in common:
+                if decoder == 'libskinstream_client':
+                    np.testing.assert_array_equal(frames[n].vertices, reference[n].vertices)
+                    np.testing.assert_array_equal(frames[n].normals, reference[n].normals)
                 np.testing.assert_array_equal(frames[n].markers, reference[n].markers)
                 np.testing.assert_array_equal(frames[n].marker_status, reference[n].marker_status)
             if encoding == 'parameters':

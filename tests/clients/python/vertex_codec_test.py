@@ -2,39 +2,16 @@
 libmeshoptimizer, loaded with ctypes): byte for byte on buffers of every shape the codec
 treats differently, and the same refusals of broken streams."""
 import ctypes
-import ctypes.util
 import os
 import sys
 import unittest
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', '..'))
 from support import python_clients  # noqa: E402,F401
+from support.meshoptimizer_encoder import MISSING, encode, pointer as _pointer  # noqa: E402
+from support.meshoptimizer_encoder import library as meshopt  # noqa: E402
 import numpy as np  # noqa: E402
 from skinstream.vertex_codec import CodecError, decode_octahedral, decode_vertex_buffer  # noqa: E402
-
-_name = ctypes.util.find_library('meshoptimizer')
-meshopt = ctypes.CDLL(_name) if _name else None
-if meshopt:
-    meshopt.meshopt_encodeVertexBufferBound.restype = ctypes.c_size_t
-    meshopt.meshopt_encodeVertexBuffer.restype = ctypes.c_size_t
-    meshopt.meshopt_decodeVertexBuffer.restype = ctypes.c_int
-
-
-def _pointer(a):
-    return a.ctypes.data_as(ctypes.c_void_p)
-
-
-def encode(vertices):
-    """meshopt_encodeVertexBuffer of an n x size uint8 array."""
-    n, size = vertices.shape
-    vertices = np.ascontiguousarray(vertices)
-    bound = meshopt.meshopt_encodeVertexBufferBound(ctypes.c_size_t(n), ctypes.c_size_t(size))
-    out = np.zeros(bound, np.uint8)
-    written = meshopt.meshopt_encodeVertexBuffer(_pointer(out), ctypes.c_size_t(bound), _pointer(vertices), ctypes.c_size_t(n),
-                                                 ctypes.c_size_t(size))
-    assert written > 0
-    return out[:written].tobytes()
-
 
 def library_accepts(data, n, size):
     out = np.zeros((max(n, 1), size), np.uint8)
@@ -43,7 +20,7 @@ def library_accepts(data, n, size):
                                               ctypes.c_size_t(len(data))) == 0
 
 
-@unittest.skipIf(meshopt is None, 'libmeshoptimizer is not installed (scripts/install-deps.sh installs it)')
+@unittest.skipIf(meshopt is None, MISSING)
 class VertexCodec(unittest.TestCase):
     def test_decodes_what_the_library_encodes(self):
         rng = np.random.default_rng(7)

@@ -64,8 +64,8 @@ TEST(SynthMotion, MotionsAreSmoothAtCaptureRateAndStayOnTheFloor) {
     }
     EXPECT_LT(max_step, 0.3) << name;  // no jumps: < 17 degrees per frame (a jab peaks near 14)
     EXPECT_NEAR(min_clearance, 0.0, 1e-6) << name;
-    if (name == "jumprope")
-      EXPECT_GT(max_clearance, 50.0);  // it really leaves the ground
+    if (name == "jumprope" || name == "medley")
+      EXPECT_GT(max_clearance, 50.0) << name;  // it really leaves the ground (the medley has a jump rope piece)
     else
       EXPECT_LT(max_clearance, 1e-6) << name;
   }

@@ -38,6 +38,9 @@ struct Options {
   bool mesh = true;          // false: markers only, no vertices
   bool paced = false;        // acknowledge each frame: at most 2 in flight (for slow readers)
   bool evaluate = true;      // parameters: evaluate them into vertices (false: parameters only)
+  // false: frames carry their numbers, times and markers only; positions and normals stay empty
+  // and nothing is decoded (a load generator that must not spend the CPU it measures).
+  bool decode = true;
   std::string subject{};     // the capture system's subject name; empty: the daemon's first
   std::string token{};       // the daemon's shared token, when it has one
   int protocol_version = 2;  // 1 speaks to a daemon older than version 2 (float or quantised)

@@ -1,0 +1,57 @@
+#include "clients/bench/bench_options.h"
+
+#include <CLI/CLI.hpp>
+
+#include "server/vicon/vicon_server.h"
+
+namespace skinstream::bench {
+
+std::optional<int> parse_bench_options(int argc, char** argv, BenchOptions& o) {
+  CLI::App app{"skinstream-bench: end-to-end latency and cost of the real skinstreamd fed by a Vicon DataStream replay"};
+  o.replay_tcp_congestion = server::ViconServerOptions{}.tcp_congestion;
+  std::string encoding = client::to_string(o.encoding);
+  bool quantised = false;
+  std::string protocol = "vicon";
+  app.add_option("--seconds", o.seconds, "how long to measure")->check(CLI::Range(0.5, 3600.0))->capture_default_str();
+  app.add_option("--subscribers", o.subscribers, "subscribers connected in-process, one thread each")->check(CLI::Range(1, 256))->capture_default_str();
+  app.add_option("--recording", o.recording, "capture the Vicon replay server streams, looped")->capture_default_str();
+  app.add_option("--subject", o.subject, "subject file for the recording's performer")->required();
+  app.add_option("--encoding", encoding, "what the subscribers ask for: float, quantised, compressed or parameters")
+      ->check(CLI::IsMember({"float", "quantised", "compressed", "parameters"}))
+      ->capture_default_str();
+  app.add_flag("--quantised", quantised, "the same as --encoding quantised");
+  app.add_flag("--normals", o.normals, "subscribers ask for normals too");
+  app.add_flag("--decode", o.decode,
+               "subscribers decode each frame (and evaluate parameters) as a renderer would; off, they read the bytes and the "
+               "header only, so this machine's CPU goes to the daemon");
+  app.add_flag("--paced", o.paced, "subscribers acknowledge each frame (at most 2 in flight)");
+  app.add_option("--link-mbit", o.link_mbit,
+                 "run the daemon in a network namespace behind a veth pair shaped by tc to this rate (Mbit/s, both ways); needs root "
+                 "and iproute2")
+      ->check(CLI::Range(1, 100000));
+  app.add_option("--deform-threads", o.deform_threads, "skinstreamd --deform-threads")->check(CLI::Range(1, 64))->capture_default_str();
+  app.add_option("--deform-cpus", o.deform_cpus, "skinstreamd --deform-cpus (default: the daemon's, auto)");
+  app.add_option("--deform-spin-lead-us", o.deform_spin_lead_us, "skinstreamd --deform-spin-lead-us (default: the daemon's)")
+      ->check(CLI::Range(0, 1'000'000));
+  app.add_option("--publish-threads", o.publish_threads, "skinstreamd --publish-threads (default: the daemon's)")->check(CLI::Range(0, 16));
+  app.add_option("--subscriber-tcp-congestion", o.subscriber_tcp_congestion,
+                 "skinstreamd --subscriber-tcp-congestion (default: the daemon's, reno; \"\" = the system's)");
+  app.add_option("--replay-tcp-congestion", o.replay_tcp_congestion,
+                 "TCP congestion control of the replay server's connection to the daemon (\"\" = the system's)")
+      ->capture_default_str();
+  app.add_option("--protocol", protocol, "the capture system the replay plays to the daemon: vicon (DataStream, TCP), qtm (QTM RT, TCP) or natnet (NatNet, UDP unicast)")
+      ->check(CLI::IsMember({"vicon", "qtm", "natnet"}))
+      ->capture_default_str();
+  app.add_option("--vicon-subject-name", o.vicon_subject_name, "subject (marker set) name the replay announces (default: the recording's file name)");
+  app.add_flag("--json", o.json, "print the report as JSON");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  }
+  o.encoding = client::encoding_from_string(quantised ? "quantised" : encoding);
+  o.protocol = protocol == "qtm" ? CaptureProtocol::Qtm : protocol == "natnet" ? CaptureProtocol::NatNet : CaptureProtocol::Vicon;
+  return std::nullopt;
+}
+
+}  // namespace skinstream::bench

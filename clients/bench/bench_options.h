@@ -1,0 +1,41 @@
+#pragma once
+// skinstream-bench's command line, parsed into one struct so a run can be started (and tested)
+// without it.
+#include <optional>
+#include <string>
+
+#include "clients/bench/replay_engine.h"
+#include "skinstream/client.h"
+
+namespace skinstream::bench {
+
+struct BenchOptions {
+  double seconds = 10;
+  int subscribers = 1;
+  std::string recording = "replay_data/cmu/85_12.c3d";
+  std::string subject;             // the subject file (required)
+  std::string vicon_subject_name;  // the replay's subject name (default: the recording's file name)
+  CaptureProtocol protocol = CaptureProtocol::Vicon;  // what the replay speaks to the daemon
+  // What the subscribers ask for and do with it.
+  client::Encoding encoding = client::Encoding::Float;
+  bool normals = false;
+  bool decode = false;  // decode (and evaluate) each frame as a renderer would, on this machine's CPU
+  bool paced = false;
+  // The daemon's threads and sockets (unset: its defaults).
+  int deform_threads = 2;
+  std::string deform_cpus;
+  int deform_spin_lead_us = -1;
+  int publish_threads = -1;
+  std::optional<std::string> subscriber_tcp_congestion;
+  std::string replay_tcp_congestion;
+  // 0: loopback. Otherwise the daemon runs in a network namespace behind a veth pair shaped to
+  // this rate, its subscribers and the replay outside.
+  int link_mbit = 0;
+  bool json = false;
+};
+
+// Parses argv; returns the exit code to leave with instead (after --help, or a usage error
+// already printed), or nothing when the run should go ahead.
+std::optional<int> parse_bench_options(int argc, char** argv, BenchOptions& options);
+
+}  // namespace skinstream::bench

@@ -1,0 +1,360 @@
+// The measured quantities, per frame (every clock is this machine's system clock, so the
+// differences need no synchronisation; with a shaped link the namespace shares it too):
+//   end to end        = subscriber ready - replay send time of the same frame number
+//   daemon processing = publish_time_ns - receive_time_ns (both from the frame header; the
+//                       publish time is taken after encoding, as the frame goes to the publishers)
+//   ingest            = receive_time_ns - replay send time (the network in, and the daemon's io thread)
+//   delivery          = subscriber arrival - publish_time_ns (the hand-off, the subscriber queue
+//                       and the network out)
+// so end to end = ingest + processing + delivery (+ decoding, with --decode), frame by frame.
+#include "clients/bench/bench_run.h"
+
+#include <unistd.h>
+
+#include <atomic>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <thread>
+
+#include "clients/bench/latency_samples.h"
+#include "clients/bench/process_usage.h"
+#include "clients/bench/replay_engine.h"
+#include "clients/bench/send_times.h"
+#include "clients/bench/shaped_link.h"
+#include "clients/bench/stall_log.h"
+#include "protocol/capture_file.h"
+#include "protocol/file_error.h"
+#include "server/client/daemon_process.h"
+#include "server/tcp_congestion.h"
+
+namespace skinstream::bench {
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+fs::path own_folder() { return fs::read_symlink("/proc/self/exe").parent_path(); }
+
+int64_t wall_clock_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch()).count();
+}
+
+std::string daemon_arguments(const BenchOptions& o, const std::string& source_option) {
+  std::string a = "--subject " + server::shell_word(o.subject) + " " + source_option + " --deform-threads " +
+                  std::to_string(o.deform_threads) + " --log-level warn";
+  if (!o.deform_cpus.empty()) a += " --deform-cpus " + server::shell_word(o.deform_cpus);
+  if (o.deform_spin_lead_us >= 0) a += " --deform-spin-lead-us " + std::to_string(o.deform_spin_lead_us);
+  if (o.publish_threads >= 0) a += " --publish-threads " + std::to_string(o.publish_threads);
+  if (o.subscriber_tcp_congestion) a += " --subscriber-tcp-congestion " + server::shell_word(*o.subscriber_tcp_congestion);
+  return a;
+}
+
+// The measurement window opens once every subscriber has its first frame (so a slow link's
+// MeshInfo and Model transfers are not counted as frame latency) and lasts options.seconds.
+struct Window {
+  std::atomic<int> subscribers_ready{0};
+  // Frames published in [start_ns, end_ns) are counted (by publish time, so the daemon's own
+  // counters read at the two ends agree with what the subscribers count).
+  std::atomic<int64_t> start_ns{0};  // 0: not open yet
+  std::atomic<int64_t> end_ns{INT64_MAX};
+  std::atomic<bool> closed{false};
+};
+
+void subscribe(const BenchOptions& o, const std::string& host, int port, int index, const SendTimes& send_times, Window& window,
+               StallLog& stalls, SubscriberTally& tally) {
+  client::Options options;
+  options.host = host;
+  options.port = static_cast<uint16_t>(port);
+  options.encoding = o.encoding;
+  options.normals = o.normals;
+  options.paced = o.paced;
+  options.decode = o.decode;
+  options.evaluate = o.decode;
+  client::Subscriber subscriber(options);
+  tally.reserve(static_cast<size_t>(o.seconds * 130) + 16);
+  const std::string who = "subscriber " + std::to_string(index);
+  const int64_t period_ns = 1'000'000'000 / 120;
+  client::Frame frame;
+  bool counted_ready = false;
+  int64_t last_frame = -1, last_arrival = 0;
+  uint32_t pipeline_dropped = 0;
+  while (!window.closed.load(std::memory_order_relaxed)) {
+    if (!subscriber.next(frame, std::chrono::milliseconds(500))) continue;
+    if (!counted_ready) {
+      counted_ready = true;
+      window.subscribers_ready.fetch_add(1);
+    }
+    const int64_t start = window.start_ns.load(std::memory_order_relaxed);
+    if (start == 0 || frame.publish_time_ns < start || frame.publish_time_ns >= window.end_ns.load(std::memory_order_relaxed)) continue;
+    const int64_t now = frame.ready_time_ns;
+    const int64_t sent = send_times.find(frame.frame_number);
+    if (sent > 0) {
+      tally.end_to_end.ms.push_back((now - sent) * 1e-6);
+      tally.ingest.ms.push_back((frame.receive_time_ns - sent) * 1e-6);
+    } else {
+      ++tally.unmatched;
+    }
+    tally.processing.ms.push_back((frame.publish_time_ns - frame.receive_time_ns) * 1e-6);
+    tally.delivery.ms.push_back((frame.arrival_time_ns - frame.publish_time_ns) * 1e-6);
+    tally.message_bytes += frame.message_bytes;
+    if (static_cast<int64_t>(frame.frame_number) <= last_frame) ++tally.out_of_order;
+    last_frame = frame.frame_number;
+    if (tally.received++ == 0) {
+      tally.dropped_first = frame.subscriber_dropped;
+      tally.first_arrival_ns = frame.arrival_time_ns;
+    } else {
+      // The pipeline's own drops, once (every subscriber sees the same counter).
+      if (index == 0 && frame.pipeline_dropped != pipeline_dropped) stalls.add_drop(now, "pipeline", frame.pipeline_dropped - pipeline_dropped);
+      const int64_t gap = frame.arrival_time_ns - last_arrival;
+      tally.longest_gap_ms = std::max(tally.longest_gap_ms, gap * 1e-6);
+      if (gap > 3 * period_ns) stalls.add_gap(last_arrival, who, gap * 1e-6);
+      if (frame.subscriber_dropped != tally.dropped_last) stalls.add_drop(now, who, frame.subscriber_dropped - tally.dropped_last);
+    }
+    tally.dropped_last = frame.subscriber_dropped;
+    pipeline_dropped = frame.pipeline_dropped;
+    last_arrival = tally.last_arrival_ns = frame.arrival_time_ns;
+  }
+  tally.model_bytes = subscriber.model_bytes();
+}
+
+// Sleeps until `until`, in short steps, throwing once `stop` is set.
+void sleep_until_or_stop(Clock::time_point until, const std::atomic<bool>& stop) {
+  while (Clock::now() < until) {
+    if (stop.load()) throw std::runtime_error("interrupted");
+    std::this_thread::sleep_until(std::min(until, Clock::now() + std::chrono::milliseconds(50)));
+  }
+}
+
+}  // namespace
+
+nlohmann::json run_bench(const BenchOptions& o, const std::atomic<bool>& stop) {
+  const fs::path daemon_path = own_folder() / "skinstreamd";
+  if (!fs::exists(daemon_path)) throw std::runtime_error(daemon_path.string() + ": skinstreamd not found next to skinstream-bench");
+  const Capture capture = read_capture(o.recording);
+  if (capture.frame_count <= 0) throw FileError(o.recording, "holds no frames");
+  if (!(capture.rate_hz > 0)) throw FileError(o.recording, "has no frame rate");
+  const fs::path work = fs::temp_directory_path() / ("skinstream-bench-" + std::to_string(getpid()));
+  fs::create_directories(work);
+  struct RemoveWork {
+    fs::path path;
+    ~RemoveWork() {
+      std::error_code ignored;
+      fs::remove_all(path, ignored);
+    }
+  } remove_work{work};
+
+  // The stage network, when asked for: made first, removed last.
+  std::unique_ptr<ShapedLink> link;
+  if (o.link_mbit > 0) link = std::make_unique<ShapedLink>(ShapedLinkOptions{.rate_mbit = o.link_mbit});
+  const std::string replay_address = link ? link->host_address() : "127.0.0.1";
+  const std::string daemon_address = link ? link->inner_address() : "127.0.0.1";
+
+  // The replay server: looping, its timeline from the daemon's first frame request.
+  server::asio::io_context replay_io;
+  ReplayEngineOptions replay_options;
+  replay_options.protocol = o.protocol;
+  replay_options.bind_address = replay_address;
+  replay_options.tcp_congestion = o.replay_tcp_congestion;
+  replay_options.subject_name = o.vicon_subject_name.empty() ? fs::path(o.recording).stem().string() : o.vicon_subject_name;
+  ReplayEngine replay(replay_io, capture, replay_options);
+  StallLog stalls;  // before send_times, which writes to it until the replay stops
+  SendTimes send_times;
+  replay.set_frame_hook([&send_times](uint32_t frame_number, int64_t send_ns) { send_times.record(frame_number, send_ns); });
+  replay.start();
+  std::thread replay_thread([&replay_io] {
+    auto guard = server::asio::make_work_guard(replay_io);
+    replay_io.run();
+  });
+  // Destroyed before `replay`: the io thread never outlives the server.
+  struct ReplayThreadStop {
+    server::asio::io_context& io;
+    std::thread& thread;
+    ~ReplayThreadStop() {
+      io.stop();
+      if (thread.joinable()) thread.join();
+    }
+  } replay_thread_stop{replay_io, replay_thread};
+
+  server::DaemonLaunch launch;
+  launch.program = daemon_path.string();
+  launch.arguments = daemon_arguments(o, replay.daemon_source_option());
+  launch.bind = daemon_address;
+  launch.files_stem = (work / "skinstreamd").string();
+  if (link)
+    for (const std::string& word : link->inside({})) launch.exec_prefix += server::shell_word(word) + " ";
+  server::DaemonProcess daemon(launch);
+  daemon.wait_until_streaming(std::chrono::seconds(15));
+
+  // Subscribers connect; the window opens once each has a frame.
+  Window window;
+  std::vector<SubscriberTally> tallies(o.subscribers);
+  std::vector<std::string> errors(o.subscribers);
+  std::vector<std::thread> threads;
+  for (int s = 0; s < o.subscribers; ++s)
+    threads.emplace_back([&, s] {
+      try {
+        subscribe(o, daemon_address, daemon.sub_port(), s, send_times, window, stalls, tallies[s]);
+      } catch (const std::exception& e) {
+        errors[s] = e.what();
+        window.subscribers_ready.fetch_add(1);  // so the window does not wait for it
+      }
+    });
+  struct JoinSubscribers {
+    Window& window;
+    std::vector<std::thread>& threads;
+    ~JoinSubscribers() {
+      window.closed = true;
+      for (std::thread& t : threads)
+        if (t.joinable()) t.join();
+    }
+  } join_subscribers{window, threads};
+  const auto ready_deadline = Clock::now() + std::chrono::seconds(120);
+  const auto connect_started = Clock::now();
+  while (window.subscribers_ready.load() < o.subscribers) {
+    if (Clock::now() > ready_deadline) throw std::runtime_error("the subscribers did not all get a frame within 120 s");
+    if (!daemon.running()) throw std::runtime_error("skinstreamd exited:\n" + daemon.log());
+    sleep_until_or_stop(Clock::now() + std::chrono::milliseconds(10), stop);
+  }
+  const double seconds_to_first_frames = std::chrono::duration<double>(Clock::now() - connect_started).count();
+  sleep_until_or_stop(Clock::now() + std::chrono::milliseconds(500), stop);  // let the joins' backlog drain
+
+  const nlohmann::json health_before = daemon.health();
+  const int64_t period_ns = static_cast<int64_t>(1e9 / capture.rate_hz);
+  const int64_t window_start_ns = wall_clock_ns();
+  stalls.start(window_start_ns);
+  send_times.start_counting(period_ns, &stalls);
+  const uint64_t sent_before = replay.frames_sent();
+  const uint64_t replay_dropped_before = replay.frames_dropped();
+  const double cpu_before = cpu_seconds(daemon.pid());
+  const double own_cpu_before = cpu_seconds(getpid());
+  window.start_ns = window_start_ns;
+  const Clock::time_point deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(o.seconds));
+
+  // RSS once a second: the first sample after warm-up against the last.
+  std::vector<long> rss_samples;
+  nlohmann::json rss_steps = nlohmann::json::array();
+  uint64_t buffers_after_1s = 0;  // the daemon's encoded frame buffers: RSS steps when they grow
+  for (auto next = Clock::now() + std::chrono::seconds(1); next < deadline; next += std::chrono::seconds(1)) {
+    sleep_until_or_stop(next, stop);
+    rss_samples.push_back(resident_kb(daemon.pid()));
+    // Every step of RSS, with its time on the stall log's clock: a leak climbs steadily, memory
+    // touched for the first time (a backlog reaching buffers never used before) steps once.
+    if (rss_samples.size() > 1 && rss_samples.back() != rss_samples[rss_samples.size() - 2])
+      rss_steps.push_back({{"at_s", (wall_clock_ns() - window_start_ns) * 1e-9}, {"kb", rss_samples.back() - rss_samples[rss_samples.size() - 2]}});
+    if (rss_samples.size() == 1) buffers_after_1s = daemon.health().value("frame_buffers_allocated", 0);
+  }
+  sleep_until_or_stop(deadline, stop);
+  const int64_t window_end_ns = wall_clock_ns();
+  window.end_ns = window_end_ns;
+  const nlohmann::json health = daemon.health();
+  const uint64_t sent = replay.frames_sent() - sent_before;
+  const uint64_t replay_dropped = replay.frames_dropped() - replay_dropped_before;
+  const double cpu = cpu_seconds(daemon.pid()) - cpu_before;
+  const long peak_rss_kb = peak_resident_kb(daemon.pid());
+  const double own_cpu = cpu_seconds(getpid()) - own_cpu_before;
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));  // the window's last frames still on their way
+  window.closed = true;
+  for (std::thread& t : threads) t.join();
+  const int exit_status = daemon.stop();
+  for (const std::string& e : errors)
+    if (!e.empty()) throw std::runtime_error("subscriber: " + e);
+  const std::string shaper = link ? link->shaper_stats() : "";
+
+  // What the daemon warned about during the run (dropped frames say why there), first lines only.
+  nlohmann::json daemon_warnings = nlohmann::json::array();
+  {
+    std::ifstream log(daemon.log_path());
+    for (std::string text; std::getline(log, text) && daemon_warnings.size() < 20;)
+      if (text.find("[warning]") != std::string::npos || text.find("[error]") != std::string::npos) daemon_warnings.push_back(text);
+  }
+
+  // The growth over the run, at a glance: a leak climbs minute after minute, a warm-up does not.
+  std::vector<long> every_minute;
+  for (size_t i = 0; i < rss_samples.size(); i += 60) every_minute.push_back(rss_samples[i]);
+  SubscriberTally all;
+  long total_dropped = 0;
+  std::vector<double> rates;
+  nlohmann::json per_subscriber = nlohmann::json::array();
+  const double window_s = (window_end_ns - window_start_ns) * 1e-9;
+  for (const SubscriberTally& tally : tallies) {
+    all.add(tally);
+    total_dropped += tally.dropped();
+    const double rate = tally.received / window_s;
+    rates.push_back(rate);
+    per_subscriber.push_back(
+        {{"received", tally.received}, {"dropped", tally.dropped()}, {"longest_gap_ms", tally.longest_gap_ms}, {"frames_per_second", rate}});
+  }
+  std::sort(rates.begin(), rates.end());
+  auto delta = [&](const char* key) { return health["frames"][key].get<uint64_t>() - health_before["frames"][key].get<uint64_t>(); };
+  const double bytes_per_frame = all.received > 0 ? static_cast<double>(all.message_bytes) / all.received : 0.0;
+  nlohmann::json report = {
+      {"mode", std::string(to_string(o.protocol)) + " replay (in-process) -> skinstreamd -> subscribers, " +
+                   (link ? "over a " + std::to_string(o.link_mbit) + " Mbit/s shaped link" : std::string("on loopback"))},
+      {"seconds", o.seconds},
+      {"window_seconds", window_s},
+      {"subscribers", o.subscribers},
+      {"encoding", client::to_string(o.encoding)},
+      {"protocol", to_string(o.protocol)},
+      {"link_mbit", o.link_mbit},
+      {"subscribers_want", {{"normals", o.normals}, {"quantised", o.encoding == client::Encoding::Quantised}, {"decode", o.decode}, {"paced", o.paced}}},
+      {"seconds_until_every_subscriber_had_a_frame", seconds_to_first_frames},
+      {"deform_threads", o.deform_threads},
+      {"deform", health["deform"]},  // as the daemon applied it: threads, CPUs pinned to, spin lead
+      {"publish_threads", health["publish_threads"]},
+      // The daemon's subscriber connections ("" = the system's, given next).
+      {"subscriber_tcp_congestion", health["subscriber_tcp_congestion"]},
+      {"replay_tcp_congestion", o.replay_tcp_congestion},
+      {"system_tcp_congestion", server::system_tcp_congestion()},
+      {"recording", o.recording},
+      {"vertices", health["subject"]["vertices"]},
+      {"markers", health["subject"]["markers"]},
+      {"bytes_per_frame", bytes_per_frame},
+      {"model_bytes", tallies.empty() ? 0 : tallies.front().model_bytes},
+      {"subscriber_frames_per_second", {{"slowest", rates.front()}, {"median", rates[rates.size() / 2]}, {"fastest", rates.back()}}},
+      {"end_to_end", all.end_to_end.summary()},
+      {"daemon_processing", all.processing.summary()},
+      {"ingest", all.ingest.summary()},      // replay send -> daemon receive
+      {"delivery", all.delivery.summary()},  // daemon publish -> subscriber arrival
+      {"replay_sends", send_times.regularity()},  // gaps between the replay's consecutive sends
+      // The daemon's own stage histograms (/health's latency_ms) over its whole life, warm-up
+      // included: quantiles as bucket upper bounds. Delivery splits into subscriber_queue_wait
+      // (published -> the write starts) and subscriber_write (-> the socket took the frame).
+      {"daemon_stages_ms", health["latency_ms"]},
+      {"frames", {{"sent_by_replay", sent},
+                  {"dropped_by_replay", replay_dropped},
+                  {"received_by_daemon", delta("received")},
+                  {"processed", delta("processed")},
+                  {"published", delta("published")},
+                  {"dropped_in_pipeline", delta("dropped")},
+                  {"dropped_in_pipeline_mailbox_full", delta("dropped_mailbox_full")},
+                  {"received_by_subscribers", all.received},
+                  {"dropped_for_subscribers", total_dropped},
+                  {"out_of_order", all.out_of_order},
+                  {"without_send_time", all.unmatched}}},
+      {"per_subscriber", per_subscriber},
+      // Gaps over 3 frame periods (the replay's sends, each subscriber's arrivals), drops for a
+      // subscriber and drops in the pipeline, in time order: a pause of the whole machine shows
+      // at one moment in all.
+      {"stalls", stalls.to_json()},
+      {"daemon", {{"cpu_seconds", cpu}, {"cpu_share_of_one_core", cpu / window_s}, {"peak_rss_kb", peak_rss_kb},
+                  {"rss_kb_after_1s", rss_samples.empty() ? 0 : rss_samples.front()},
+                  {"rss_kb_at_end", rss_samples.empty() ? 0 : rss_samples.back()},
+                  {"rss_kb_max_sampled", rss_samples.empty() ? 0 : *std::max_element(rss_samples.begin(), rss_samples.end())},
+                  {"rss_kb_every_60s", every_minute},
+                  {"rss_steps", rss_steps},  // each change between two 1 s samples: at_s, kb
+                  {"frame_buffers_after_1s", buffers_after_1s},
+                  {"frame_buffers_at_end", health.value("frame_buffers_allocated", 0)},
+                  // Of those, made on the 120 Hz thread because no prepared one was ready: 0 when
+                  // every subscriber's encoding was prepared on its Hello.
+                  {"frame_buffers_made_by_pipeline", health.value("frame_buffers_allocated_by_pipeline", 0)},
+                  {"exit_status", exit_status},
+                  {"warnings", daemon_warnings}}},
+      // This process: the replay server and the subscribers, sharing the machine with the daemon.
+      {"load_generator", {{"cpu_seconds", own_cpu}, {"cpu_share_of_one_core", own_cpu / window_s}}}};
+  if (link) report["shaped_link"] = nlohmann::json::parse(shaper);
+  return report;
+}
+
+}  // namespace skinstream::bench
