@@ -25,7 +25,7 @@ if [ ! -s "$forbidden" ]; then  # nothing to compare against would pass anything
 fi
 found=$(strong_symbols "$program" | comm -12 - "$forbidden")
 if [ -n "$found" ]; then
-  echo "$program holds code of the offline or research libraries ($(echo "$found" | wc -l) symbols), e.g.:"
+  echo "$program defines $(echo "$found" | wc -l) of the functions and variables of $*, e.g.:"
   echo "$found" | head -20 | c++filt
   exit 1
 fi
