@@ -80,6 +80,7 @@ Capture fill_capture(const SubjectModel& model, const Capture& input, const Capt
     report.filled += stats.filled;
     report.held += stats.held;
     report.rejected_labels += stats.rejected_labels;
+    report.changed_measured += stats.changed_measured;
     if (out_fragments)
       for (int m = 0; m < n; ++m) {
         const int id = frame_fragments[m];

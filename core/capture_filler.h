@@ -24,6 +24,7 @@ struct CaptureFillOptions {
 
 struct CaptureFillReport {
   long measured = 0, relabelled = 0, filled = 0, held = 0, rejected_labels = 0;
+  long changed_measured = 0;  // labelled samples the filler replaced (before any smoothing)
   std::vector<std::string> unknown_labels;   // labelled channels the subject does not have: used as unlabelled
   std::vector<std::string> absent_markers;   // subject markers with no channel in the capture
   int latency_frames = 0;                    // lookahead + online smoothing lookahead

@@ -34,11 +34,24 @@ GapFiller::GapFiller(const SubjectModel& model, const GapFillerOptions& options)
   assigned_id_.assign(n_, kNoFragment);
   gap_offset_.assign(n_, Vec3::Zero());
   gap_age_.assign(n_, 0);
+  gap_start_known_.assign(n_, 0);
+  gap_start_position_.assign(n_, Vec3::Zero());
+  gap_start_anchor_.assign(model.anchors.size(), Vec3::Zero());
+  gap_start_anchor_seen_.assign(model.anchors.size(), 0);
+  carry_check_frames_ = std::max(1, static_cast<int>(std::lround(0.5 * options_.rate_hz)));
+  snapshot_frame_.assign(n_, -1);
+  snapshot_position_.assign(n_, Vec3::Zero());
+  snapshot_anchor_.assign(model.anchors.size(), Vec3::Zero());
+  snapshot_anchor_seen_.assign(model.anchors.size(), 0);
+  carry_drift_.assign(n_, 0.0);
+  carry_checks_.assign(n_, 0);
   current_.assign(n_, Vec3::Zero());
   status_.assign(n_, MarkerStatus::Held);
   observed_.assign(n_, 0);
   estimated_.assign(n_, 0);
   has_rotation_.assign(n_, 0);
+  suspects_.reserve(n_);
+  changed_.reserve(n_);
   estimate_.assign(n_, Vec3::Zero());
   rotation_.assign(n_, Eigen::Matrix3d::Identity());
   available_neighbours_.assign(n_, 0);
@@ -54,6 +67,12 @@ GapFiller::GapFiller(const SubjectModel& model, const GapFillerOptions& options)
   pca_slot_variance_.assign(model.ring.size(), 1.0);
   rigid_support_.assign(n_, 0);
   precompute_single_gaps();
+  static_assert(SubjectModel::kMaxRing < 32, "observed slots are a 32-bit mask");
+  for (int j = 0; j < n_; ++j) {
+    pattern_offset_.push_back(static_cast<int>(pattern_factor_.size()));
+    pattern_factor_.resize(pattern_factor_.size() + model.pca[j].variance.size() * model.pca[j].variance.size());
+  }
+  pattern_mask_.assign(n_, 0);  // no pattern: a mask has at least two bits
   const size_t scratch = std::max<size_t>(n_, SubjectModel::kMaxRing);
   scratch_source_.assign(scratch, Vec3::Zero());
   scratch_target_.assign(scratch, Vec3::Zero());
@@ -94,6 +113,10 @@ void GapFiller::reset() {
   std::fill(assigned_id_.begin(), assigned_id_.end(), kNoFragment);
   std::fill(gap_age_.begin(), gap_age_.end(), 0);
   std::fill(gap_offset_.begin(), gap_offset_.end(), Vec3::Zero());
+  std::fill(gap_start_known_.begin(), gap_start_known_.end(), 0);
+  std::fill(snapshot_frame_.begin(), snapshot_frame_.end(), -1);
+  std::fill(carry_drift_.begin(), carry_drift_.end(), 0.0);
+  std::fill(carry_checks_.begin(), carry_checks_.end(), 0);
 }
 
 void GapFiller::add_free_point(const Vec3& p, int id) {
@@ -130,18 +153,22 @@ FillStats GapFiller::run(const FrameInput& in, const FrameOutput& out) {
   for (size_t p = 0; p < in.unlabelled.size(); ++p)
     add_free_point(in.unlabelled[p], in.unlabelled_ids.empty() ? static_cast<int>(p) : in.unlabelled_ids[p]);
 
-  if (options_.check_labels && has_previous_) check_labels();
+  suspects_.clear();
+  if (options_.check_labels && has_previous_) find_suspect_labels();
+  estimate_rigid();
+  if (!suspects_.empty()) judge_suspect_labels();
   for (int i = 0; i < n_; ++i)
     if (observed_[i]) assigned_id_[i] = kNoFragment;  // the capture system has it again
 
-  estimate_rigid();
   relabel();
   fill_missing();
+  if (options_.carry_from_gap_start) check_carries();
 
   for (int i = 0; i < n_; ++i) {
     out.positions[i] = current_[i];
     out.status[i] = status_[i];
     if (!out.fragments.empty()) out.fragments[i] = status_[i] == MarkerStatus::Relabelled ? assigned_id_[i] : kNoFragment;
+    if (is_present(in.labelled[i]) && current_[i] != in.labelled[i]) ++stats_.changed_measured;
     previous_[i] = current_[i];
     previous_status_[i] = status_[i];
     switch (status_[i]) {
@@ -156,30 +183,76 @@ FillStats GapFiller::run(const FrameInput& in, const FrameOutput& out) {
   return stats_;
 }
 
-// A correctly labelled point moves with its neighbours: within 8 ms its offset from them changes
-// by millimetres, while a swapped or mislabelled point is off by about the marker spacing. The
-// previous position (measured, or estimated during a gap) is carried by the mean displacement
-// of the observed one-ring; a labelled point farther than eps2 from there is taken as unlabelled.
-// Rotation within one frame moves a neighbour a few mm at most, far below eps2.
-void GapFiller::check_labels() {
+// Where marker i would be now had it moved with its neighbours since the last frame: its last
+// position (measured, or estimated during a gap) carried by the mean displacement of its
+// observed one-ring. False with fewer than two of them.
+bool GapFiller::carried_position(int i, Vec3& out) const {
+  Vec3 displacement = Vec3::Zero();
+  int count = 0;
+  for (int k = model_.ring_offsets[i]; k < model_.ring_offsets[i + 1]; ++k) {
+    const int j = model_.ring[k];
+    if (!observed_[j]) continue;
+    displacement += current_[j] - previous_[j];
+    ++count;
+  }
+  if (count < 2) return false;
+  out = previous_[i] + displacement / count;
+  return true;
+}
+
+// A correctly labelled point moves with its neighbours: within a frame its offset from them
+// changes by millimetres, while a swapped or mislabelled point is off by about the marker
+// spacing. A labelled point farther than eps2 from where its marker was carried is suspect, and
+// held back from the estimates until judged.
+void GapFiller::find_suspect_labels() {
   for (int i = 0; i < n_; ++i) {
-    if (!observed_[i] || previous_status_[i] == MarkerStatus::Held) continue;
-    Vec3 displacement = Vec3::Zero();
-    int count = 0;
-    for (int k = model_.ring_offsets[i]; k < model_.ring_offsets[i + 1]; ++k) {
-      const int j = model_.ring[k];
-      if (!observed_[j]) continue;
-      displacement += current_[j] - previous_[j];
-      ++count;
-    }
-    if (count < 2) continue;
-    const Vec3 expected = previous_[i] + displacement / count;
-    if ((current_[i] - expected).norm() > eps2_[i]) {
+    Vec3 expected;
+    if (!observed_[i] || previous_status_[i] == MarkerStatus::Held || !carried_position(i, expected)) continue;
+    if ((current_[i] - expected).norm() > eps2_[i]) suspects_.push_back(i);
+  }
+  for (int i : suspects_) observed_[i] = 0;
+}
+
+// Being off is not proof: a fast limb at a low frame rate, or the end of a gap whose estimate
+// was poor, puts a true measurement beyond eps2 too, and so does a rejected point that another
+// marker took last frame and carried along. A suspect point is judged against estimates made
+// this frame from the other markers alone. It stands when its own estimate agrees (within
+// eps2); it is taken as unlabelled when another marker explains it clearly better (a swap), or
+// when it was tracked last frame and its own estimate disagrees as well (two independent
+// estimates, the motion of its ring and the shape of its neighbourhood, against it).
+// Otherwise the measurement stands.
+void GapFiller::judge_suspect_labels() {
+  for (int i : suspects_) {
+    Vec3 own;
+    const bool has_own = expected_position(i, own);
+    const double own_distance = has_own ? (current_[i] - own).norm() : std::numeric_limits<double>::infinity();
+    const bool reject = own_distance > eps2_[i] &&
+                        (explained_by_another(i, own_distance) || (has_own && is_observed(previous_status_[i])));
+    if (reject) {
       add_free_point(current_[i], -(i + 1));
-      observed_[i] = 0;
       ++stats_.rejected_labels;
+    } else {
+      observed_[i] = 1;
+      changed_.push_back(i);
     }
   }
+  refresh_estimates();
+}
+
+// Whether a missing (or suspect) marker near i is expected within eps1 of i's labelled point and
+// at most half as far from it as i's own estimate.
+bool GapFiller::explained_by_another(int i, double own_distance) {
+  auto explains = [&](int j) {
+    Vec3 expected;
+    if (observed_[j] || j == i || !expected_position(j, expected)) return false;
+    const double d = (current_[i] - expected).norm();
+    return d <= eps1_[j] && d <= 0.5 * own_distance;
+  };
+  for (int k = model_.ring_offsets[i]; k < model_.ring_offsets[i + 1]; ++k)
+    if (explains(model_.ring[k])) return true;
+  for (int p = predictor_offsets_[i]; p < predictor_offsets_[i + 1]; ++p)
+    if (explains(predictor_marker_[p])) return true;
+  return false;
 }
 
 // Eq. 2, greedy: repeatedly estimate the missing marker with the most available neighbours
@@ -204,30 +277,34 @@ void GapFiller::estimate_rigid() {
         best_count = available_neighbours_[i];
       }
     if (best < 0) break;
-    int count = 0;
-    for (int k = model_.ring_offsets[best]; k < model_.ring_offsets[best + 1]; ++k) {
-      const int j = model_.ring[k];
-      if (!estimated_[j]) continue;
-      scratch_source_[count] = model_.ring_local_reference[k];
-      scratch_target_[count] = estimate_[j];
-      ++count;
-    }
-    int observed_support = 0;
-    for (int k = model_.ring_offsets[best]; k < model_.ring_offsets[best + 1]; ++k) observed_support += observed_[model_.ring[k]];
-    rigid_support_[best] = observed_support;
-    RigidTransform t;
-    fit_rigid({scratch_source_.data(), static_cast<size_t>(count)}, {scratch_target_.data(), static_cast<size_t>(count)}, t);
-    estimate_[best] = t.translation;  // the local frame's origin is the marker
-    rotation_[best] = t.rotation;
-    has_rotation_[best] = 1;
-    estimated_[best] = 1;
+    fit_rigid_estimate(best);
     for (int p = predictor_offsets_[best]; p < predictor_offsets_[best + 1]; ++p)
       ++available_neighbours_[predictor_marker_[p]];
   }
 }
 
+// Eq. 2 for marker i from the ring members known (observed or estimated) now, at least three
+// (estimate_rigid picks only such a marker).
+void GapFiller::fit_rigid_estimate(int i) {
+  int count = 0, observed_support = 0;
+  for (int k = model_.ring_offsets[i]; k < model_.ring_offsets[i + 1]; ++k) {
+    const int j = model_.ring[k];
+    observed_support += observed_[j];
+    if (!estimated_[j]) continue;
+    scratch_source_[count] = model_.ring_local_reference[k];
+    scratch_target_[count] = estimate_[j];
+    ++count;
+  }
+  rigid_support_[i] = observed_support;
+  RigidTransform t;
+  fit_rigid({scratch_source_.data(), static_cast<size_t>(count)}, {scratch_target_.data(), static_cast<size_t>(count)}, t);
+  estimate_[i] = t.translation;  // the local frame's origin is the marker
+  rotation_[i] = t.rotation;
+  has_rotation_[i] = 1;
+  estimated_[i] = 1;
+}
+
 void GapFiller::relabel() {
-  bool changed = false;
   // Fragments already standing for a marker stay while within eps2 of where it is expected.
   for (int i : missing_) {
     const int id = assigned_id_[i];
@@ -242,12 +319,11 @@ void GapFiller::relabel() {
     if (found >= 0 && !expected_position(i, expected)) expected = previous_[i];  // no estimate: continuity
     if (found >= 0 && (free_points_[found] - expected).norm() <= eps2_[i]) {
       take_free_point(i, found);
-      changed = true;
     } else {
       assigned_id_[i] = kNoFragment;
     }
   }
-  if (changed) refresh_estimates();
+  refresh_estimates();
   // New matches: each still-missing marker's nearest free point within eps1 of where it is
   // expected, closest pairs first. Points taken at the edge of an occluded patch make the
   // estimates inside it better, so matching repeats while it finds something.
@@ -292,16 +368,24 @@ bool GapFiller::free_point_near(const Vec3& p, double reach) const {
 }
 
 void GapFiller::take_free_point(int marker, int point) {
+  changed_.push_back(marker);
   free_used_[point] = 1;
   current_[marker] = free_points_[point];
   observed_[marker] = 1;
   status_[marker] = MarkerStatus::Relabelled;
 }
 
-// After points were taken: rigid estimates again from the new set, PCA solves redone on demand.
+// After points were taken for the markers in changed_: rigid estimates again from the new set
+// (their chains reach past the ring), and the PCA solves that use those markers redone on
+// demand. A model's solve depends only on its ring's observed members, so the others stand.
 void GapFiller::refresh_estimates() {
+  if (changed_.empty()) return;
   estimate_rigid();
-  ++solve_stamp_;
+  for (int m : changed_) {
+    pca_stamp_[m] = -1;
+    for (int p = predictor_offsets_[m]; p < predictor_offsets_[m + 1]; ++p) pca_stamp_[predictor_marker_[p]] = -1;
+  }
+  changed_.clear();
 }
 
 // Section 4.3 for the model of marker j: rotate j's observed one-ring into its local frame
@@ -344,8 +428,18 @@ bool GapFiller::solve_pca(int j) {
     pca_ok_[j] = 1;
     return true;
   }
-  if (!pca_fit_.fit(m, {scratch_index_.data(), static_cast<size_t>(count)}, {scratch_source_.data(), static_cast<size_t>(count)}))
-    return false;
+  // Several missing: the pattern's factor, made when the pattern changes.
+  const std::span<const int> slots(scratch_index_.data(), static_cast<size_t>(count));
+  const size_t components = m.variance.size();
+  const std::span<double> factor(pattern_factor_.data() + pattern_offset_[j], components * components);
+  uint32_t mask = 0;
+  for (int slot : slots) mask |= 1u << slot;
+  if (pattern_mask_[j] != mask) {
+    pattern_mask_[j] = 0;
+    if (!PcaFit::factor_slots(m, slots, factor)) return false;
+    pattern_mask_[j] = mask;
+  }
+  pca_fit_.fit_factored(m, slots, {scratch_source_.data(), static_cast<size_t>(count)}, factor);
   for (int k = 0; k < ring; ++k) {
     if (observed_[model_.ring[first + k]]) continue;
     pca_slot_local_[first + k] = pca_fit_.reconstruct(m, k);
@@ -378,10 +472,10 @@ bool GapFiller::transfer_motion(int first, int last, const std::vector<int>& mem
 
 // The neighbours' PCA estimates of marker i, each weighted by its calibrated predictive
 // variance, fused with the rigid estimate weighed likewise. Returns how many PCA models spoke.
-int GapFiller::pca_estimate(int i, Vec3& out) {
+int GapFiller::pca_estimate(int i, Vec3& out, double* out_variance) {
   Vec3 sum = Vec3::Zero();
-  double weights = 0.0;
-  int count = 0;
+  double weights = 0.0, precision = 0.0;
+  int count = 0, opinions = 0;
   for (int p = predictor_offsets_[i]; p < predictor_offsets_[i + 1]; ++p) {
     const int j = predictor_marker_[p];
     if (!observed_[j]) continue;
@@ -391,6 +485,8 @@ int GapFiller::pca_estimate(int i, Vec3& out) {
     const double weight = options_.weight_by_variance ? 1.0 / pca_slot_variance_[at] : 1.0;
     sum += weight * (current_[j] + pca_rotation_[j].transpose() * pca_slot_local_[at]);
     weights += weight;
+    precision += 1.0 / pca_slot_variance_[at];
+    ++opinions;
     ++count;
   }
   // The rigid estimate joins as one more opinion, weighed by its error on the training take,
@@ -399,8 +495,13 @@ int GapFiller::pca_estimate(int i, Vec3& out) {
     const double variance = model_.pca[i].rigid_variance * model_.ring_size(i) / rigid_support_[i];
     sum += estimate_[i] / variance;
     weights += 1.0 / variance;
+    precision += 1.0 / variance;
+    ++opinions;
   }
   if (count > 0) out = sum / weights;
+  // The opinions rest on the same observed markers, so together they are no surer than a typical
+  // one: the harmonic mean of their variances, not the variance of independent ones' mean.
+  if (count > 0 && out_variance) *out_variance = opinions / precision;
   return count;
 }
 
@@ -414,21 +515,116 @@ bool GapFiller::expected_position(int i, Vec3& out) {
   return true;
 }
 
+// At the first frame of a gap: where the marker and its anchors were last frame.
+void GapFiller::remember_gap_start(int i) {
+  gap_start_known_[i] = 1;
+  gap_start_position_[i] = previous_[i];
+  for (int k = model_.anchor_offsets[i]; k < model_.anchor_offsets[i + 1]; ++k) {
+    const int a = model_.anchors[k];
+    gap_start_anchor_[k] = previous_[a];
+    gap_start_anchor_seen_[k] = is_observed(previous_status_[a]);
+  }
+}
+
+// A marker's position `from_position` at an earlier frame carried by the rigid motion, from then
+// to now, of its three steadiest anchors seen both then and now (`from_anchors`, `from_seen`:
+// parallel to its anchors). Also the fit's squared residual over those three, per degree of
+// freedom (how far they moved from rigid).
+bool GapFiller::carry_rigidly(int i, const Vec3& from_position, std::span<const Vec3> from_anchors,
+                              std::span<const char> from_seen, Vec3& out, double& out_residual) {
+  const int first = model_.anchor_offsets[i];
+  int count = 0;
+  for (int k = first; k < model_.anchor_offsets[i + 1] && count < kCarryAnchors; ++k) {
+    const int a = model_.anchors[k];
+    if (!from_seen[k - first] || !observed_[a]) continue;
+    scratch_source_[count] = from_anchors[k - first];
+    scratch_target_[count] = current_[a];
+    ++count;
+  }
+  if (count < kCarryAnchors) return false;
+  RigidTransform t;
+  fit_rigid({scratch_source_.data(), static_cast<size_t>(count)}, {scratch_target_.data(), static_cast<size_t>(count)}, t);
+  double residual = 0.0;
+  for (int k = 0; k < count; ++k) residual += (t.apply(scratch_source_[k]) - scratch_target_[k]).squaredNorm();
+  out = t.apply(from_position);
+  out_residual = residual / (3 * count - 6);
+  return true;
+}
+
+// The marker's last measurement carried from the start of its gap. Over a long gap this does not
+// drift as a chain of frame-to-frame motions does, and where the marker sits on a rigid segment
+// with its anchors (a head, a pelvis, a foot) it is nearly exact, while a neighbourhood spanning a
+// joint is not. Its variance per coordinate grows with the gap's age at the rate the same carry
+// drifted for this marker while it was seen, on top of the anchors' own departure from rigid;
+// never below the marker model's residual. No estimate before that rate was measured over two
+// seconds of the marker being seen: one half-second check says little about a joint.
+bool GapFiller::carried_from_gap_start(int i, Vec3& out, double& out_variance) {
+  if (!gap_start_known_[i] || carry_checks_[i] < kCarryWarmupChecks) return false;
+  const int first = model_.anchor_offsets[i], count = model_.anchor_offsets[i + 1] - first;
+  double residual = 0.0;
+  if (!carry_rigidly(i, gap_start_position_[i], {&gap_start_anchor_[first], static_cast<size_t>(count)},
+                     {&gap_start_anchor_seen_[first], static_cast<size_t>(count)}, out, residual))
+    return false;
+  const double age = gap_age_[i] + 1.0;
+  out_variance = std::max(residual + carry_drift_[i] * age * age / 3.0, model_.pca[i].residual_variance);
+  return true;
+}
+
+// Every carry_check_frames_, for each marker seen now: how far the carry from its snapshot missed
+// it, then a new snapshot.
+void GapFiller::check_carries() {
+  for (int i = 0; i < n_; ++i) {
+    if (!is_observed(status_[i])) continue;
+    const long age = frame_ - snapshot_frame_[i];
+    if (snapshot_frame_[i] >= 0 && age < carry_check_frames_) continue;
+    const int first = model_.anchor_offsets[i], count = model_.anchor_offsets[i + 1] - first;
+    Vec3 carried;
+    double residual = 0.0;
+    if (snapshot_frame_[i] >= 0 &&
+        carry_rigidly(i, snapshot_position_[i], {&snapshot_anchor_[first], static_cast<size_t>(count)},
+                      {&snapshot_anchor_seen_[first], static_cast<size_t>(count)}, carried, residual)) {
+      const double drift = (carried - current_[i]).squaredNorm() / (static_cast<double>(age) * age);
+      carry_drift_[i] = carry_checks_[i] == 0 ? drift : 0.5 * (carry_drift_[i] + drift);
+      ++carry_checks_[i];
+    }
+    snapshot_frame_[i] = frame_;
+    snapshot_position_[i] = current_[i];
+    for (int k = first; k < first + count; ++k) {
+      snapshot_anchor_[k] = current_[model_.anchors[k]];
+      snapshot_anchor_seen_[k] = is_observed(status_[model_.anchors[k]]);
+    }
+  }
+}
+
 void GapFiller::fill_missing() {
   const double decay_frames = options_.continuity_seconds * options_.rate_hz;
+  const bool carry_on = options_.carry_from_gap_start && options_.weight_by_variance;
+  // Two estimates of one point weighed by their variances.
+  auto combine = [](const Vec3& a, double variance_a, const Vec3& b, double variance_b) {
+    return (a * variance_b + b * variance_a) / (variance_a + variance_b);
+  };
   for (int i : missing_) {
     if (observed_[i]) continue;  // relabelled
+    if (has_previous_ && is_observed(previous_status_[i])) remember_gap_start(i);
+    Vec3 carried;
+    double carried_variance = 0.0;
+    const bool carry = carry_on && carried_from_gap_start(i, carried, carried_variance);
     Vec3 fused;
-    if (options_.use_pca && pca_estimate(i, fused) > 0) {
-      current_[i] = fused;
+    double variance = 0.0;
+    if (options_.use_pca && pca_estimate(i, fused, &variance) > 0) {
+      current_[i] = carry ? combine(fused, variance, carried, carried_variance) : fused;
       status_[i] = MarkerStatus::FilledPca;
     } else if (estimated_[i]) {
-      current_[i] = estimate_[i];
+      const double rigid_variance = model_.pca[i].rigid_variance * model_.ring_size(i) / std::max(1, rigid_support_[i]);
+      current_[i] = carry ? combine(estimate_[i], rigid_variance, carried, carried_variance) : estimate_[i];
       status_[i] = MarkerStatus::FilledRigid;
     } else {
-      // Held: carried with the rigid motion of the anchors, else kept where it was.
+      // Held: carried with the rigid motion of the anchors (since the gap started, else since
+      // the last frame), else kept where it was.
       Vec3 moved;
-      if (has_previous_ && transfer_motion(model_.anchor_offsets[i], model_.anchor_offsets[i + 1], model_.anchors, previous_[i], moved))
+      if (carry)
+        current_[i] = carried;
+      else if (has_previous_ && transfer_motion(model_.anchor_offsets[i], model_.anchor_offsets[i + 1], model_.anchors, previous_[i], moved))
         current_[i] = moved;
       else
         current_[i] = has_previous_ ? previous_[i] : model_.reference_positions[i];

@@ -3,8 +3,11 @@
 // (NaN = missing) and unlabelled points, and returns every marker of the subject.
 //
 //   1. Label check: a labelled point that did not move with its one-ring since the last frame
-//      (off by more than eps2) is treated as unlabelled: that is how swapped and mislabelled
-//      fragments look.
+//      (off by more than eps2) is suspect: that is how swapped and mislabelled fragments look,
+//      but also a true measurement after a gap whose estimate was poor. It is treated as
+//      unlabelled only on strong evidence, judged against this frame's estimates from the other
+//      markers: another missing marker explains it clearly better (a swap), or it was tracked
+//      and its neighbourhood's estimate disagrees too. Otherwise the measurement stands.
 //   2. Rigid estimates (eq. 2, Horn), greedy: the missing marker with the most available
 //      neighbours first, reusing earlier estimates.
 //   3. Relabelling: a tracked fragment stays with its marker while within eps2 (alpha2) of
@@ -23,6 +26,7 @@
 // All buffers are sized in the constructor; run() allocates nothing.
 
 #include <Eigen/Core>
+#include <cstdint>
 #include <limits>
 #include <span>
 #include <vector>
@@ -42,6 +46,10 @@ struct GapFillerOptions {
   // or plainly as the paper does (false).
   bool weight_by_variance = true;
   bool fuse_rigid = true;  // with weighting: the rigid estimate (eq. 2) is one more weighed opinion
+  // With weighting: during a gap, the marker's last measurement carried by the rigid motion of
+  // its steadiest anchors since then is one more opinion too (and replaces the frame-to-frame
+  // hold when nothing else is known).
+  bool carry_from_gap_start = true;
   bool check_labels = true;
 };
 
@@ -70,6 +78,8 @@ struct FillStats {
   int filled = 0;           // PCA or rigid
   int held = 0;
   int rejected_labels = 0;  // labelled points taken as mislabelled this frame
+  int changed_measured = 0;  // labelled points whose marker was output elsewhere: rejected labels
+                             // that were not given back to their own marker
   int ignored_points = 0;   // non-finite or beyond capacity
 };
 
@@ -84,12 +94,21 @@ class GapFiller {
 
 
  private:
-  void check_labels();
+  void find_suspect_labels();
+  void judge_suspect_labels();
+  bool explained_by_another(int i, double own_distance);
+  bool carried_position(int i, Vec3& out) const;
   void estimate_rigid();
+  void fit_rigid_estimate(int i);
   void relabel();
   void precompute_single_gaps();
   bool solve_pca(int j);
-  int pca_estimate(int i, Vec3& out);
+  int pca_estimate(int i, Vec3& out, double* out_variance = nullptr);
+  void remember_gap_start(int i);
+  bool carried_from_gap_start(int i, Vec3& out, double& out_variance);
+  bool carry_rigidly(int i, const Vec3& from_position, std::span<const Vec3> from_anchors,
+                     std::span<const char> from_seen, Vec3& out, double& out_residual);
+  void check_carries();
   bool expected_position(int i, Vec3& out);
   void take_free_point(int marker, int point);
   bool free_point_near(const Vec3& p, double reach) const;
@@ -113,17 +132,37 @@ class GapFiller {
   static constexpr double kPrefilterReach = 3.0;  // in eps1, around the rigid estimate
   bool has_previous_ = false;
   long frame_ = 0;
-  long solve_stamp_ = 0;  // PCA solves are valid while the observed set is unchanged
+  long solve_stamp_ = 0;  // this frame's: a PCA solve made in it stands until its ring changes (refresh_estimates)
   std::vector<Vec3> previous_;
   std::vector<MarkerStatus> previous_status_;
   std::vector<int> assigned_id_;      // free-point trajectory currently standing for marker i
   std::vector<Vec3> gap_offset_;      // continuity offset in the local frame
   std::vector<int> gap_age_;
+  // At the start of each marker's gap: its last position and its anchors' (parallel to
+  // model.anchors; usable where the anchor was measured or relabelled then).
+  static constexpr int kCarryAnchors = 3;
+  std::vector<char> gap_start_known_;
+  std::vector<Vec3> gap_start_position_;
+  std::vector<Vec3> gap_start_anchor_;
+  std::vector<char> gap_start_anchor_seen_;
+  // While a marker is seen, every carry_check_frames_ (half a second) the same carry is tried on
+  // it from a snapshot of then: the squared miss per frame squared, averaged over the recent
+  // checks (mm^2 / frame^2), is how fast the carry drifts for this marker in this take.
+  static constexpr int kCarryWarmupChecks = 4;
+  int carry_check_frames_ = 1;
+  std::vector<long> snapshot_frame_;
+  std::vector<Vec3> snapshot_position_;
+  std::vector<Vec3> snapshot_anchor_;
+  std::vector<char> snapshot_anchor_seen_;
+  std::vector<double> carry_drift_;
+  std::vector<int> carry_checks_;  // how many checks carry_drift_ rests on
 
   // Per-frame scratch.
   std::vector<Vec3> current_;
   std::vector<MarkerStatus> status_;
   std::vector<char> observed_, estimated_, has_rotation_;
+  std::vector<int> suspects_;  // labelled points that did not move with their ring, held back
+  std::vector<int> changed_;   // markers that became observed since the estimates were made
   std::vector<Vec3> estimate_;
   std::vector<Eigen::Matrix3d> rotation_;
   std::vector<int> available_neighbours_, missing_;
@@ -149,6 +188,11 @@ class GapFiller {
   std::vector<double> single_gap_gain_;
   std::vector<int> single_gap_offset_;
   std::vector<double> single_gap_variance_;
+  // Several ring members missing: per model, the observed slots (a bit each) its factor below
+  // was made for, and that factor (PcaFit::factor_slots, components^2 at pattern_offset_).
+  std::vector<uint32_t> pattern_mask_;
+  std::vector<int> pattern_offset_;
+  std::vector<double> pattern_factor_;
   std::vector<Vec3> scratch_source_, scratch_target_;
   std::vector<int> scratch_index_;
   FillStats stats_;

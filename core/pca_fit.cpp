@@ -24,6 +24,28 @@ bool PcaFit::fit(const MarkerPcaModel& model, std::span<const int> slots, std::s
   return true;
 }
 
+bool PcaFit::factor_slots(const MarkerPcaModel& model, std::span<const int> slots, std::span<double> out_factor) {
+  const int components = static_cast<int>(model.variance.size());
+  PcaMatrix normal = PcaMatrix::Zero(components, components);
+  for (int slot : slots) normal.noalias() += model.basis.middleRows<3>(3 * slot).transpose().lazyProduct(model.basis.middleRows<3>(3 * slot));
+  for (int c = 0; c < components; ++c) normal(c, c) += model.residual_variance / model.variance(c);
+  const Eigen::LLT<Eigen::Ref<PcaMatrix>> llt(normal);  // in place
+  if (llt.info() != Eigen::Success) return false;
+  Eigen::Map<Eigen::MatrixXd>(out_factor.data(), components, components) = normal.triangularView<Eigen::Lower>();
+  return true;
+}
+
+void PcaFit::fit_factored(const MarkerPcaModel& model, std::span<const int> slots, std::span<const Vec3> local,
+                          std::span<const double> factor) {
+  const int components = static_cast<int>(model.variance.size());
+  coefficients_.setZero(components);
+  for (size_t o = 0; o < slots.size(); ++o)
+    coefficients_.noalias() += model.basis.middleRows<3>(3 * slots[o]).transpose() * (local[o] - model.mean.segment<3>(3 * slots[o]));
+  const Eigen::Map<const Eigen::MatrixXd> l(factor.data(), components, components);
+  l.triangularView<Eigen::Lower>().solveInPlace(coefficients_);
+  l.triangularView<Eigen::Lower>().transpose().solveInPlace(coefficients_);
+}
+
 Vec3 PcaFit::reconstruct(const MarkerPcaModel& model, int slot) const {
   Vec3 p = model.mean.segment<3>(3 * slot);
   for (Eigen::Index k = 0; k < coefficients_.size(); ++k) p += model.basis.block<3, 1>(3 * slot, k) * coefficients_(k);

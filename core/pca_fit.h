@@ -24,6 +24,14 @@ class PcaFit {
   // local frame (eq. 4). Returns false when the system cannot be solved.
   bool fit(const MarkerPcaModel& model, std::span<const int> slots, std::span<const Vec3> local);
 
+  // The same fit in two steps, for a caller that sees one set of observed slots frame after
+  // frame: the normal matrix depends only on which slots are observed, so its lower Cholesky
+  // factor (k x k, column-major, k = components) is made once per set (false when it cannot
+  // be) and each fit is then a right-hand side and two triangular solves.
+  static bool factor_slots(const MarkerPcaModel& model, std::span<const int> slots, std::span<double> out_factor);
+  void fit_factored(const MarkerPcaModel& model, std::span<const int> slots, std::span<const Vec3> local,
+                    std::span<const double> factor);
+
   // The model's reconstruction of ring member `slot` in the local frame, and its predictive
   // variance per coordinate (mm^2): coefficient uncertainty seen through that member's rows,
   // plus the residual.

@@ -15,8 +15,9 @@ packages=(
   python3 python3-numpy python3-pip python3-venv python3-setuptools python3-wheel libmeshoptimizer2d
   # The Blender add-on's headless test (clients/blender): Blender 3.4, about a minute to install.
   blender
-  # skinstream-bench --link-mbit: a network namespace and tc's shaper (ip, tc).
-  iproute2
+  # skinstream-bench --link-mbit: a network namespace and tc's shaper (ip, tc); the multicast
+  # test between network namespaces on a bridge (ip), one receiver's datagrams dropped by nft.
+  iproute2 nftables
 )
 # The web viewer's build (npm) and its browser test (node + playwright-core + chromium). A
 # machine with Node.js from elsewhere (e.g. NodeSource, which bundles npm) keeps it.

@@ -24,24 +24,59 @@ void take(const nlohmann::json& json, const char* key, T& out, const std::string
   }
 }
 
+nlohmann::json to_json(const SubjectConfig& subject) { return {{"name", subject.name}, {"file", subject.file}}; }
+
+SubjectConfig subject_from_json(const nlohmann::json& json, const std::string& origin) {
+  SubjectConfig subject;
+  if (json.is_object()) {
+    for (const auto& [key, value] : json.items())
+      if (key != "name" && key != "file") throw ConfigError(origin + ": unknown key \"" + key + "\" in a subject (name, file)");
+    take(json, "name", subject.name, origin);
+    take(json, "file", subject.file, origin);
+  } else if (json.is_string()) {
+    subject = parse_subject(json.get<std::string>());
+  } else {
+    throw ConfigError(origin + ": a subject is {\"name\": NAME, \"file\": FILE} or \"NAME=FILE\"");
+  }
+  return subject;
+}
+
 }  // namespace
+
+SubjectConfig parse_subject(const std::string& text) {
+  const size_t equals = text.find('=');
+  if (equals == std::string::npos || equals == 0 || text.find('/') < equals) return {"", text};
+  return {text.substr(0, equals), text.substr(equals + 1)};
+}
 
 void apply_json(const nlohmann::json& json, DaemonConfig& c, const std::string& origin) {
   if (!json.is_object()) throw ConfigError(origin + ": the configuration must be a JSON object");
-  static const char* const kKeys[] = {"subject", "replay", "loop", "speed", "vicon", "vicon_pull", "vicon_multicast", "qtm", "natnet", "natnet_interface", "bind_address",
+  static const char* const kKeys[] = {"subject", "subjects", "replay", "replay_subject", "loop", "speed", "vicon", "vicon_pull",
+                                      "vicon_multicast", "qtm", "natnet", "natnet_interface", "bind_address",
                                       "http_port", "sub_port", "web_root", "lookahead", "max_frame_wait_ms", "deform_threads",
                                       "deform_cpus", "deform_spin_lead_us",
                                       "continuity_seconds", "use_pca", "ports_file", "log_level", "hello_timeout_ms",
-                                      "subscriber_queue_frames", "subscriber_tcp_congestion", "publish_threads", "status_interval_ms", "default_rate_hz",
-                                      "compressed_key_interval", "source_max_subjects", "source_max_markers_per_subject",
+                                      "subscriber_queue_frames", "subscriber_tcp_congestion", "publish_threads", "status_interval_ms", "status_log_seconds", "default_rate_hz",
+                                      "compressed_key_interval", "multicast", "multicast_interface", "multicast_ttl", "source_max_subjects", "source_max_markers_per_subject",
                                       "source_max_name_bytes"};
   for (const auto& [key, value] : json.items()) {
     bool known = false;
     for (const char* k : kKeys) known = known || key == k;
     if (!known) throw ConfigError(origin + ": unknown key \"" + key + "\"");
   }
-  take(json, "subject", c.subject, origin);
+  if (json.contains("subject") && json.contains("subjects"))
+    throw ConfigError(origin + ": give \"subject\" (one) or \"subjects\" (a list), not both");
+  if (const auto it = json.find("subject"); it != json.end()) {
+    if (!it->is_string()) throw ConfigError(origin + ": key \"subject\" has the wrong type (" + it->type_name() + ")");
+    c.subjects = {parse_subject(it->get<std::string>())};
+  }
+  if (const auto it = json.find("subjects"); it != json.end()) {
+    if (!it->is_array()) throw ConfigError(origin + ": key \"subjects\" must be a list of {\"name\": NAME, \"file\": FILE}");
+    c.subjects.clear();
+    for (const nlohmann::json& subject : *it) c.subjects.push_back(subject_from_json(subject, origin));
+  }
   take(json, "replay", c.replay, origin);
+  take(json, "replay_subject", c.replay_subject, origin);
   take(json, "loop", c.loop, origin);
   take(json, "speed", c.speed, origin);
   take(json, "vicon", c.vicon, origin);
@@ -69,7 +104,11 @@ void apply_json(const nlohmann::json& json, DaemonConfig& c, const std::string& 
   take(json, "subscriber_tcp_congestion", c.subscriber_tcp_congestion, origin);
   take(json, "publish_threads", c.publish_threads, origin);
   take(json, "status_interval_ms", c.status_interval_ms, origin);
+  take(json, "status_log_seconds", c.status_log_seconds, origin);
   take(json, "default_rate_hz", c.default_rate_hz, origin);
+  take(json, "multicast", c.multicast, origin);
+  take(json, "multicast_interface", c.multicast_interface, origin);
+  take(json, "multicast_ttl", c.multicast_ttl, origin);
   take(json, "source_max_subjects", c.source_max_subjects, origin);
   take(json, "source_max_markers_per_subject", c.source_max_markers_per_subject, origin);
   take(json, "source_max_name_bytes", c.source_max_name_bytes, origin);
@@ -92,8 +131,11 @@ DaemonConfig load_config_file(const std::string& path) {
 }
 
 nlohmann::json to_json(const DaemonConfig& c) {
-  return {{"subject", c.subject},
+  nlohmann::json subjects = nlohmann::json::array();
+  for (const SubjectConfig& subject : c.subjects) subjects.push_back(to_json(subject));
+  return {{"subjects", subjects},
           {"replay", c.replay},
+          {"replay_subject", c.replay_subject},
           {"loop", c.loop},
           {"speed", c.speed},
           {"vicon", c.vicon},
@@ -121,7 +163,11 @@ nlohmann::json to_json(const DaemonConfig& c) {
           {"subscriber_tcp_congestion", c.subscriber_tcp_congestion},
           {"publish_threads", c.publish_threads},
           {"status_interval_ms", c.status_interval_ms},
+          {"status_log_seconds", c.status_log_seconds},
           {"default_rate_hz", c.default_rate_hz},
+          {"multicast", c.multicast},
+          {"multicast_interface", c.multicast_interface},
+          {"multicast_ttl", c.multicast_ttl},
           {"source_max_subjects", c.source_max_subjects},
           {"source_max_markers_per_subject", c.source_max_markers_per_subject},
           {"source_max_name_bytes", c.source_max_name_bytes}};
@@ -132,6 +178,15 @@ void validate(const DaemonConfig& c) {
   if (!c.replay.empty() + !c.vicon.empty() + !c.vicon_multicast.empty() + !c.qtm.empty() + !c.natnet.empty() > 1)
     fail("give one source: a replay file, a Vicon server, a Vicon multicast address, a QTM or a NatNet server");
   if (!(c.speed > 0 && c.speed <= 100)) fail("speed must be in (0, 100]");
+  for (size_t i = 0; i < c.subjects.size(); ++i) {
+    const SubjectConfig& subject = c.subjects[i];
+    if (subject.file.empty()) fail("subject \"" + subject.name + "\" has no file");
+    if (subject.name.size() > kMaxSubjectNameBytes) fail("a subject name is at most 256 bytes");
+    if (subject.name.empty() && c.subjects.size() > 1)
+      fail("with several subjects each follows a named one: --subject NAME=FILE (" + subject.file + " has no name)");
+    for (size_t j = 0; j < i; ++j)
+      if (c.subjects[j].name == subject.name) fail("subject \"" + subject.name + "\" is given twice");
+  }
   if (c.http_port < 0 || c.http_port > 65535) fail("http_port must be 0-65535");
   if (c.sub_port < 0 || c.sub_port > 65535) fail("sub_port must be 0-65535");
   if (c.lookahead < 0 || c.lookahead > 240) fail("lookahead must be 0-240 frames");
@@ -148,6 +203,7 @@ void validate(const DaemonConfig& c) {
     fail("subscriber_tcp_congestion must be empty (the system's) or a Linux congestion control name such as reno, not \"" +
          c.subscriber_tcp_congestion + "\"");
   if (c.status_interval_ms < 10) fail("status_interval_ms must be >= 10");
+  if (c.status_log_seconds < 0 || c.status_log_seconds > 3600) fail("status_log_seconds must be 0 (none) to 3600");
   if (!(c.default_rate_hz > 0)) fail("default_rate_hz must be > 0");
   if (c.source_max_subjects < 1 || c.source_max_subjects > 4096) fail("source_max_subjects must be 1-4096");
   if (c.source_max_markers_per_subject < 1 || c.source_max_markers_per_subject > 65536)
@@ -166,6 +222,15 @@ void validate(const DaemonConfig& c) {
   if (!c.natnet.empty() && !parse_host_with_port(c.natnet, 1510))
     fail("natnet must be HOST or HOST:PORT with a port of 1-65535 (the command port is 1510), not \"" + c.natnet + "\"");
   in_addr address{};
+  if (!c.multicast.empty()) {
+    const std::optional<HostPort> group = parse_host_port(c.multicast);
+    if (!group || inet_pton(AF_INET, group->host.c_str(), &address) != 1 || !IN_MULTICAST(ntohl(address.s_addr)))
+      fail("multicast must be GROUP:PORT with an IPv4 multicast group (224.0.0.0-239.255.255.255; 239.x.x.x is for a site's own use) "
+           "and a port of 1-65535, not \"" + c.multicast + "\"");
+  }
+  if (inet_pton(AF_INET, c.multicast_interface.c_str(), &address) != 1)
+    fail("multicast_interface must be an IPv4 address of this host (0.0.0.0: the system's route), not \"" + c.multicast_interface + "\"");
+  if (c.multicast_ttl < 0 || c.multicast_ttl > 255) fail("multicast_ttl must be 0-255");
   if (inet_pton(AF_INET, c.natnet_interface.c_str(), &address) != 1) fail("natnet_interface must be an IPv4 address of this host, not \"" + c.natnet_interface + "\"");
 }
 
@@ -191,8 +256,15 @@ std::optional<CommandLine> parse_command_line(int argc, const char* const* argv,
   DaemonConfig flags;  // values of the flags; only those given are applied
   CommandLine result;
   app.add_option("--config", config_path, "JSON configuration file (see config/skinstreamd.reference.json)");
-  auto* subject = app.add_option("--subject", flags.subject, "subject file (skinstream build-subject)");
+  std::vector<std::string> subject_specs;
+  auto* subject = app.add_option("--subject", subject_specs,
+                                 "subject file (skinstream build-subject), or NAME=FILE to follow the capture system's subject NAME; "
+                                 "repeat for several subjects")
+                      ->expected(1)
+                      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   auto* replay = app.add_option("--replay", flags.replay, "replay a capture file (C3D/TRC) as the source");
+  auto* replay_subject = app.add_option("--replay-subject", flags.replay_subject,
+                                        "replay: the name of the file's subject (default: the file's stem)");
   auto* loop = app.add_flag("--loop", flags.loop, "replay: start again at the end");
   auto* speed = app.add_option("--speed", flags.speed, "replay: multiple of the capture rate");
   auto* vicon = app.add_option("--vicon", flags.vicon, "Vicon DataStream server HOST:PORT as the source");
@@ -203,6 +275,11 @@ std::optional<CommandLine> parse_command_line(int argc, const char* const* argv,
   auto* natnet = app.add_option("--natnet", flags.natnet, "OptiTrack NatNet server HOST[:PORT] as the source (command port, 1510)");
   auto* natnet_interface = app.add_option("--natnet-interface", flags.natnet_interface,
                                           "NatNet: this host's IPv4 address to join the multicast group on");
+  auto* multicast = app.add_option("--multicast", flags.multicast,
+                                   "also send every frame's parameters to this IPv4 multicast GROUP:PORT (docs/subscriber-protocol.md)");
+  auto* multicast_interface = app.add_option("--multicast-interface", flags.multicast_interface,
+                                             "multicast: this host's IPv4 address to send from (default: the system's route)");
+  auto* multicast_ttl = app.add_option("--multicast-ttl", flags.multicast_ttl, "multicast: hops the datagrams may cross (default 1: this link)");
   auto* bind = app.add_option("--bind", flags.bind_address, "address to listen on");
   auto* http_port = app.add_option("--http-port", flags.http_port, "HTTP/WebSocket port (0 = ephemeral)");
   auto* sub_port = app.add_option("--sub-port", flags.sub_port, "TCP subscriber port (0 = ephemeral)");
@@ -231,7 +308,11 @@ std::optional<CommandLine> parse_command_line(int argc, const char* const* argv,
   DaemonConfig& c = result.config;
   if (!config_path.empty()) c = load_config_file(config_path);
   auto given = [](const CLI::Option* o) { return o->count() > 0; };
-  if (given(subject)) c.subject = flags.subject;
+  if (given(subject)) {
+    c.subjects.clear();
+    for (const std::string& spec : subject_specs) c.subjects.push_back(parse_subject(spec));
+  }
+  if (given(replay_subject)) c.replay_subject = flags.replay_subject;
   // A source given on the command line replaces the file's (several on the command line: validate() refuses).
   if (given(replay) || given(vicon) || given(vicon_multicast) || given(qtm) || given(natnet)) {
     c.replay = given(replay) ? flags.replay : std::string();
@@ -241,6 +322,9 @@ std::optional<CommandLine> parse_command_line(int argc, const char* const* argv,
     c.natnet = given(natnet) ? flags.natnet : std::string();
   }
   if (given(natnet_interface)) c.natnet_interface = flags.natnet_interface;
+  if (given(multicast)) c.multicast = flags.multicast;
+  if (given(multicast_interface)) c.multicast_interface = flags.multicast_interface;
+  if (given(multicast_ttl)) c.multicast_ttl = flags.multicast_ttl;
   if (given(loop)) c.loop = flags.loop;
   if (given(speed)) c.speed = flags.speed;
   if (given(vicon_pull)) c.vicon_pull = flags.vicon_pull;

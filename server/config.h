@@ -12,9 +12,24 @@
 
 namespace skinstream::server {
 
+// A subject's name is at most this long (as in a subscriber's Hello, docs/subscriber-protocol.md).
+inline constexpr size_t kMaxSubjectNameBytes = 256;
+
+// One subject the daemon serves: its subject file, and the capture system's subject it follows.
+struct SubjectConfig {
+  std::string name;  // the source subject (Vicon subject name); empty: one actor, found by its labels
+  std::string file;  // subject file (skinstream build-subject)
+  bool operator==(const SubjectConfig&) const = default;
+};
+
+// "NAME=FILE" or "FILE": the form of --subject and of the "subject" key. A NAME has no '/' (so
+// "dir/a=b.sks" is a file).
+SubjectConfig parse_subject(const std::string& text);
+
 struct DaemonConfig {
-  std::string subject;            // subject file; empty = none
+  std::vector<SubjectConfig> subjects;  // none = nothing to serve (an error at start)
   std::string replay;             // capture file to replay (C3D/TRC); empty = none
+  std::string replay_subject;     // replay: the name of the file's one subject; empty = the file's stem
   bool loop = false;              // replay: start again at the end
   double speed = 1.0;             // replay: multiple of the capture rate
   std::string vicon;              // HOST:PORT of a Vicon DataStream server; empty = none
@@ -42,6 +57,10 @@ struct DaemonConfig {
   int subscriber_queue_frames = 32;  // per subscriber at most; max_frame_wait_ms bounds their age
   int compressed_key_interval = 10;  // frames between key frames of the compressed encoding
   int status_interval_ms = 1000;
+  int status_log_seconds = 5;  // a status line per subject in the log this often (0: none)
+  std::string multicast;          // GROUP:PORT: also send every frame's parameters to this IPv4 multicast group; empty = off
+  std::string multicast_interface = "0.0.0.0";  // multicast: this host's address to send from; 0.0.0.0 = the system's route
+  int multicast_ttl = 1;          // multicast: hops the datagrams may cross (1: this link)
   double default_rate_hz = 120.0;  // until the source says its rate
   // What one source message may describe (vicon::DescriptionLimits); more is a malformed packet.
   int source_max_subjects = 128;

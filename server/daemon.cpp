@@ -10,7 +10,6 @@
 #include <unistd.h>
 
 #include "protocol/file_error.h"
-#include "protocol/subscriber_model.h"
 #include "protocol/printable_text.h"
 #include "server/http/http_server.h"
 #include "server/ingest/file_replay_source.h"
@@ -20,6 +19,7 @@
 #include "server/ingest/vicon_source.h"
 #include "server/listener.h"
 #include "server/pipeline/deform_cpus.h"
+#include "server/publish/multicast_sender.h"
 #include "server/publish/subscriber_hub.h"
 #include "server/publish/tcp_subscriber.h"
 #include "server/thread_name.h"
@@ -27,33 +27,64 @@
 namespace skinstream::server {
 namespace {
 
-SubjectFile load_subject(const DaemonConfig& config) {
-  if (config.subject.empty()) throw ConfigError("no subject file given (--subject FILE or \"subject\" in the config)");
-  return read_subject_file(config.subject);
+// Each subject's deform threads' CPUs, subject after subject: `deform_threads` each.
+std::vector<int> deform_cpus_of(const DaemonConfig& config) {
+  if (config.subjects.empty())
+    throw ConfigError("no subject file given (--subject FILE or NAME=FILE, or \"subject\" in the config)");
+  const int subjects = static_cast<int>(config.subjects.size());
+  try {
+    return choose_deform_cpus(config.deform_cpus, config.deform_threads * subjects, allowed_cpus());
+  } catch (const std::invalid_argument& e) {
+    throw ConfigError(std::string("configuration: ") + e.what() +
+                      (subjects > 1 ? " (deform_threads for each of the " + std::to_string(subjects) + " subjects)" : ""));
+  }
 }
 
-subscriber::MeshInfo mesh_info_of(const SubjectFile& subject, const std::string& path) {
-  subscriber::MeshInfo info;
-  // The subject's name: its file's stem until subjects are named on the command line.
-  info.subject = std::filesystem::path(path).stem().string();
-  const SubjectModel& model = subject.model;
-  info.marker_count = static_cast<uint32_t>(model.marker_count());
-  info.marker_names = model.marker_names;
-  for (const auto& t : model.triangles)
-    info.marker_triangles.push_back({static_cast<uint32_t>(t[0]), static_cast<uint32_t>(t[1]), static_cast<uint32_t>(t[2])});
-  if (subject.deformation) {
-    const DeformationModel& d = *subject.deformation;
-    info.vertex_count = static_cast<uint32_t>(d.vertex_count());
-    info.part_count = static_cast<uint32_t>(d.part_count());
-    for (const auto& f : d.faces)
-      info.faces.push_back({static_cast<uint32_t>(f[0]), static_cast<uint32_t>(f[1]), static_cast<uint32_t>(f[2])});
-    info.dominant_part.resize(info.vertex_count);
-    for (int v = 0; v < d.vertex_count(); ++v) {
-      const int p = d.dominant_part(v);
-      info.dominant_part[v] = p >= 0 && p < 255 ? static_cast<uint8_t>(p) : uint8_t{255};
+MulticastSenderOptions multicast_options_of(const DaemonConfig& config, uint32_t stream_id);
+
+std::vector<std::unique_ptr<SubjectStream>> load_subjects(const DaemonConfig& config, const std::vector<int>& cpus) {
+  SubjectStreamOptions options;
+  options.max_frame_wait = std::chrono::milliseconds(config.max_frame_wait_ms);
+  options.hub.queue_frames = config.subscriber_queue_frames;
+  options.hub.frame_max_wait = std::chrono::milliseconds(config.max_frame_wait_ms);
+  options.hub.hello_timeout = std::chrono::milliseconds(config.hello_timeout_ms);
+  PipelineOptions& pipeline = options.pipeline;
+  pipeline.lookahead = config.lookahead;
+  pipeline.deform_threads = config.deform_threads;
+  pipeline.deform_spin_lead = std::chrono::microseconds(config.deform_spin_lead_us);
+  pipeline.default_rate_hz = config.default_rate_hz;
+  pipeline.filler.continuity_seconds = config.continuity_seconds;
+  pipeline.filler.use_pca = config.use_pca;
+  pipeline.compressed_key_interval = config.compressed_key_interval;
+  const bool several = config.subjects.size() > 1;
+  std::vector<std::unique_ptr<SubjectStream>> subjects;
+  for (size_t k = 0; k < config.subjects.size(); ++k) {
+    // One subject keeps the names "pipeline" and "deform-N"; several are told apart by index.
+    pipeline.thread_name = several ? "pipeline-" + std::to_string(k) : "pipeline";
+    pipeline.deform_thread_name = several ? "deform-" + std::to_string(k) : "deform";
+    pipeline.deform_cpus.clear();
+    if (!cpus.empty()) {
+      const auto first = cpus.begin() + static_cast<long>(k) * config.deform_threads;
+      pipeline.deform_cpus.assign(first, first + config.deform_threads);
     }
+    // Every subject's parameters to the one group, told apart by the stream id (its index).
+    if (!config.multicast.empty()) options.multicast = multicast_options_of(config, static_cast<uint32_t>(k));
+    subjects.push_back(std::make_unique<SubjectStream>(config.subjects[k], options));
+    const SubjectStream& s = *subjects.back();
+    if (pipeline.deform_cpus.empty())
+      spdlog::info("subject {}: deform threads: {}, not pinned (deform_cpus \"{}\"), spin lead {} us", s.name(), config.deform_threads,
+                   config.deform_cpus, config.deform_spin_lead_us);
+    else
+      spdlog::info("subject {}: deform threads: {} on CPUs {}, spin lead {} us", s.name(), config.deform_threads,
+                   fmt::join(pipeline.deform_cpus, ","), config.deform_spin_lead_us);
   }
-  return info;
+  return subjects;
+}
+
+std::vector<SubjectTarget> targets_of(const std::vector<std::unique_ptr<SubjectStream>>& subjects) {
+  std::vector<SubjectTarget> targets;
+  for (const auto& s : subjects) targets.push_back(s->target());
+  return targets;
 }
 
 // A "HOST:PORT" key, for a config that may not have been through validate().
@@ -87,87 +118,39 @@ vicon::DescriptionLimits description_limits_of(const DaemonConfig& config) {
   return limits;
 }
 
-subscriber::SourceStateCode code_of(SourceState s) { return static_cast<subscriber::SourceStateCode>(static_cast<uint32_t>(s)); }
-
-// The /metrics histograms condensed for scripts, over the daemon's life: per stage its count,
-// the quantiles as bucket upper bounds ("le") and the largest value seen.
-nlohmann::json latency_summaries(const Metrics& metrics) {
-  nlohmann::json out = nlohmann::json::object();
-  auto add = [&](const char* name, const LatencyHistogram& histogram) {
-    const LatencyHistogram::Summary s = histogram.summary();
-    out[name] = {{"count", s.count}, {"p50_le", s.p50_le_ms}, {"p99_le", s.p99_le_ms}, {"p99_9_le", s.p99_9_le_ms}, {"max", s.max_ms}};
-  };
-  add("receive_to_take", metrics.receive_to_take);
-  add("fill", metrics.fill);
-  add("deform", metrics.deform);
-  add("normals", metrics.normals);
-  add("encode", metrics.encode);
-  add("encode_compressed", metrics.encode_compressed);
-  add("receive_to_publish", metrics.receive_to_publish);
-  add("subscriber_queue_wait", metrics.subscriber_queue_wait);
-  add("subscriber_write", metrics.subscriber_write);
-  return out;
+MulticastSenderOptions multicast_options_of(const DaemonConfig& config, uint32_t stream_id) {
+  const HostPort group = host_port_of("--multicast", config.multicast);
+  return {group.host, group.port, config.multicast_interface, config.multicast_ttl, stream_id};
 }
 
 }  // namespace
 
 Daemon::Daemon(const DaemonConfig& config)
     : config_(config),
-      subject_(load_subject(config)),
-      mailbox_(subject_.model.marker_count(), std::chrono::milliseconds(config.max_frame_wait_ms)),
-      router_({SubjectTarget{"", subject_.model.marker_names}}, static_cast<SubjectRouter::Observer&>(*this)),
+      deform_cpus_(deform_cpus_of(config)),
+      subjects_(load_subjects(config, deform_cpus_)),
+      router_(targets_of(subjects_), static_cast<SubjectRouter::Observer&>(*this)),
+      routed_(subjects_.size(), nullptr),
       publish_(config.publish_threads),
-      status_timer_(io_) {
-  const SubjectModel& model = subject_.model;
-  if (!subject_.deformation)
-    spdlog::warn("{}: no deformation model (built without --mesh): publishing markers only (MeshInfo with V = 0)",
-                 config.subject);
-  HubOptions hub_options;
-  hub_options.queue_frames = config.subscriber_queue_frames;
-  hub_options.frame_max_wait = std::chrono::milliseconds(config.max_frame_wait_ms);
-  hub_options.hello_timeout = std::chrono::milliseconds(config.hello_timeout_ms);
-  hub_ = std::make_unique<SubscriberHub>(metrics_, hub_options, mesh_info_of(subject_, config.subject), subject_.deformation.has_value());
-
-  PipelineOptions pipeline_options;
-  pipeline_options.lookahead = config.lookahead;
-  pipeline_options.deform_threads = config.deform_threads;
-  pipeline_options.deform_spin_lead = std::chrono::microseconds(config.deform_spin_lead_us);
-  try {
-    deform_cpus_ = pipeline_options.deform_cpus = choose_deform_cpus(config.deform_cpus, config.deform_threads, allowed_cpus());
-  } catch (const std::invalid_argument& e) {
-    throw ConfigError(std::string("configuration: ") + e.what());
+      status_timer_(io_),
+      status_log_timer_(io_) {
+  for (auto& s : subjects_) {
+    directory_.add(s->name(), s->hub());
+    s->hub().set_directory(&directory_);
   }
-  if (pipeline_options.deform_cpus.empty())
-    spdlog::info("deform threads: {}, not pinned (deform_cpus \"{}\"), spin lead {} us", config.deform_threads,
-                 config.deform_cpus, config.deform_spin_lead_us);
-  else
-    spdlog::info("deform threads: {} on CPUs {}, spin lead {} us", config.deform_threads,
-                 fmt::join(pipeline_options.deform_cpus, ","), config.deform_spin_lead_us);
-  pipeline_options.default_rate_hz = config.default_rate_hz;
-  pipeline_options.filler.continuity_seconds = config.continuity_seconds;
-  pipeline_options.filler.use_pca = config.use_pca;
-  pipeline_options.compressed_key_interval = config.compressed_key_interval;
-  try {
-    pipeline_ = std::make_unique<Pipeline>(model, subject_.deformation ? &*subject_.deformation : nullptr, pipeline_options,
-                                           mailbox_, *hub_, metrics_);
-  } catch (const std::invalid_argument& e) {
-    throw FileError(config.subject, std::string("deformation model unusable: ") + e.what());
-  }
-
-  hub_->set_encoding_preparer([pipeline = pipeline_.get()](StreamKey key) { pipeline->prepare_encoding(key); });
-  hub_->set_compressed_order(pipeline_->compressed_order());
-  if (const EvaluationModel* evaluation = pipeline_->evaluation_model()) {
-    hub_->set_model_message(std::make_shared<const std::vector<unsigned char>>(subscriber::encode_model(*evaluation)));
-    spdlog::info("parameter encoding: Model message of {} bytes ({} parts, {} RBF centres, {} influences)",
-                 hub_->model_message()->size(), evaluation->part_count(), evaluation->member_count(), evaluation->influence_count());
-  }
-
   if (!config.replay.empty()) {
     auto replay = std::make_unique<FileReplaySource>(io_, config.replay, static_cast<SourceSink&>(*this),
-                                                     ReplayOptions{config.loop, config.speed, {}});
-    if (router_.markers_labelled_by(0, replay->subject()) == 0)
-      throw FileError(config.replay, "none of the subject's " + std::to_string(model.marker_count()) +
-                                         " marker labels is in this capture (wrong subject file?)");
+                                                     ReplayOptions{config.loop, config.speed, config.replay_subject});
+    // A replay's one subject never changes: a subject that cannot follow it is an error now.
+    for (int k = 0; k < subject_count(); ++k) {
+      const SubjectStream& s = subject(k);
+      if (!s.config().name.empty() && s.config().name != replay->subject().name)
+        throw ConfigError("subject \"" + s.config().name + "\" is not in the replay " + config.replay + ", whose subject is \"" +
+                          replay->subject().name + "\" (name it with --replay-subject)");
+      if (router_.markers_labelled_by(k, replay->subject()) == 0)
+        throw FileError(config.replay, "none of the subject's " + std::to_string(s.model().marker_count()) +
+                                           " marker labels is in this capture (wrong subject file?)");
+    }
     source_ = std::move(replay);
   } else if (!config.vicon_multicast.empty()) {
     const HostPort address = host_port_of("--vicon-multicast", config.vicon_multicast);
@@ -225,19 +208,20 @@ Daemon::Daemon(const DaemonConfig& config)
       }
       socket = std::move(own);
     }
-    auto subscriber = std::make_shared<TcpSubscriber>(placed.io, *hub_, std::move(socket), remote, std::move(placed.token));
-    hub_->add(subscriber);
+    SubscriberHub& hub = subject(0).hub();  // until a version 2 Hello names another
+    auto subscriber = std::make_shared<TcpSubscriber>(placed.io, hub, std::move(socket), remote, std::move(placed.token));
+    hub.add(subscriber);
     asio::post(placed.io, [subscriber] { subscriber->start(); });
-  }, ListenerOptions{config.subscriber_tcp_congestion, &metrics_, &descriptor_reserve_, false});
+  }, ListenerOptions{config.subscriber_tcp_congestion, &source_metrics_, &descriptor_reserve_, false});
   HttpRoutes routes;
   routes.health_json = [this] { return health_json(); };
-  routes.metrics_text = [this] { return metrics_.render_prometheus(hub_->subscriber_metrics()); };
+  routes.metrics_text = [this] { return metrics_text(); };
   routes.web_root = config.web_root;
   if (!config.web_root.empty() && !std::filesystem::is_directory(config.web_root))
     throw FileError(config.web_root, "web root is not a directory");
   // Out of descriptors, the HTTP port spends the reserve: /health answers while subscribers hold the rest.
-  http_ = std::make_unique<HttpServer>(io_, config.bind_address, config.http_port, *hub_, std::move(routes),
-                                       ListenerOptions{config.subscriber_tcp_congestion, &metrics_, &descriptor_reserve_, true});
+  http_ = std::make_unique<HttpServer>(io_, config.bind_address, config.http_port, subject(0).hub(), std::move(routes),
+                                       ListenerOptions{config.subscriber_tcp_congestion, &source_metrics_, &descriptor_reserve_, true});
 }
 
 Daemon::~Daemon() { stop(); }
@@ -261,14 +245,17 @@ void Daemon::start_source() {
 
 void Daemon::start_serving() {
   if (started_.exchange(true)) return;
-  pipeline_->start();
+  for (auto& s : subjects_) s->start();
   publish_.start();
   sub_listener_->start();
   http_->start();
   schedule_status();
+  if (config_.status_log_seconds > 0) schedule_status_log();
   write_ports_file();
-  spdlog::info("skinstreamd: subject {} ({} markers, {} vertices), HTTP port {}, subscriber port {}", config_.subject,
-               subject_.model.marker_count(), pipeline_->vertex_count(), http_port(), sub_port());
+  for (const auto& s : subjects_)
+    spdlog::info("skinstreamd: subject {} ({}, {} markers, {} vertices)", s->name(), s->config().file, s->model().marker_count(),
+                 s->vertex_count());
+  spdlog::info("skinstreamd: HTTP port {}, subscriber port {}", http_port(), sub_port());
   io_thread_ = std::thread([this] {
     name_this_thread("io");
     auto guard = asio::make_work_guard(io_);
@@ -284,9 +271,10 @@ void Daemon::request_stop() {
     sub_listener_->stop();
     http_->stop();
     status_timer_.cancel();
-    pipeline_->stop();  // no more frames published after this
-    hub_->close_all();  // posted to each TCP subscriber's thread
-    publish_.stop();    // after those closes
+    status_log_timer_.cancel();
+    for (auto& s : subjects_) s->stop();  // no more frames published after this
+    for (auto& s : subjects_) s->hub().close_all();  // posted to each TCP subscriber's thread
+    publish_.stop();  // after those closes
     io_.stop();
   });
 }
@@ -297,7 +285,7 @@ void Daemon::wait() {
   publish_.join();
   if (!stopped_) {
     stopped_ = true;
-    pipeline_->stop();
+    for (auto& s : subjects_) s->stop();
   }
 }
 
@@ -307,72 +295,55 @@ void Daemon::stop() {
 }
 
 void Daemon::on_frame(const SourceFrame& frame) {
-  metrics_.frames_received.fetch_add(1, std::memory_order_relaxed);
-  MarkerFrame* const out[] = {&mailbox_.writable()};
-  const SubjectRouter::Stats routed = router_.route(frame, out);
-  if (routed.rejected_points > 0) on_rejected_points(frame.frame_number, routed.rejected_points);
-  if (!router_.present(0)) return;
-  const MarkerFrame& in = *out[0];
-  if (in.rejected_points > 0) on_rejected_points(in.frame_number, in.rejected_points);
-  if (in.source_rate_hz > 0 && in.source_rate_hz != source_rate_hz_) {
-    {
-      std::lock_guard lock(state_mutex_);
-      source_rate_hz_ = in.source_rate_hz;
-    }
-    hub_->set_source_rate(static_cast<float>(in.source_rate_hz));
-  }
-  uint64_t generation;
-  {
+  source_metrics_.frames_received.fetch_add(1, std::memory_order_relaxed);
+  if (frame.rate_hz > 0 && frame.rate_hz != source_rate_hz_) {  // only this thread writes it
     std::lock_guard lock(state_mutex_);
-    generation = generation_;
+    source_rate_hz_ = frame.rate_hz;
   }
-  if (const std::optional<FrameMailbox::Drop> drop = mailbox_.post(generation)) {
-    // Says which side fell behind: the pipeline (it took nothing for a while), or the source,
-    // whose frames came in a burst longer than the mailbox holds.
-    using Ms = std::chrono::duration<double, std::milli>;
-    const bool full = drop->reason == FrameMailbox::DropReason::kMailboxFull;
-    drop_log_.warn("frame_gave_way",
-                   fmt::format("frame {} gave way to newer ones after waiting {:.1f} ms: {}; the pipeline last took a frame {:.1f} ms "
-                               "before ({} dropped in all)",
-                               drop->frame_number, Ms(drop->waited).count(),
-                               full ? "more frames arrived together than the mailbox holds (a burst from the source)"
-                                    : "the pipeline is behind (longer than max_frame_wait_ms)",
-                               Ms(drop->since_last_take).count(), mailbox_.dropped()));
+  for (size_t k = 0; k < subjects_.size(); ++k) routed_[k] = &subjects_[k]->writable();
+  const SubjectRouter::Stats routed = router_.route(frame, routed_);
+  if (routed.rejected_points > 0) {
+    source_metrics_.count_bad_input("rejected_point");
+    bad_input_log_.warn("rejected_point", "frame " + std::to_string(frame.frame_number) + ": " + std::to_string(routed.rejected_points) +
+                                              " unlabelled points ignored (not finite)");
   }
+  for (size_t k = 0; k < subjects_.size(); ++k)
+    if (router_.present(static_cast<int>(k))) subjects_[k]->post();
 }
 
 void Daemon::on_source_state(SourceState state, std::string_view detail) {
+  SourceState previous;
   {
     std::lock_guard lock(state_mutex_);
-    // Every start of streaming (first connect, reconnect, replay loop) is a new take for the filler.
-    if (state == SourceState::Streaming) ++generation_;
+    previous = state_;
     state_ = state;
     state_detail_ = std::string(detail);
   }
-  spdlog::info("source: {} ({})", to_string(state), detail);
+  // Every start of streaming (first connect, reconnect, replay loop) is a new take for the fillers.
+  if (state == SourceState::Streaming)
+    for (auto& s : subjects_) s->new_take();
+  // A change of state is news; streaming again (a replay's loop) is not: the status line says
+  // that the frames keep coming.
+  if (state != previous) spdlog::info("source: {} ({})", to_string(state), detail);
+  else spdlog::debug("source: {} ({})", to_string(state), detail);
   broadcast_status();
 }
 
 void Daemon::on_bad_input(std::string_view what, std::string_view detail) {
-  metrics_.count_bad_input(what);
+  source_metrics_.count_bad_input(what);
   bad_input_log_.warn(what, detail);
 }
 
-void Daemon::on_rejected_points(uint32_t frame_number, int count) {
-  metrics_.count_bad_input("rejected_point");
-  bad_input_log_.warn("rejected_point", "frame " + std::to_string(frame_number) + ": " + std::to_string(count) +
-                                            " points ignored (not finite, or beyond " +
-                                            std::to_string(MarkerFrame::kMaxUnlabelled) + " unlabelled)");
-}
-
-void Daemon::on_match(int, bool present, std::string_view detail) {
-  if (present) {
-    // Back in the stream: a new take for its filler.
+void Daemon::on_match(int target, bool present, std::string_view detail) {
+  subject(target).set_presence(present, detail);
+  SourceState state;
+  std::string source_detail;
+  {
     std::lock_guard lock(state_mutex_);
-    ++generation_;
+    state = state_;
+    source_detail = state_detail_;
   }
-  if (present) spdlog::info("subject {}: {}", config_.subject, detail);
-  else spdlog::warn("subject {}: absent, waiting for it: {}", config_.subject, detail);
+  subject(target).broadcast_status(state, source_detail);
 }
 
 void Daemon::on_unknown_subjects(std::span<const std::string> names, size_t not_listed) {
@@ -381,28 +352,28 @@ void Daemon::on_unknown_subjects(std::span<const std::string> names, size_t not_
     bad_input_log_.warn("unknown_subjects", std::to_string(not_listed) + " more source subjects that are none of ours (no longer listed)");
 }
 
-void Daemon::on_unknown_labels(int, std::span<const std::string> names, size_t not_listed) {
+void Daemon::on_unknown_labels(int target, std::span<const std::string> names, size_t not_listed) {
+  SubjectStream& s = subject(target);
   for (const std::string& name : names) {
-    metrics_.count_bad_input("unknown_label");
+    s.metrics().count_bad_input("unknown_label");
     // Rate-limited and made printable: the names come from the source, which may send thousands.
-    bad_input_log_.warn("unknown_label", "source label " + quoted_text(name) + " is not a marker of the subject: used as an unlabelled point");
+    bad_input_log_.warn("unknown_label", "subject " + s.name() + ": source label " + quoted_text(name) +
+                                             " is not one of its markers: used as an unlabelled point");
   }
   if (not_listed > 0)
-    bad_input_log_.warn("unknown_labels", std::to_string(not_listed) + " more labels that are not markers of the subject (no longer listed)");
+    bad_input_log_.warn("unknown_labels", "subject " + s.name() + ": " + std::to_string(not_listed) +
+                                              " more labels that are not its markers (no longer listed)");
 }
 
 void Daemon::broadcast_status() {
-  subscriber::Status status;
+  SourceState state;
+  std::string detail;
   {
     std::lock_guard lock(state_mutex_);
-    status.state = code_of(state_);
-    status.source_rate_hz = static_cast<float>(source_rate_hz_);
-    status.detail = state_detail_;
-    status.subject_present = state_ == SourceState::Streaming;
+    state = state_;
+    detail = state_detail_;
   }
-  status.frames_received = metrics_.frames_received.load();
-  status.frames_published = metrics_.frames_published.load();
-  hub_->broadcast_status(status);
+  for (auto& s : subjects_) s->broadcast_status(state, detail);
 }
 
 void Daemon::schedule_status() {
@@ -414,36 +385,58 @@ void Daemon::schedule_status() {
   });
 }
 
+void Daemon::schedule_status_log() {
+  status_log_timer_.expires_after(std::chrono::seconds(config_.status_log_seconds));
+  status_log_timer_.async_wait([this](const boost::system::error_code& ec) {
+    if (ec || stopping_.load()) return;
+    for (auto& s : subjects_) spdlog::info("{}", s->status_line(StatusLine::Clock::now()));
+    schedule_status_log();
+  });
+}
+
 std::string Daemon::health_json() const {
   nlohmann::json source;
   {
     std::lock_guard lock(state_mutex_);
-    source = {{"state", to_string(state_)}, {"detail", state_detail_}, {"rate_hz", source_rate_hz_}};
+    source = {{"state", to_string(state_)}, {"detail", state_detail_}, {"rate_hz", source_rate_hz_},
+              {"frames", source_metrics_.frames_received.load()}};
   }
+  nlohmann::json subjects = nlohmann::json::array();
+  size_t subscribers = 0;
+  for (const auto& s : subjects_) {
+    subjects.push_back(s->health());
+    subscribers += subjects.back()["subscribers"].get<size_t>();
+  }
+  // The first subject's figures also at the top level, where they were when a daemon had one.
+  const nlohmann::json& first = subjects.front();
   const nlohmann::json health = {
       {"status", "ok"},
       {"source", source},
-      {"frames",
-       {{"received", metrics_.frames_received.load()},
-        {"processed", metrics_.frames_processed.load()},
-        {"published", metrics_.frames_published.load()},
-        {"dropped", metrics_.frames_dropped.load()},
-        {"dropped_mailbox_full", metrics_.frames_dropped_mailbox_full.load()}}},
-      // Encoded frame buffers created so far: grows only while the pool meets a new high-water
-      // mark of frames in use (bounded by the subscribers' queues), so RSS steps with it.
-      {"frame_buffers_allocated", metrics_.frame_buffers_allocated.load()},
-      {"frame_buffers_allocated_by_pipeline", metrics_.frame_buffers_allocated_by_pipeline.load()},
-      {"subscribers", hub_->subscriber_count()},
+      {"subjects", subjects},
+      {"subscribers", subscribers},
       {"deform", {{"threads", config_.deform_threads}, {"cpus", deform_cpus_}, {"spin_lead_us", config_.deform_spin_lead_us}}},
       {"publish_threads", publish_.count()},
       {"subscriber_tcp_congestion", config_.subscriber_tcp_congestion},  // empty: the system's
-      {"subject", {{"markers", subject_.model.marker_count()}, {"vertices", pipeline_->vertex_count()}}},
+      {"subject", {{"name", first["name"]}, {"file", first["file"]}, {"present", first["present"]}, {"detail", first["detail"]},
+                   {"markers", first["markers"]}, {"vertices", first["vertices"]}}},
+      {"frames", first["frames"]},
+      {"frame_buffers_allocated", first["frame_buffers_allocated"]},
+      {"frame_buffers_allocated_by_pipeline", first["frame_buffers_allocated_by_pipeline"]},
       {"source_limits",
        {{"max_subjects", config_.source_max_subjects},
         {"max_markers_per_subject", config_.source_max_markers_per_subject},
         {"max_name_bytes", config_.source_max_name_bytes}}},
-      {"latency_ms", latency_summaries(metrics_)}};
+      {"latency_ms", first["latency_ms"]}};
   return health.dump();
+}
+
+std::string Daemon::metrics_text() const {
+  std::vector<SubjectMetricsView> views;
+  for (const auto& s : subjects_) views.push_back({s->name(), &s->metrics(), s->hub().subscriber_metrics()});
+  std::string text = render_prometheus(source_metrics_, views);
+  // The sender's series carry no subject label: with several subjects they are in /health only.
+  if (subjects_.size() == 1) subjects_.front()->render_multicast_metrics(text);
+  return text;
 }
 
 void Daemon::write_ports_file() const {

@@ -1,19 +1,21 @@
 #pragma once
-// skinstreamd put together: the subject, the source (file replay or Vicon), the mailbox, the
-// pipeline thread, the publishers (TCP subscriber port, HTTP port with /stream, /health,
-// /metrics and static files) and the 1 Hz Status. One io thread runs the source, HTTP, the
-// WebSocket subscribers and the timers; the TCP subscribers are written by the publish threads.
+// skinstreamd put together: wiring and lifecycle. The subjects (each a SubjectStream: its
+// mailbox, pipeline thread, subscribers, metrics and status), the source (file replay or
+// Vicon) and the SubjectRouter that gives each subject its part of every source frame, the
+// publishers (TCP subscriber port, HTTP port with /stream, /health, /metrics and static files)
+// and the 1 Hz Status. One io thread runs the source, the routing, HTTP, the WebSocket
+// subscribers and the timers; the TCP subscribers are written by the publish threads.
 // main.cpp adds only argument parsing and signals; tests run the same object in-process.
 
 #include <atomic>
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <span>
 #include <string>
 #include <thread>
 #include <vector>
 
-#include "protocol/subject_file.h"
 #include "server/asio.h"
 #include "server/config.h"
 #include "server/descriptor_reserve.h"
@@ -21,25 +23,26 @@
 #include "server/ingest/subject_router.h"
 #include "server/logging.h"
 #include "server/metrics/metrics.h"
-#include "server/pipeline/frame_mailbox.h"
-#include "server/pipeline/pipeline.h"
 #include "server/publish/publish_threads.h"
+#include "server/publish/subject_directory.h"
+#include "server/subject_stream.h"
 
 namespace skinstream::server {
 
 class SubscriberHub;
+class MulticastSender;
 class HttpServer;
 class Listener;
 
 class Daemon : private SourceSink, private SubjectRouter::Observer {
  public:
-  // Loads the subject, opens the source file, binds both ports. Throws with a one-line message
+  // Loads the subjects, opens the source file, binds both ports. Throws with a one-line message
   // (FileError, ConfigError, std::runtime_error) when any of it fails.
   explicit Daemon(const DaemonConfig& config);
   ~Daemon() override;
 
   void start();               // start_serving() then start_source()
-  void start_serving();       // the io thread, the pipeline, both ports
+  void start_serving();       // the io thread, the pipelines, both ports
   void start_source();        // frames begin to flow
   void request_stop();        // from any thread (signal handler, test)
   void wait();                // until stopped
@@ -48,10 +51,13 @@ class Daemon : private SourceSink, private SubjectRouter::Observer {
   int http_port() const;
   int sub_port() const;
   asio::io_context& io() { return io_; }
-  Metrics& metrics() { return metrics_; }
-  SubscriberHub& hub() { return *hub_; }
+  // The source's own counters: its frames, its bad input (each subject has its own metrics).
+  Metrics& source_metrics() { return source_metrics_; }
+  int subject_count() const { return static_cast<int>(subjects_.size()); }
+  SubjectStream& subject(int index) { return *subjects_[static_cast<size_t>(index)]; }
   SourceState source_state() const;
   std::string health_json() const;
+  std::string metrics_text() const;
 
  private:
   // SourceSink (called on the io thread by the source).
@@ -62,24 +68,22 @@ class Daemon : private SourceSink, private SubjectRouter::Observer {
   void on_match(int target, bool present, std::string_view detail) override;
   void on_unknown_subjects(std::span<const std::string> names, size_t not_listed) override;
   void on_unknown_labels(int target, std::span<const std::string> names, size_t not_listed) override;
-  void on_rejected_points(uint32_t frame_number, int count);
 
   void broadcast_status();
   void schedule_status();
+  void schedule_status_log();
   void write_ports_file() const;
 
   DaemonConfig config_;
-  std::vector<int> deform_cpus_;  // one per deform thread, or none (not pinned)
-  SubjectFile subject_;
-  Metrics metrics_;
+  std::vector<int> deform_cpus_;  // deform_threads per subject, subject after subject, or none (not pinned)
+  Metrics source_metrics_;
   RateLimitedLog bad_input_log_;
-  RateLimitedLog drop_log_;  // frames that gave way in the mailbox, with the reason
-  FrameMailbox mailbox_;
+  SubjectDirectory directory_;  // the subjects' hubs by name; outlives them
+  // Before io_: the io_context is destroyed first, and with it the handlers still holding
+  // sessions whose queues hold frames of the subjects' pipelines' pools.
+  std::vector<std::unique_ptr<SubjectStream>> subjects_;
   SubjectRouter router_;
-  std::unique_ptr<SubscriberHub> hub_;
-  std::unique_ptr<Pipeline> pipeline_;
-  // After the pipeline and the hub: the io_context is destroyed first, and with it the handlers
-  // still holding sessions whose queues hold frames of the pipeline's pool.
+  std::vector<MarkerFrame*> routed_;  // per subject, its mailbox slot being filled (one frame)
   asio::io_context io_;
   // The TCP subscribers' threads: destroyed before io_ and after the listeners (declared
   // between), once every session was closed on its own thread.
@@ -89,12 +93,12 @@ class Daemon : private SourceSink, private SubjectRouter::Observer {
   std::unique_ptr<HttpServer> http_;
   std::unique_ptr<FrameSource> source_;
   asio::steady_timer status_timer_;
+  asio::steady_timer status_log_timer_;
 
   mutable std::mutex state_mutex_;
   SourceState state_ = SourceState::Connecting;
   std::string state_detail_;
   double source_rate_hz_ = 0.0;
-  uint64_t generation_ = 0;  // bumped when the source (re)starts streaming
 
   std::thread io_thread_;
   std::atomic<bool> started_{false}, stopping_{false};

@@ -43,6 +43,10 @@ std::optional<int> parse_bench_options(int argc, char** argv, BenchOptions& o) {
       ->check(CLI::IsMember({"vicon", "qtm", "natnet"}))
       ->capture_default_str();
   app.add_option("--vicon-subject-name", o.vicon_subject_name, "subject (marker set) name the replay announces (default: the recording's file name)");
+  app.add_option("--subjects", o.subjects, "actors on the stage: the recording streamed this many times, moved apart, as Actor1..ActorN; subscriber s follows ActorN with N = s mod subjects + 1")
+      ->check(CLI::Range(1, 16))
+      ->capture_default_str();
+  app.add_option("--subject-spacing-mm", o.subject_spacing_mm, "with --subjects: how far apart the actors stand along x")->capture_default_str();
   app.add_flag("--json", o.json, "print the report as JSON");
   try {
     app.parse(argc, argv);

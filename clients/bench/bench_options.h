@@ -16,6 +16,8 @@ struct BenchOptions {
   std::string subject;             // the subject file (required)
   std::string vicon_subject_name;  // the replay's subject name (default: the recording's file name)
   CaptureProtocol protocol = CaptureProtocol::Vicon;  // what the replay speaks to the daemon
+  int subjects = 1;                  // actors: the recording streamed this many times, apart
+  double subject_spacing_mm = 3000;  // how far apart along x
   // What the subscribers ask for and do with it.
   client::Encoding encoding = client::Encoding::Float;
   bool normals = false;

@@ -33,6 +33,11 @@ void print_report(const nlohmann::json& report, bool as_json) {
                 h["p99_le"].get<double>(), h["max"].get<double>(), h["count"].get<unsigned long>());
   }
   std::printf("frames: %s\n", report["frames"].dump().c_str());
+  for (const auto& row : report["per_subject"]["subjects"])
+    std::printf("subject %s: %.0f%% of one core, end to end p50 %.3f ms p99 %.3f ms (%ld frames to its subscribers), frames %s\n",
+                row["name"].get<std::string>().c_str(), 100 * row["cpu_share_of_one_core"].get<double>(),
+                row["subscribers"]["end_to_end"]["p50_ms"].get<double>(), row["subscribers"]["end_to_end"]["p99_ms"].get<double>(),
+                row["subscribers"]["received"].get<long>(), row["frames"].dump().c_str());
   const nlohmann::json& d = report["daemon"];
   std::printf("daemon: %.2f s CPU (%.0f%% of one core), peak RSS %ld kB, RSS %ld kB after 1 s and %ld kB at the end\n",
               d["cpu_seconds"].get<double>(), 100 * d["cpu_share_of_one_core"].get<double>(), d["peak_rss_kb"].get<long>(),

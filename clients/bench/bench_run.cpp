@@ -15,6 +15,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <memory>
 #include <thread>
 
@@ -24,6 +25,7 @@
 #include "clients/bench/send_times.h"
 #include "clients/bench/shaped_link.h"
 #include "clients/bench/stall_log.h"
+#include "clients/bench/subjects.h"
 #include "protocol/capture_file.h"
 #include "protocol/file_error.h"
 #include "server/client/daemon_process.h"
@@ -42,8 +44,8 @@ int64_t wall_clock_ns() {
 }
 
 std::string daemon_arguments(const BenchOptions& o, const std::string& source_option) {
-  std::string a = "--subject " + server::shell_word(o.subject) + " " + source_option + " --deform-threads " +
-                  std::to_string(o.deform_threads) + " --log-level warn";
+  std::string a = source_option + " --deform-threads " + std::to_string(o.deform_threads) + " --log-level warn";
+  for (const std::string& word : daemon_subject_arguments(o.subject, o.subjects)) a += " " + server::shell_word(word);
   if (!o.deform_cpus.empty()) a += " --deform-cpus " + server::shell_word(o.deform_cpus);
   if (o.deform_spin_lead_us >= 0) a += " --deform-spin-lead-us " + std::to_string(o.deform_spin_lead_us);
   if (o.publish_threads >= 0) a += " --publish-threads " + std::to_string(o.publish_threads);
@@ -72,6 +74,7 @@ void subscribe(const BenchOptions& o, const std::string& host, int port, int ind
   options.paced = o.paced;
   options.decode = o.decode;
   options.evaluate = o.decode;
+  options.subject = subscriber_subject(index, o.subjects);
   client::Subscriber subscriber(options);
   tally.reserve(static_cast<size_t>(o.seconds * 130) + 16);
   const std::string who = "subscriber " + std::to_string(index);
@@ -157,8 +160,9 @@ nlohmann::json run_bench(const BenchOptions& o, const std::atomic<bool>& stop) {
   replay_options.protocol = o.protocol;
   replay_options.bind_address = replay_address;
   replay_options.tcp_congestion = o.replay_tcp_congestion;
-  replay_options.subject_name = o.vicon_subject_name.empty() ? fs::path(o.recording).stem().string() : o.vicon_subject_name;
-  ReplayEngine replay(replay_io, capture, replay_options);
+  const ReplayStage stage = replay_stage(capture, o.subjects, o.subject_spacing_mm,
+                                         o.vicon_subject_name.empty() ? fs::path(o.recording).stem().string() : o.vicon_subject_name);
+  ReplayEngine replay(replay_io, stage.subjects, replay_options);
   StallLog stalls;  // before send_times, which writes to it until the replay stops
   SendTimes send_times;
   replay.set_frame_hook([&send_times](uint32_t frame_number, int64_t send_ns) { send_times.record(frame_number, send_ns); });
@@ -228,6 +232,7 @@ nlohmann::json run_bench(const BenchOptions& o, const std::atomic<bool>& stop) {
   const uint64_t sent_before = replay.frames_sent();
   const uint64_t replay_dropped_before = replay.frames_dropped();
   const double cpu_before = cpu_seconds(daemon.pid());
+  const std::map<std::string, double> thread_cpu_before = thread_cpu_seconds(daemon.pid());
   const double own_cpu_before = cpu_seconds(getpid());
   window.start_ns = window_start_ns;
   const Clock::time_point deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(o.seconds));
@@ -252,6 +257,7 @@ nlohmann::json run_bench(const BenchOptions& o, const std::atomic<bool>& stop) {
   const uint64_t sent = replay.frames_sent() - sent_before;
   const uint64_t replay_dropped = replay.frames_dropped() - replay_dropped_before;
   const double cpu = cpu_seconds(daemon.pid()) - cpu_before;
+  const std::map<std::string, double> thread_cpu_after = thread_cpu_seconds(daemon.pid());
   const long peak_rss_kb = peak_resident_kb(daemon.pid());
   const double own_cpu = cpu_seconds(getpid()) - own_cpu_before;
   std::this_thread::sleep_for(std::chrono::milliseconds(500));  // the window's last frames still on their way
@@ -278,8 +284,11 @@ nlohmann::json run_bench(const BenchOptions& o, const std::atomic<bool>& stop) {
   std::vector<double> rates;
   nlohmann::json per_subscriber = nlohmann::json::array();
   const double window_s = (window_end_ns - window_start_ns) * 1e-9;
-  for (const SubscriberTally& tally : tallies) {
+  std::vector<SubscriberTally> by_subject(static_cast<size_t>(o.subjects));  // subscriber s follows subject s mod N
+  for (size_t s = 0; s < tallies.size(); ++s) {
+    const SubscriberTally& tally = tallies[s];
     all.add(tally);
+    by_subject[s % by_subject.size()].add(tally);
     total_dropped += tally.dropped();
     const double rate = tally.received / window_s;
     rates.push_back(rate);
@@ -287,6 +296,9 @@ nlohmann::json run_bench(const BenchOptions& o, const std::atomic<bool>& stop) {
         {{"received", tally.received}, {"dropped", tally.dropped()}, {"longest_gap_ms", tally.longest_gap_ms}, {"frames_per_second", rate}});
   }
   std::sort(rates.begin(), rates.end());
+  std::vector<nlohmann::json> subject_subscribers;
+  for (SubscriberTally& t : by_subject)
+    subject_subscribers.push_back({{"received", t.received}, {"end_to_end", t.end_to_end.summary()}, {"daemon_processing", t.processing.summary()}});
   auto delta = [&](const char* key) { return health["frames"][key].get<uint64_t>() - health_before["frames"][key].get<uint64_t>(); };
   const double bytes_per_frame = all.received > 0 ? static_cast<double>(all.message_bytes) / all.received : 0.0;
   nlohmann::json report = {
@@ -295,6 +307,7 @@ nlohmann::json run_bench(const BenchOptions& o, const std::atomic<bool>& stop) {
       {"seconds", o.seconds},
       {"window_seconds", window_s},
       {"subscribers", o.subscribers},
+      {"subjects", o.subjects},
       {"encoding", client::to_string(o.encoding)},
       {"protocol", to_string(o.protocol)},
       {"link_mbit", o.link_mbit},
@@ -334,6 +347,8 @@ nlohmann::json run_bench(const BenchOptions& o, const std::atomic<bool>& stop) {
                   {"out_of_order", all.out_of_order},
                   {"without_send_time", all.unmatched}}},
       {"per_subscriber", per_subscriber},
+      // Each actor's own threads' CPU and the daemon's figures for it; the threads they share.
+      {"per_subject", per_subject_report(o.subjects, thread_cpu_before, thread_cpu_after, health_before, health, subject_subscribers, window_s)},
       // Gaps over 3 frame periods (the replay's sends, each subscriber's arrivals), drops for a
       // subscriber and drops in the pipeline, in time order: a pause of the whole machine shows
       // at one moment in all.

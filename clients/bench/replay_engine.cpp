@@ -1,6 +1,5 @@
 #include "clients/bench/replay_engine.h"
 
-#include "protocol/replay_subject.h"
 #include "server/natnet/natnet_server.h"
 #include "server/qtm/qtm_server.h"
 #include "server/vicon/vicon_server.h"
@@ -22,9 +21,8 @@ struct ReplayEngine::Servers {
   std::unique_ptr<server::NatNetServer> natnet;
 };
 
-ReplayEngine::ReplayEngine(server::asio::io_context& io, const Capture& recording, const ReplayEngineOptions& options)
+ReplayEngine::ReplayEngine(server::asio::io_context& io, const std::vector<ReplaySubject>& subjects, const ReplayEngineOptions& options)
     : options_(options), servers_(std::make_unique<Servers>()) {
-  const std::vector<ReplaySubject> subjects = {{options.subject_name, &recording}};
   switch (options.protocol) {
     case CaptureProtocol::Vicon: {
       server::ViconServerOptions o;
@@ -32,8 +30,7 @@ ReplayEngine::ReplayEngine(server::asio::io_context& io, const Capture& recordin
       o.port = 0;
       o.loop = true;
       o.tcp_congestion = options.tcp_congestion;
-      o.subject_name = options.subject_name;
-      servers_->vicon = std::make_unique<server::ViconServer>(io, recording, o);
+      servers_->vicon = std::make_unique<server::ViconServer>(io, subjects, o);
       break;
     }
     case CaptureProtocol::Qtm: {

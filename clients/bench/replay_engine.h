@@ -6,8 +6,9 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <vector>
 
-#include "core/capture.h"
+#include "protocol/replay_subject.h"
 #include "server/asio.h"
 
 namespace skinstream::bench {
@@ -18,15 +19,15 @@ const char* to_string(CaptureProtocol protocol);
 struct ReplayEngineOptions {
   CaptureProtocol protocol = CaptureProtocol::Vicon;
   std::string bind_address = "127.0.0.1";
-  std::string subject_name;    // the subject (marker set) the recording is streamed as
   std::string tcp_congestion;  // Vicon's connection to the daemon ("" = the system's)
 };
 
 class ReplayEngine {
  public:
   using FrameHook = std::function<void(uint32_t frame_number, int64_t send_time_ns)>;
-  // Looping, on an ephemeral port; the recording must outlive the engine.
-  ReplayEngine(server::asio::io_context& io, const Capture& recording, const ReplayEngineOptions& options);
+  // Looping, on an ephemeral port: each recording one subject (marker set) of the stream; the
+  // recordings must outlive the engine.
+  ReplayEngine(server::asio::io_context& io, const std::vector<ReplaySubject>& subjects, const ReplayEngineOptions& options);
   ~ReplayEngine();
   void set_frame_hook(FrameHook hook);  // before start()
   void start();

@@ -1,17 +1,17 @@
 // skinstream-replay: streams recorded captures (C3D or TRC) as a capture system would, so that
 // skinstreamd, benchmarks and unmodified clients can run without a capture stage: a Vicon
-// DataStream server (one recording), a QTM RT server or a NatNet server (several recordings
-// become several subjects: server/qtm/qtm_server.h, server/natnet/natnet_server.h).
+// DataStream, QTM RT or NatNet server; several recordings become several subjects of one stream
+// (a stage with several actors: server/vicon/vicon_server.h, server/qtm/qtm_server.h,
+// server/natnet/natnet_server.h).
 //
 //   skinstream-replay [--protocol vicon|qtm|natnet] RECORDING... --port P [--rate HZ] [--speed X]
-//                     [--loop | --hold] [--subject NAME] [--multicast GROUP[:PORT]] [--multicast-ttl N]
+//                     [--loop | --hold] [--subject NAME]... [--multicast GROUP[:PORT]] [--multicast-ttl N]
 //                     [--start-now] [--unicast] [--multicast-interface ADDR] [--natnet-version 3.1|4.0|4.1]
 //
 // Prints one JSON line {"port": N} on stdout once listening (port 0 picks a free one); logs go to
 // stderr. Errors are one line on stderr and a non-zero exit code.
 #include <csignal>
 #include <cstdio>
-#include <filesystem>
 #include <functional>
 #include <iostream>
 #include <memory>
@@ -23,8 +23,6 @@
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
-#include "protocol/capture_file.h"
-#include "protocol/file_error.h"
 #include "server/asio.h"
 #include "server/natnet/natnet_server.h"
 #include "server/qtm/qtm_server.h"
@@ -46,7 +44,7 @@ struct Arguments {
   bool loop = false;
   bool hold = false;
   bool start_now = false;
-  std::string subject;
+  std::vector<std::string> subjects;  // one per recording, or none (the files' stems)
   std::string multicast;
   int multicast_ttl = 1;
   int max_queued = 4;
@@ -67,20 +65,21 @@ std::pair<std::string, uint16_t> split_address(const std::string& text) {
 
 int run_qtm_or_natnet(const Arguments& args);
 
+void log_streaming(const server::ReplayRecordings& recordings, const Arguments& args, uint16_t port) {
+  for (const ReplaySubject& s : recordings.subjects)
+    spdlog::info("streaming '{}' ({} markers, {} frames) at {} Hz, speed {}, as subject '{}' of a {} stream on {}:{}", s.name,
+                 s.capture->point_count(), s.capture->frame_count, recordings.rate_hz, args.speed, s.name, args.protocol,
+                 args.bind, port);
+}
+
 int run(const Arguments& args) {
   if (args.protocol != "vicon") return run_qtm_or_natnet(args);
-  if (args.recordings.size() != 1)
-    throw std::invalid_argument("--protocol vicon streams one recording; several need --protocol qtm or natnet");
-  const std::string& recording = args.recordings[0];
-  const Capture capture = read_capture(recording);
-  if (capture.frame_count <= 0) throw FileError(recording, "holds no frames");
-  if (!(capture.rate_hz > 0.0) && !(args.rate > 0.0)) throw FileError(recording, "has no frame rate; pass --rate");
+  const server::ReplayRecordings recordings = server::load_replay_recordings(args.recordings, args.subjects, args.rate);
 
   server::ViconServerOptions options;
   options.bind_address = args.bind;
   options.port = static_cast<uint16_t>(args.port < 0 ? vicon::kDefaultPort : args.port);
-  options.subject_name = args.subject.empty() ? std::filesystem::path(recording).stem().string() : args.subject;
-  options.rate_hz = args.rate;
+  options.rate_hz = recordings.rate_hz;
   options.speed = args.speed;
   options.loop = args.loop;
   options.start_on_first_request = !args.start_now;
@@ -89,7 +88,7 @@ int run(const Arguments& args) {
   options.tcp_congestion = args.tcp_congestion;
 
   server::asio::io_context io;
-  server::ViconServer vicon_server(io, capture, options);
+  server::ViconServer vicon_server(io, recordings.subjects, options);
   vicon_server.start();  // throws with the address on failure
 
   // Without --loop or --hold: once the last frame is out, wait (up to 2 s) for the clients'
@@ -126,9 +125,7 @@ int run(const Arguments& args) {
   }
 
   std::cout << "{\"port\": " << vicon_server.port() << "}" << std::endl;
-  spdlog::info("streaming {} ({} markers, {} frames at {} Hz, speed {}) as subject '{}' on {}:{}", recording,
-               capture.point_count(), capture.frame_count, args.rate > 0.0 ? args.rate : capture.rate_hz, args.speed,
-               options.subject_name, args.bind, vicon_server.port());
+  log_streaming(recordings, args, vicon_server.port());
   io.run();
   return 0;
 }
@@ -137,7 +134,7 @@ int run(const Arguments& args) {
 // program exits once the last frame has left (QTM: once every client's queue has drained, at
 // most 2 s).
 int run_qtm_or_natnet(const Arguments& args) {
-  const server::ReplayRecordings recordings = server::load_replay_recordings(args.recordings, args.subject, args.rate);
+  const server::ReplayRecordings recordings = server::load_replay_recordings(args.recordings, args.subjects, args.rate);
   server::asio::io_context io;
   std::unique_ptr<server::QtmServer> qtm;
   std::unique_ptr<server::NatNetServer> natnet;
@@ -207,10 +204,7 @@ int run_qtm_or_natnet(const Arguments& args) {
     io.stop();
   });
   std::cout << "{\"port\": " << port << "}" << std::endl;
-  for (const ReplaySubject& s : recordings.subjects)
-    spdlog::info("streaming '{}' ({} markers, {} frames) at {} Hz, speed {}, as {} on {}:{}", s.name,
-                 s.capture->point_count(), s.capture->frame_count, recordings.rate_hz, args.speed, args.protocol,
-                 args.bind, port);
+  log_streaming(recordings, args, port);
   io.run();
   return 0;
 }
@@ -224,8 +218,7 @@ int main(int argc, char** argv) {
   app.add_option("--protocol", args.protocol, "the capture system to stream as")
       ->check(CLI::IsMember({"vicon", "qtm", "natnet"}))
       ->capture_default_str();
-  app.add_option("RECORDING", args.recordings, "capture files (.c3d or .trc); several: one subject each (qtm, natnet)")
-      ->required();
+  app.add_option("RECORDING", args.recordings, "capture files (.c3d or .trc); several: one subject each")->required();
   app.add_option("--port", args.port,
                  "port to listen on: TCP for vicon (801) and qtm (22223, little-endian), the UDP command port for "
                  "natnet (1510); 0: pick a free one; printed as {\"port\": N}")
@@ -241,7 +234,9 @@ int main(int argc, char** argv) {
       ->excludes(loop);
   app.add_flag("--start-now", args.start_now,
                "start the recording at once instead of when the first client asks for a frame");
-  app.add_option("--subject", args.subject, "subject name of a single recording (default: the file stem)");
+  app.add_option("--subject", args.subjects, "subject name, once per recording in their order (default: each file's stem)")
+      ->expected(1)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   app.add_option("--multicast", args.multicast,
                  "vicon: also send every frame as UDP datagrams to GROUP[:PORT]; natnet: the group and data port "
                  "(default 239.255.42.99:1511)");
@@ -267,6 +262,8 @@ int main(int argc, char** argv) {
   app.footer(
       "The recording starts when the first client asks for frames (vicon: RequestFrame, qtm: StreamFrames,\n"
       "natnet: CONNECT), unless --start-now.\n"
+      "Several recordings stream as several subjects, frame k of each in frame k of the stream; a Vicon\n"
+      "subject is listed only in frames where its recording has a marker (it leaves the stage, and comes back).\n"
       "Without --loop or --hold the program exits 0 once the last frame has been sent to the connected\n"
       "clients. SIGINT/SIGTERM stop it cleanly (exit 0).");
   CLI11_PARSE(app, argc, argv);

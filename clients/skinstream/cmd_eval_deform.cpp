@@ -117,6 +117,7 @@ void add_eval_deform(CLI::App& app) {
       result["takes"].push_back(evaluate_deformation(setup, take, motion, options));
       if (!json) std::fprintf(stderr, "eval-deform: %s done\n", motion.c_str());
     }
+    result["table_rule"] = judge_table_rule(result["takes"]);
     if (json) {
       std::printf("%s\n", result.dump(2).c_str());
     } else {

@@ -26,6 +26,14 @@ struct Method {
   std::function<Capture(const Capture&)> fill;
 };
 
+// Samples present in `gapped` that `filled` moved: a measurement the method overruled.
+long changed_measured(const Capture& gapped, const Capture& filled) {
+  long changed = 0;
+  for (size_t k = 0; k < gapped.positions.size(); ++k)
+    if (is_present(gapped.positions[k]) && filled.positions[k] != gapped.positions[k]) ++changed;
+  return changed;
+}
+
 }  // namespace
 
 void add_eval_fill(CLI::App& app) {
@@ -34,12 +42,17 @@ void add_eval_fill(CLI::App& app) {
   static double split = 0.5;
   static int lookahead = 6;
   static bool json = false, ablations = false;
+  static std::string protocol = "short";
   static GapPlanOptions gaps_options;
   cmd->add_option("--capture", capture_path, "capture with no gaps (truth)")->required();
   cmd->add_option("--train", train_path, "training capture of the same subject (default: the first part of --capture)");
   cmd->add_option("--split", split, "without --train: train on this fraction of --capture, test on the rest")
       ->check(CLI::Range(0.1, 0.9))->capture_default_str();
   cmd->add_option("--seed", gaps_options.seed, "seed of the gap plan")->capture_default_str();
+  cmd->add_option("--gap-protocol", protocol,
+                  "short: 3 frames to --max-gap-seconds, --gaps-per-minute per marker, each marker on its own; "
+                  "long: 2-6 s, three markers at a time, 4% of samples (the other gap options are ignored)")
+      ->check(CLI::IsMember({"short", "long"}))->capture_default_str();
   cmd->add_option("--max-gap-seconds", gaps_options.max_seconds, "longest deleted gap")->capture_default_str();
   cmd->add_option("--gaps-per-minute", gaps_options.gaps_per_marker_per_minute, "gaps per marker per minute")->capture_default_str();
   cmd->add_option("--lookahead", lookahead, "lookahead frames of the 'skinstream lookahead' row")->capture_default_str();
@@ -73,18 +86,20 @@ void add_eval_fill(CLI::App& app) {
       for (int p = 0; p < truth.point_count(); ++p)
         if (!truth.present(f, p)) throw std::runtime_error("--capture must have no gaps in the test part (marker " + truth.labels[p] + ")");
 
-    const std::vector<Gap> gaps = plan_gaps(truth, gaps_options);
+    const GapPlanOptions plan = protocol == "long" ? long_gap_plan(gaps_options.seed) : gaps_options;
+    const std::vector<Gap> gaps = plan_gaps(truth, plan);
     const Capture gapped = apply_gaps(truth, gaps);
     std::vector<double> normaliser(model.marker_count());
     for (int m = 0; m < model.marker_count(); ++m) normaliser[m] = model.neighbour_distance(m);
 
     auto skinstream_fill = [&](CaptureFillOptions o) { return [&model, o](const Capture& c) { return fill_capture(model, c, o); }; };
-    CaptureFillOptions online, ahead, no_pca, no_continuity, plain_average, no_rigid_fusion;
+    CaptureFillOptions online, ahead, no_pca, no_continuity, plain_average, no_rigid_fusion, no_carry;
     ahead.lookahead = lookahead;
     no_pca.filler.use_pca = false;
     no_continuity.filler.continuity_seconds = 0.0;
     plain_average.filler.weight_by_variance = false;
     no_rigid_fusion.filler.fuse_rigid = false;
+    no_carry.filler.carry_from_gap_start = false;
     std::vector<Method> methods = {
         {"linear", "linear interpolation (offline)", fill_linear},
         {"spline", "cubic spline (offline)", [](const Capture& c) { return fill_cubic_spline(c); }},
@@ -97,6 +112,7 @@ void add_eval_fill(CLI::App& app) {
       methods.push_back({"skinstream_no_continuity", "skinstream online, no gap-start continuity", skinstream_fill(no_continuity)});
       methods.push_back({"skinstream_plain_average", "skinstream online, neighbours' PCA estimates averaged unweighted (as the paper)", skinstream_fill(plain_average)});
       methods.push_back({"skinstream_pca_only", "skinstream online, PCA estimates weighted, rigid estimate not fused", skinstream_fill(no_rigid_fusion)});
+      methods.push_back({"skinstream_no_carry", "skinstream online, no carry from the gap start by the steadiest anchors", skinstream_fill(no_carry)});
     }
 
     long gap_samples = 0;
@@ -113,9 +129,9 @@ void add_eval_fill(CLI::App& app) {
         {"train_frames", train.frame_count},
         {"test_frames", truth.frame_count},
         {"rate_hz", truth.rate_hz},
-        {"gaps", {{"count", gaps.size()}, {"samples", gap_samples}, {"longest_frames", longest},
+        {"gaps", {{"protocol", protocol}, {"count", gaps.size()}, {"samples", gap_samples}, {"longest_frames", longest},
                   {"fraction_of_samples", double(gap_samples) / (double(truth.frame_count) * truth.point_count())}}},
-        {"metric", "error = |filled - truth| over deleted samples; normalised = error / the marker's mean distance to its one-ring in the reference pose (Park & Hodgins Table 2)"},
+        {"metric", "error = |filled - truth| over deleted samples; normalised = error / the marker's mean distance to its one-ring in the reference pose (Park & Hodgins Table 2); changed_measured_samples: samples left in the capture that the method moved"},
         {"methods", nlohmann::json::array()}};
     for (const Method& method : methods) {
       const auto start = std::chrono::steady_clock::now();
@@ -127,19 +143,32 @@ void add_eval_fill(CLI::App& app) {
         regions[region.region] = {{"mm", to_json(region.millimetres)}, {"normalised", to_json(region.normalised)}};
       out["methods"].push_back({{"name", method.name}, {"description", method.description}, {"mm", to_json(r.millimetres)},
                                 {"normalised", to_json(r.normalised)}, {"unfilled", r.unfilled}, {"regions", regions},
-                                {"seconds", seconds}});
+                                {"changed_measured_samples", changed_measured(gapped, filled)}, {"seconds", seconds}});
     }
+    // The online filler against the offline Gloersen PCA on the same gaps.
+    auto errors_of = [&](const std::string& name) {
+      for (const auto& m : out["methods"])
+        if (m["name"] == name) return m["mm"];
+      throw std::logic_error("no method " + name);
+    };
+    const nlohmann::json offline_pca = errors_of("gloersen_pca"), causal = errors_of("skinstream_online");
+    out["online_to_gloersen"] = {{"mean_ratio", causal["mean"].get<double>() / offline_pca["mean"].get<double>()},
+                                 {"max_ratio", causal["max"].get<double>() / offline_pca["max"].get<double>()}};
     if (json) {
       std::printf("%s\n", out.dump(2).c_str());
       return;
     }
     std::printf("%s: %d markers, %d test frames, %zu gaps (%ld samples, longest %d frames)\n", capture_path.c_str(),
                 model.marker_count(), truth.frame_count, gaps.size(), gap_samples, longest);
-    std::printf("%-26s %9s %9s %9s %9s %10s %10s\n", "method", "mean mm", "median", "p95", "max", "mean norm", "max norm");
+    std::printf("%-26s %9s %9s %9s %9s %10s %10s %8s\n", "method", "mean mm", "median", "p95", "max", "mean norm", "max norm",
+                "changed");
     for (const auto& m : out["methods"])
-      std::printf("%-26s %9.2f %9.2f %9.2f %9.2f %10.4f %10.4f\n", m["name"].get<std::string>().c_str(),
+      std::printf("%-26s %9.2f %9.2f %9.2f %9.2f %10.4f %10.4f %8ld\n", m["name"].get<std::string>().c_str(),
                   m["mm"]["mean"].get<double>(), m["mm"]["median"].get<double>(), m["mm"]["p95"].get<double>(),
-                  m["mm"]["max"].get<double>(), m["normalised"]["mean"].get<double>(), m["normalised"]["max"].get<double>());
+                  m["mm"]["max"].get<double>(), m["normalised"]["mean"].get<double>(), m["normalised"]["max"].get<double>(),
+                  m["changed_measured_samples"].get<long>());
+    std::printf("online / Gloersen PCA: mean %.2f, max %.2f\n", out["online_to_gloersen"]["mean_ratio"].get<double>(),
+                out["online_to_gloersen"]["max_ratio"].get<double>());
   });
 }
 

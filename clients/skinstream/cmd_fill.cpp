@@ -46,6 +46,7 @@ void add_fill(CLI::App& app) {
                           {"samples", {{"measured", report.measured}, {"relabelled", report.relabelled},
                                        {"filled", report.filled}, {"held", report.held}}},
                           {"rejected_labels", report.rejected_labels},
+                          {"changed_measured", report.changed_measured},
                           {"unknown_labels", report.unknown_labels},
                           {"absent_markers", report.absent_markers},
                           {"latency_frames", report.latency_frames},

@@ -21,18 +21,22 @@ namespace {
 
 using synth::SynthCapture;
 
+// Which skin weights a conventional (sparse-marker LBS) row uses; None: a part-based method.
+enum class Skinning { None, BoneHeat, TruthOracle };
+
 struct Method {
   const char* name;
   const char* caption;
-  bool conventional;
+  Skinning skinning;
   DeformationMode mode;
 };
 constexpr Method kMethods[] = {
-    {"rigid", "rigid", false, DeformationMode::Rigid},
-    {"quadratic", "quadratic", false, DeformationMode::Quadratic},
-    {"rigid_rbf", "rigid+rbf", false, DeformationMode::RigidRbf},
-    {"full", "full", false, DeformationMode::QuadraticRbf},
-    {"lbs_sparse", "lbs sparse", true, DeformationMode::Rigid},
+    {"rigid", "rigid", Skinning::None, DeformationMode::Rigid},
+    {"quadratic", "quadratic", Skinning::None, DeformationMode::Quadratic},
+    {"rigid_rbf", "rigid+rbf", Skinning::None, DeformationMode::RigidRbf},
+    {"full", "full", Skinning::None, DeformationMode::QuadraticRbf},
+    {"lbs_bone_heat", "lbs heat", Skinning::BoneHeat, DeformationMode::Rigid},
+    {"lbs_truth_weights", "lbs oracle", Skinning::TruthOracle, DeformationMode::Rigid},
 };
 constexpr double kHeatMaxMm = 20.0;  // the render's colour scale: blue 0 .. red 20 mm
 
@@ -127,10 +131,15 @@ nlohmann::ordered_json worst_vertices(const std::vector<double>& peak_error, con
     const Vec3& at = model.reference_vertices[v];
     double nearest = std::numeric_limits<double>::infinity();
     for (const Vec3& m : subject.reference_positions) nearest = std::min(nearest, (m - at).norm());
+    int nearest_marker = 0;
+    for (int m = 0; m < subject.marker_count(); ++m)
+      if ((subject.reference_positions[m] - at).norm() < (subject.reference_positions[nearest_marker] - at).norm())
+        nearest_marker = m;
     nlohmann::ordered_json row = {{"vertex", v},
                                   {"error_mm", peak_error[v]},
                                   {"frame", peak_frame[v]},
                                   {"reference_mm", {at.x(), at.y(), at.z()}},
+                                  {"nearest_marker", subject.marker_names[nearest_marker]},
                                   {"nearest_marker_mm", nearest}};
     if (deformer) {
       row["parts"] = nlohmann::ordered_json::array();
@@ -199,14 +208,14 @@ DeformationSetup prepare_deformation(const synth::Body& body, const SynthCapture
                                               options.deform_registered_mesh ? registered : truth_skin, faces, build,
                                               &setup.build);
 
-  const synth::SkinWeights weights =
-      training.mesh_vertex_count() == body.vertex_count() ? body.weights : synth::subdivide(body).weights;
-  setup.conventional = synth::choose_conventional_markers(body, training, weights);
+  const synth::Body skinned = training.mesh_vertex_count() == body.vertex_count() ? body : synth::subdivide(body);
+  setup.conventional = synth::choose_conventional_markers(body, training, skinned.weights);
   // Its markers in subject order.
   for (auto& segment : setup.conventional.skinning.segment_markers)
     for (int& m : segment)
       m = static_cast<int>(std::find(setup.subject_to_truth.begin(), setup.subject_to_truth.end(), m) -
                            setup.subject_to_truth.begin());
+  setup.conventional_heat = synth::bone_heat_skinning(skinned, setup.conventional);
   setup.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return setup;
 }
@@ -223,9 +232,17 @@ nlohmann::ordered_json evaluate_deformation(const DeformationSetup& setup, const
 
   const int method_count = static_cast<int>(std::size(kMethods));
   std::vector<std::unique_ptr<MeshDeformer>> deformers;
-  for (const Method& m : kMethods)
-    deformers.push_back(m.conventional ? nullptr : std::make_unique<MeshDeformer>(model, setup.subject, m.mode));
-  SegmentSkinning skinning(setup.conventional.skinning, setup.subject.reference_positions, model.reference_vertices);
+  std::vector<std::unique_ptr<SegmentSkinning>> skinnings;
+  for (const Method& m : kMethods) {
+    const bool parts = m.skinning == Skinning::None;
+    deformers.push_back(parts ? std::make_unique<MeshDeformer>(model, setup.subject, m.mode) : nullptr);
+    skinnings.push_back(parts ? nullptr
+                              : std::make_unique<SegmentSkinning>(m.skinning == Skinning::TruthOracle
+                                                                      ? setup.conventional.skinning
+                                                                      : setup.conventional_heat,
+                                                                  setup.subject.reference_positions,
+                                                                  model.reference_vertices));
+  }
 
   const std::vector<char> covered = covered_vertices(model, setup.subject, options.covered_reach_mm);
   int covered_count = 0;
@@ -242,9 +259,9 @@ nlohmann::ordered_json evaluate_deformation(const DeformationSetup& setup, const
     const std::vector<Vec3> truth = take.pose_mesh(f);
     for (int k = 0; k < method_count; ++k) {
       const auto start = std::chrono::steady_clock::now();
-      if (kMethods[k].conventional) {
-        if (!skinning.solve(markers)) throw std::logic_error("conventional markers missing from the truth");
-        skinning.deform(positions);
+      if (skinnings[k]) {
+        if (!skinnings[k]->solve(markers)) throw std::logic_error("conventional markers missing from the truth");
+        skinnings[k]->deform(positions);
       } else if (!deformers[k]->deform(markers, positions, {})) {
         throw std::logic_error("markers missing from the truth");
       }
@@ -276,9 +293,9 @@ nlohmann::ordered_json evaluate_deformation(const DeformationSetup& setup, const
       truth_mesh.faces = model.faces;
       images.push_back(render::render_mesh(truth_mesh, camera));
       for (int k = 0; k < method_count; ++k) {
-        if (kMethods[k].conventional) {
-          skinning.solve(markers);
-          skinning.deform(positions);
+        if (skinnings[k]) {
+          skinnings[k]->solve(markers);
+          skinnings[k]->deform(positions);
         } else {
           deformers[k]->deform(markers, positions, {});
         }
@@ -310,6 +327,7 @@ nlohmann::ordered_json evaluate_deformation(const DeformationSetup& setup, const
     const ErrorStats m = summarize_errors(std::move(marker_errors[k]));
     const ErrorStats all = summarize_errors(std::move(all_vertex_errors[k]));
     rows.push_back({{"method", kMethods[k].name},
+                    {"oracle", kMethods[k].skinning == Skinning::TruthOracle},
                     {"vertex_mean_mm", v.mean},
                     {"vertex_p95_mm", v.p95},
                     {"vertex_max_mm", v.max},
@@ -326,6 +344,43 @@ nlohmann::ordered_json evaluate_deformation(const DeformationSetup& setup, const
           {"covered_vertices", covered_count},
           {"renders", rendered},
           {"methods", rows}};
+}
+
+nlohmann::ordered_json judge_table_rule(const nlohmann::ordered_json& takes) {
+  int met = 0;
+  nlohmann::ordered_json misses = nlohmann::ordered_json::array(), maxima = nlohmann::ordered_json::array();
+  for (const auto& take : takes) {
+    const nlohmann::ordered_json* full = nullptr;
+    const nlohmann::ordered_json* lowest_max = nullptr;
+    for (const auto& row : take["methods"]) {
+      if (row["method"] == "full") full = &row;
+      if (!lowest_max || row["vertex_max_mm"].get<double>() < (*lowest_max)["vertex_max_mm"].get<double>()) lowest_max = &row;
+    }
+    if (!full) throw std::logic_error("judge_table_rule: a take without the full method");
+    bool lowest = true;
+    for (const auto& row : take["methods"]) {
+      if (&row == full || row["oracle"].get<bool>()) continue;
+      for (const char* column : {"vertex_mean_mm", "vertex_p95_mm"})
+        if ((*full)[column].get<double>() >= row[column].get<double>()) {
+          lowest = false;
+          misses.push_back({{"motion", take["motion"]}, {"column", column}, {"by", row["method"]},
+                            {"full", (*full)[column]}, {"theirs", row[column]}});
+        }
+    }
+    met += lowest;
+    const auto& worst = (*full)["worst_vertices"][0];
+    maxima.push_back({{"motion", take["motion"]},
+                      {"lowest", (*lowest_max)["method"]},
+                      {"lowest_mm", (*lowest_max)["vertex_max_mm"]},
+                      {"full_mm", (*full)["vertex_max_mm"]},
+                      {"full_at", {{"vertex", worst["vertex"]}, {"frame", worst["frame"]},
+                                   {"nearest_marker", worst["nearest_marker"]}}}});
+  }
+  return {{"rule", "full method: lowest vertex mean and p95 against every non-oracle row"},
+          {"takes", takes.size()},
+          {"met", met},
+          {"misses", misses},
+          {"maxima", maxima}};
 }
 
 }  // namespace skinstream::cli

@@ -2,7 +2,10 @@
 // Section 5 judged against the synthetic ground truth, side by side: the detailed mesh deformed
 // from the markers by rigid parts only, quadratic without residual, rigid with RBF residual, the
 // full method (quadratic + RBF), and conventional linear blend skinning driven by a sparse
-// marker set (the paper's Figures 7 and 8), each compared with the generator's true mesh.
+// marker set (the paper's Figures 7 and 8), each compared with the generator's true mesh. LBS
+// runs twice: with weights computed from the rest mesh and skeleton alone (bone heat, as a
+// rigging tool would), and with the very weights the truth is skinned with (an oracle: no
+// conventional pipeline has them).
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -42,7 +45,8 @@ struct DeformationSetup {
   DeformationBuildReport build;
   RegistrationReport registration;        // the artist's model registered to the markers
   double registration_vertex_error_mm = 0;  // mean |registered vertex - truth vertex|, reference frame
-  synth::ConventionalMarkerSet conventional;
+  synth::ConventionalMarkerSet conventional;  // its skinning: the truth's weights (the oracle)
+  SegmentSkinningModel conventional_heat;     // the same markers, bone heat weights
   std::vector<int> subject_to_truth;  // subject marker -> truth channel
   double build_seconds = 0.0;
 };
@@ -54,5 +58,11 @@ DeformationSetup prepare_deformation(const synth::Body& body, const synth::Synth
 
 nlohmann::ordered_json evaluate_deformation(const DeformationSetup& setup, const synth::SynthCapture& take,
                                             const std::string& motion, const DeformEvaluationOptions& options);
+
+// The table's acceptance rule over evaluate_deformation's takes: the full method has the lowest
+// vertex mean and the lowest vertex p95 of every row that is not an oracle, on every take.
+// Maxima are not part of it; each take's lowest maximum is reported with where the full
+// method's maximum occurs (vertex, frame, nearest marker).
+nlohmann::ordered_json judge_table_rule(const nlohmann::ordered_json& takes);
 
 }  // namespace skinstream::cli

@@ -91,9 +91,11 @@ nlohmann::ordered_json evaluate_on_synthetic(const synth::SynthCapture& take, co
   j["unmerged_fragments"] = merge.unmerged_fragments;
   j["wrongly_labelled_fragments"] = merge.wrong_fragments;
   j["wrongly_labelled_rate"] = merge.wrong_rate();
+  j["wrongly_labelled_by"] = {{"measured", merge.wrong_measured_fragments}, {"relabelled", merge.wrong_relabelled_fragments}};
   j["wrongly_labelled_samples"] = merge.wrong_samples;
   j["samples"] = {{"measured", report.measured}, {"relabelled", report.relabelled}, {"filled", report.filled},
-                  {"held", report.held}, {"rejected_labels", report.rejected_labels}};
+                  {"held", report.held}, {"rejected_labels", report.rejected_labels},
+                  {"changed_measured", report.changed_measured}};
   j["filled_error"] = {{"metric", "|filled - truth| over samples not measured or relabelled; normalised by the marker's mean one-ring distance in the reference pose"},
                        {"mm", to_json(summarize_errors(mm))},
                        {"normalised", to_json(summarize_errors(normalised))},

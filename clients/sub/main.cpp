@@ -50,7 +50,8 @@ std::vector<Vec3> to_points(std::span<const float> xyz) {
 
 int main(int argc, char** argv) {
   CLI::App app{"skinstream-sub: subscribe to skinstreamd and report what arrives"};
-  std::string address, save_dir, encoding_name, record_path, subject, token;
+  std::string address, save_dir, encoding_name, record_path, subject, token, multicast, multicast_interface = "0.0.0.0";
+  uint32_t multicast_stream = 0;
   bool normals = false, quantised = false, markers = false, no_mesh = false, stats = false, json = false, evaluate = false, paced = false;
   long frames_wanted = 0;
   int save_every = 0, protocol = 2;
@@ -67,6 +68,11 @@ int main(int argc, char** argv) {
   app.add_option("--subject", subject, "the subject's name (protocol 2; default: the daemon's first)");
   app.add_option("--token", token, "the daemon's shared token, when it has one");
   app.add_option("--protocol", protocol, "subscriber protocol version: 2 (default) or 1 (float and quantised only)")->check(CLI::Range(1, 2));
+  app.add_option("--multicast", multicast,
+                 "GROUP:PORT: the parameters of every frame from the daemon's multicast group (its --multicast; --evaluate "
+                 "turns them into vertices); MeshInfo and the Model still come from ADDRESS over TCP");
+  app.add_option("--multicast-interface", multicast_interface, "multicast: this host's IPv4 address to join the group on");
+  app.add_option("--multicast-stream", multicast_stream, "multicast: the subject's stream id (0: the daemon's first)");
   app.add_option("--frames", frames_wanted, "exit after this many frames (0 = run until the daemon closes)");
   std::vector<std::string> save_arguments;
   app.add_option("--save-every", save_arguments, "N DIR: save every Nth frame as DIR/frame_<frame number>.ply")->expected(2);
@@ -103,6 +109,13 @@ int main(int argc, char** argv) {
     options.subject = subject;
     options.token = token;
     options.protocol_version = protocol;
+    if (!multicast.empty()) {
+      if (!encoding_name.empty() && encoding_name != "parameters") throw std::invalid_argument("--multicast carries the parameters encoding only");
+      std::tie(options.multicast.group, options.multicast.port) = split_host_port(multicast);
+      options.multicast.interface_address = multicast_interface;
+      options.multicast.stream_id = multicast_stream;
+      options.encoding = client::Encoding::Parameters;
+    }
     if (save_every > 0) std::filesystem::create_directories(save_dir);
     client::Subscriber sub(options);
 
@@ -220,6 +233,20 @@ int main(int argc, char** argv) {
                               {"latency_since_publish", since_publish.summary()},
                               {"latency_since_receive", since_receive.summary()}};
     if (!end_to_end.values.empty()) summary["latency_end_to_end"] = end_to_end.summary();
+    if (!multicast.empty()) {
+      const client::MulticastStats m = sub.multicast_stats();
+      summary["multicast"] = {{"datagrams", m.datagrams},
+                              {"frames_completed", m.frames_completed},
+                              {"frames_lost", m.frames_lost},
+                              {"frames_incomplete", m.frames_incomplete},
+                              {"datagrams_rejected", m.datagrams_rejected},
+                              {"datagrams_other_stream", m.datagrams_other_stream},
+                              {"datagrams_late", m.datagrams_late},
+                              {"datagrams_duplicate", m.datagrams_duplicate},
+                              {"frames_superseded", m.frames_superseded},
+                              {"messages_rejected", m.messages_rejected},
+                              {"last_error", m.last_error}};
+    }
     if (json) std::printf("%s\n", nlohmann::json{{"summary", summary}}.dump().c_str());
     else std::printf("%s\n", summary.dump(2).c_str());
     if (finished && frames_wanted > 0 && frames < frames_wanted) {

@@ -12,10 +12,19 @@ namespace skinstream {
 struct GapPlanOptions {
   uint64_t seed = 1;
   int min_frames = 3;                       // shortest gap
+  double min_seconds = 0.0;                 // shortest gap in seconds too (the longer of the two)
   double max_seconds = 4.0;                 // longest gap, converted with the capture's rate
   double gaps_per_marker_per_minute = 6.0;  // expected count per labelled channel
+  // When > 0, instead of a count per channel: gaps of `markers_per_gap` channels at once are
+  // placed anywhere until this share of the labelled samples is missing (see below).
+  double fraction_of_samples = 0.0;
+  int markers_per_gap = 1;
   int margin_frames = 2;                    // present samples kept on each side of every gap
 };
+
+// The long-gap protocol: occlusions of 2 to 6 s, three markers at a time, until 4 % of the
+// labelled samples are missing (a walking take's long occlusions, where drift shows).
+GapPlanOptions long_gap_plan(uint64_t seed);
 
 // Plans gaps on the labelled channels of `full`, a capture meant to have no gaps.
 //   - Lengths are log-uniform between min_frames and L = max(min_frames, round(max_seconds * rate))
@@ -31,11 +40,18 @@ struct GapPlanOptions {
 //     missing in `full` are treated like planned gaps (a planned gap and its margins only cover
 //     present samples), so a capture with a few real holes is usable too.
 //   - Channels are independent, so several markers are often missing at the same time.
+//   - With fraction_of_samples > 0 the gaps are not counted per channel: each draw is a length,
+//     a start uniform over the capture and `markers_per_gap` channels chosen at random among
+//     those where the gap fits (as above), all missing over the same frames. Draws go on until
+//     the planned samples reach fraction_of_samples of all labelled samples, or 1000 draws in a
+//     row find too few channels. The last gap may overshoot the share by one gap.
+//   - Shortest length: max(min_frames, round(min_seconds * rate)).
 // Randomness: std::mt19937_64 seeded with `seed`, converted to doubles by this code (not by
 // std:: distributions, whose output differs between standard libraries).
 // Returns the gaps sorted by point, then first_frame. Throws std::invalid_argument for
-// min_frames < 1, max_seconds <= 0, negative rate of gaps or margin, rate_hz <= 0, or
-// positions that do not match labels x frame_count.
+// min_frames < 1, negative min_seconds, max_seconds <= 0, negative rate of gaps or margin,
+// fraction_of_samples outside [0, 0.5], markers_per_gap < 1, rate_hz <= 0, or positions that
+// do not match labels x frame_count.
 std::vector<Gap> plan_gaps(const Capture& full, const GapPlanOptions& options);
 
 // A copy of `capture` with the samples of every gap set to missing. Throws std::invalid_argument

@@ -14,6 +14,7 @@ MergeStats merge_stats(const Capture& delivered, const std::vector<int>& true_ma
 
   // Which marker took each delivered sample.
   std::vector<int> taken_by(samples, -1);
+  std::vector<char> relabelled(samples, 0);
   std::vector<char> marker_seen(markers, 0);
   for (int f = 0; f < frames; ++f)
     for (int m = 0; m < markers; ++m) {
@@ -23,6 +24,7 @@ MergeStats merge_stats(const Capture& delivered, const std::vector<int>& true_ma
       else if (status[at] == MarkerStatus::Relabelled) channel = fragments[at];
       if (channel < 0 || channel >= channels) continue;
       taken_by[static_cast<size_t>(f) * channels + channel] = m;
+      relabelled[static_cast<size_t>(f) * channels + channel] = status[at] == MarkerStatus::Relabelled;
       marker_seen[m] = 1;
     }
 
@@ -33,19 +35,22 @@ MergeStats merge_stats(const Capture& delivered, const std::vector<int>& true_ma
         ++f;
         continue;
       }
-      bool used = false, wrong = false;
+      bool used = false, wrong = false, wrong_measured = false, wrong_relabelled = false;
       for (; f < frames && delivered.present(f, c); ++f) {
         const size_t at = static_cast<size_t>(f) * channels + c;
         if (taken_by[at] < 0) continue;
         used = true;
         if (taken_by[at] != true_marker[at]) {
           wrong = true;
+          (relabelled[at] ? wrong_relabelled : wrong_measured) = true;
           ++s.wrong_samples;
         }
       }
       ++s.fragments;
       s.unmerged_fragments += !used;
       s.wrong_fragments += wrong;
+      s.wrong_measured_fragments += wrong_measured;
+      s.wrong_relabelled_fragments += wrong_relabelled;
     }
   }
   for (char seen : marker_seen) s.trajectories_after += seen;

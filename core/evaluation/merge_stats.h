@@ -15,6 +15,10 @@ struct MergeStats {
   int unmerged_fragments = 0;  // fragments no marker took a sample of
   int trajectories_after = 0;  // markers with any observed sample + unmerged fragments
   int wrong_fragments = 0;     // fragments with a sample given to a marker that is not its own
+  // Of those, how the wrong sample got there: a labelled channel's sample kept as measured (a
+  // mislabel the label check let stand) or a free point taken by the relabeller.
+  int wrong_measured_fragments = 0;
+  int wrong_relabelled_fragments = 0;
   long wrong_samples = 0;
   double wrong_rate() const { return fragments ? static_cast<double>(wrong_fragments) / fragments : 0.0; }
 };

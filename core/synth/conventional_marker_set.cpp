@@ -4,6 +4,7 @@
 #include <limits>
 #include <stdexcept>
 
+#include "core/baselines/bone_heat_weights.h"
 #include "core/synth/anatomy.h"
 
 namespace skinstream::synth {
@@ -137,6 +138,16 @@ ConventionalMarkerSet choose_conventional_markers(const Body& body, const SynthC
     offsets.push_back(static_cast<int>(entries.size()));
   }
   return set;
+}
+
+SegmentSkinningModel bone_heat_skinning(const Body& body, const ConventionalMarkerSet& set) {
+  std::vector<HeatBone> bones;
+  for (int b = 0; b < body.skeleton.size(); ++b)
+    bones.push_back({body.skeleton.bone(b).head, body.skeleton.bone(b).tail, set.bone_segment[b]});
+  SegmentSkinningModel model = set.skinning;
+  bone_heat_weights(body.rest, triangulate(body.faces), bones, static_cast<int>(set.segment_names.size()), {},
+                    model.vertex_weight_offsets, model.vertex_weights);
+  return model;
 }
 
 }  // namespace skinstream::synth

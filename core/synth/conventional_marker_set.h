@@ -29,4 +29,10 @@ struct ConventionalMarkerSet {
 ConventionalMarkerSet choose_conventional_markers(const Body& body, const SynthCapture& training,
                                                   const SkinWeights& weights, int per_segment = 3);
 
+// The same segments and markers with skin weights a rigging tool would compute from the rest
+// mesh and skeleton alone (bone heat, core/baselines/bone_heat_weights.h) instead of the body's
+// own weights, the ones the synthetic truth is skinned with. `body`: the mesh to be skinned (the
+// subdivided body when the takes are subdivided).
+SegmentSkinningModel bone_heat_skinning(const Body& body, const ConventionalMarkerSet& set);
+
 }  // namespace skinstream::synth

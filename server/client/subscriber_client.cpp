@@ -15,7 +15,10 @@ int64_t wall_clock_ns() {
   return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch()).count();
 }
 
-SubscriberClient::SubscriberClient(const std::string& host, const std::string& port, uint32_t wants) : socket_(io_) {
+SubscriberClient::SubscriberClient(const std::string& host, const std::string& port, uint32_t wants)
+    : SubscriberClient(host, port, subscriber::Hello{.wants = wants}) {}
+
+SubscriberClient::SubscriberClient(const std::string& host, const std::string& port, const subscriber::Hello& hello) : socket_(io_) {
   server::tcp::resolver resolver(io_);
   boost::system::error_code ec;
   const auto endpoints = resolver.resolve(host, port, ec);
@@ -23,8 +26,7 @@ SubscriberClient::SubscriberClient(const std::string& host, const std::string& p
   server::asio::connect(socket_, endpoints, ec);
   if (ec) throw std::runtime_error(host + ":" + port + ": " + ec.message());
   socket_.set_option(server::tcp::no_delay(true));
-  const std::vector<unsigned char> hello = subscriber::encode_hello({.wants = wants});
-  server::asio::write(socket_, server::asio::buffer(hello));
+  server::asio::write(socket_, server::asio::buffer(subscriber::encode_hello(hello)));
 }
 
 bool SubscriberClient::run(

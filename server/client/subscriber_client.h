@@ -19,7 +19,9 @@ int64_t wall_clock_ns();
 
 class SubscriberClient {
  public:
-  SubscriberClient(const std::string& host, const std::string& port, uint32_t wants);
+  SubscriberClient(const std::string& host, const std::string& port, uint32_t wants);  // version 1
+  // Any Hello: version 2 names a subject and an encoding; decode what comes in hello.version.
+  SubscriberClient(const std::string& host, const std::string& port, const subscriber::Hello& hello);
   // Reads until `on_message` returns false or the daemon closes the connection (returns false then).
   bool run(const std::function<bool(subscriber::MessageType, std::span<const unsigned char>, int64_t receive_ns)>& on_message);
 

@@ -20,7 +20,7 @@ void WebSocketSubscriber::accept(http::request<http::string_body> request) {
       self->on_disconnected("WebSocket handshake failed: " + ec.message());
       return;
     }
-    self->start_hello_timer(self->hub_.options().hello_timeout);
+    self->start_hello_timer(self->hub_->options().hello_timeout);
     self->read_next();
   });
 }
@@ -57,7 +57,7 @@ void WebSocketSubscriber::read_next() {
 }
 
 void WebSocketSubscriber::refuse_text_message() {
-  hub_.metrics().bad_subscriber_messages.fetch_add(1, std::memory_order_relaxed);
+  hub_->metrics().bad_subscriber_messages.fetch_add(1, std::memory_order_relaxed);
   spdlog::warn("subscriber {} (websocket {}): a text message; the subscriber protocol is binary only; closing", id(),
                stats().remote);
   // Closed with a reason (1003, data of a kind the daemon does not take) the peer's WebSocket API

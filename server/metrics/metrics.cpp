@@ -7,9 +7,9 @@
 namespace skinstream::server {
 namespace {
 
-void counter(std::string& out, const char* name, const char* help, uint64_t value) {
-  out += "# HELP skinstream_" + std::string(name) + " " + help + "\n# TYPE skinstream_" + name + " counter\nskinstream_" +
-         name + " " + std::to_string(value) + "\n";
+void header(std::string& out, std::string_view name, std::string_view help, std::string_view type) {
+  const std::string n = "skinstream_" + std::string(name);
+  out += "# HELP " + n + " " + std::string(help) + "\n# TYPE " + n + " " + std::string(type) + "\n";
 }
 
 // Prometheus label values escape backslash, quote and newline.
@@ -55,6 +55,12 @@ double LatencyHistogram::quantile_upper_bound_ms(double q, uint64_t total, int64
   return max_ms;  // beyond the last bound
 }
 
+LatencyHistogram::Buckets LatencyHistogram::bucket_counts() const {
+  Buckets counts;
+  for (size_t b = 0; b < kBounds.size(); ++b) counts[b] = buckets_[b].load(std::memory_order_relaxed);
+  return counts;
+}
+
 LatencyHistogram::Summary LatencyHistogram::summary() const {
   Summary s;
   s.count = count_.load(std::memory_order_relaxed);
@@ -68,17 +74,23 @@ LatencyHistogram::Summary LatencyHistogram::summary() const {
 }
 
 void LatencyHistogram::render(std::string& out, std::string_view name, std::string_view help) const {
+  header(out, name, help, "histogram");
+  render_samples(out, name, "");
+}
+
+void LatencyHistogram::render_samples(std::string& out, std::string_view name, std::string_view labels) const {
   const std::string n = "skinstream_" + std::string(name);
-  out += "# HELP " + n + " " + std::string(help) + "\n# TYPE " + n + " histogram\n";
+  const std::string before = labels.empty() ? std::string() : std::string(labels) + ",";
   uint64_t cumulative = 0;
   for (size_t b = 0; b < kBounds.size(); ++b) {
     cumulative += buckets_[b].load(std::memory_order_relaxed);
-    out += n + "_bucket{le=\"" + number(kBounds[b]) + "\"} " + std::to_string(cumulative) + "\n";
+    out += n + "_bucket{" + before + "le=\"" + number(kBounds[b]) + "\"} " + std::to_string(cumulative) + "\n";
   }
   const uint64_t total = count_.load(std::memory_order_relaxed);
-  out += n + "_bucket{le=\"+Inf\"} " + std::to_string(total) + "\n";
-  out += n + "_sum " + number(sum_ns_.load(std::memory_order_relaxed) * 1e-9) + "\n";
-  out += n + "_count " + std::to_string(total) + "\n";
+  const std::string own = labels.empty() ? std::string() : "{" + std::string(labels) + "}";
+  out += n + "_bucket{" + before + "le=\"+Inf\"} " + std::to_string(total) + "\n";
+  out += n + "_sum" + own + " " + number(sum_ns_.load(std::memory_order_relaxed) * 1e-9) + "\n";
+  out += n + "_count" + own + " " + std::to_string(total) + "\n";
 }
 
 void Metrics::count_bad_input(std::string_view category) {
@@ -94,56 +106,80 @@ uint64_t Metrics::bad_input(std::string_view category) const {
   return it == bad_input_.end() ? 0 : it->second;
 }
 
-std::string Metrics::render_prometheus(const std::vector<SubscriberMetrics>& subscribers) const {
+std::map<std::string, uint64_t, std::less<>> Metrics::bad_input_counts() const {
+  std::lock_guard lock(bad_input_mutex_);
+  return bad_input_;
+}
+
+std::string render_prometheus(const Metrics& source, const std::vector<SubjectMetricsView>& subjects) {
   std::string out;
-  counter(out, "frames_received_total", "Marker frames received from the source.", frames_received);
-  counter(out, "frames_processed_total", "Frames through the gap filler.", frames_processed);
-  counter(out, "frames_published_total", "Frames handed to the publishers.", frames_published);
-  counter(out, "frames_dropped_total", "Frames that gave way to newer ones in the mailbox (waited longer than max_frame_wait_ms, or a burst overfilled it).", frames_dropped);
-  counter(out, "frames_dropped_mailbox_full_total", "Of the dropped frames, those of bursts longer than the mailbox holds.", frames_dropped_mailbox_full);
-  counter(out, "markers_filled_total", "Marker samples filled (PCA, rigid or held).", markers_filled);
-  counter(out, "markers_relabelled_total", "Marker samples taken from unlabelled points.", markers_relabelled);
-  counter(out, "markers_held_total", "Marker samples held relative to their anchors.", markers_held);
-  counter(out, "bad_subscriber_messages_total", "Subscriber messages that broke the protocol.", bad_subscriber_messages);
-  counter(out, "subscribers_accepted_total", "Subscriber connections accepted.", subscribers_connected);
-  counter(out, "subscribers_refused_total", "Subscribers refused after their Hello (unknown subject, ...).", subscribers_refused);
-  counter(out, "accepts_failed_no_descriptor_total",
-          "Accepts (HTTP and subscriber ports) that failed for lack of file descriptors; each pauses that port's accepts, 10 ms doubling to 1 s.",
-          accepts_failed_no_descriptor);
-  counter(out, "frame_buffers_allocated_total", "Encoded frame buffers created (steady state: constant).", frame_buffers_allocated);
-  counter(out, "frame_buffers_allocated_by_pipeline_total",
-          "Of those, created on the pipeline thread because none was prepared when the subscriber asked (expected: 0).",
-          frame_buffers_allocated_by_pipeline);
-  out += "# HELP skinstream_bad_input_total Source input dropped, by category.\n# TYPE skinstream_bad_input_total counter\n";
-  {
-    std::lock_guard lock(bad_input_mutex_);
-    for (const auto& [category, count] : bad_input_)
-      out += "skinstream_bad_input_total{category=\"" + label_value(category) + "\"} " + std::to_string(count) + "\n";
-  }
-  receive_to_take.render(out, "receive_to_take_seconds",
-                         "From frame received to taken by the pipeline thread (the wait and the thread's wake-up).");
-  fill.render(out, "fill_seconds", "Gap filler time per frame.");
-  deform.render(out, "deform_seconds", "Mesh deformation time per frame (parts and vertices).");
-  normals.render(out, "normals_seconds", "Normal computation time per frame.");
-  encode.render(out, "encode_seconds", "Frame encoding time per frame (every encoding but the compressed one).");
-  encode_compressed.render(out, "encode_compressed_seconds", "The compressed encoding's time per frame (vertex codec, after the other encodings were handed over).");
-  receive_to_publish.render(out, "receive_to_publish_seconds", "From frame received to handed to the publishers.");
-  subscriber_queue_wait.render(out, "subscriber_queue_wait_seconds",
-                               "Per frame and subscriber: from published to its write starting (the subscriber's queue and its io thread's turn).");
-  subscriber_write.render(out, "subscriber_write_seconds",
-                          "Per frame and subscriber: from its write starting to the socket taking the last byte (longer when the subscriber reads slowly).");
-  out += "# HELP skinstream_subscriber_frames_sent_total Frames written to each subscriber.\n"
-         "# TYPE skinstream_subscriber_frames_sent_total counter\n";
-  for (const SubscriberMetrics& s : subscribers)
-    out += "skinstream_subscriber_frames_sent_total{id=\"" + std::to_string(s.id) + "\",transport=\"" + s.transport +
-           "\",remote=\"" + label_value(s.remote) + "\"} " + std::to_string(s.sent) + "\n";
-  out += "# HELP skinstream_subscriber_frames_dropped_total Frames dropped for each subscriber (waited longer than max_frame_wait_ms while a newer one was queued, or its queue was full).\n"
-         "# TYPE skinstream_subscriber_frames_dropped_total counter\n";
-  for (const SubscriberMetrics& s : subscribers)
-    out += "skinstream_subscriber_frames_dropped_total{id=\"" + std::to_string(s.id) + "\",transport=\"" + s.transport +
-           "\",remote=\"" + label_value(s.remote) + "\"} " + std::to_string(s.dropped) + "\n";
-  out += "# HELP skinstream_subscribers Subscribers connected now.\n# TYPE skinstream_subscribers gauge\nskinstream_subscribers " +
-         std::to_string(subscribers.size()) + "\n";
+  std::vector<std::string> labels;  // subject="NAME", per subject
+  for (const SubjectMetricsView& s : subjects) labels.push_back("subject=\"" + label_value(s.subject) + "\"");
+  // A counter of every subject, read from its Metrics.
+  auto per_subject = [&](const char* name, const char* help, const std::atomic<uint64_t> Metrics::*field) {
+    header(out, name, help, "counter");
+    for (size_t i = 0; i < subjects.size(); ++i)
+      out += "skinstream_" + std::string(name) + "{" + labels[i] + "} " + std::to_string((subjects[i].metrics->*field).load()) + "\n";
+  };
+  header(out, "source_frames_total", "Frames received from the source (every subject's together).", "counter");
+  out += "skinstream_source_frames_total " + std::to_string(source.frames_received.load()) + "\n";
+  header(out, "accepts_failed_no_descriptor_total",
+         "Accepts (HTTP and subscriber ports) that failed for lack of file descriptors; each pauses that port's accepts, 10 ms doubling to 1 s.",
+         "counter");
+  out += "skinstream_accepts_failed_no_descriptor_total " + std::to_string(source.accepts_failed_no_descriptor.load()) + "\n";
+  per_subject("frames_received_total", "Marker frames of the subject received from the source.", &Metrics::frames_received);
+  per_subject("frames_processed_total", "Frames through the gap filler.", &Metrics::frames_processed);
+  per_subject("frames_published_total", "Frames handed to the publishers.", &Metrics::frames_published);
+  per_subject("frames_dropped_total", "Frames that gave way to newer ones in the mailbox (waited longer than max_frame_wait_ms, or a burst overfilled it).", &Metrics::frames_dropped);
+  per_subject("frames_dropped_mailbox_full_total", "Of the dropped frames, those of bursts longer than the mailbox holds.", &Metrics::frames_dropped_mailbox_full);
+  per_subject("markers_filled_total", "Marker samples filled (PCA, rigid or held).", &Metrics::markers_filled);
+  per_subject("markers_relabelled_total", "Marker samples taken from unlabelled points.", &Metrics::markers_relabelled);
+  per_subject("markers_held_total", "Marker samples held relative to their anchors.", &Metrics::markers_held);
+  per_subject("bad_subscriber_messages_total", "Subscriber messages that broke the protocol.", &Metrics::bad_subscriber_messages);
+  per_subject("subscribers_accepted_total", "Subscriber connections accepted.", &Metrics::subscribers_connected);
+  per_subject("subscribers_refused_total", "Subscribers refused after their Hello (unknown subject, ...).", &Metrics::subscribers_refused);
+  per_subject("frame_buffers_allocated_total", "Encoded frame buffers created (steady state: constant).", &Metrics::frame_buffers_allocated);
+  per_subject("frame_buffers_allocated_by_pipeline_total",
+              "Of those, created on the pipeline thread because none was prepared when the subscriber asked (expected: 0).",
+              &Metrics::frame_buffers_allocated_by_pipeline);
+  header(out, "bad_input_total", "Input dropped, by category: the source's without a subject label, a subject's pipeline's with one.", "counter");
+  for (const auto& [category, count] : source.bad_input_counts())
+    out += "skinstream_bad_input_total{category=\"" + label_value(category) + "\"} " + std::to_string(count) + "\n";
+  for (size_t i = 0; i < subjects.size(); ++i)
+    for (const auto& [category, count] : subjects[i].metrics->bad_input_counts())
+      out += "skinstream_bad_input_total{" + labels[i] + ",category=\"" + label_value(category) + "\"} " + std::to_string(count) + "\n";
+  auto histogram = [&](const char* name, const char* help, const LatencyHistogram Metrics::*field) {
+    header(out, name, help, "histogram");
+    for (size_t i = 0; i < subjects.size(); ++i) (subjects[i].metrics->*field).render_samples(out, name, labels[i]);
+  };
+  histogram("receive_to_take_seconds", "From frame received to taken by the pipeline thread (the wait and the thread's wake-up).", &Metrics::receive_to_take);
+  histogram("fill_seconds", "Gap filler time per frame.", &Metrics::fill);
+  histogram("deform_seconds", "Mesh deformation time per frame (parts and vertices).", &Metrics::deform);
+  histogram("normals_seconds", "Normal computation time per frame.", &Metrics::normals);
+  histogram("encode_seconds", "Frame encoding time per frame (every encoding but the compressed one).", &Metrics::encode);
+  histogram("encode_compressed_seconds", "The compressed encoding's time per frame (vertex codec, after the other encodings were handed over).",
+            &Metrics::encode_compressed);
+  histogram("receive_to_publish_seconds", "From frame received to handed to the publishers.", &Metrics::receive_to_publish);
+  histogram("subscriber_queue_wait_seconds",
+            "Per frame and subscriber: from published to its write starting (the subscriber's queue and its io thread's turn).",
+            &Metrics::subscriber_queue_wait);
+  histogram("subscriber_write_seconds",
+            "Per frame and subscriber: from its write starting to the socket taking the last byte (longer when the subscriber reads slowly).",
+            &Metrics::subscriber_write);
+  auto per_subscriber = [&](const char* name, const char* help, uint64_t SubscriberMetrics::*field) {
+    header(out, name, help, "counter");
+    for (size_t i = 0; i < subjects.size(); ++i)
+      for (const SubscriberMetrics& s : subjects[i].subscribers)
+        out += "skinstream_" + std::string(name) + "{" + labels[i] + ",id=\"" + std::to_string(s.id) + "\",transport=\"" + s.transport +
+               "\",remote=\"" + label_value(s.remote) + "\"} " + std::to_string(s.*field) + "\n";
+  };
+  per_subscriber("subscriber_frames_sent_total", "Frames written to each subscriber.", &SubscriberMetrics::sent);
+  per_subscriber("subscriber_frames_dropped_total",
+                 "Frames dropped for each subscriber (waited longer than max_frame_wait_ms while a newer one was queued, or its queue was full).",
+                 &SubscriberMetrics::dropped);
+  header(out, "subscribers", "Subscribers connected now.", "gauge");
+  for (size_t i = 0; i < subjects.size(); ++i)
+    out += "skinstream_subscribers{" + labels[i] + "} " + std::to_string(subjects[i].subscribers.size()) + "\n";
   return out;
 }
 

@@ -23,6 +23,8 @@ class LatencyHistogram {
                                                      7.5e-3, 10e-3,  25e-3, 50e-3, 100e-3, 1.0};
   void observe_ns(int64_t ns);
   void render(std::string& out, std::string_view name, std::string_view help) const;
+  // The samples alone (no HELP or TYPE), each with `labels` (e.g. subject="A") before its own.
+  void render_samples(std::string& out, std::string_view name, std::string_view labels) const;
   uint64_t count() const { return count_.load(std::memory_order_relaxed); }
 
   // For /health and scripts: each quantile as an upper bound, the smaller of its bucket's bound
@@ -32,6 +34,9 @@ class LatencyHistogram {
     double p50_le_ms = 0, p99_le_ms = 0, p99_9_le_ms = 0, max_ms = 0;
   };
   Summary summary() const;
+  // Each bucket's count now (not cumulative): the difference of two gives an interval's histogram.
+  using Buckets = std::array<uint64_t, kBounds.size()>;
+  Buckets bucket_counts() const;
 
  private:
   double quantile_upper_bound_ms(double q, uint64_t total, int64_t max_ns) const;
@@ -76,12 +81,23 @@ class Metrics {
 
   void count_bad_input(std::string_view category);
   uint64_t bad_input(std::string_view category) const;
-
-  std::string render_prometheus(const std::vector<SubscriberMetrics>& subscribers) const;
+  std::map<std::string, uint64_t, std::less<>> bad_input_counts() const;
 
  private:
   mutable std::mutex bad_input_mutex_;
   std::map<std::string, uint64_t, std::less<>> bad_input_;
 };
+
+// One subject's metrics and its subscribers, as /metrics labels them.
+struct SubjectMetricsView {
+  std::string subject;
+  const Metrics* metrics = nullptr;
+  std::vector<SubscriberMetrics> subscribers;
+};
+
+// /metrics: the daemon's own counters (the source's frames, as skinstream_source_frames_total, its
+// bad input, the failed accepts) without a subject label, then every subject's series labelled subject="NAME" (each
+// metric's HELP and TYPE once, its samples for every subject after them).
+std::string render_prometheus(const Metrics& source, const std::vector<SubjectMetricsView>& subjects);
 
 }  // namespace skinstream::server

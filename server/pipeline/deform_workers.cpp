@@ -80,8 +80,8 @@ DeformWorkers::DeformWorkers(MeshDeformer& deformer, const DeformWorkerOptions& 
   vertices_.tasks = normals_stage_.tasks =
       static_cast<uint32_t>((deformer_.vertex_count() + vertex_chunk_ - 1) / vertex_chunk_);
   for (int i = 1; i < threads_; ++i) {
-    workers_.emplace_back([this, i] {
-      name_this_thread("deform-" + std::to_string(i));
+    workers_.emplace_back([this, name = options.thread_name + "-" + std::to_string(i)] {
+      name_this_thread(name);
       work();
     });
     if (static_cast<int>(options.cpus.size()) == threads_ && !set_thread_cpus(workers_.back(), {options.cpus[i]}))

@@ -24,6 +24,7 @@
 #include <cstdint>
 #include <memory>
 #include <span>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -38,6 +39,7 @@ struct DeformWorkerOptions {
   // Empty, or one CPU per thread: index 0 is the calling thread's (its owner pins it, with
   // pin_this_thread from deform_cpus.h), the others the workers', pinned as they are made.
   std::vector<int> cpus;
+  std::string thread_name = "deform";  // worker i is named thread_name-i
 };
 
 class DeformWorkers {

@@ -82,7 +82,7 @@ Pipeline::Pipeline(const SubjectModel& model, const DeformationModel* deformatio
     positions_.resize(3 * static_cast<size_t>(deformer_->vertex_count()));
     normals_.resize(positions_.size());
     workers_ = std::make_unique<DeformWorkers>(
-        *deformer_, DeformWorkerOptions{options.deform_threads, options.deform_spin_lead, options.deform_cpus});
+        *deformer_, DeformWorkerOptions{options.deform_threads, options.deform_spin_lead, options.deform_cpus, options.deform_thread_name});
     const EvaluationModel& evaluation = deformer_->evaluation_model();
     parameter_block_.resize(subscriber::parameter_block_bytes(evaluation.part_count(), evaluation.member_count()));
     compressed_order_ = subscriber::compressed_vertex_order(evaluation.reference_vertices);
@@ -100,7 +100,7 @@ Pipeline::~Pipeline() { stop(); }
 void Pipeline::start() {
   if (running_.exchange(true)) return;
   thread_ = std::thread([this] {
-    name_this_thread("pipeline");
+    name_this_thread(options_.thread_name);
     run();
   });
 }

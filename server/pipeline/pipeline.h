@@ -10,6 +10,7 @@
 #include <atomic>
 #include <memory>
 #include <optional>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -46,6 +47,8 @@ struct PipelineOptions {
   double default_rate_hz = 120.0;
   GapFillerOptions filler;
   int compressed_key_interval = 10;  // frames; the compressed encoding's key frames (protocol/compressed_vertices.h)
+  std::string thread_name = "pipeline";  // its deform workers: DeformWorkerOptions::thread_name
+  std::string deform_thread_name = "deform";
 };
 
 class Pipeline {

@@ -34,10 +34,10 @@ SubscriberHub::SubscriberHub(Metrics& metrics, const HubOptions& options, subscr
   broadcast_status(status_);
 }
 
-void SubscriberHub::add(const std::shared_ptr<SubscriberSession>& session) {
+void SubscriberHub::add(const std::shared_ptr<SubscriberSession>& session, bool accepted) {
   std::lock_guard lock(mutex_);
   sessions_.push_back(session);
-  metrics_.subscribers_connected.fetch_add(1, std::memory_order_relaxed);
+  if (accepted) metrics_.subscribers_connected.fetch_add(1, std::memory_order_relaxed);
 }
 
 void SubscriberHub::activate(SubscriberSession& session, StreamKey key) {

@@ -1,5 +1,5 @@
 #pragma once
-// Every connected subscriber (TCP and WebSocket): fans each published frame out to their queues
+// Every subscriber of one subject (TCP and WebSocket): fans each published frame out to their queues
 // without waiting for any of them, keeps the MeshInfo for each stream key, the Model message and
 // the latest Status in each version, and says which stream keys are wanted so the pipeline
 // encodes only those.
@@ -16,6 +16,7 @@
 #include "server/asio.h"
 #include "server/metrics/metrics.h"
 #include "server/pipeline/pipeline.h"
+#include "server/publish/subject_directory.h"
 #include "server/publish/subscriber_queue.h"
 
 namespace skinstream::server {
@@ -38,8 +39,13 @@ class SubscriberHub : public FrameConsumer {
   Metrics& metrics() { return metrics_; }
   bool has_mesh() const { return has_mesh_; }
   const std::string& subject_name() const { return mesh_info_.subject; }
+  // Every subject's hub, for a Hello naming one (a new subscriber starts in the first subject's
+  // hub and moves to the one it names); null: this hub serves alone. Set before any subscriber.
+  void set_directory(const SubjectDirectory* directory) { directory_ = directory; }
+  const SubjectDirectory* directory() const { return directory_; }
 
-  void add(const std::shared_ptr<SubscriberSession>& session);
+  // `accepted`: a new connection (counted); false for one moving in from another subject's hub.
+  void add(const std::shared_ptr<SubscriberSession>& session, bool accepted = true);
   // Called by activate() on the subscriber's thread before its stream key becomes wanted, so
   // the pipeline can make that key's buffers there (Pipeline::prepare_encoding). Set before any
   // subscriber connects.
@@ -96,6 +102,7 @@ class SubscriberHub : public FrameConsumer {
   std::array<ControlMessage, 1 + subscriber::kEncodingCount> status_messages_;
   std::array<std::atomic<uint64_t>, 2> wanted_{};  // StreamKeySet::bits
   std::function<void(StreamKey)> prepare_encoding_;
+  const SubjectDirectory* directory_ = nullptr;
 };
 
 }  // namespace skinstream::server

@@ -15,7 +15,7 @@ std::atomic<uint64_t> next_id{1};
 
 SubscriberSession::SubscriberSession(asio::io_context& io, SubscriberHub& hub, std::string transport, std::string remote)
     : io_(io),
-      hub_(hub),
+      hub_(&hub),
       id_(next_id.fetch_add(1)),
       transport_(std::move(transport)),
       remote_(std::move(remote)),
@@ -84,10 +84,12 @@ void SubscriberSession::on_hello(const subscriber::Hello& hello) {
   paced_ = (hello.wants & subscriber::kWantPaced) != 0;
   // Version 2: the encoding asked for, or what can be served instead, and why.
   std::string notice;
-  uint32_t flags = subscriber::frame_flags_for(hello.wants, hub_.has_mesh());
+  uint32_t flags = subscriber::frame_flags_for(hello.wants, hub_->has_mesh());
   if (hello.version >= subscriber::kVersion2) {
-    if (!hello.subject.empty() && hello.subject != hub_.subject_name()) {
-      refuse("no subject \"" + hello.subject + "\" here (this daemon serves \"" + hub_.subject_name() + "\")");
+    // The first Hello chooses the subject; a later one may not name another.
+    if (!greeted_ && !join_subject(hello.subject)) return;
+    if (greeted_ && !hello.subject.empty() && hello.subject != hub_->subject_name()) {
+      refuse("a Hello naming subject \"" + hello.subject + "\" after one naming \"" + hub_->subject_name() + "\"");
       return;
     }
     subscriber::Encoding served = subscriber::Encoding::Float;
@@ -97,9 +99,9 @@ void SubscriberSession::on_hello(const subscriber::Hello& hello) {
       notice = "encoding " + std::to_string(hello.encoding) + " is not one this daemon serves: positions in float";
     }
     const bool needs_mesh = served == subscriber::Encoding::Parameters || served == subscriber::Encoding::Compressed;
-    if (needs_mesh && !hub_.has_mesh())
+    if (needs_mesh && !hub_->has_mesh())
       notice = std::string("no ") + subscriber::to_string(served) + " encoding for a subject without a mesh: markers only";
-    flags = subscriber::frame_flags_for(hello.wants, served, hub_.has_mesh());
+    flags = subscriber::frame_flags_for(hello.wants, served, hub_->has_mesh());
   }
   const StreamKey key = server::stream_key(flags, hello.version);
   const bool changed = !greeted_ || key != key_.load();
@@ -107,30 +109,48 @@ void SubscriberSession::on_hello(const subscriber::Hello& hello) {
   hello_timer_.cancel();
   if (!changed) return;
   key_.store(key);
-  offer_control(hub_.mesh_info_message(key));
-  if ((flags & subscriber::kFrameParameters) && hub_.model_message()) offer_control(hub_.model_message());
-  offer_control(hub_.status_message(key));
+  offer_control(hub_->mesh_info_message(key));
+  if ((flags & subscriber::kFrameParameters) && hub_->model_message()) offer_control(hub_->model_message());
+  offer_control(hub_->status_message(key));
   if (!notice.empty()) {
-    offer_control(hub_.status_message(key, notice, subscriber::SourceStateCode::Streaming));
+    offer_control(hub_->status_message(key, notice, subscriber::SourceStateCode::Streaming));
     spdlog::info("subscriber {} ({} {}): {}", id_, transport_, remote_, notice);
   }
-  hub_.activate(*this, key);
+  hub_->activate(*this, key);
   spdlog::info("subscriber {} ({} {}): protocol {}, wants {:#x}, frame flags {:#x}", id_, transport_, remote_, hello.version,
                hello.wants, flags);
 }
 
+bool SubscriberSession::join_subject(const std::string& subject) {
+  const SubjectDirectory* directory = hub_->directory();
+  SubscriberHub* chosen =
+      directory ? directory->find(subject) : (subject.empty() || subject == hub_->subject_name() ? hub_ : nullptr);
+  if (!chosen) {
+    refuse("no subject \"" + subject + "\" here (this daemon serves " +
+           (directory ? directory->names() : "\"" + hub_->subject_name() + "\"") + ")");
+    return false;
+  }
+  if (chosen != hub_) {
+    std::shared_ptr<SubscriberSession> self = shared_from_this();  // the old hub held it
+    hub_->remove(*this);
+    hub_ = chosen;
+    hub_->add(self, /*accepted=*/false);
+  }
+  return true;
+}
+
 void SubscriberSession::refuse(const std::string& reason) {
-  hub_.metrics().subscribers_refused.fetch_add(1, std::memory_order_relaxed);
+  hub_->metrics().subscribers_refused.fetch_add(1, std::memory_order_relaxed);
   spdlog::warn("subscriber {} ({} {}): refused: {}", id_, transport_, remote_, reason);
   greeted_ = true;
   hello_timer_.cancel();
   // The Status goes out first; the session closes once its queue has been written.
   close_after_write_ = true;
-  offer_control(hub_.status_message(server::stream_key(0, version_), reason, subscriber::SourceStateCode::Refused));
+  offer_control(hub_->status_message(server::stream_key(0, version_), reason, subscriber::SourceStateCode::Refused));
 }
 
 void SubscriberSession::on_protocol_error(const std::string& reason) {
-  hub_.metrics().bad_subscriber_messages.fetch_add(1, std::memory_order_relaxed);
+  hub_->metrics().bad_subscriber_messages.fetch_add(1, std::memory_order_relaxed);
   spdlog::warn("subscriber {} ({} {}): {}; closing", id_, transport_, remote_, reason);
   close();
 }
@@ -141,7 +161,7 @@ void SubscriberSession::on_disconnected(const std::string& reason) {
   hello_timer_.cancel();
   spdlog::info("subscriber {} ({} {}) gone: {} (sent {}, dropped {})", id_, transport_, remote_, reason, sent_.load(),
                queue_.frames_dropped());
-  hub_.remove(*this);
+  hub_->remove(*this);
 }
 
 void SubscriberSession::kick() {
@@ -175,7 +195,7 @@ void SubscriberSession::pump() {
   }
   if (paced_) ++unacked_;
   write_started_ = std::chrono::steady_clock::now();
-  hub_.metrics().subscriber_queue_wait.observe_ns(
+  hub_->metrics().subscriber_queue_wait.observe_ns(
       std::chrono::duration_cast<std::chrono::nanoseconds>(write_started_ - in_flight_.frame->published).count());
   const std::span<const unsigned char> message = in_flight_.frame->message(key_.load());
   const size_t prefix = std::min(frame_prefix_.size(), message.size());
@@ -195,7 +215,7 @@ void SubscriberSession::write_done(const boost::system::error_code& ec) {
   }
   if (was_frame) {
     sent_.fetch_add(1, std::memory_order_relaxed);
-    hub_.metrics().subscriber_write.observe_ns(
+    hub_->metrics().subscriber_write.observe_ns(
         std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - write_started_).count());
   }
   pump();

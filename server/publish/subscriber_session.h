@@ -57,11 +57,14 @@ class SubscriberSession : public std::enable_shared_from_this<SubscriberSession>
   void write_done(const boost::system::error_code& ec);
 
   asio::io_context& io_;
-  SubscriberHub& hub_;
+  SubscriberHub* hub_;  // the subject's; changes only at the first version 2 Hello, before frames flow
 
  private:
   void kick();
   void pump();
+  // Version 2's first Hello: into the hub of the subject it names (SubjectDirectory); false when
+  // refused (no such subject).
+  bool join_subject(const std::string& subject);
 
   uint64_t id_;
   std::string transport_, remote_;

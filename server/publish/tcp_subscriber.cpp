@@ -9,7 +9,7 @@ TcpSubscriber::TcpSubscriber(asio::io_context& io, SubscriberHub& hub, tcp::sock
     : SubscriberSession(io, hub, "tcp", std::move(remote)), socket_(std::move(socket)), placement_(std::move(placement)) {}
 
 void TcpSubscriber::start() {
-  start_hello_timer(hub_.options().hello_timeout);
+  start_hello_timer(hub_->options().hello_timeout);
   read_next();
 }
 

@@ -1,7 +1,7 @@
 #pragma once
 // The recordings skinstream-replay streams together: each read (C3D or TRC) and named as a
-// subject after its file stem (or the name given for a single recording); names made unique by a
-// suffix ("_2"). Several recordings must share a frame rate unless one is given.
+// subject, by the names given (one per recording) or else after its file stem, stems made unique
+// by a suffix ("_2"). Several recordings must share a frame rate unless one is given.
 
 #include <memory>
 #include <string>
@@ -19,8 +19,9 @@ struct ReplayRecordings {
 };
 
 // Throws FileError for a file that cannot be read or holds no frames, std::invalid_argument for
-// recordings of different rates (without `rate`) or a missing rate.
-ReplayRecordings load_replay_recordings(const std::vector<std::string>& paths, const std::string& subject_name,
+// recordings of different rates (without `rate`), a missing rate, or names that are not one per
+// recording or name one subject twice.
+ReplayRecordings load_replay_recordings(const std::vector<std::string>& paths, const std::vector<std::string>& subject_names,
                                         double rate);
 
 }  // namespace skinstream::server

@@ -52,18 +52,16 @@ Packet filter_packet(const Packet& packet, const std::vector<uint32_t>& wanted) 
 struct ViconServer::State : std::enable_shared_from_this<ViconServer::State> {
   struct Session;
 
-  State(asio::io_context& io_context, const Capture& capture_in, ViconServerOptions opts)
+  State(asio::io_context& io_context, std::vector<ReplaySubject> subjects, ViconServerOptions opts)
       : io(io_context),
-        capture(capture_in),
         options(std::move(opts)),
         congestion("vicon server", options.tcp_congestion),
-        encoder(capture, options.subject_name, options.rate_hz),
+        encoder(subjects, options.rate_hz, options.loop),
         acceptor(io),
         timer(io),
         multicast_socket(io) {}
 
   asio::io_context& io;
-  const Capture& capture;
   ViconServerOptions options;
   AcceptedSocketCongestion congestion;  // options.tcp_congestion on each client
   vicon::CaptureFrameEncoder encoder;
@@ -81,6 +79,7 @@ struct ViconServer::State : std::enable_shared_from_this<ViconServer::State> {
   Clock::time_point timeline_start;
   uint64_t next_sequence = 0;      // k of the next frame to produce
   uint64_t latest_sequence = 0;    // k of the newest produced frame (valid when produced > 0)
+  uint64_t latest_listed = 0;      // the subjects the newest frame lists (CaptureFrameEncoder::listed)
   Packet latest_plain;             // the newest frame without static objects
   Packet latest_with_static;       // ... and with them (made when a client first needs it)
 
@@ -105,6 +104,7 @@ struct ViconServer::State : std::enable_shared_from_this<ViconServer::State> {
     bool push = false;
     int pull_requests = 0;
     bool sent_any_frame = false;
+    uint64_t listed_sent = 0;  // the subjects listed in the SubjectInfo it was sent last
     bool has_last_sent = false;
     uint64_t last_sent_sequence = 0;
     std::vector<uint32_t> wanted;  // empty: everything offered
@@ -316,7 +316,7 @@ struct ViconServer::State : std::enable_shared_from_this<ViconServer::State> {
   }
 
   void start_timeline() {
-    if (timeline_started || !running || capture.frame_count <= 0) return;
+    if (timeline_started || !running || encoder.frame_count() <= 0) return;
     timeline_started = true;
     timeline_start = Clock::now();
     schedule();
@@ -338,13 +338,12 @@ struct ViconServer::State : std::enable_shared_from_this<ViconServer::State> {
 
   void produce() {
     const uint64_t sequence = next_sequence++;
-    const int index = static_cast<int>(sequence % static_cast<uint64_t>(capture.frame_count));
-    const auto frame_number = static_cast<uint32_t>(static_cast<int64_t>(capture.first_frame) + static_cast<int64_t>(sequence));
-    encoder.encode_frame(index, frame_number, false, writer);
+    const auto frame_number = static_cast<uint32_t>(static_cast<int64_t>(encoder.first_frame()) + static_cast<int64_t>(sequence));
+    encoder.encode_frame(sequence, frame_number, false, writer);
     latest_plain = copy_packet(writer.finish());
     latest_with_static.reset();
     latest_sequence = sequence;
-    latest_index = index;
+    latest_listed = encoder.listed(sequence);
     latest_frame_number = frame_number;
     ++stats.frames_produced;
 
@@ -356,7 +355,7 @@ struct ViconServer::State : std::enable_shared_from_this<ViconServer::State> {
     for (auto& session : std::vector<std::shared_ptr<Session>>(sessions)) serve(*session);
     send_multicast();
 
-    if (!options.loop && next_sequence >= static_cast<uint64_t>(capture.frame_count)) {
+    if (!options.loop && next_sequence >= static_cast<uint64_t>(encoder.frame_count())) {
       done = true;
       if (on_finished) on_finished();
       return;
@@ -366,7 +365,7 @@ struct ViconServer::State : std::enable_shared_from_this<ViconServer::State> {
 
   const Packet& with_static() {
     if (!latest_with_static) {
-      encoder.encode_frame(latest_index, latest_frame_number, true, writer);
+      encoder.encode_frame(latest_sequence, latest_frame_number, true, writer);
       latest_with_static = copy_packet(writer.finish());
     }
     return latest_with_static;
@@ -377,9 +376,12 @@ struct ViconServer::State : std::enable_shared_from_this<ViconServer::State> {
     if (!session.open || stats.frames_produced == 0) return;
     if (!session.push && session.pull_requests <= 0) return;
     if (session.has_last_sent && session.last_sent_sequence >= latest_sequence) return;
-    Packet packet = session.sent_any_frame ? latest_plain : with_static();
+    // Static objects in a client's first frame and whenever the subjects listed changed.
+    const bool needs_static = !session.sent_any_frame || session.listed_sent != latest_listed;
+    Packet packet = needs_static ? with_static() : latest_plain;
     if (!session.wanted.empty()) packet = filter_packet(packet, session.wanted);
     session.sent_any_frame = true;
+    session.listed_sent = latest_listed;
     session.has_last_sent = true;
     session.last_sent_sequence = latest_sequence;
     if (!session.push) --session.pull_requests;
@@ -419,12 +421,14 @@ struct ViconServer::State : std::enable_shared_from_this<ViconServer::State> {
     }
   }
 
-  int latest_index = 0;
   uint32_t latest_frame_number = 0;
 };
 
+ViconServer::ViconServer(asio::io_context& io, std::vector<ReplaySubject> subjects, ViconServerOptions options)
+    : state_(std::make_shared<State>(io, std::move(subjects), std::move(options))) {}
+
 ViconServer::ViconServer(asio::io_context& io, const Capture& capture, ViconServerOptions options)
-    : state_(std::make_shared<State>(io, capture, std::move(options))) {}
+    : ViconServer(io, {{options.subject_name, &capture}}, options) {}
 
 ViconServer::~ViconServer() { stop(); }
 

@@ -9,7 +9,12 @@
 //                                          sent to that client (waits for the next if none)
 //   Ping                                   echoed back
 //   StartMulticastSender / Stop...         UDP datagrams, one whole packet each, to group:port
-// A client's first frame also carries StreamInfo and SubjectInfo; every datagram carries them.
+// A client's first frame also carries StreamInfo and SubjectInfo, and so does the first frame
+// after the subjects listed changed (a subject came or went); every datagram carries them.
+//
+// Several recordings stream as several subjects of one stream, each frame holding one frame of
+// each (protocol/vicon_capture_encoder.h: a subject whose recording has no marker in a frame is
+// not listed in it).
 //
 // Frames leave on absolute steady-clock deadlines (start + k * period / speed), so the stream
 // does not drift. The timeline starts when the first client asks for a frame (or at start() with
@@ -28,8 +33,10 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "core/capture.h"
+#include "protocol/vicon_capture_encoder.h"
 #include "protocol/vicon_datastream.h"
 #include "server/asio.h"
 
@@ -38,7 +45,7 @@ namespace skinstream::server {
 struct ViconServerOptions {
   std::string bind_address = "0.0.0.0";
   uint16_t port = vicon::kDefaultPort;  // 0: an ephemeral port (see ViconServer::port())
-  std::string subject_name = "subject";
+  std::string subject_name = "subject";  // of a single recording
   double rate_hz = 0.0;  // announced and streamed rate; 0: the capture's
   double speed = 1.0;    // 2: twice as fast in wall time (StreamInfo still announces rate_hz)
   bool loop = false;
@@ -67,8 +74,11 @@ class ViconServer {
  public:
   using FrameHook = std::function<void(uint32_t frame_number, int64_t send_time_ns)>;
 
-  // The capture must outlive the server. Everything but stats() runs on the io_context's
+  // The captures must outlive the server. Everything but stats() runs on the io_context's
   // thread (or before it runs / after it stopped), destruction included: the sessions live there.
+  // Throws std::invalid_argument for recordings that cannot share a stream (different rates).
+  ViconServer(asio::io_context& io, std::vector<ReplaySubject> subjects, ViconServerOptions options);
+  // One recording, streamed as the subject options.subject_name.
   ViconServer(asio::io_context& io, const Capture& capture, ViconServerOptions options);
   ~ViconServer();
   ViconServer(const ViconServer&) = delete;

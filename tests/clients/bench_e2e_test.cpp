@@ -179,6 +179,36 @@ TEST(BenchProgram, ShapedLinkWithoutRootSaysWhatItNeeds) {
                                                                 "/live.c3d --seconds 1 --link-mbit 100"));
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.output.find("--link-mbit needs root"), std::string::npos) << r.output;
+// --subjects 2: two actors (the recording twice, apart), each followed by the daemon, with a
+// subscriber each, and reported with its own threads' CPU, frames and its subscriber's latency;
+// the io and publish threads are nobody's.
+TEST(BenchProgram, SeveralSubjectsAreEachReportedWithTheirOwnThreadsAndSubscribers) {
+  const test::ProgramRun r = test::run_program(
+      bench("--subject " + kDemo + "/subject.sksubj --recording " + kDemo + "/live.c3d --seconds 2 --subjects 2 --subscribers 2 --json"),
+      /*stderr_too=*/false);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto j = nlohmann::json::parse(r.output);
+  EXPECT_EQ(j["subjects"], 2);
+  const auto& rows = j["per_subject"]["subjects"];
+  ASSERT_EQ(rows.size(), 2u);
+  double total = 0.0;
+  for (int k = 0; k < 2; ++k) {
+    SCOPED_TRACE(k);
+    EXPECT_EQ(rows[k]["name"], "Actor" + std::to_string(k + 1));
+    EXPECT_GT(rows[k]["frames"]["received"].get<long>(), 0);
+    EXPECT_GT(rows[k]["cpu_share_of_one_core"].get<double>(), 0.0);
+    EXPECT_EQ(rows[k]["deform"]["threads"], 2);
+    EXPECT_GT(rows[k]["subscribers"]["received"].get<long>(), 0);
+    EXPECT_LE(rows[k]["subscribers"]["end_to_end"]["count"].get<long>(), rows[k]["subscribers"]["received"].get<long>());
+    EXPECT_LE(rows[k]["subscribers"]["end_to_end"]["p50_ms"].get<double>(), rows[k]["subscribers"]["end_to_end"]["p99_ms"].get<double>());
+    total += rows[k]["cpu_share_of_one_core"].get<double>();
+  }
+  EXPECT_DOUBLE_EQ(j["per_subject"]["mean_cpu_share_per_subject"].get<double>(), total / 2);
+  EXPECT_EQ(rows[0]["subscribers"]["received"].get<long>() + rows[1]["subscribers"]["received"].get<long>(),
+            j["frames"]["received_by_subscribers"].get<long>());
+  EXPECT_TRUE(j["per_subject"]["shared_threads_cpu_share"].contains("io")) << j["per_subject"].dump();
+  EXPECT_FALSE(j["per_subject"]["shared_threads_cpu_share"].contains("pipeline-0"));
+  EXPECT_EQ(j["daemon"]["exit_status"], 0);
 }
 
 TEST(BenchProgram, MissingRecordingFailsNamingIt) {

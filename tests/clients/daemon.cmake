@@ -3,8 +3,9 @@
 # `skinstream fill`; a Vicon DataStream source (skinstream-replay) going away and coming back;
 # the demo subject's vertex buffers against `skinstream fill` + `deform`; bad paths fail clearly.
 if(TARGET skinstreamd AND TARGET skinstream-sub AND TARGET skinstream-replay)
-  add_executable(daemon_tests ${CMAKE_CURRENT_LIST_DIR}/daemon_e2e_test.cpp ${PROJECT_SOURCE_DIR}/tests/support/test_data.cpp
-  ${PROJECT_SOURCE_DIR}/tests/support/program_run.cpp ${PROJECT_SOURCE_DIR}/tests/support/daemon_process.cpp)
+  add_executable(daemon_tests ${CMAKE_CURRENT_LIST_DIR}/daemon_e2e_test.cpp ${CMAKE_CURRENT_LIST_DIR}/daemon_subjects_e2e_test.cpp
+    ${PROJECT_SOURCE_DIR}/tests/support/test_data.cpp ${PROJECT_SOURCE_DIR}/tests/support/program_run.cpp
+    ${PROJECT_SOURCE_DIR}/tests/support/daemon_process.cpp)
   target_include_directories(daemon_tests PRIVATE ${PROJECT_SOURCE_DIR}/tests)
   # skinstream_server for the blocking subscriber client (server/client/) the tests subscribe with.
   target_link_libraries(daemon_tests PRIVATE skinstream_server skinstream_protocol_offline nlohmann_json::nlohmann_json GTest::gtest_main)

@@ -26,139 +26,20 @@
 #include "protocol/capture_file.h"
 #include "protocol/point_cache.h"
 #include "server/client/subscriber_client.h"
+#include "support/program_processes.h"
 #include "support/program_run.h"
-#include "support/daemon_process.h"
+#include "support/recording_match.h"
 #include "support/test_data.h"
 
 namespace skinstream {
 namespace {
 
+using test::BackgroundSubscriber;
+using test::DaemonProcess;
+using test::eventually;
 using test::ProgramRun;
+using test::ReplayProcess;
 ProgramRun run(const std::string& command_line) { return test::run_program(command_line); }
-
-// A daemon in the background, through the harness the bench uses too.
-struct DaemonProcess : test::DaemonProcess {
-  explicit DaemonProcess(const std::string& arguments, const std::string& shell_prefix = "")
-      : test::DaemonProcess(SKINSTREAMD, arguments, shell_prefix) {}
-};
-
-// skinstream-replay in the background: a Vicon DataStream server looping a recording.
-class ReplayProcess {
- public:
-  // port 0: any free port (see port). `extra` goes on the command line as it is.
-  ReplayProcess(const std::string& recording, int port, const std::string& extra = "") {
-    out_path_ = test::scratch_path("replay_" + std::to_string(getpid()) + "_" + std::to_string(counter_++) + ".out");
-    std::remove(out_path_.c_str());
-    pid_ = fork();
-    if (pid_ == 0) {
-      const std::string command = "exec " + std::string(SKINSTREAM_REPLAY) + " " + recording + " --bind 127.0.0.1 --port " +
-                                  std::to_string(port) + " --loop " + extra + " > " + out_path_ + " 2> " + out_path_ + ".log";
-      execl("/bin/sh", "sh", "-c", command.c_str(), static_cast<char*>(nullptr));
-      _exit(127);
-    }
-    for (;;) {
-      std::ifstream in(out_path_);
-      std::string line;
-      if (in && std::getline(in, line) && line.find('}') != std::string::npos) {
-        this->port = nlohmann::json::parse(line)["port"];
-        return;
-      }
-      if (waitpid(pid_, nullptr, WNOHANG) == pid_) {
-        pid_ = -1;
-        ADD_FAILURE() << "skinstream-replay exited at startup";
-        return;
-      }
-      std::this_thread::sleep_for(std::chrono::milliseconds(20));
-    }
-  }
-  ~ReplayProcess() { kill_now(); }
-  // SIGKILL: the source vanishes as a crashed or unplugged server would, without a goodbye.
-  void kill_now() {
-    if (pid_ <= 0) return;
-    kill(pid_, SIGKILL);
-    waitpid(pid_, nullptr, 0);
-    pid_ = -1;
-  }
-  int port = 0;
-
- private:
-  static inline int counter_ = 0;
-  pid_t pid_ = -1;
-  std::string out_path_;
-};
-
-
-// Polls `condition` every 20 ms for up to `limit`: a bound on a hang, not a timing assertion.
-bool eventually(const std::function<bool()>& condition, std::chrono::seconds limit = std::chrono::seconds(20)) {
-  const auto end = std::chrono::steady_clock::now() + limit;
-  while (std::chrono::steady_clock::now() < end) {
-    if (condition()) return true;
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
-  }
-  return condition();
-}
-
-// A subscriber on its own thread that keeps every Status and counts frames, until stopped.
-class BackgroundSubscriber {
- public:
-  BackgroundSubscriber(int port, uint32_t wants) {
-    thread_ = std::thread([this, port, wants] {
-      try {
-        sub::SubscriberClient client("127.0.0.1", std::to_string(port), wants);
-        client.run([this](subscriber::MessageType type, std::span<const unsigned char> payload, int64_t) {
-          std::lock_guard lock(mutex_);
-          if (type == subscriber::MessageType::Status) statuses_.push_back(subscriber::decode_status(payload));
-          if (type == subscriber::MessageType::Frame) {
-            last_frame_number_ = subscriber::decode_frame(payload).info.frame_number;
-            ++frames_;
-          }
-          return !stop_.load();
-        });
-      } catch (const std::exception& e) {
-        std::lock_guard lock(mutex_);
-        error_ = e.what();
-      }
-      closed_ = true;
-    });
-  }
-  ~BackgroundSubscriber() {
-    stop_ = true;
-    thread_.join();  // a Status arrives at least every status interval, so run() returns
-  }
-  long frames() const {
-    std::lock_guard lock(mutex_);
-    return frames_;
-  }
-  uint32_t last_frame_number() const {
-    std::lock_guard lock(mutex_);
-    return last_frame_number_;
-  }
-  // Statuses received from index `from` on with this state.
-  bool saw_status(subscriber::SourceStateCode state, size_t from = 0) const {
-    std::lock_guard lock(mutex_);
-    for (size_t i = from; i < statuses_.size(); ++i)
-      if (statuses_[i].state == state) return true;
-    return false;
-  }
-  size_t status_count() const {
-    std::lock_guard lock(mutex_);
-    return statuses_.size();
-  }
-  bool closed() const { return closed_.load(); }
-  std::string error() const {
-    std::lock_guard lock(mutex_);
-    return error_;
-  }
-
- private:
-  mutable std::mutex mutex_;
-  std::vector<subscriber::Status> statuses_;
-  long frames_ = 0;
-  uint32_t last_frame_number_ = 0;
-  std::string error_;
-  std::atomic<bool> stop_{false}, closed_{false};
-  std::thread thread_;
-};
 
 class DaemonProgram : public ::testing::Test {
  protected:
@@ -373,6 +254,22 @@ long count_lines_with(const std::string& text, const std::string& needle) {
   return count;
 }
 
+// A person watching the log: a status line per subject every status_log_seconds, and the
+// replay's loops (each a new take for the filler) not announced each time.
+TEST_F(DaemonProgram, LogsAStatusLineAndNotEveryLoopOfAReplay) {
+  const std::string config = test::scratch_path("status_" + std::to_string(getpid()) + ".json");
+  { std::ofstream(config) << R"({"status_log_seconds": 1})"; }
+  DaemonProcess daemon("--config " + config + " --subject " + subject_ + " --replay " + take_ + " --loop --speed 4");
+  ASSERT_GT(daemon.http_port, 0);
+  ASSERT_TRUE(eventually([&] { return count_lines_with(daemon.log(), "frames in") >= 3; })) << daemon.log();
+  EXPECT_EQ(daemon.stop(), 0);
+  const std::string log = daemon.log();
+  EXPECT_EQ(count_lines_with(log, "source: streaming"), 1) << log;
+  // The take lasts 0.5 s at 4x: several loops in the run, one "streaming" line.
+  EXPECT_NE(log.find(" out ("), std::string::npos) << log;
+  EXPECT_NE(log.find("0 subscribers; dropped"), std::string::npos) << log;
+}
+
 // Out of file descriptors (the daemon limited to 64) with subscriber connections still waiting in
 // the kernel's queue, every accept fails at once: the daemon pauses its accepts instead of
 // retrying (it spun, logging every failure), counts the failures, answers /health on the
@@ -430,18 +327,6 @@ TEST_F(DaemonProgram, OutOfDescriptorsPausesAcceptsAndHealthStillAnswers) {
 // through each capture system's protocol).
 enum class ViconMode { Push, Pull, Multicast, Qtm, NatNet };
 
-// A UDP port free on loopback right now: bound, noted, closed.
-int free_udp_port() {
-  const int holder = socket(AF_INET, SOCK_DGRAM, 0);
-  sockaddr_in address{};
-  address.sin_family = AF_INET;
-  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  if (bind(holder, reinterpret_cast<sockaddr*>(&address), sizeof address) != 0) return 0;
-  socklen_t length = sizeof address;
-  getsockname(holder, reinterpret_cast<sockaddr*>(&address), &length);
-  close(holder);
-  return ntohs(address.sin_port);
-}
 
 void expect_vicon_stream_in_order(const std::string& subject, const std::string& take, ViconMode mode) {
   const Capture recording = read_capture(take);
@@ -451,7 +336,7 @@ void expect_vicon_stream_in_order(const std::string& subject, const std::string&
   if (mode == ViconMode::Multicast) {
     // Datagrams to this host's loopback address (a 239.x group does not loop back in every
     // sandbox); the daemon listens first, then the replay streams with nobody on TCP.
-    const int udp_port = free_udp_port();
+    const int udp_port = test::free_loopback_port(SOCK_DGRAM);
     ASSERT_GT(udp_port, 0);
     daemon_process = std::make_unique<DaemonProcess>("--subject " + subject + " --vicon-multicast 127.0.0.1:" + std::to_string(udp_port));
     replay = std::make_unique<ReplayProcess>(take, 0, "--multicast 127.0.0.1:" + std::to_string(udp_port) + " --start-now");
@@ -480,38 +365,9 @@ void expect_vicon_stream_in_order(const std::string& subject, const std::string&
   EXPECT_EQ(health["source"]["state"], "streaming") << health.dump();
   EXPECT_NE(daemon.log().find(expected_log), std::string::npos) << daemon.log();
 
-  const int markers = recording.point_count();
-  std::vector<nlohmann::json> frames;
-  std::istringstream lines(sub.output);
-  for (std::string line; std::getline(lines, line);) {
-    const nlohmann::json j = nlohmann::json::parse(line);
-    if (j.contains("frame")) frames.push_back(j);
-  }
+  const std::vector<nlohmann::json> frames = test::frames_of(sub.output);
   ASSERT_EQ(frames.size(), static_cast<size_t>(kFrames));
-  long measured = 0, measured_equal = 0;
-  for (size_t i = 0; i < frames.size(); ++i) {
-    const int number = frames[i]["frame"];
-    if (i > 0) {  // numbers never go back, even across loops
-      EXPECT_GT(number, frames[i - 1]["frame"].get<int>()) << "frame " << i;
-    }
-    ASSERT_GE(number, recording.first_frame);
-    const int index = (number - recording.first_frame) % recording.frame_count;
-    const std::vector<float> live = frames[i]["markers"];
-    ASSERT_EQ(live.size(), static_cast<size_t>(3 * markers));
-    for (int m = 0; m < markers; ++m) {
-      for (int a = 0; a < 3; ++a) ASSERT_TRUE(std::isfinite(live[3 * m + a])) << "frame " << number << " marker " << m;
-      const Vec3 sample = recording.at(index, m);
-      if (!is_present(sample)) continue;
-      ++measured;
-      // Measured samples pass through unchanged (C3D float -> Vicon double / QTM float / NatNet
-      // float metres -> published float), NatNet's metres within 0.2 um.
-      const Vec3 got(live[3 * m], live[3 * m + 1], live[3 * m + 2]);
-      if ((got - sample).norm() < 1e-3) ++measured_equal;
-    }
-  }
-  ASSERT_GT(measured, 0);
-  // The relabeller may refuse a label now and then; the mapping is wrong if many differ.
-  EXPECT_GE(measured_equal, measured * 99 / 100) << measured_equal << " of " << measured << " measured samples equal the recording";
+  test::expect_frames_follow_recording(recording, frames);
 }
 
 TEST_F(DaemonProgram, ViconServerPushReachesTheSubscriberInOrder) { expect_vicon_stream_in_order(subject_, take_, ViconMode::Push); }
@@ -525,16 +381,9 @@ TEST_F(DaemonProgram, QtmReachesTheSubscriberInOrder) { expect_vicon_stream_in_o
 TEST_F(DaemonProgram, NatNetReachesTheSubscriberInOrder) { expect_vicon_stream_in_order(subject_, take_, ViconMode::NatNet); }
 
 TEST_F(DaemonProgram, ViconUnreachableIsReportedAndServingGoesOn) {
-  // A port nobody listens on: bind one, note it, close it.
-  const int holder = socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in address{};
-  address.sin_family = AF_INET;
-  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  ASSERT_EQ(bind(holder, reinterpret_cast<sockaddr*>(&address), sizeof address), 0);
-  socklen_t length = sizeof address;
-  getsockname(holder, reinterpret_cast<sockaddr*>(&address), &length);
-  close(holder);
-  DaemonProcess daemon("--subject " + subject_ + " --vicon 127.0.0.1:" + std::to_string(ntohs(address.sin_port)));
+  const int port = test::free_loopback_port(SOCK_STREAM);  // nobody listens on it
+  ASSERT_GT(port, 0);
+  DaemonProcess daemon("--subject " + subject_ + " --vicon 127.0.0.1:" + std::to_string(port));
   EXPECT_TRUE(eventually([&] { return server::fetch_health(daemon.http_port)["source"]["state"] == "disconnected"; })) << daemon.log();
   BackgroundSubscriber subscriber(daemon.sub_port, subscriber::kWantMarkers | subscriber::kWantNoMesh);
   EXPECT_TRUE(eventually([&] { return subscriber.saw_status(subscriber::SourceStateCode::Disconnected); })) << subscriber.error();
@@ -547,6 +396,32 @@ TEST_F(DaemonProgram, BadViconAddressFailsNamingIt) {
   const ProgramRun r = run(std::string(SKINSTREAMD) + " --subject " + subject_ + " --vicon localhost:eighty --http-port 0 --sub-port 0");
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.output.find("localhost:eighty"), std::string::npos) << r.output;
+}
+
+// A subject named after a Vicon subject the stream does not have is reported absent (/health,
+// Status, the log) and waited for; named after the one it has, it streams.
+TEST_F(DaemonProgram, NamedSubjectAbsentFromTheStreamIsReportedAndWaitedFor) {
+  ReplayProcess replay(take_, 0, "--subject Actor1");
+  DaemonProcess absent("--subject Actor2=" + subject_ + " --vicon 127.0.0.1:" + std::to_string(replay.port));
+  BackgroundSubscriber waiting(absent.sub_port, subscriber::kWantMarkers | subscriber::kWantNoMesh);
+  ASSERT_TRUE(eventually([&] { return server::fetch_health(absent.http_port)["source"]["state"] == "streaming"; })) << absent.log();
+  const nlohmann::json subject = server::fetch_health(absent.http_port)["subject"];
+  EXPECT_EQ(subject["name"], "Actor2");
+  EXPECT_FALSE(subject["present"].get<bool>()) << subject.dump();
+  EXPECT_EQ(subject["detail"], "the stream has no subject \"Actor2\" (it has \"Actor1\")");
+  EXPECT_TRUE(eventually([&] { return waiting.last_status_detail().find("subject Actor2 absent, waiting for it") == 0; }))
+      << waiting.last_status_detail();
+  EXPECT_EQ(waiting.frames(), 0);
+  EXPECT_NE(absent.log().find("subject Actor2: absent, waiting for it: the stream has no subject \"Actor2\""), std::string::npos)
+      << absent.log();
+
+  DaemonProcess present("--subject Actor1=" + subject_ + " --vicon 127.0.0.1:" + std::to_string(replay.port));
+  BackgroundSubscriber streaming(present.sub_port, subscriber::kWantMarkers | subscriber::kWantNoMesh);
+  EXPECT_TRUE(eventually([&] { return streaming.frames() >= 20; })) << streaming.error() << present.log();
+  EXPECT_TRUE(server::fetch_health(present.http_port)["subject"]["present"].get<bool>());
+  EXPECT_EQ(waiting.frames(), 0);
+  EXPECT_EQ(present.stop(), 0) << present.log();
+  EXPECT_EQ(absent.stop(), 0) << absent.log();
 }
 
 // The source goes away (skinstream-replay killed) and comes back on the same port: the daemon
@@ -585,39 +460,46 @@ class DaemonDemo : public ::testing::Test {
   static void SetUpTestSuite() {
     subject_ = std::string(SKINSTREAM_DEMO_DIR) + "/subject.sksubj";
     live_ = std::string(SKINSTREAM_DEMO_DIR) + "/live.c3d";
-    const std::string filled = test::scratch_path("demo_filled.c3d");
-    const std::string out = test::scratch_path("demo_deformed");
-    const ProgramRun fill = run(std::string(SKINSTREAM_CLI) + " fill --subject " + subject_ + " " + live_ + " --out " + filled);
-    ASSERT_EQ(fill.exit_code, 0) << fill.output;
+    offline_ = offline_deform(live_, "demo");
+    first_frame_ = read_capture(live_).first_frame;
+  }
+  // The offline pipeline on a take: `skinstream fill` (causal, lookahead 0) then `deform`.
+  static PointCache offline_deform(const std::string& take, const std::string& name) {
+    const std::string filled = test::scratch_path(name + "_filled.c3d");
+    const std::string out = test::scratch_path(name + "_deformed");
+    const ProgramRun fill = run(std::string(SKINSTREAM_CLI) + " fill --subject " + subject_ + " " + take + " --out " + filled);
+    EXPECT_EQ(fill.exit_code, 0) << fill.output;
     const ProgramRun deform = run(std::string(SKINSTREAM_CLI) + " deform --subject " + subject_ + " --capture " + filled + " --out " +
                                   out + " --format none");
-    ASSERT_EQ(deform.exit_code, 0) << deform.output;
-    offline_ = read_point_cache(out + "/deformed.pc2");
-    first_frame_ = read_capture(filled).first_frame;
+    EXPECT_EQ(deform.exit_code, 0) << deform.output;
+    return read_point_cache(out + "/deformed.pc2");
   }
   static inline std::string subject_, live_;
   static inline PointCache offline_;
   static inline int first_frame_ = 0;
 };
 
-// One pass of the looped replay as a subscriber saw it: the frames from the first one of a pass
-// (a new take for the filler) on, `count` of them, with their positions.
+// One pass of the replay as a subscriber saw it: the frames from the first one of a pass (a new
+// take for the filler) on, `count` of them, with their positions.
 struct DemoPass {
   std::vector<subscriber::Frame> frames;
   std::string problem;  // why the pass cannot be compared: a drop or a gap in the numbers
 };
 
-DemoPass receive_demo_pass(int sub_port, int first_frame, int count) {
+DemoPass receive_demo_pass(int sub_port, int first_frame, int count, const subscriber::Hello& hello = {}) {
   DemoPass pass;
-  sub::SubscriberClient client("127.0.0.1", std::to_string(sub_port), 0);  // float positions
+  long seen = 0;
+  sub::SubscriberClient client("127.0.0.1", std::to_string(sub_port), hello);  // wants 0: float positions
   client.run([&](subscriber::MessageType type, std::span<const unsigned char> payload, int64_t) {
     if (type != subscriber::MessageType::Frame) return true;
-    subscriber::Frame frame = subscriber::decode_frame(payload);
-    if (pass.frames.empty() && frame.info.frame_number != static_cast<uint32_t>(first_frame)) return true;  // wait for a pass
+    subscriber::Frame frame = subscriber::decode_frame(payload, hello.version);
+    // Wait for a pass, a bounded while (a source that never starts one again would hang the test).
+    if (pass.frames.empty() && frame.info.frame_number != static_cast<uint32_t>(first_frame)) return ++seen < 4L * count;
     pass.frames.push_back(std::move(frame));
     return static_cast<int>(pass.frames.size()) < count;
   });
-  if (static_cast<int>(pass.frames.size()) < count) pass.problem = "the daemon closed the connection";
+  if (pass.frames.empty()) pass.problem = "no pass started at frame " + std::to_string(first_frame);
+  else if (static_cast<int>(pass.frames.size()) < count) pass.problem = "the daemon closed the connection";
   for (size_t i = 0; i < pass.frames.size() && pass.problem.empty(); ++i) {
     const subscriber::FrameInfo& info = pass.frames[i].info;
     const subscriber::FrameInfo& start = pass.frames[0].info;
@@ -627,6 +509,36 @@ DemoPass receive_demo_pass(int sub_port, int first_frame, int count) {
       pass.problem = "a frame was dropped at frame " + std::to_string(info.frame_number);
   }
   return pass;
+}
+
+// Both sides run the same float deformer on the same filled markers, except that the daemon
+// deforms the filler's double markers while `deform` reads them back from the C3D file as
+// float32. At 1-2 m one float step is 1.22e-4 mm; the rounded marker positions move the
+// quadratic and RBF fits by a few steps (measured: frame 0, all markers measured, is exact;
+// later frames differ by 2-7 steps, at most 8.5e-4 mm, not growing over the take).
+// 2.5e-3 mm (~20 steps, 2e-6 relative to the ~1200 mm coordinates) bounds that with margin,
+// while the neighbouring frame of this take differs by 1.6-10 mm somewhere on the body.
+constexpr double kToleranceMm = 2.5e-3;
+
+// Every vertex of the pass's first `frames` frames within kToleranceMm of `offline`; returns the
+// largest difference.
+double expect_vertices_equal(const PointCache& offline, const DemoPass& pass, int frames) {
+  double worst = 0.0;
+  for (int f = 0; f < frames; ++f) {
+    const std::vector<float>& live = pass.frames[f].positions;
+    EXPECT_EQ(live.size(), static_cast<size_t>(3 * offline.point_count)) << "frame " << f;
+    if (live.size() != static_cast<size_t>(3 * offline.point_count)) return worst;
+    for (int v = 0; v < offline.point_count; ++v) {
+      const Vec3& expected = offline.at(f, v);
+      const double error = (Vec3(live[3 * v], live[3 * v + 1], live[3 * v + 2]) - expected).cwiseAbs().maxCoeff();
+      worst = std::max(worst, error);
+      if (error > kToleranceMm) {
+        ADD_FAILURE() << "frame " << f << " vertex " << v << " differs by " << error << " mm";
+        return worst;
+      }
+    }
+  }
+  return worst;
 }
 
 TEST_F(DaemonDemo, VertexBuffersEqualTheOfflinePipeline) {
@@ -645,27 +557,57 @@ TEST_F(DaemonDemo, VertexBuffersEqualTheOfflinePipeline) {
     std::printf("attempt %d: %s\n", attempt + 1, pass.problem.c_str());
   }
   ASSERT_TRUE(pass.problem.empty()) << pass.problem << " in both attempts: the fill history differs from the offline run";
-
-  // Both sides run the same float deformer on the same filled markers, except that the daemon
-  // deforms the filler's double markers while `deform` reads them back from the C3D file as
-  // float32. At 1-2 m one float step is 1.22e-4 mm; the rounded marker positions move the
-  // quadratic and RBF fits by a few steps (measured: frame 0, all markers measured, is exact;
-  // later frames differ by 2-7 steps, at most 8.5e-4 mm, not growing over the take).
-  // 2.5e-3 mm (~20 steps, 2e-6 relative to the ~1200 mm coordinates) bounds that with margin,
-  // while the neighbouring frame of this take differs by 1.6-10 mm somewhere on the body.
-  constexpr double kToleranceMm = 2.5e-3;
-  double worst = 0.0;
-  for (int f = 0; f < kFrames; ++f) {
-    const std::vector<float>& live = pass.frames[f].positions;
-    ASSERT_EQ(live.size(), static_cast<size_t>(3 * offline_.point_count)) << "frame " << first_frame_ + f;
-    for (int v = 0; v < offline_.point_count; ++v) {
-      const Vec3& expected = offline_.at(f, v);
-      const double error = (Vec3(live[3 * v], live[3 * v + 1], live[3 * v + 2]) - expected).cwiseAbs().maxCoeff();
-      worst = std::max(worst, error);
-      ASSERT_LE(error, kToleranceMm) << "frame " << first_frame_ + f << " vertex " << v;
-    }
-  }
+  const double worst = expect_vertices_equal(offline_, pass, kFrames);
   std::printf("largest vertex difference over %d frames x %d vertices: %.3g mm\n", kFrames, offline_.point_count, worst);
+}
+
+// Two actors of the demo subject on one stage, from skinstream-replay: Actor1 plays the jump rope,
+// Actor2 the punch 3 m away. Each subject's subscriber (naming it, protocol version 2) receives
+// that subject's vertices, equal to the offline fill + deform of its own take.
+TEST_F(DaemonDemo, TwoSubjectsEachReceiveTheVerticesOfTheirOwnTake) {
+  constexpr int kFrames = 60;  // half a second of each, the takes cut to it
+  std::vector<int> channels;
+  const Capture jump = read_capture(live_);
+  for (int c = 0; c < jump.point_count(); ++c) channels.push_back(c);
+  const std::string take1 = test::scratch_path("stage_jumprope.c3d"), take2 = test::scratch_path("stage_punch.c3d");
+  write_capture(jump.select(channels, 0, kFrames), take1);
+  Capture punch = read_capture(test::source_path("replay_data/synthetic/punch_2s_seed1.c3d"));
+  channels.resize(static_cast<size_t>(punch.point_count()));
+  for (int c = 0; c < punch.point_count(); ++c) channels[static_cast<size_t>(c)] = c;
+  punch = punch.select(channels, 0, kFrames);
+  for (int f = 0; f < punch.frame_count; ++f)
+    for (int c = 0; c < punch.point_count(); ++c)
+      if (punch.present(f, c)) punch.at(f, c) += Vec3(3000.0, 0.0, 0.0);
+  write_capture(punch, take2);
+  ASSERT_EQ(punch.first_frame, first_frame_);
+  const PointCache offline1 = offline_deform(take1, "stage_jumprope"), offline2 = offline_deform(take2, "stage_punch");
+
+  DemoPass actor1, actor2;
+  for (int attempt = 0; attempt < 2; ++attempt) {  // one retry; a second drop fails the test
+    // The daemon and both subscribers are up before the replay is: each sees its take from its
+    // first frame. A tenth of the speed: each frame waits rather than gives way on a busy machine.
+    const int port = test::free_loopback_port(SOCK_STREAM);
+    ASSERT_GT(port, 0);
+    DaemonProcess daemon("--subject Actor1=" + subject_ + " --subject Actor2=" + subject_ + " --vicon 127.0.0.1:" +
+                         std::to_string(port) + " --max-frame-wait-ms 1000");
+    std::thread other([&] { actor2 = receive_demo_pass(daemon.sub_port, first_frame_, kFrames, {.version = subscriber::kVersion2, .subject = "Actor2"}); });
+    std::thread first([&] { actor1 = receive_demo_pass(daemon.sub_port, first_frame_, kFrames, {.version = subscriber::kVersion2, .subject = "Actor1"}); });
+    EXPECT_TRUE(eventually([&] {
+      const nlohmann::json health = server::fetch_health(daemon.http_port);
+      return health["subjects"][0]["subscribers"] == 1 && health["subjects"][1]["subscribers"] == 1;
+    })) << daemon.log();
+    ReplayProcess replay(take1 + " " + take2, port, "--subject Actor1 --subject Actor2 --speed 0.1");
+    first.join();
+    other.join();
+    EXPECT_EQ(daemon.stop(), 0) << daemon.log();
+    if (actor1.problem.empty() && actor2.problem.empty()) break;
+    std::printf("attempt %d: Actor1: %s; Actor2: %s\n", attempt + 1, actor1.problem.c_str(), actor2.problem.c_str());
+  }
+  ASSERT_TRUE(actor1.problem.empty()) << "Actor1: " << actor1.problem;
+  ASSERT_TRUE(actor2.problem.empty()) << "Actor2: " << actor2.problem;
+  const double worst1 = expect_vertices_equal(offline1, actor1, kFrames);
+  const double worst2 = expect_vertices_equal(offline2, actor2, kFrames);
+  std::printf("largest vertex difference over %d frames: Actor1 %.3g mm, Actor2 %.3g mm\n", kFrames, worst1, worst2);
 }
 
 }  // namespace

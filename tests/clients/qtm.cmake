@@ -26,8 +26,8 @@ endif()
 
 # skinstream-replay's QTM RT and NatNet modes: bad command lines fail with one error line.
 set(other_rate ${SKINSTREAM_SHARED_DIR}/data/captures/kineticstoolkit/kinematics_tennis_serve.c3d)
-add_test(NAME replay.vicon_takes_one_recording COMMAND skinstream-replay ${qtm_cmu} ${qtm_dense} --port 0)
-set_tests_properties(replay.vicon_takes_one_recording PROPERTIES PASS_REGULAR_EXPRESSION "error: --protocol vicon streams one recording")
+add_test(NAME replay.vicon_rates_must_agree COMMAND skinstream-replay ${qtm_cmu} ${other_rate} --port 0)
+set_tests_properties(replay.vicon_rates_must_agree PROPERTIES PASS_REGULAR_EXPRESSION "error: .* Hz; pass --rate")
 add_test(NAME replay.unknown_protocol COMMAND skinstream-replay --protocol motive ${qtm_cmu} --port 0)
 add_test(NAME replay.rates_must_agree COMMAND skinstream-replay --protocol natnet ${qtm_cmu} ${other_rate} --port 0)
 set_tests_properties(replay.rates_must_agree PROPERTIES PASS_REGULAR_EXPRESSION "error: .* Hz; pass --rate")
@@ -38,6 +38,6 @@ set_tests_properties(replay.qtm_missing_file PROPERTIES PASS_REGULAR_EXPRESSION 
 add_test(NAME replay.qtm_plays_to_the_end COMMAND skinstream-replay --protocol qtm ${qtm_cmu} ${qtm_dense} --port 0 --start-now --speed 50)
 add_test(NAME replay.natnet_plays_to_the_end COMMAND skinstream-replay --protocol natnet --unicast ${qtm_cmu} --port 0 --start-now --speed 50)
 set_tests_properties(replay.unknown_protocol replay.bad_natnet_version PROPERTIES WILL_FAIL TRUE)
-set_tests_properties(replay.vicon_takes_one_recording replay.unknown_protocol replay.rates_must_agree
+set_tests_properties(replay.vicon_rates_must_agree replay.unknown_protocol replay.rates_must_agree
   replay.bad_natnet_version replay.qtm_missing_file replay.qtm_plays_to_the_end replay.natnet_plays_to_the_end
   PROPERTIES LABELS clients)

@@ -12,6 +12,15 @@ add_test(NAME replay.plays_to_the_end COMMAND skinstream-replay ${replay_capture
 add_test(NAME replay.prints_port_json COMMAND skinstream-replay ${replay_capture} --port 0 --start-now --speed 50)
 set_tests_properties(replay.prints_port_json PROPERTIES PASS_REGULAR_EXPRESSION "{\"port\": [1-9][0-9]*}")
 
+# Several recordings stream as several subjects of one stream; each needs its own name.
+add_test(NAME replay.several_recordings COMMAND skinstream-replay ${replay_capture} ${PROJECT_SOURCE_DIR}/replay_data/cmu/85_12.c3d
+  --subject Actor1 --subject Actor2 --port 0 --start-now --speed 50)
+set_tests_properties(replay.several_recordings PROPERTIES PASS_REGULAR_EXPRESSION "as subject 'Actor1'.*as subject 'Actor2'")
+add_test(NAME replay.subject_per_recording COMMAND skinstream-replay ${replay_capture} ${replay_capture} --subject Actor1 --port 0)
+set_tests_properties(replay.subject_per_recording PROPERTIES PASS_REGULAR_EXPRESSION "error: --subject is given 1 times for 2 recordings")
+add_test(NAME replay.one_name_twice COMMAND skinstream-replay ${replay_capture} ${replay_capture} --subject A --subject A --port 0)
+set_tests_properties(replay.one_name_twice PROPERTIES PASS_REGULAR_EXPRESSION "error: two recordings stream as subject \"A\"")
+
 # A real client over TCP (bash /dev/tcp): the server greets with ObjectEnums (type 100001 =
 # a1 86 01 00, packet length 44), answers RequestFrame{true} with frames, then exits 0.
 add_test(NAME replay.serves_a_tcp_client COMMAND bash -c [=[
@@ -55,4 +64,4 @@ set_tests_properties(replay.missing_file replay.truncated_file replay.port_out_o
 set_tests_properties(replay.help replay.plays_to_the_end replay.prints_port_json replay.serves_a_tcp_client
   replay.missing_file replay.missing_file_message replay.truncated_file replay.truncated_file_message
   replay.port_out_of_range replay.port_not_a_number replay.port_message replay.bad_speed replay.loop_and_hold
-  replay.bad_tcp_congestion PROPERTIES LABELS clients)
+  replay.bad_tcp_congestion replay.several_recordings replay.subject_per_recording replay.one_name_twice PROPERTIES LABELS clients)

@@ -138,6 +138,34 @@ TEST(SkinstreamCli, FillsDeletedGapsOfARealCaptureAccurately) {
   for (const Vec3& p : filled.positions) ASSERT_TRUE(p.allFinite());
 }
 
+// The long-gap protocol on a shared real take (CMU 85_12, first half trains, seeded 2-6 s gaps of
+// three markers at once in the second): the online filler against the offline Gloersen PCA on the
+// same gaps, with the targets of the accuracy issue (mean at most 1.5 times, maximum at most
+// the offline one's), and no measured sample changed. Measured when written: mean 18.2 against
+// 31.1 mm (0.58), maximum 84 against 145 mm (0.58).
+TEST(SkinstreamCli, EvalFillLongGapsHoldUpAgainstTheOfflinePca) {
+  const ProgramRun r = run("eval-fill --capture " + std::string(SKINSTREAM_SHARED_DIR) +
+                           "/data/captures/cmu/85_12.c3d --seed 4 --gap-protocol long --json");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto j = nlohmann::json::parse(r.output);
+  EXPECT_EQ(j["gaps"]["protocol"], "long");
+  EXPECT_GE(j["gaps"]["fraction_of_samples"].get<double>(), 0.04);
+  EXPECT_GE(j["gaps"]["longest_frames"].get<int>(), 240);
+  EXPECT_LE(j["gaps"]["longest_frames"].get<int>(), 720);
+  nlohmann::json online, offline;
+  for (const auto& m : j["methods"]) {
+    if (m["name"] == "skinstream_online") online = m;
+    if (m["name"] == "gloersen_pca") offline = m;
+  }
+  ASSERT_FALSE(online.is_null() || offline.is_null());
+  EXPECT_EQ(online["unfilled"], 0);
+  EXPECT_EQ(online["changed_measured_samples"], 0);
+  EXPECT_LE(online["mm"]["mean"].get<double>(), 1.5 * offline["mm"]["mean"].get<double>());
+  EXPECT_LE(online["mm"]["max"].get<double>(), offline["mm"]["max"].get<double>());
+  EXPECT_DOUBLE_EQ(j["online_to_gloersen"]["mean_ratio"].get<double>(),
+                   online["mm"]["mean"].get<double>() / offline["mm"]["mean"].get<double>());
+}
+
 // A short synthetic flexing take, with skinstream's relabeller and online filler judged against
 // its truth by `synth --stats`. Asserts the targets of the synthetic-data issue on this gentle
 // motion. Measured when written: 1.006 trajectories per marker after merging, 0.2% wrongly
@@ -165,7 +193,7 @@ TEST(SkinstreamCli, EvalDeformNamesTheVerticesBehindEachMaximum) {
   const auto j = nlohmann::json::parse(r.output);
   const auto& take = j["takes"][0];
   const int vertices = j["vertices"], frames = take["frames_evaluated"].get<int>() * 4;  // stride 4
-  ASSERT_EQ(take["methods"].size(), 5u);
+  ASSERT_EQ(take["methods"].size(), 6u);
   for (const auto& method : take["methods"]) {
     SCOPED_TRACE(method["method"].get<std::string>());
     const auto& worst = method["worst_vertices"];
@@ -180,7 +208,8 @@ TEST(SkinstreamCli, EvalDeformNamesTheVerticesBehindEachMaximum) {
       EXPECT_GE(worst[i]["frame"].get<int>(), 0);
       EXPECT_LT(worst[i]["frame"].get<int>(), frames);
       EXPECT_GT(worst[i]["nearest_marker_mm"].get<double>(), 0.0);
-      const bool part_based = method["method"] != "lbs_sparse";
+      EXPECT_FALSE(worst[i]["nearest_marker"].get<std::string>().empty());
+      const bool part_based = !method["method"].get<std::string>().starts_with("lbs_");
       ASSERT_EQ(worst[i].contains("parts"), part_based);
       if (!part_based) continue;
       double sum = 0.0;
@@ -194,6 +223,38 @@ TEST(SkinstreamCli, EvalDeformNamesTheVerticesBehindEachMaximum) {
       EXPECT_GE(best["error_mm"].get<double>(), 0.0);
     }
   }
+}
+
+// Conventional LBS runs twice: with weights from the rest mesh and skeleton alone (bone heat) and,
+// as an oracle, with the weights the synthetic truth is skinned with. The table's rule compares
+// the full method with every row but the oracle, on mean and p95; the maxima are reported with
+// the method that has the lowest and where the full method's occurs.
+TEST(SkinstreamCli, EvalDeformHasAConventionalLbsRowBehindTheFullMethod) {
+  const ProgramRun r = run(quick_eval_deform());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto j = nlohmann::json::parse(r.output);
+  const auto& methods = j["takes"][0]["methods"];
+  auto row = [&](const std::string& name) -> const nlohmann::json& {
+    for (const auto& m : methods)
+      if (m["method"] == name) return m;
+    ADD_FAILURE() << "no row " << name;
+    return methods[0];
+  };
+  const auto& full = row("full");
+  const auto& heat = row("lbs_bone_heat");
+  EXPECT_FALSE(heat["oracle"].get<bool>());
+  EXPECT_TRUE(row("lbs_truth_weights")["oracle"].get<bool>());
+  EXPECT_LT(full["vertex_mean_mm"].get<double>(), heat["vertex_mean_mm"].get<double>());
+  EXPECT_LT(full["vertex_p95_mm"].get<double>(), heat["vertex_p95_mm"].get<double>());
+  // LBS moves the skin with its bones, and weights made without the truth are a different
+  // deformation from the oracle's.
+  EXPECT_NE(heat["vertex_mean_mm"], row("lbs_truth_weights")["vertex_mean_mm"]);
+  const auto& rule = j["table_rule"];
+  EXPECT_EQ(rule["takes"], 1);
+  EXPECT_EQ(rule["met"], 1) << rule.dump(2);
+  ASSERT_EQ(rule["maxima"].size(), 1u);
+  EXPECT_EQ(rule["maxima"][0]["full_mm"], full["vertex_max_mm"]);
+  EXPECT_EQ(rule["maxima"][0]["full_at"]["vertex"], full["worst_vertices"][0]["vertex"]);
 }
 
 // Issue 4's claim, checked on a subject no setting was chosen on: with the generator's seed 2

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "support/allocation_counter.h"
 #include "core/offline/subject_builder.h"
 #include "support/synthetic_limb.h"
@@ -99,6 +101,7 @@ TEST(GapFiller, PcaBeatsTheRigidEstimateOnADeformingLimb) {
   rigid.use_pca = false;
   GapFillerOptions pca;
   pca.continuity_seconds = rigid.continuity_seconds = 0.0;  // compare the estimators alone
+  pca.carry_from_gap_start = rigid.carry_from_gap_start = false;
   const double rigid_error = mean_fill_error(fx, rigid, 0);
   const double pca_error = mean_fill_error(fx, pca, 0);
   const double spacing = fx.model.neighbour_distance(kMiddle);
@@ -190,6 +193,68 @@ TEST(GapFiller, RejoinsSwappedLabels) {
   }
 }
 
+// The overruled wrist of a real capture: a marker comes back from a gap where its estimate went
+// wrong (here it slid over the skin while hidden, which its ring cannot tell; there the hand
+// moved, which a few forearm markers cannot tell), while four of its ring members are still
+// missing. Its true measurement is then farther than eps2 from where the filler had it, and
+// nothing else explains the point (it lies between the neighbours' places): the measurement
+// stands, in every frame, untouched.
+TEST(GapFiller, KeepsATrueMeasurementItsPoorEstimateDisagreesWith) {
+  Fixture fx;
+  GapFiller filler(fx.model);
+  Frame frame(fx.model.marker_count());
+  const double eps2 = fx.model.parameters.alpha2 * fx.model.neighbour_distance(kMiddle);
+  // Between the next marker along the limb and the next one around it.
+  const Vec3 diagonal = (fx.truth.at(0, kMiddle + 8) + fx.truth.at(0, kMiddle + 1) - 2.0 * fx.truth.at(0, kMiddle)).normalized();
+  Vec3 before_return = Vec3::Zero();
+  for (int f = 0; f < 300; ++f) {
+    load(fx.truth, f, frame);
+    frame.labelled[kMiddle] += 1.2 * eps2 * std::clamp((f - 100) / 100.0, 0.0, 1.0) * diagonal;
+    if (f >= 100 && f < 200) frame.labelled[kMiddle] = missing_point();
+    if (f >= 100 && f < 210)
+      for (int k = 0; k < 4; ++k) frame.labelled[fx.model.ring[fx.model.ring_offsets[kMiddle] + k]] = missing_point();
+    const FillStats s = frame.run(filler);
+    if (f == 199) before_return = frame.positions[kMiddle];
+    if (f < 200) continue;
+    if (f == 200) {
+      ASSERT_GT((frame.labelled[kMiddle] - before_return).norm(), eps2) << "the estimate must disagree for this test";
+      for (int j = 0; j < fx.model.marker_count(); ++j)
+        if (j != kMiddle) {
+          ASSERT_GT((frame.labelled[kMiddle] - fx.truth.at(f, j)).norm(),
+                    fx.model.parameters.alpha1 * fx.model.neighbour_distance(j))
+              << "no other marker may be where the point is";
+        }
+    }
+    EXPECT_EQ(frame.status[kMiddle], MarkerStatus::Measured) << "frame " << f;
+    EXPECT_EQ(frame.positions[kMiddle], frame.labelled[kMiddle]) << "frame " << f;
+    EXPECT_EQ(s.rejected_labels, 0) << "frame " << f;
+    EXPECT_EQ(s.changed_measured, 0) << "frame " << f;
+  }
+}
+
+// A marker comes back from a gap under the label of a neighbour that was itself missing: the
+// point is far from the neighbour's estimate and next to the estimate of the marker it really
+// is, which is missing. That explains it: it goes to that marker, and the neighbour is filled.
+TEST(GapFiller, GivesAReturningPointToTheMissingMarkerItIs) {
+  Fixture fx;
+  GapFiller filler(fx.model);
+  Frame frame(fx.model.marker_count());
+  const int a = kMiddle, b = fx.model.ring[fx.model.ring_offsets[kMiddle]];
+  for (int f = 0; f < 220; ++f) {
+    load(fx.truth, f, frame);
+    if (f >= 100 && f < 200) frame.labelled[a] = missing_point();
+    if (f >= 140 && f < 150) frame.labelled[b] = missing_point();
+    if (f >= 150 && f < 200) frame.labelled[b] = fx.truth.at(f, a);
+    const FillStats s = frame.run(filler);
+    if (f < 150 || f >= 200) continue;
+    EXPECT_EQ(s.rejected_labels, 1) << "frame " << f;
+    EXPECT_EQ(s.changed_measured, 1) << "frame " << f;
+    EXPECT_EQ(frame.status[a], MarkerStatus::Relabelled) << "frame " << f;
+    EXPECT_EQ(frame.positions[a], fx.truth.at(f, a)) << "frame " << f;
+    EXPECT_EQ(frame.status[b], MarkerStatus::FilledPca) << "frame " << f;
+  }
+}
+
 TEST(GapFiller, NeverOutputsNaN) {
   Fixture fx;
   GapFiller filler(fx.model);
@@ -210,11 +275,14 @@ TEST(GapFiller, AllocatesNothingPerFrame) {
   Frame frame(fx.model.marker_count());
   frame.unlabelled.reserve(8);
   frame.ids.reserve(8);
+  const int b = fx.model.ring[fx.model.ring_offsets[kOther]];
   auto make = [&](int f) {
     load(fx.truth, f, frame);
     const Vec3 truth = frame.labelled[kMiddle];
     frame.labelled[kMiddle] = missing_point();
     if (f % 3 == 0) frame.labelled[kOther] = missing_point();
+    if (f % 5 == 0) std::swap(frame.labelled[kOther], frame.labelled[b]);  // labels to judge
+    if (f % 7 < 3) frame.labelled[fx.model.ring[fx.model.ring_offsets[kMiddle]]] = missing_point();  // two of a ring
     if (f % 2 == 0) {
       frame.unlabelled.push_back(truth);
       frame.ids.push_back(f % 4);

@@ -2,6 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <vector>
+
 namespace skinstream {
 namespace {
 
@@ -54,6 +57,35 @@ TEST(PcaFit, PredictiveVarianceGrowsWhenLessIsObserved) {
   ASSERT_TRUE(one.fit(m, one_slot, one_local));
   EXPECT_GE(both.predictive_variance(m, 2), m.residual_variance);
   EXPECT_GT(one.predictive_variance(m, 2), both.predictive_variance(m, 2));
+}
+
+// The factored fit is the same fit: one factor per set of observed slots serves every frame
+// that sees that set, whatever the positions.
+TEST(PcaFit, FactoredFitMatchesTheDirectFitForEveryObservation) {
+  MarkerPcaModel m;
+  m.mean = Eigen::VectorXd::LinSpaced(12, -30.0, 25.0);
+  m.basis = Eigen::MatrixXd(12, 2);
+  for (int r = 0; r < 12; ++r) m.basis.row(r) << std::sin(0.7 * r + 0.3), std::cos(1.3 * r);
+  m.basis.col(0).normalize();
+  m.basis.col(1) -= m.basis.col(0) * m.basis.col(0).dot(m.basis.col(1));
+  m.basis.col(1).normalize();
+  m.variance = Eigen::VectorXd(2);
+  m.variance << 400.0, 25.0;
+  m.residual_variance = 2.0;
+  m.slot_calibration = Eigen::VectorXd::Ones(4);
+  m.rigid_variance = 1.0;
+  const std::vector<int> slots = {0, 2};  // members 1 and 3 missing
+  std::vector<double> factor(4);
+  ASSERT_TRUE(PcaFit::factor_slots(m, slots, factor));
+  for (double c : {-12.0, 0.5, 31.0}) {
+    const std::vector<Vec3> local = {m.mean.segment<3>(0) + m.basis.block<3, 1>(0, 0) * c + Vec3(1, -2, 0.5),
+                                     m.mean.segment<3>(6) + m.basis.block<3, 1>(6, 1) * (0.3 * c)};
+    PcaFit direct, factored;
+    ASSERT_TRUE(direct.fit(m, slots, local));
+    factored.fit_factored(m, slots, local, factor);
+    EXPECT_LT((factored.coefficients() - direct.coefficients()).norm(), 1e-9 * (1.0 + direct.coefficients().norm()));
+    EXPECT_LT((factored.reconstruct(m, 3) - direct.reconstruct(m, 3)).norm(), 1e-9);
+  }
 }
 
 TEST(PcaFit, ModelWithoutComponentsIsItsMean) {

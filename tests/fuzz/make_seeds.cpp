@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <string>
 #include <vector>
 
@@ -43,7 +44,8 @@ int main(int argc, char** argv) {
     return 2;
   }
   const fs::path out = argv[1];
-  for (const char* target : {"c3d", "trc", "obj", "ply", "subject_file", "vicon_packets"}) fs::create_directories(out / target);
+  for (const char* target : {"c3d", "trc", "obj", "ply", "subject_file", "vicon_packets", "multicast_datagrams"})
+    fs::create_directories(out / target);
   try {
     const Capture full = read_capture(SKINSTREAM_SOURCE_DIR "/replay_data/cmu/85_02.c3d");
     std::vector<int> points;
@@ -78,6 +80,23 @@ int main(int argc, char** argv) {
       stream.insert(stream.end(), packet.begin(), packet.end());
     }
     write_bytes(out / "vicon_packets" / "three_frames.bin", stream);
+
+    // The golden frame's two datagrams, each after its 2-byte length: in order, and the last first.
+    std::vector<std::vector<unsigned char>> datagrams;
+    for (const char* name : {"datagram_0.bin", "datagram_1.bin"}) {
+      std::ifstream in(fs::path(SKINSTREAM_SOURCE_DIR "/tests/protocol/fixtures/multicast") / name, std::ios::binary);
+      datagrams.emplace_back(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    }
+    for (const bool reversed : {false, true}) {
+      std::vector<unsigned char> seed;
+      for (size_t i = 0; i < datagrams.size(); ++i) {
+        const std::vector<unsigned char>& d = datagrams[reversed ? datagrams.size() - 1 - i : i];
+        seed.push_back(static_cast<unsigned char>(d.size() & 0xFF));
+        seed.push_back(static_cast<unsigned char>(d.size() >> 8));
+        seed.insert(seed.end(), d.begin(), d.end());
+      }
+      write_bytes(out / "multicast_datagrams" / (reversed ? "last_first.bin" : "in_order.bin"), seed);
+    }
   } catch (const std::exception& e) {
     std::fprintf(stderr, "fuzz_make_seeds: %s\n", e.what());
     return 1;

@@ -60,7 +60,7 @@ TEST(Config, FlagsOverrideTheFile) {
   const auto parsed = parse({"--config", path, "--http-port", "0", "--lookahead", "6", "--max-frame-wait-ms", "40"});
   ASSERT_TRUE(parsed);
   EXPECT_EQ(parsed->config.max_frame_wait_ms, 40);
-  EXPECT_EQ(parsed->config.subject, "a.sks");
+  EXPECT_EQ(parsed->config.subjects, (std::vector<SubjectConfig>{{"", "a.sks"}}));
   EXPECT_EQ(parsed->config.http_port, 0);
   EXPECT_EQ(parsed->config.sub_port, 9001);
   EXPECT_EQ(parsed->config.lookahead, 6);
@@ -74,6 +74,45 @@ TEST(Config, FlagsOverrideTheFile) {
   ASSERT_TRUE(multicast);
   EXPECT_EQ(multicast->config.vicon_multicast, "239.255.42.1:44801");
   EXPECT_TRUE(multicast->config.replay.empty());
+}
+
+TEST(Config, SubjectsAreNamedFilesOnTheCommandLineAndInTheFile) {
+  EXPECT_EQ(parse_subject("a.sks"), (SubjectConfig{"", "a.sks"}));
+  EXPECT_EQ(parse_subject("Actor1=a.sks"), (SubjectConfig{"Actor1", "a.sks"}));
+  EXPECT_EQ(parse_subject("takes/a=b.sks"), (SubjectConfig{"", "takes/a=b.sks"}));  // a '/' first: a file
+  EXPECT_EQ(parse_subject("=a.sks"), (SubjectConfig{"", "=a.sks"}));
+
+  const auto two = parse({"--subject", "Actor1=a.sks", "--subject", "Actor2=b.sks", "--replay-subject", "Actor1"});
+  ASSERT_TRUE(two);
+  EXPECT_EQ(two->config.subjects, (std::vector<SubjectConfig>{{"Actor1", "a.sks"}, {"Actor2", "b.sks"}}));
+  EXPECT_EQ(two->config.replay_subject, "Actor1");
+
+  const std::string list = write_file("subjects.json", R"({"subjects": [{"name": "Actor1", "file": "a.sks"}, "Actor2=b.sks"]})");
+  EXPECT_EQ(load_config_file(list).subjects, (std::vector<SubjectConfig>{{"Actor1", "a.sks"}, {"Actor2", "b.sks"}}));
+  const std::string one = write_file("subject.json", R"({"subject": "Actor1=a.sks"})");
+  EXPECT_EQ(load_config_file(one).subjects, (std::vector<SubjectConfig>{{"Actor1", "a.sks"}}));
+  // The command line replaces the file's subjects; the effective list prints and reads back.
+  const auto replaced = parse({"--config", list, "--subject", "c.sks"});
+  ASSERT_TRUE(replaced);
+  EXPECT_EQ(replaced->config.subjects, (std::vector<SubjectConfig>{{"", "c.sks"}}));
+  DaemonConfig round_trip;
+  apply_json(to_json(load_config_file(list)), round_trip, "printed");
+  EXPECT_EQ(round_trip.subjects, load_config_file(list).subjects);
+}
+
+TEST(Config, SubjectMistakesAreClearErrors) {
+  EXPECT_NE(error_of([] { parse({"--subject", "a.sks", "--subject", "Actor2=b.sks"}); }).find("each follows a named one"),
+            std::string::npos);
+  EXPECT_NE(error_of([] { parse({"--subject", "Actor1=a.sks", "--subject", "Actor1=b.sks"}); }).find("\"Actor1\" is given twice"),
+            std::string::npos);
+  EXPECT_NE(error_of([] { parse({"--subject", "Actor1="}); }).find("has no file"), std::string::npos);
+  EXPECT_NE(error_of([] { parse({"--subject", std::string(300, 'n') + "=a.sks"}); }).find("at most 256 bytes"), std::string::npos);
+  const std::string both = write_file("both.json", R"({"subject": "a.sks", "subjects": []})");
+  EXPECT_NE(error_of([&] { load_config_file(both); }).find("not both"), std::string::npos);
+  const std::string typo = write_file("subject_typo.json", R"({"subjects": [{"name": "A", "fiel": "a.sks"}]})");
+  EXPECT_NE(error_of([&] { load_config_file(typo); }).find("unknown key \"fiel\" in a subject"), std::string::npos);
+  const std::string number = write_file("subject_number.json", R"({"subjects": [7]})");
+  EXPECT_NE(error_of([&] { load_config_file(number); }).find("a subject is"), std::string::npos);
 }
 
 TEST(Config, DeformCpusAndSpinLeadComeFromFileAndFlags) {
@@ -164,6 +203,25 @@ TEST(Config, QtmAndNatNetTakeAHostWithOrWithoutItsPort) {
   EXPECT_EQ(parse_host_with_port(natnet->config.natnet, 1510)->port, 1600);
   EXPECT_EQ(natnet->config.natnet_interface, "10.0.0.9");
   EXPECT_FALSE(parse_host_with_port("", 1510));
+}
+
+TEST(Config, MulticastIsOffByDefaultAndComesFromFileAndFlags) {
+  EXPECT_EQ(DaemonConfig{}.multicast, "");
+  EXPECT_EQ(DaemonConfig{}.multicast_ttl, 1);
+  const std::string path = write_file("multicast.json", R"({"multicast": "239.1.2.3:9500", "multicast_ttl": 4})");
+  const auto from_file = parse({"--config", path});
+  ASSERT_TRUE(from_file);
+  EXPECT_EQ(from_file->config.multicast, "239.1.2.3:9500");
+  EXPECT_EQ(from_file->config.multicast_ttl, 4);
+  const auto flags = parse({"--config", path, "--multicast", "239.9.9.9:9600", "--multicast-interface", "10.0.0.2", "--multicast-ttl", "2"});
+  ASSERT_TRUE(flags);
+  EXPECT_EQ(flags->config.multicast, "239.9.9.9:9600");
+  EXPECT_EQ(flags->config.multicast_interface, "10.0.0.2");
+  EXPECT_EQ(flags->config.multicast_ttl, 2);
+  for (const char* bad : {"10.0.0.1:9500", "239.1.2.3", "239.1.2.3:0", "stage-group:9500"})
+    EXPECT_NE(error_of([&] { parse({"--multicast", bad}); }).find("multicast must be GROUP:PORT"), std::string::npos) << bad;
+  EXPECT_NE(error_of([] { parse({"--multicast-interface", "eth0"}); }).find("multicast_interface"), std::string::npos);
+  EXPECT_NE(error_of([] { parse({"--multicast-ttl", "256"}); }).find("multicast_ttl"), std::string::npos);
 }
 
 TEST(Config, PrintConfigIsAFlag) {

@@ -21,8 +21,11 @@
 #include "server/publish/subscriber_hub.h"
 #include "server/tcp_congestion.h"
 #include "support/socket_lookup.h"
+#include "support/loopback_config.h"
+#include "support/stalled_subscriber.h"
 #include "support/test_data.h"
 #include "support/thread_names.h"
+#include "support/wait_until.h"
 
 namespace skinstream::server {
 namespace {
@@ -55,28 +58,13 @@ const Fixture& fixture() {
 }
 
 DaemonConfig test_config() {
-  DaemonConfig config;
-  config.subject = fixture().subject_path;
+  DaemonConfig config = test::loopback_config();
+  config.subjects = {{"", fixture().subject_path}};
   config.replay = fixture().take_path;
-  config.bind_address = "127.0.0.1";
-  config.http_port = 0;
-  config.sub_port = 0;
-  config.hello_timeout_ms = 200;
-  config.log_level = "warn";
   return config;
 }
 
-// Waits for a condition the daemon must reach soon; a test stuck here fails instead of hanging.
-void wait_until(const std::function<bool()>& done) {
-  const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(60);
-  while (!done()) {
-    if (std::chrono::steady_clock::now() > give_up) {
-      ADD_FAILURE() << "condition not reached within 60 s";
-      return;
-    }
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
-  }
-}
+using test::wait_until;
 
 std::string http_get(int port, const std::string& target, int* out_status = nullptr) {
   asio::io_context io;
@@ -94,13 +82,34 @@ std::string http_get(int port, const std::string& target, int* out_status = null
 
 TEST(Daemon, MissingSubjectFailsClearly) {
   DaemonConfig config = test_config();
-  config.subject = test::scratch_path("absent.sks");
+  config.subjects = {{"", test::scratch_path("absent.sks")}};
   try {
     Daemon daemon(config);
     FAIL() << "started without a subject";
   } catch (const std::exception& e) {
     EXPECT_NE(std::string(e.what()).find("absent.sks"), std::string::npos) << e.what();
   }
+}
+
+TEST(Daemon, NamedSubjectIsTheReplaysOneSubject) {
+  DaemonConfig config = test_config();
+  config.subjects = {{"Actor1", fixture().subject_path}};
+  try {
+    Daemon daemon(config);
+    FAIL() << "followed a subject the replay does not have";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("subject \"Actor1\" is not in the replay"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("--replay-subject"), std::string::npos) << e.what();
+  }
+  config.replay_subject = "Actor1";
+  Daemon daemon(config);
+  daemon.start();
+  wait_until([&] { return nlohmann::json::parse(daemon.health_json())["frames"]["processed"].get<int>() > 0; });
+  const nlohmann::json subject = nlohmann::json::parse(daemon.health_json())["subject"];
+  daemon.stop();
+  EXPECT_EQ(subject["name"], "Actor1");
+  EXPECT_TRUE(subject["present"].get<bool>());
+  EXPECT_EQ(subject["detail"], "follows \"Actor1\": 41 of the subject's 41 markers labelled");
 }
 
 TEST(Daemon, PortInUseFailsClearly) {
@@ -133,7 +142,7 @@ TEST(Daemon, PublishesTheOfflineFillFrameByFrameInOrder) {
   });
   // The replay starts only once the subscriber listens, so it sees the take from its first frame.
   daemon.start_serving();
-  wait_until([&] { return !daemon.hub().wanted_encodings().empty(); });
+  wait_until([&] { return !daemon.subject(0).hub().wanted_encodings().empty(); });
   daemon.start_source();
   reader.join();
   daemon.stop();
@@ -174,14 +183,10 @@ TEST(Daemon, StalledSubscriberDoesNotHoldBackTheOthers) {
   Daemon daemon(config);
   daemon.start_serving();
 
-  // The stalled subscriber asks for everything and never reads; its receive buffer is tiny.
+  // The stalled subscriber asks for markers and never reads.
   asio::io_context io;
-  tcp::socket stalled(io);
-  stalled.open(tcp::v4());
-  stalled.set_option(asio::socket_base::receive_buffer_size(1024));
-  stalled.connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), static_cast<unsigned short>(daemon.sub_port())));
-  asio::write(stalled, asio::buffer(subscriber::encode_hello({.wants = subscriber::kWantMarkers})));
-  wait_until([&] { return !daemon.hub().wanted_encodings().empty(); });
+  tcp::socket stalled = test::stalled_subscriber(io, daemon.sub_port(), subscriber::encode_hello({.wants = subscriber::kWantMarkers}));
+  wait_until([&] { return !daemon.subject(0).hub().wanted_encodings().empty(); });
 
   daemon.start_source();
   long received = 0;
@@ -191,7 +196,7 @@ TEST(Daemon, StalledSubscriberDoesNotHoldBackTheOthers) {
   uint32_t own_drops = 0;
   auto stalled_dropped = [&] {
     uint64_t most = 0;
-    for (const SubscriberMetrics& s : daemon.hub().subscriber_metrics()) most = std::max(most, s.dropped);
+    for (const SubscriberMetrics& s : daemon.subject(0).hub().subscriber_metrics()) most = std::max(most, s.dropped);
     return most;
   };
   sub::SubscriberClient client("127.0.0.1", std::to_string(daemon.sub_port()), subscriber::kWantMarkers);
@@ -255,7 +260,7 @@ TEST_P(DaemonPublishThreads, EverySubscriberGetsEveryFrameInOrderAndStopClosesTh
         return numbers[s].size() < kFrames;
       });
     });
-  wait_until([&] { return daemon.hub().subscriber_count() == kSubscribers + 1 && !daemon.hub().wanted_encodings().empty(); });
+  wait_until([&] { return daemon.subject(0).hub().subscriber_count() == kSubscribers + 1 && !daemon.subject(0).hub().wanted_encodings().empty(); });
   daemon.start_source();
   for (std::thread& t : readers) t.join();
   daemon.stop();
@@ -321,7 +326,7 @@ TEST(Daemon, PacedSubscriberHasAtMostTheWindowInFlightAndGetsTheNewestFrameOnAck
   tcp::socket paced(io);
   paced.connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), static_cast<unsigned short>(daemon.sub_port())));
   asio::write(paced, asio::buffer(subscriber::encode_hello({.wants = subscriber::kWantMarkers | subscriber::kWantPaced})));
-  wait_until([&] { return !daemon.hub().wanted_encodings().empty(); });
+  wait_until([&] { return !daemon.subject(0).hub().wanted_encodings().empty(); });
   daemon.start_source();
   subscriber::StreamDecoder decoder;
   using std::chrono::milliseconds;
@@ -410,7 +415,7 @@ TEST(Daemon, ServesHealthMetricsWebSocketAndSubscribersWithoutHello) {
   asio::write(rude, asio::buffer(subscriber::encode_status({})));
   boost::system::error_code ec;
   while (!ec) rude.read_some(asio::buffer(buffer), ec);  // until the daemon closes it
-  EXPECT_EQ(daemon.metrics().bad_subscriber_messages.load(), 1u);
+  EXPECT_EQ(daemon.subject(0).metrics().bad_subscriber_messages.load(), 1u);
 
   int status = 0;
   const nlohmann::json health = nlohmann::json::parse(http_get(daemon.http_port(), "/health", &status));
@@ -423,7 +428,7 @@ TEST(Daemon, ServesHealthMetricsWebSocketAndSubscribersWithoutHello) {
   EXPECT_EQ(health["source_limits"]["max_name_bytes"].get<int>(), DaemonConfig{}.source_max_name_bytes);
   // Frames went out, so encoded buffers exist (the counter only grows, and frames keep coming).
   EXPECT_GE(health["frame_buffers_allocated"].get<long>(), 1);
-  EXPECT_LE(health["frame_buffers_allocated"].get<uint64_t>(), daemon.metrics().frame_buffers_allocated.load());
+  EXPECT_LE(health["frame_buffers_allocated"].get<uint64_t>(), daemon.subject(0).metrics().frame_buffers_allocated.load());
   // Every stage summarised for scripts, each summary ordered. Frames were filled, encoded and
   // written to subscribers; this subject has no mesh, so nothing was deformed.
   for (const char* stage : {"receive_to_take", "fill", "deform", "normals", "encode", "receive_to_publish",
@@ -441,11 +446,16 @@ TEST(Daemon, ServesHealthMetricsWebSocketAndSubscribersWithoutHello) {
   }
   const std::string metrics = http_get(daemon.http_port(), "/metrics", &status);
   EXPECT_EQ(status, 200);
-  for (const char* name : {"skinstream_frames_received_total ", "skinstream_frames_published_total ", "skinstream_frames_dropped_total ",
-                           "skinstream_frames_dropped_mailbox_full_total ", "skinstream_markers_filled_total ", "skinstream_fill_seconds_bucket{le=\"+Inf\"}",
-                           "skinstream_encode_seconds_count", "skinstream_receive_to_take_seconds_count",
-                           "skinstream_subscriber_queue_wait_seconds_count", "skinstream_subscriber_write_seconds_count", "skinstream_bad_subscriber_messages_total 1"})
-    EXPECT_NE(metrics.find(name), std::string::npos) << name;
+  // The source's frames unlabelled, the subject's series labelled with its name.
+  const std::string subject = "{subject=\"" + daemon.subject(0).name() + "\"";
+  EXPECT_NE(metrics.find("skinstream_source_frames_total "), std::string::npos);
+  for (const char* name : {"skinstream_frames_received_total", "skinstream_frames_published_total", "skinstream_frames_dropped_total",
+                           "skinstream_frames_dropped_mailbox_full_total", "skinstream_markers_filled_total", "skinstream_encode_seconds_count",
+                           "skinstream_receive_to_take_seconds_count", "skinstream_subscriber_queue_wait_seconds_count",
+                           "skinstream_subscriber_write_seconds_count"})
+    EXPECT_NE(metrics.find(name + subject + "} "), std::string::npos) << name;
+  EXPECT_NE(metrics.find("skinstream_fill_seconds_bucket" + subject + ",le=\"+Inf\"}"), std::string::npos);
+  EXPECT_NE(metrics.find("skinstream_bad_subscriber_messages_total" + subject + "} 1"), std::string::npos);
   http_get(daemon.http_port(), "/nothing-here", &status);
   EXPECT_EQ(status, 404);
   http_get(daemon.http_port(), "/", &status);
@@ -472,7 +482,7 @@ TEST(Daemon, WebSocketTextMessageIsRefusedWithACloseAndCounted) {
   EXPECT_EQ(ec, websocket::error::closed) << ec.message();
   EXPECT_EQ(ws.reason().code, websocket::close_code::unknown_data);
   EXPECT_EQ(std::string(ws.reason().reason.c_str()), "binary messages only");
-  EXPECT_EQ(daemon.metrics().bad_subscriber_messages.load(), 1u);
+  EXPECT_EQ(daemon.subject(0).metrics().bad_subscriber_messages.load(), 1u);
   daemon.stop();
 }
 

@@ -9,10 +9,10 @@
 
 namespace skinstream::test {
 
-DaemonProcess::DaemonProcess(const std::string& skinstreamd, const std::string& arguments, const std::string& shell_prefix) {
+DaemonProcess::DaemonProcess(const std::string& arguments, const std::string& shell_prefix) {
   static std::atomic<int> counter{0};
   server::DaemonLaunch launch;
-  launch.program = skinstreamd;
+  launch.program = SKINSTREAMD;
   launch.arguments = arguments;
   launch.shell_prefix = shell_prefix;
   // The process id too: ctest runs each test as its own process, several at once.

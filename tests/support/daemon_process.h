@@ -1,7 +1,8 @@
 #pragma once
 // The real skinstreamd in the background for a test, through the harness the bench uses too
 // (server/client/daemon_process.h), on ephemeral loopback ports. A daemon that exits at startup
-// fails the test (ADD_FAILURE, with its log) and leaves the ports at 0.
+// fails the test (ADD_FAILURE, with its log) and leaves the ports at 0. The program is the test
+// target's SKINSTREAMD.
 #include <memory>
 #include <string>
 #include <sys/types.h>
@@ -14,7 +15,7 @@ class DaemonProcess {
  public:
   // `arguments` go on its command line as shell words; `shell_prefix` runs first in the same
   // shell (e.g. "ulimit -n 64; ").
-  DaemonProcess(const std::string& skinstreamd, const std::string& arguments, const std::string& shell_prefix = "");
+  explicit DaemonProcess(const std::string& arguments, const std::string& shell_prefix = "");
   ~DaemonProcess();
   DaemonProcess(const DaemonProcess&) = delete;
   DaemonProcess& operator=(const DaemonProcess&) = delete;

@@ -3,7 +3,9 @@
 #include <optional>
 
 #include "core/deform/mesh_evaluator.h"
+#include "multicast_socket.h"
 #include "protocol/compressed_vertices.h"
+#include "protocol/datagram_reassembler.h"
 #include "protocol/frame_parameters.h"
 #include "protocol/subscriber_model.h"
 #include "protocol/subscriber_stream.h"
@@ -21,6 +23,8 @@ int64_t wall_clock_ns() {
 
 // Up to 1 MiB a read: a 53,500-vertex float frame (640 kB) in one or two reads.
 constexpr size_t kReadBytes = 1 << 20;
+// The largest UDP datagram: one that breaks the protocol's 1,400 is read whole and rejected.
+constexpr size_t kDatagramReadBytes = 65536;
 
 }  // namespace
 
@@ -51,6 +55,16 @@ struct Subscriber::State {
   std::vector<unsigned char> parameter_block;
   // Compressed.
   std::unique_ptr<wire::CompressedVertexDecoder> compressed;
+  // Multicast: frames from the group once the Model came over TCP (then the connection closes).
+  std::optional<MulticastSocket> group;
+  std::optional<wire::DatagramReassembler> reassembler;
+  std::vector<unsigned char> datagram;
+  uint32_t model_id = 0;
+  std::vector<unsigned char> ready_message;  // the newest complete frame, not yet handed out
+  int64_t ready_arrival_ns = 0;
+  uint64_t superseded = 0;
+  uint64_t messages_rejected = 0;
+  std::string last_error;
 
   std::vector<float> positions, normals, markers;
   std::vector<uint8_t> marker_status;
@@ -60,6 +74,14 @@ struct Subscriber::State {
   void on_status(std::span<const unsigned char> payload);
   // False when the frame cannot be shown (a compressed delta without its key).
   bool on_frame(std::span<const unsigned char> payload, Frame& frame);
+  // Reads the TCP stream until a frame is ready (true), the deadline passes, or, with multicast,
+  // the Model came and the connection was closed (false).
+  bool read_connection(Frame& frame, std::chrono::steady_clock::time_point deadline);
+  // Reads the group's datagrams until a frame is ready (true) or the deadline passes.
+  bool read_group(Frame& frame, std::chrono::steady_clock::time_point deadline);
+  // Decodes and evaluates ready_message into `frame` (false: it broke the protocol; counted).
+  bool take_ready_message(Frame& frame);
+  void reject(const std::string& what);
 };
 
 Subscriber::Subscriber(Options options) : state_(std::make_unique<State>()) {
@@ -81,6 +103,16 @@ Subscriber::Subscriber(Options options) : state_(std::make_unique<State>()) {
   hello.encoding = static_cast<uint32_t>(o.encoding);
   hello.subject = o.subject;
   hello.token = o.token;
+  if (!o.multicast.group.empty()) {
+    if (s.version != wire::kVersion2 || o.encoding != Encoding::Parameters || o.paced || !o.mesh)
+      throw std::invalid_argument("multicast carries the parameters of the mesh only: encoding parameters, protocol 2, not paced");
+    // Joined first, so the group's datagrams wait in the socket while the Model comes.
+    s.group.emplace(o.multicast.group, o.multicast.port, o.multicast.interface_address);
+    s.reassembler.emplace(wire::DatagramReassembler::Options{o.multicast.stream_id, o.multicast.window});
+    s.datagram.resize(kDatagramReadBytes);
+    s.ready_message.reserve(wire::kMaxDatagramMessageBytes);
+    hello.wants &= ~(wire::kWantMarkers);  // the group's frames carry none
+  }
   s.connection.emplace(o.host, o.port, o.connect_timeout);
   s.connection->send_all(wire::encode_hello(hello));
 }
@@ -90,6 +122,12 @@ Subscriber::~Subscriber() = default;
 bool Subscriber::next(Frame& frame, std::chrono::milliseconds timeout) {
   State& s = *state_;
   const auto deadline = std::chrono::steady_clock::now() + timeout;
+  if (s.connection && s.read_connection(frame, deadline)) return true;
+  return s.group && !s.connection && s.read_group(frame, deadline);
+}
+
+bool Subscriber::State::read_connection(Frame& frame, std::chrono::steady_clock::time_point deadline) {
+  State& s = *this;
   for (;;) {
     try {
       while (const std::optional<wire::RawMessage> message = s.decoder.next()) {
@@ -97,7 +135,14 @@ bool Subscriber::next(Frame& frame, std::chrono::milliseconds timeout) {
           throw Error("the daemon answered in protocol version " + std::to_string(message->version) + ", not " + std::to_string(s.version));
         switch (message->type) {
           case wire::MessageType::MeshInfo: s.on_mesh_info(message->payload); break;
-          case wire::MessageType::Model: s.on_model(message->payload); break;
+          case wire::MessageType::Model:
+            s.on_model(message->payload);
+            if (s.group) {  // the frames come from the group from now on
+              s.model_id = wire::model_id_of(s.model_payload);
+              s.connection.reset();
+              return false;
+            }
+            break;
           case wire::MessageType::Status: s.on_status(message->payload); break;
           case wire::MessageType::Frame: {
             const bool ready = s.on_frame(message->payload, frame);
@@ -126,6 +171,77 @@ bool Subscriber::next(Frame& frame, std::chrono::milliseconds timeout) {
     s.bytes += n;
     s.arrival_ns = wall_clock_ns();
   }
+}
+
+bool Subscriber::State::read_group(Frame& frame, std::chrono::steady_clock::time_point deadline) {
+  for (;;) {
+    // The newest complete frame wins: once one is complete, the datagrams already waiting are
+    // read too (without waiting), and a newer frame among them replaces it. A reader slower than
+    // the stream so skips frames instead of falling behind by what the socket buffer holds.
+    const bool have_one = !ready_message.empty();
+    const auto now = std::chrono::steady_clock::now();
+    const auto left = have_one ? std::chrono::milliseconds(0)
+                               : std::max(std::chrono::duration_cast<std::chrono::milliseconds>(deadline - now), std::chrono::milliseconds(0));
+    std::chrono::steady_clock::time_point arrival;
+    const size_t n = group->receive(datagram, left, arrival);
+    if (n == 0) {
+      // Nothing waiting: a frame begun longer than the window ago will not complete.
+      reassembler->expire(std::chrono::steady_clock::now());
+      if (have_one) {
+        if (take_ready_message(frame)) return true;
+        continue;
+      }
+      if (std::chrono::steady_clock::now() >= deadline) return false;
+      continue;
+    }
+    bytes += n;
+    arrival_ns = wall_clock_ns();
+    std::optional<wire::DatagramReassembler::Message> message;
+    try {
+      message = reassembler->add(std::span<const unsigned char>(datagram).first(n), arrival);
+    } catch (const wire::DecodeError& e) {
+      last_error = std::string("bad datagram: ") + e.what();  // counted by the reassembler
+      continue;
+    }
+    if (!message) continue;
+    if (message->header.model_id != model_id) {
+      char text[160];
+      std::snprintf(text, sizeof text, "the multicast frames fit another Model (id %08x, this receiver holds %08x): the daemon's subject changed",
+                    message->header.model_id, model_id);
+      throw Error(text);
+    }
+    if (have_one) ++superseded;
+    ready_message.assign(message->bytes.begin(), message->bytes.end());  // within its capacity: allocates once
+    ready_arrival_ns = arrival_ns;
+  }
+}
+
+bool Subscriber::State::take_ready_message(Frame& frame) {
+  const std::span<const unsigned char> bytes = ready_message;
+  arrival_ns = ready_arrival_ns;
+  bool ready = false;
+  // Anyone on the LAN can send to the group: a message that breaks the protocol is counted,
+  // never the end of the stream.
+  try {
+    const wire::MessageHeader header = wire::decode_header(bytes);
+    if (header.type != wire::MessageType::Frame || header.version != wire::kVersion2 || header.payload_bytes != bytes.size() - wire::kHeaderBytes)
+      throw wire::DecodeError(std::string("a ") + wire::to_string(header.type) + " message of version " + std::to_string(header.version) +
+                              " and " + std::to_string(header.payload_bytes) + " bytes, not a version 2 Frame filling the datagrams");
+    const std::span<const unsigned char> payload = bytes.subspan(wire::kHeaderBytes);
+    if (!(wire::decode_frame_info(payload, version).flags & wire::kFrameParameters)) throw wire::DecodeError("a Frame without parameters");
+    ready = on_frame(payload, frame);
+  } catch (const wire::DecodeError& e) {
+    reject(std::string("bad multicast frame: ") + e.what());
+  } catch (const Error& e) {
+    reject(std::string("bad multicast frame: ") + e.what());
+  }
+  ready_message.clear();
+  return ready;
+}
+
+void Subscriber::State::reject(const std::string& what) {
+  ++messages_rejected;
+  last_error = what;
 }
 
 void Subscriber::State::on_mesh_info(std::span<const unsigned char> payload) {
@@ -279,5 +395,13 @@ uint64_t Subscriber::bytes_received() const { return state_->bytes; }
 size_t Subscriber::model_bytes() const { return state_->model_payload.empty() ? 0 : wire::kHeaderBytes + state_->model_payload.size(); }
 std::span<const unsigned char> Subscriber::parameter_block() const { return state_->parameter_block; }
 std::span<const unsigned char> Subscriber::model_payload() const { return state_->model_payload; }
+
+MulticastStats Subscriber::multicast_stats() const {
+  const State& s = *state_;
+  if (!s.reassembler) return {};
+  const wire::DatagramReassembler::Stats& r = s.reassembler->stats();
+  return {r.datagrams,          r.frames_completed,    r.frames_lost,    r.frames_incomplete,   r.datagrams_rejected,
+          r.datagrams_other_stream, r.datagrams_late, r.datagrams_duplicate, s.superseded, s.messages_rejected, s.last_error};
+}
 
 }  // namespace skinstream::client

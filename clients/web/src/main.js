@@ -12,6 +12,7 @@ import { MarkerOverlay } from './marker_overlay.js';
 import { StatusBar } from './status_bar.js';
 import { installToggles } from './toggles.js';
 import { installEncodingPicker, requestedEncoding } from './encoding_picker.js';
+import { installSubjectPicker } from './subject_picker.js';
 
 const SAMPLED_POINTS = 8;
 const STATUS_INTERVAL_MS = 250;
@@ -272,6 +273,8 @@ function updateStatus() {
   const status = stats ? stats.status : null;
   if (status && status.state === SourceState.REFUSED) {
     statusBar.showBanner('source', `The daemon refused this viewer: ${status.detail}`);
+  } else if (status && status.subject && !status.subjectPresent && status.state === SourceState.STREAMING) {
+    statusBar.showBanner('source', `Subject ${status.subject} is not in the stream; waiting for it.`);
   } else if (state === 'closed') {
     const seconds = (stats.retryInMs / 1000).toFixed(1);
     statusBar.showBanner('connection', `Connection to the daemon closed (${stats.closeReason}). Reconnecting in ${seconds} s…`);
@@ -338,6 +341,7 @@ window.skinstreamViewer = Object.freeze({
   get encodingRequested() { return ENCODING_NAMES[requested.encoding]; },
   get encoding() { return meshInfo ? ENCODING_NAMES[meshInfo.encoding] : ''; },
   get quantised() { return meshInfo !== null && meshInfo.encoding === Encoding.QUANTISED; },
+  get subject() { return meshInfo ? meshInfo.subject : ''; },
   get gpuEvaluation() { return evaluator ? evaluator.describe() : null; },
   get frameWorkMs() { return frameWorkMs; },
   get lastError() { return stats ? stats.lastError : ''; },
@@ -352,6 +356,7 @@ worker.postMessage({
   url: streamUrl,
   hello: { wants: Wants.NORMALS | Wants.MARKERS | Wants.PACED, encoding: requested.encoding, subject: params.get('subject') || '', token: params.get('token') || '' },
 });
+installSubjectPicker(document.getElementById('panel'), params);
 setInterval(updateStatus, STATUS_INTERVAL_MS);
 updateStatus();
 requestAnimationFrame(animate);

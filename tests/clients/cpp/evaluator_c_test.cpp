@@ -207,8 +207,7 @@ std::map<uint32_t, Received> receive(uint16_t port, client::Encoding encoding, i
 // normals bit for bit (the daemon's own evaluator on the same floats).
 TEST(EvaluatorCDemo, EqualsTheDaemonsFloatBufferBitForBit) {
   const std::string demo = SKINSTREAM_DEMO_DIR;
-  test::DaemonProcess daemon(
-      SKINSTREAMD, "--subject " + demo + "/subject.sksubj --replay " + demo + "/live.c3d --loop --speed 0.2");
+  test::DaemonProcess daemon("--subject " + demo + "/subject.sksubj --replay " + demo + "/live.c3d --loop --speed 0.2");
   ASSERT_GT(daemon.sub_port, 0);
   const uint16_t port = static_cast<uint16_t>(daemon.sub_port);
   constexpr int kFrames = 20;

@@ -15,16 +15,16 @@
 
 #include "support/client_frames.h"
 #include "support/daemon_process.h"
+#include "support/received_vertices.h"
 #include "support/test_data.h"
 
 namespace skinstream {
 namespace {
 
 using client::Encoding;
-
-struct Received {
-  std::vector<float> positions, normals;
-};
+using test::compare;
+using test::Difference;
+using test::Received;
 
 // Frames by number from one subscriber, until it has `count` frames past the first.
 std::map<uint32_t, Received> receive(uint16_t port, Encoding encoding, bool normals, int count, size_t* model_bytes = nullptr) {
@@ -33,42 +33,10 @@ std::map<uint32_t, Received> receive(uint16_t port, Encoding encoding, bool norm
   options.encoding = encoding;
   options.normals = normals;
   client::Subscriber sub(options);
-  auto frames = test::receive_frames<Received>(sub, count, [](const client::Frame& frame, Received& r) {
-    r.positions.assign(frame.positions.begin(), frame.positions.end());
-    r.normals.assign(frame.normals.begin(), frame.normals.end());
-  });
+  auto frames = test::receive_frames<Received>(sub, count, test::keep_vertices);
   EXPECT_EQ(sub.mesh().encoding, encoding);
   if (model_bytes) *model_bytes = sub.model_bytes();
   return frames;
-}
-
-struct Difference {
-  double position_mm = 0.0;     // largest coordinate difference
-  double normal_degrees = 0.0;  // largest angle between normals
-  int frames = 0;               // frames both received
-};
-
-Difference compare(const std::map<uint32_t, Received>& reference, const std::map<uint32_t, Received>& other) {
-  Difference d;
-  for (const auto& [number, frame] : other) {
-    const auto it = reference.find(number);
-    if (it == reference.end()) continue;
-    ++d.frames;
-    const Received& truth = it->second;
-    EXPECT_EQ(frame.positions.size(), truth.positions.size());
-    for (size_t i = 0; i < std::min(frame.positions.size(), truth.positions.size()); ++i)
-      d.position_mm = std::max(d.position_mm, std::abs(double(frame.positions[i]) - truth.positions[i]));
-    for (size_t v = 0; 3 * v + 2 < std::min(frame.normals.size(), truth.normals.size()); ++v) {
-      // The angle as atan2(|a x b|, a . b): exact near 0, where acos of the dot product is not.
-      const double a[3] = {frame.normals[3 * v], frame.normals[3 * v + 1], frame.normals[3 * v + 2]};
-      const double b[3] = {truth.normals[3 * v], truth.normals[3 * v + 1], truth.normals[3 * v + 2]};
-      const double cross[3] = {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-      const double sine = std::sqrt(cross[0] * cross[0] + cross[1] * cross[1] + cross[2] * cross[2]);
-      const double cosine = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-      d.normal_degrees = std::max(d.normal_degrees, std::atan2(sine, cosine) * 180.0 / M_PI);
-    }
-  }
-  return d;
 }
 
 // The demo subject (53,514 vertices) replaying its jump-rope take; four subscribers of the
@@ -76,7 +44,7 @@ Difference compare(const std::map<uint32_t, Received>& reference, const std::map
 TEST(ClientSubscriberDemo, EveryEncodingGivesTheDaemonsVertices) {
   const std::string demo = SKINSTREAM_DEMO_DIR;
   // A fifth of real time: every subscriber takes every frame on this shared machine.
-  test::DaemonProcess daemon(SKINSTREAMD, "--subject " + demo + "/subject.sksubj --replay " + demo + "/live.c3d --loop --speed 0.2");
+  test::DaemonProcess daemon("--subject " + demo + "/subject.sksubj --replay " + demo + "/live.c3d --loop --speed 0.2");
   ASSERT_GT(daemon.sub_port, 0);
   const uint16_t port = static_cast<uint16_t>(daemon.sub_port);
   constexpr int kFrames = 40;
@@ -121,7 +89,7 @@ TEST(ClientSubscriberDemo, EveryEncodingGivesTheDaemonsVertices) {
 
 TEST(ClientSubscriberDemo, AnUnknownSubjectIsRefusedWithTheReason) {
   const std::string demo = SKINSTREAM_DEMO_DIR;
-  test::DaemonProcess daemon(SKINSTREAMD, "--subject " + demo + "/subject.sksubj");
+  test::DaemonProcess daemon("--subject " + demo + "/subject.sksubj");
   client::Options options;
   options.port = static_cast<uint16_t>(daemon.sub_port);
   options.subject = "Actor9";

@@ -1,7 +1,8 @@
 // The browser live preview against the real daemon: starts skinstreamd replaying a recording in a
 // loop, opens the page it serves in the system Chromium (headless, WebGL through SwiftShader),
 // and checks that frames arrive, are drawn and move, that the status bar shows the source rate,
-// and that stopping the daemon puts up the banner. The page asks for parameters by default and
+// that a page naming the subject is served it and one naming an unknown subject is told it was
+// refused, and that stopping the daemon puts up the banner. The page asks for parameters by default and
 // evaluates the mesh on the GPU: its positions and normals, read back, are compared with the
 // daemon's float buffers of the same frames (a second subscriber from node), as are those of the
 // float, quantised and compressed encodings. Then it measures the page's main-thread time and
@@ -156,6 +157,8 @@ async function measureFrameCost(browser, url, encoding, { warmupMs = 3000, windo
 
 async function main() {
   const options = parseArguments(process.argv.slice(2));
+  // The daemon calls a subject file given without a name by the file's stem.
+  options.subjectName = path.parse(options.subject).name;
   for (const file of [options.daemon, options.subject, options.recording, path.join(options.webRoot, 'index.html')]) {
     if (!fs.existsSync(file)) throw new Error(`missing input ${file}`);
   }
@@ -340,6 +343,20 @@ async function main() {
       viewport: '800x600', bytes_per_frame: bytes, model_message_bytes: bytes.model_message,
       gpu_evaluation: after.gpuEvaluation, accuracy, modes: costs,
     }));
+
+    // A page naming the subject is served it and shows it in the menu; a name the daemon does not
+    // serve is refused, and the page says so.
+    const named = await browser.newPage({ viewport: { width: 480, height: 360 } });
+    named.on('pageerror', (error) => pageErrors.push(`named page: ${error.message}`));
+    await named.goto(`${url}?subject=${encodeURIComponent(options.subjectName)}`);
+    await waitUntil(named, 'the page naming its subject rendered no frame', () => window.skinstreamViewer && window.skinstreamViewer.framesRendered > 2, null, 60000);
+    assert.equal(await named.evaluate(() => window.skinstreamViewer.subject), options.subjectName);
+    await waitUntil(named, 'no subject menu', () => document.getElementById('subject') !== null);
+    assert.equal(await named.evaluate(() => document.getElementById('subject').value), options.subjectName);
+    await named.goto(`${url}?subject=Nobody`);
+    await waitUntil(named, 'no refusal shown for an unknown subject', () => /refused/.test(window.skinstreamViewer.bannerText));
+    console.log(`unknown subject: "${await named.evaluate(() => window.skinstreamViewer.bannerText)}"`);
+    await named.close();
 
     assert.deepEqual(pageErrors, [], 'errors on the page');
 

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <stdexcept>
 
 namespace skinstream {
@@ -28,6 +29,10 @@ TEST(GapPlan, RejectsInvalidOptions) {
   EXPECT_THROW(plan_gaps(capture, {.gaps_per_marker_per_minute = -1.0}), std::invalid_argument);
   EXPECT_THROW(plan_gaps(capture, {.gaps_per_marker_per_minute = INFINITY}), std::invalid_argument);
   EXPECT_THROW(plan_gaps(capture, {.margin_frames = -1}), std::invalid_argument);
+  EXPECT_THROW(plan_gaps(capture, {.min_seconds = -1.0}), std::invalid_argument);
+  EXPECT_THROW(plan_gaps(capture, {.fraction_of_samples = 0.6}), std::invalid_argument);
+  EXPECT_THROW(plan_gaps(capture, {.fraction_of_samples = NAN}), std::invalid_argument);
+  EXPECT_THROW(plan_gaps(capture, {.markers_per_gap = 0}), std::invalid_argument);
 }
 
 TEST(GapPlan, RejectsACaptureWithoutRateOrWithMismatchedPositions) {
@@ -139,6 +144,34 @@ TEST(GapPlan, KeepsAwayFromSamplesAlreadyMissing) {
 TEST(GapPlan, NoGapsWhenTheRateOfGapsIsZeroOrTheCaptureTooShort) {
   EXPECT_TRUE(plan_gaps(full_capture(5, 1000), {.gaps_per_marker_per_minute = 0.0}).empty());
   EXPECT_TRUE(plan_gaps(full_capture(5, 6), {.min_frames = 3, .gaps_per_marker_per_minute = 6000.0}).empty());
+}
+
+// The long-gap protocol: 2-6 s occlusions of three markers at once until 4 % of the samples
+// are missing, each gap interior with its margins, never overlapping on a channel.
+TEST(GapPlan, LongGapProtocolCoversItsShareWithGroupsOfThreeLongGaps) {
+  const Capture capture = full_capture(40, 6000);  // 50 s at 120 Hz
+  const GapPlanOptions options = long_gap_plan(4);
+  const std::vector<Gap> plan = plan_gaps(capture, options);
+  long samples = 0;
+  std::map<std::pair<int, int>, int> markers_per_span;
+  for (const Gap& g : plan) {
+    EXPECT_GE(g.length, 240);
+    EXPECT_LE(g.length, 720);
+    EXPECT_GE(g.first_frame, options.margin_frames);
+    EXPECT_LE(g.first_frame + g.length + options.margin_frames, capture.frame_count);
+    samples += g.length;
+    ++markers_per_span[{g.first_frame, g.length}];
+  }
+  const double share = static_cast<double>(samples) / (40.0 * 6000.0);
+  EXPECT_GE(share, 0.04);
+  EXPECT_LE(share, 0.04 + 3.0 * 720 / (40.0 * 6000.0));  // overshoots by one group at most
+  for (const auto& [span, markers] : markers_per_span) EXPECT_EQ(markers % 3, 0) << span.first;
+  for (size_t a = 0; a < plan.size(); ++a)
+    for (size_t b = a + 1; b < plan.size(); ++b)
+      if (plan[a].point == plan[b].point) {
+        EXPECT_TRUE(plan[a].first_frame + plan[a].length + options.margin_frames <= plan[b].first_frame ||
+                    plan[b].first_frame + plan[b].length + options.margin_frames <= plan[a].first_frame);
+      }
 }
 
 TEST(GapPlan, ApplySetsExactlyThoseSamplesMissing) {

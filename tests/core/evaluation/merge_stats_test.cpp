@@ -43,7 +43,16 @@ TEST(MergeStats, CountsMergedUnmergedAndWrongFragments) {
   s = merge_stats(c, truth, channel_of, status, fragments);
   EXPECT_EQ(s.wrong_fragments, 1);
   EXPECT_EQ(s.wrong_samples, 1);
+  EXPECT_EQ(s.wrong_relabelled_fragments, 1);
+  EXPECT_EQ(s.wrong_measured_fragments, 0);
   EXPECT_EQ(s.unmerged_fragments, 0);
+
+  // And b's channel delivers a's point in frame 2 (a mislabel), kept as b's measurement.
+  truth[2 * 4 + 1] = 0;
+  s = merge_stats(c, truth, channel_of, status, fragments);
+  EXPECT_EQ(s.wrong_fragments, 2);
+  EXPECT_EQ(s.wrong_measured_fragments, 1);
+  EXPECT_EQ(s.wrong_relabelled_fragments, 1);
 }
 
 }  // namespace

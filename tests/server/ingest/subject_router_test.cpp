@@ -40,7 +40,7 @@ struct Recorder : SubjectRouter::Observer {
 
 const std::vector<std::string> kTemplate = {"LFHD", "RFHD", "C7", "STRN"};
 
-// A source subject wearing the template, its markers around `centre` (x), numbered by `base`.
+// A source subject wearing `labels`, its markers at x = `centre` (y 0, 100, 200, ... mm by label).
 void add_subject(SourceFrame& frame, const std::string& name, double centre, std::vector<std::string> labels = kTemplate) {
   SourceSubject& s = frame.subjects.emplace_back();
   s.name = name;
@@ -62,6 +62,17 @@ Routed route(SubjectRouter& router, const SourceFrame& frame) {
   for (MarkerFrame& f : r.frames) out.push_back(&f);
   r.stats = router.route(frame, out);
   return r;
+}
+
+// Actor1 at x = -2 m wearing the template and `extra`, a label the subject file lacks; Actor2 at
+// +2 m wearing the template.
+SourceFrame two_actors_one_with(const std::string& extra) {
+  SourceFrame frame;
+  std::vector<std::string> labels = kTemplate;
+  labels.push_back(extra);
+  add_subject(frame, "Actor1", -2000.0, labels);
+  add_subject(frame, "Actor2", 2000.0);
+  return frame;
 }
 
 TEST(SubjectRouter, TwoActorsWithOneTemplateNeverMix) {
@@ -192,9 +203,7 @@ TEST(SubjectRouter, UnlabelledPointsGoToTheNearestSubjectAndNeverToTwo) {
 TEST(SubjectRouter, UnknownLabelsStayWithTheirOwnSubject) {
   Recorder recorder;
   SubjectRouter router({{"Actor1", kTemplate}, {"Actor2", kTemplate}}, recorder);
-  SourceFrame frame;
-  add_subject(frame, "Actor1", -2000.0, {"LFHD", "RFHD", "C7", "STRN", "LWRB"});
-  add_subject(frame, "Actor2", 2000.0);
+  SourceFrame frame = two_actors_one_with("LWRB");
   frame.labelled[0][4] = Vec3(1999, 0, 1000);  // Actor1's LWRB, though it lies next to Actor2
   const Routed r = route(router, frame);
   ASSERT_EQ(r.frames[0].unlabelled_count, 1);
@@ -273,9 +282,7 @@ TEST(SubjectRouter, ASourceInventingNamesEveryFrameIsBounded) {
 TEST(SubjectRouter, RoutingAllocatesNothingOnceMatched) {
   Recorder recorder;
   SubjectRouter router({{"Actor1", kTemplate}, {"Actor2", kTemplate}}, recorder);
-  SourceFrame frame;
-  add_subject(frame, "Actor1", -2000.0, {"LFHD", "RFHD", "C7", "STRN", "EXTRA"});
-  add_subject(frame, "Actor2", 2000.0);
+  SourceFrame frame = two_actors_one_with("EXTRA");
   frame.unlabelled = {Vec3(-1990, 0, 1000), Vec3(1990, 0, 1000)};
   frame.unlabelled_ids = {1, 2};
   MarkerFrame a(4), b(4);

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <map>
 #include <sstream>
 #include <string>
 
@@ -70,24 +71,51 @@ TEST(LatencyHistogram, SummaryGivesEachQuantileAsItsBucketsBoundCappedByTheMaxim
 }
 
 TEST(Metrics, BadInputIsCountedByCategoryAndLabelValuesAreEscaped) {
-  Metrics m;
-  m.count_bad_input("nan");
-  m.count_bad_input("nan");
-  m.count_bad_input("wrong_marker_count");
-  m.frames_received = 7;
-  EXPECT_EQ(m.bad_input("nan"), 2u);
-  EXPECT_EQ(m.bad_input("unseen"), 0u);
+  Metrics source;
+  source.count_bad_input("nan");
+  source.count_bad_input("nan");
+  source.count_bad_input("wrong_marker_count");
+  source.frames_received = 7;
+  EXPECT_EQ(source.bad_input("nan"), 2u);
+  EXPECT_EQ(source.bad_input("unseen"), 0u);
+  Metrics subject;
+  subject.frames_received = 5;
   SubscriberMetrics s;
   s.id = 3;
   s.transport = "tcp";
   s.remote = "a\"b\\c\nd";
   s.sent = 11;
-  const std::string out = m.render_prometheus({s});
-  EXPECT_EQ(value_of(out, "skinstream_frames_received_total "), 7);
+  const std::string out = render_prometheus(source, {{"A\"1", &subject, {s}}});
+  EXPECT_EQ(value_of(out, "skinstream_source_frames_total "), 7);
+  EXPECT_EQ(value_of(out, "skinstream_frames_received_total{subject=\"A\\\"1\"} "), 5);
   EXPECT_EQ(value_of(out, "skinstream_bad_input_total{category=\"nan\"} "), 2);
   EXPECT_EQ(value_of(out, "skinstream_bad_input_total{category=\"wrong_marker_count\"} "), 1);
-  EXPECT_EQ(value_of(out, "skinstream_subscriber_frames_sent_total{id=\"3\",transport=\"tcp\",remote=\"a\\\"b\\\\c\\nd\"} "), 11);
-  EXPECT_EQ(value_of(out, "skinstream_subscribers "), 1);
+  EXPECT_EQ(value_of(out, "skinstream_subscriber_frames_sent_total{subject=\"A\\\"1\",id=\"3\",transport=\"tcp\",remote=\"a\\\"b\\\\c\\nd\"} "), 11);
+  EXPECT_EQ(value_of(out, "skinstream_subscribers{subject=\"A\\\"1\"} "), 1);
+}
+
+// Several subjects: each metric's HELP and TYPE once, then a sample per subject, labelled.
+TEST(Metrics, EverySubjectHasItsOwnLabelledSeriesUnderOneHeader) {
+  Metrics source, actor1, actor2;
+  actor1.frames_published = 100;
+  actor2.frames_published = 200;
+  actor1.fill.observe_ns(400'000);
+  actor2.fill.observe_ns(400'000);
+  actor2.fill.observe_ns(400'000);
+  actor2.count_bad_input("deform_failed");
+  const std::string out = render_prometheus(source, {{"Actor1", &actor1, {}}, {"Actor2", &actor2, {}}});
+  EXPECT_EQ(value_of(out, "skinstream_frames_published_total{subject=\"Actor1\"} "), 100);
+  EXPECT_EQ(value_of(out, "skinstream_frames_published_total{subject=\"Actor2\"} "), 200);
+  EXPECT_EQ(value_of(out, "skinstream_fill_seconds_count{subject=\"Actor1\"} "), 1);
+  EXPECT_EQ(value_of(out, "skinstream_fill_seconds_bucket{subject=\"Actor2\",le=\"0.0005\"} "), 2);
+  EXPECT_EQ(value_of(out, "skinstream_bad_input_total{subject=\"Actor2\",category=\"deform_failed\"} "), 1);
+  EXPECT_EQ(value_of(out, "skinstream_subscribers{subject=\"Actor2\"} "), 0);
+  std::istringstream lines(out);
+  std::map<std::string, int> types;
+  for (std::string line; std::getline(lines, line);)
+    if (line.rfind("# TYPE ", 0) == 0) ++types[line.substr(7, line.find(' ', 7) - 7)];
+  EXPECT_GT(types.size(), 20u);
+  for (const auto& [name, count] : types) EXPECT_EQ(count, 1) << name;
 }
 
 }  // namespace

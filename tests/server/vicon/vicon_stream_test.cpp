@@ -25,37 +25,17 @@
 #include "server/tcp_congestion.h"
 #include "server/vicon/vicon_server.h"
 #include "support/allocation_counter.h"
+#include "support/io_thread.h"
 #include "support/socket_lookup.h"
 #include "support/test_data.h"
 
 namespace skinstream::server {
 namespace {
 
+using test::IoThread;
+
 using namespace std::chrono_literals;
 constexpr auto kPatience = 20s;  // only bounds a failing test; passing ones never wait this long
-
-// An io_context running on its own thread; call() runs a function there and waits for it.
-class IoThread {
- public:
-  IoThread() : guard_(asio::make_work_guard(io)), thread_([this] { io.run(); }) {}
-  ~IoThread() {
-    guard_.reset();
-    io.stop();
-    thread_.join();
-  }
-  template <typename F>
-  auto call(F&& f) {
-    std::packaged_task<decltype(f())()> task(std::forward<F>(f));
-    auto result = task.get_future();
-    asio::post(io, [&task] { task(); });
-    return result.get();
-  }
-  asio::io_context io;
-
- private:
-  asio::executor_work_guard<asio::io_context::executor_type> guard_;
-  std::thread thread_;
-};
 
 struct ReceivedFrame {
   uint32_t number = 0;
@@ -69,17 +49,25 @@ struct ReceivedFrame {
   SourceTimecode timecode;
 };
 
-// Records what a source hands on, as one subject of `markers` (matched by the SubjectRouter, as
-// the daemon does) sees it.
+// Records what a source hands on, as our subjects (matched by the SubjectRouter, as the daemon
+// does) see it: frames_ is the first subject's, by_target_ every subject's.
 class RecordingSink : public SourceSink, private SubjectRouter::Observer {
  public:
-  explicit RecordingSink(std::vector<std::string> markers)
-      : out_(static_cast<int>(markers.size())), router_({SubjectTarget{"", std::move(markers)}}, *this) {}
+  explicit RecordingSink(std::vector<std::string> markers) : RecordingSink(std::vector<SubjectTarget>{{"", std::move(markers)}}) {}
+  explicit RecordingSink(std::vector<SubjectTarget> targets) : by_target_(targets.size()), router_(targets, *this) {
+    for (const SubjectTarget& t : targets) out_.emplace_back(static_cast<int>(t.marker_names.size()));
+    for (MarkerFrame& f : out_) out_pointers_.push_back(&f);
+  }
 
   void on_frame(const SourceFrame& source) override {
-    MarkerFrame* const out[] = {&out_};
-    router_.route(source, out);
-    const MarkerFrame& frame = out_;
+    router_.route(source, out_pointers_);
+    std::lock_guard lock(mutex_);
+    for (size_t t = 0; t < out_.size(); ++t)
+      if (router_.present(static_cast<int>(t))) by_target_[t].push_back(received(source, out_[t]));
+    changed_.notify_all();
+  }
+
+  static ReceivedFrame received(const SourceFrame& source, const MarkerFrame& frame) {
     ReceivedFrame r;
     r.number = frame.frame_number;
     r.source_time_ns = frame.source_time_ns;
@@ -91,9 +79,7 @@ class RecordingSink : public SourceSink, private SubjectRouter::Observer {
     r.unknown_labels = frame.unknown_labels;
     r.timecode = frame.timecode;
     for (const SourceSubject& subject : source.subjects) r.subjects.push_back(subject.name);
-    std::lock_guard lock(mutex_);
-    frames_.push_back(std::move(r));
-    changed_.notify_all();
+    return r;
   }
   void on_source_state(SourceState state, std::string_view detail) override {
     std::lock_guard lock(mutex_);
@@ -105,7 +91,10 @@ class RecordingSink : public SourceSink, private SubjectRouter::Observer {
     bad_inputs_.emplace_back(what);
     changed_.notify_all();
   }
-  void on_match(int, bool, std::string_view) override {}
+  void on_match(int target, bool present, std::string_view) override {
+    std::lock_guard lock(mutex_);
+    matches_.emplace_back(target, present);
+  }
   void on_unknown_subjects(std::span<const std::string>, size_t) override {}
   void on_unknown_labels(int, std::span<const std::string> names, size_t) override {
     std::lock_guard lock(mutex_);
@@ -132,13 +121,16 @@ class RecordingSink : public SourceSink, private SubjectRouter::Observer {
 
   std::mutex mutex_;
   std::condition_variable changed_;
-  std::vector<ReceivedFrame> frames_;
+  std::vector<std::vector<ReceivedFrame>> by_target_;  // sized once: frames_ refers into it
+  std::vector<ReceivedFrame>& frames_ = by_target_.front();
+  std::vector<std::pair<int, bool>> matches_;  // the router's verdicts: target, present
   std::vector<std::pair<SourceState, std::string>> states_;
   std::vector<std::string> bad_inputs_;
   std::vector<std::string> unknown_labels_;
 
  private:
-  MarkerFrame out_;
+  std::vector<MarkerFrame> out_;
+  std::vector<MarkerFrame*> out_pointers_;
   SubjectRouter router_;
 };
 
@@ -287,6 +279,45 @@ TEST(ViconStream, PullDeliversOneFramePerRequestInOrder) {
         EXPECT_EQ(r.unlabelled[1].first, 4);
       }
     }
+  });
+}
+
+// Two recordings wearing one template, streamed as Actor1 and Actor2: each named subject gets its
+// own recording's positions exactly, never the other's; Actor2 leaves the stage (a stretch of its
+// recording without markers) and comes back.
+TEST(ViconStream, TwoRecordingsAreTwoSubjectsThatNeverMixAndOneLeavesAndReturns) {
+  const Capture one = synthetic_capture();
+  Capture two = synthetic_capture();
+  for (int f = 0; f < two.frame_count; ++f)
+    for (int p = 0; p < two.point_count(); ++p) {
+      two.at(f, p) += Vec3(4000.0, 0.0, 0.0);
+      if (f >= 30 && f < 50 && two.is_labelled(p)) two.at(f, p) = missing_point();
+    }
+  Loopback net;
+  net.server_io.call([&] {
+    net.server = std::make_unique<ViconServer>(net.server_io.io, std::vector<ReplaySubject>{{"Actor1", &one}, {"Actor2", &two}},
+                                               fast_options(4.0));
+    net.server->start();
+    net.port = net.server->port();
+  });
+  const std::vector<std::string> markers = {"A", "B", "C"};
+  RecordingSink sink({{"Actor1", markers}, {"Actor2", markers}});
+  ViconSource source(net.client_io.io, {.host = "127.0.0.1", .port = net.port}, sink);
+  source.start();
+  ASSERT_TRUE(sink.wait_frames(static_cast<size_t>(one.frame_count)));
+  source.stop();
+  sink.with_lock([&] {
+    for (const ReceivedFrame& r : sink.by_target_[0]) expect_frame_matches(one, markers, r);
+    for (const ReceivedFrame& r : sink.by_target_[1]) {
+      expect_frame_matches(two, markers, r);
+      const int index = static_cast<int>(r.number) - two.first_frame;
+      EXPECT_TRUE(index < 30 || index >= 50) << "Actor2 off stage, yet given frame " << r.number;
+      EXPECT_EQ(r.subjects, (std::vector<std::string>{"Actor1", "Actor2"}));
+    }
+    EXPECT_EQ(sink.by_target_[1].size(), static_cast<size_t>(two.frame_count - 20));
+    // Present, gone at frame 30, back at frame 50.
+    const std::vector<std::pair<int, bool>> expected = {{0, true}, {1, true}, {1, false}, {1, true}};
+    EXPECT_EQ(sink.matches_, expected);
   });
 }
 

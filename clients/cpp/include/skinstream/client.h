@@ -11,7 +11,8 @@
 //     upload(frame.positions, frame.normals);  // 3 floats per vertex, mm; sub.mesh().indices
 //
 // Errors (no daemon, refused, a daemon that goes away, bytes that break the protocol) throw
-// skinstream::client::Error with a one-line reason; make a new Subscriber to try again.
+// skinstream::client::Error with a one-line reason; make a new Subscriber to try again. From a
+// multicast group, bad datagrams are counted instead (multicast_stats()): anyone can send to it.
 
 #include <chrono>
 #include <cstdint>
@@ -29,6 +30,35 @@ const char* to_string(Encoding encoding);
 // "float", "quantised", "compressed", "parameters"; throws std::invalid_argument otherwise.
 Encoding encoding_from_string(const std::string& name);
 
+// Frames from the daemon's multicast group instead of the TCP connection (the daemon's
+// --multicast; docs/subscriber-protocol.md, "Multicast"): the Subscriber fetches MeshInfo and the
+// Model over TCP from host:port, closes that connection, and then reads the parameters of every
+// frame from the group. A lost datagram costs the frame it carried; next() never waits for it,
+// and gives the newest complete frame (a reader slower than the stream skips frames instead of
+// falling behind by what the socket buffer holds).
+struct MulticastOptions {
+  std::string group{};                       // IPv4 multicast address; empty: frames over TCP
+  uint16_t port = 0;
+  std::string interface_address = "0.0.0.0";  // this host's address to join on (name the stage network's)
+  uint32_t stream_id = 0;                    // the subject's stream (0: the daemon's first)
+  std::chrono::milliseconds window{50};      // a frame's datagrams must all arrive within it
+};
+
+// What arrived from the multicast group so far.
+struct MulticastStats {
+  uint64_t datagrams = 0;           // of this stream
+  uint64_t frames_completed = 0;
+  uint64_t frames_lost = 0;         // the daemon sent them and they never completed here
+  uint64_t frames_incomplete = 0;   // of those, frames some of whose datagrams arrived
+  uint64_t datagrams_rejected = 0;  // broke the protocol (last_error says how)
+  uint64_t datagrams_other_stream = 0;
+  uint64_t datagrams_late = 0;      // for a frame already complete or given up
+  uint64_t datagrams_duplicate = 0;
+  uint64_t frames_superseded = 0;   // complete, and a newer one was complete before next() took it
+  uint64_t messages_rejected = 0;   // whole messages that broke the protocol
+  std::string last_error{};         // one line, of the last datagram or message rejected
+};
+
 struct Options {
   std::string host = "127.0.0.1";
   uint16_t port = 8481;
@@ -45,6 +75,7 @@ struct Options {
   std::string token{};       // the daemon's shared token, when it has one
   int protocol_version = 2;  // 1 speaks to a daemon older than version 2 (float or quantised)
   std::chrono::milliseconds connect_timeout{5000};
+  MulticastOptions multicast{};  // group set: frames from it (encoding parameters, protocol 2)
 };
 
 class Error : public std::runtime_error {
@@ -135,6 +166,8 @@ class Subscriber {
   std::span<const unsigned char> parameter_block() const;
   // Parameters: the Model message's payload, for the same renderers.
   std::span<const unsigned char> model_payload() const;
+  // Multicast: what arrived from the group (all zero without Options::multicast).
+  MulticastStats multicast_stats() const;
 
  private:
   struct State;

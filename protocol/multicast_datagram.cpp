@@ -1,0 +1,87 @@
+#include "protocol/multicast_datagram.h"
+
+#include <cstring>
+#include <string>
+
+#include "protocol/byte_buffer.h"
+
+namespace skinstream::subscriber {
+namespace {
+
+size_t stride(size_t message_bytes, uint16_t count) { return (message_bytes + count - 1) / count; }
+
+template <typename T>
+void put(unsigned char*& p, T value) {
+  std::memcpy(p, &value, sizeof value);  // little-endian hosts only, as everywhere in the protocol
+  p += sizeof value;
+}
+
+template <typename T>
+T get(const unsigned char*& p) {
+  T value;
+  std::memcpy(&value, p, sizeof value);
+  p += sizeof value;
+  return value;
+}
+
+}  // namespace
+
+uint16_t fragment_count(size_t message_bytes) {
+  if (message_bytes == 0 || message_bytes > kMaxDatagramMessageBytes) return 0;
+  return static_cast<uint16_t>((message_bytes + kMaxFragmentBytes - 1) / kMaxFragmentBytes);
+}
+
+size_t fragment_offset(size_t message_bytes, uint16_t count, uint16_t index) { return index * stride(message_bytes, count); }
+
+size_t fragment_bytes(size_t message_bytes, uint16_t count, uint16_t index) {
+  const size_t start = fragment_offset(message_bytes, count, index);
+  return start >= message_bytes ? 0 : std::min(stride(message_bytes, count), message_bytes - start);
+}
+
+void encode_datagram_header(const DatagramHeader& h, std::span<unsigned char, kDatagramHeaderBytes> out) {
+  unsigned char* p = out.data();
+  put<uint32_t>(p, kDatagramMagic);
+  put<uint16_t>(p, kDatagramVersion);
+  put<uint16_t>(p, 0);  // reserved
+  put<uint32_t>(p, h.stream_id);
+  put<uint32_t>(p, h.model_id);
+  put<uint32_t>(p, h.sequence);
+  put<uint16_t>(p, h.index);
+  put<uint16_t>(p, h.count);
+  put<uint32_t>(p, h.message_bytes);
+}
+
+DatagramHeader decode_datagram_header(std::span<const unsigned char> datagram) {
+  if (datagram.size() < kDatagramHeaderBytes)
+    throw DecodeError("datagram of " + std::to_string(datagram.size()) + " bytes is shorter than its " +
+                      std::to_string(kDatagramHeaderBytes) + "-byte header");
+  if (datagram.size() > kMaxDatagramBytes)
+    throw DecodeError("datagram of " + std::to_string(datagram.size()) + " bytes is over the " + std::to_string(kMaxDatagramBytes) + " allowed");
+  const unsigned char* p = datagram.data();
+  if (get<uint32_t>(p) != kDatagramMagic) throw DecodeError("bad magic (not a skinstream multicast datagram)");
+  const uint16_t version = get<uint16_t>(p);
+  if (version != kDatagramVersion) throw DecodeError("multicast datagram version " + std::to_string(version) + " (this side speaks 1)");
+  if (get<uint16_t>(p) != 0) throw DecodeError("reserved header bits set");
+  DatagramHeader h;
+  h.stream_id = get<uint32_t>(p);
+  h.model_id = get<uint32_t>(p);
+  h.sequence = get<uint32_t>(p);
+  h.index = get<uint16_t>(p);
+  h.count = get<uint16_t>(p);
+  h.message_bytes = get<uint32_t>(p);
+  if (h.count == 0 || h.count > kMaxFragments)
+    throw DecodeError("fragment count " + std::to_string(h.count) + " (1-" + std::to_string(kMaxFragments) + ")");
+  if (h.index >= h.count) throw DecodeError("fragment " + std::to_string(h.index) + " of " + std::to_string(h.count));
+  if (h.message_bytes == 0 || stride(h.message_bytes, h.count) > kMaxFragmentBytes ||
+      fragment_bytes(h.message_bytes, h.count, static_cast<uint16_t>(h.count - 1)) == 0)
+    throw DecodeError("a message of " + std::to_string(h.message_bytes) + " bytes cannot be cut into " + std::to_string(h.count) + " fragments");
+  const size_t expected = fragment_bytes(h.message_bytes, h.count, h.index);
+  if (datagram.size() - kDatagramHeaderBytes != expected)
+    throw DecodeError("fragment " + std::to_string(h.index) + " of " + std::to_string(h.count) + " holds " +
+                      std::to_string(datagram.size() - kDatagramHeaderBytes) + " bytes, not " + std::to_string(expected));
+  return h;
+}
+
+uint32_t model_id_of(std::span<const unsigned char> model_payload) { return crc32(model_payload.data(), model_payload.size()); }
+
+}  // namespace skinstream::subscriber

@@ -1,0 +1,50 @@
+#include "server/metrics/status_line.h"
+
+#include <cmath>
+#include <cstdio>
+
+namespace skinstream::server {
+namespace {
+
+// The interval's p99 as its bucket's upper bound (ms); 0 without observations.
+double p99_upper_bound_ms(const LatencyHistogram::Buckets& now, const LatencyHistogram::Buckets& before) {
+  uint64_t total = 0;
+  for (size_t b = 0; b < now.size(); ++b) total += now[b] - before[b];
+  if (total == 0) return 0.0;
+  const auto rank = static_cast<uint64_t>(std::ceil(0.99 * static_cast<double>(total)));
+  uint64_t cumulative = 0;
+  for (size_t b = 0; b < now.size(); ++b) {
+    cumulative += now[b] - before[b];
+    if (cumulative >= rank) return LatencyHistogram::kBounds[b] * 1e3;
+  }
+  return LatencyHistogram::kBounds.back() * 1e3;
+}
+
+}  // namespace
+
+std::string StatusLine::next(std::string_view subject, const Metrics& metrics, size_t subscribers, uint64_t subscriber_drops,
+                             Clock::time_point now) {
+  const uint64_t received = metrics.frames_received.load(), published = metrics.frames_published.load();
+  const uint64_t dropped = metrics.frames_dropped.load();
+  const LatencyHistogram::Buckets processing = metrics.receive_to_publish.bucket_counts();
+  const double seconds = std::chrono::duration<double>(now - last_).count();
+  const uint64_t out = published - published_;
+  const uint64_t new_subscriber_drops = subscriber_drops > subscriber_drops_ ? subscriber_drops - subscriber_drops_ : 0;
+  char line[256];
+  std::snprintf(line, sizeof line,
+                "status %.*s: %llu frames in, %llu out (%.1f/s) in %.0f s; processing p99 <= %.2f ms; %zu subscribers; dropped %llu in "
+                "the pipeline, %llu for subscribers",
+                static_cast<int>(subject.size()), subject.data(), static_cast<unsigned long long>(received - received_),
+                static_cast<unsigned long long>(out), seconds > 0 ? out / seconds : 0.0, seconds,
+                p99_upper_bound_ms(processing, processing_), subscribers, static_cast<unsigned long long>(dropped - dropped_),
+                static_cast<unsigned long long>(new_subscriber_drops));
+  last_ = now;
+  received_ = received;
+  published_ = published;
+  dropped_ = dropped;
+  processing_ = processing;
+  subscriber_drops_ = subscriber_drops;
+  return line;
+}
+
+}  // namespace skinstream::server

@@ -1,0 +1,151 @@
+#include "server/publish/multicast_sender.h"
+
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <chrono>
+#include <cstring>
+#include <nlohmann/json.hpp>
+#include <stdexcept>
+
+namespace skinstream::server {
+namespace {
+
+namespace wire = skinstream::subscriber;
+
+std::string where(const MulticastSenderOptions& o) { return "multicast " + o.group + ":" + std::to_string(o.port); }
+
+}  // namespace
+
+StreamKey MulticastSender::sent_key() { return stream_key(wire::kFrameParameters, wire::kVersion2); }
+
+MulticastSender::MulticastSender(FrameConsumer& next, const MulticastSenderOptions& options) : next_(next), options_(options) {
+  in_addr group{}, interface{};
+  if (inet_pton(AF_INET, options.group.c_str(), &group) != 1 || !IN_MULTICAST(ntohl(group.s_addr)))
+    throw std::runtime_error(where(options) + ": " + options.group + " is not an IPv4 multicast address (224.0.0.0-239.255.255.255)");
+  if (inet_pton(AF_INET, options.interface_address.c_str(), &interface) != 1)
+    throw std::runtime_error(where(options) + ": interface " + options.interface_address + " is not an IPv4 address");
+  if (options.ttl < 0 || options.ttl > 255) throw std::runtime_error(where(options) + ": ttl must be 0-255");
+  fd_ = socket(AF_INET, SOCK_DGRAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
+  if (fd_ < 0) throw std::runtime_error(where(options) + ": socket: " + std::strerror(errno));
+  sockaddr_in to{};
+  to.sin_family = AF_INET;
+  to.sin_addr = group;
+  to.sin_port = htons(options.port);
+  const int ttl = options.ttl;
+  const char* failed = nullptr;
+  if (setsockopt(fd_, IPPROTO_IP, IP_MULTICAST_TTL, &ttl, sizeof ttl) != 0) failed = "the TTL";
+  else if (interface.s_addr != INADDR_ANY && setsockopt(fd_, IPPROTO_IP, IP_MULTICAST_IF, &interface, sizeof interface) != 0)
+    failed = "the interface (an address of this host?)";
+  else if (connect(fd_, reinterpret_cast<const sockaddr*>(&to), sizeof to) != 0) failed = "the group (a route to it?)";
+  if (failed) {
+    const std::string reason = std::strerror(errno);
+    close(fd_);
+    throw std::runtime_error(where(options) + ": cannot set " + failed + ": " + reason);
+  }
+  std::memset(datagrams_, 0, sizeof datagrams_);
+  for (int i = 0; i < wire::kMaxFragments; ++i) {
+    pieces_[2 * i] = {headers_[i], wire::kDatagramHeaderBytes};
+    datagrams_[i].msg_hdr.msg_iov = &pieces_[2 * i];
+    datagrams_[i].msg_hdr.msg_iovlen = 2;
+  }
+}
+
+MulticastSender::~MulticastSender() {
+  if (fd_ >= 0) close(fd_);
+}
+
+void MulticastSender::set_model(std::span<const unsigned char> model_payload) {
+  model_id_ = wire::model_id_of(model_payload);
+  has_model_ = true;
+}
+
+StreamKeySet MulticastSender::wanted_encodings() const {
+  StreamKeySet keys = next_.wanted_encodings();
+  keys.add(sent_key());
+  return keys;
+}
+
+void MulticastSender::publish(const FrameRef& frame) {
+  next_.publish(frame);
+  if (!has_model_ || !frame->has(sent_key())) return;  // no Model yet; or a later hand-over of the frame (compressed)
+  const auto start = std::chrono::steady_clock::now();
+  const std::span<const unsigned char> message = frame->message(sent_key());
+  const uint16_t count = wire::fragment_count(message.size());
+  if (count == 0) {
+    frames_too_large_.fetch_add(1, std::memory_order_relaxed);
+    error_log_.warn("too_large", where(options_) + ": a frame of " + std::to_string(message.size()) + " bytes is over the " +
+                                     std::to_string(wire::kMaxDatagramMessageBytes) + " 64 datagrams carry; not sent");
+    return;
+  }
+  wire::DatagramHeader header{options_.stream_id, model_id_, sequence_++, 0, count, static_cast<uint32_t>(message.size())};
+  for (uint16_t i = 0; i < count; ++i) {
+    header.index = i;
+    wire::encode_datagram_header(header, headers_[i]);
+    // sendmmsg only reads the fragment; iovec has no const.
+    pieces_[2 * i + 1] = {const_cast<unsigned char*>(message.data()) + wire::fragment_offset(message.size(), count, i),
+                          wire::fragment_bytes(message.size(), count, i)};
+  }
+  int sent = 0;
+  while (sent < count) {
+    const int n = sendmmsg(fd_, datagrams_ + sent, static_cast<unsigned>(count - sent), MSG_DONTWAIT);
+    if (n > 0) {
+      sent += n;
+      continue;
+    }
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK || errno == ENOBUFS)) {
+      datagrams_dropped_.fetch_add(static_cast<uint64_t>(count - sent), std::memory_order_relaxed);
+    } else {
+      send_errors_.fetch_add(1, std::memory_order_relaxed);
+      error_log_.warn("send", where(options_) + ": send failed: " + std::strerror(errno) + "; the frame's other datagrams are dropped");
+    }
+    break;
+  }
+  if (sent == count) frames_sent_.fetch_add(1, std::memory_order_relaxed);
+  datagrams_sent_.fetch_add(static_cast<uint64_t>(sent), std::memory_order_relaxed);
+  uint64_t bytes = 0;
+  for (int i = 0; i < sent; ++i) bytes += wire::kDatagramHeaderBytes + pieces_[2 * i + 1].iov_len;
+  bytes_sent_.fetch_add(bytes, std::memory_order_relaxed);
+  send_time_.observe_ns(std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - start).count());
+}
+
+nlohmann::json MulticastSender::health() const {
+  const LatencyHistogram::Summary send = send_time_.summary();
+  return {{"group", options_.group},
+          {"port", options_.port},
+          {"interface", options_.interface_address},
+          {"ttl", options_.ttl},
+          {"stream_id", options_.stream_id},
+          {"model_id", model_id_},
+          {"frames_sent", frames_sent_.load()},
+          {"datagrams_sent", datagrams_sent_.load()},
+          {"bytes_sent", bytes_sent_.load()},
+          {"datagrams_dropped", datagrams_dropped_.load()},
+          {"send_errors", send_errors_.load()},
+          {"frames_too_large", frames_too_large_.load()},
+          {"send_ms", {{"count", send.count}, {"p50_le", send.p50_le_ms}, {"p99_le", send.p99_le_ms}, {"max", send.max_ms}}}};
+}
+
+void MulticastSender::render_prometheus(std::string& out) const {
+  const struct {
+    const char* name;
+    const char* help;
+    const std::atomic<uint64_t>& value;
+  } counters[] = {
+      {"multicast_frames_sent_total", "Frames whose every datagram went to the multicast group.", frames_sent_},
+      {"multicast_datagrams_sent_total", "Multicast datagrams sent.", datagrams_sent_},
+      {"multicast_bytes_sent_total", "UDP payload bytes sent to the multicast group.", bytes_sent_},
+      {"multicast_datagrams_dropped_total", "Multicast datagrams dropped because the socket buffer was full.", datagrams_dropped_},
+      {"multicast_send_errors_total", "Failed multicast sends (each drops the rest of its frame).", send_errors_},
+      {"multicast_frames_too_large_total", "Frames over 64 datagrams, not sent.", frames_too_large_},
+  };
+  for (const auto& c : counters)
+    out += std::string("# HELP skinstream_") + c.name + " " + c.help + "\n# TYPE skinstream_" + c.name + " counter\nskinstream_" + c.name +
+           " " + std::to_string(c.value.load(std::memory_order_relaxed)) + "\n";
+  send_time_.render(out, "multicast_send_seconds", "Time per frame to hand its datagrams to the socket (pipeline thread).");
+}
+
+}  // namespace skinstream::server

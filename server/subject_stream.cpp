@@ -1,0 +1,204 @@
+#include "server/subject_stream.h"
+
+#include <spdlog/fmt/ranges.h>
+#include <spdlog/spdlog.h>
+
+#include <filesystem>
+#include <nlohmann/json.hpp>
+
+#include "protocol/file_error.h"
+#include "protocol/subscriber_model.h"
+
+namespace skinstream::server {
+namespace {
+
+subscriber::MeshInfo mesh_info_of(const SubjectFile& subject) {
+  subscriber::MeshInfo info;
+  const SubjectModel& model = subject.model;
+  info.marker_count = static_cast<uint32_t>(model.marker_count());
+  info.marker_names = model.marker_names;
+  for (const auto& t : model.triangles)
+    info.marker_triangles.push_back({static_cast<uint32_t>(t[0]), static_cast<uint32_t>(t[1]), static_cast<uint32_t>(t[2])});
+  if (subject.deformation) {
+    const DeformationModel& d = *subject.deformation;
+    info.vertex_count = static_cast<uint32_t>(d.vertex_count());
+    info.part_count = static_cast<uint32_t>(d.part_count());
+    for (const auto& f : d.faces)
+      info.faces.push_back({static_cast<uint32_t>(f[0]), static_cast<uint32_t>(f[1]), static_cast<uint32_t>(f[2])});
+    info.dominant_part.resize(info.vertex_count);
+    for (int v = 0; v < d.vertex_count(); ++v) {
+      const int p = d.dominant_part(v);
+      info.dominant_part[v] = p >= 0 && p < 255 ? static_cast<uint8_t>(p) : uint8_t{255};
+    }
+  }
+  return info;
+}
+
+subscriber::SourceStateCode code_of(SourceState s) { return static_cast<subscriber::SourceStateCode>(static_cast<uint32_t>(s)); }
+
+// The /metrics histograms condensed for scripts, over the stream's life: per stage its count,
+// the quantiles as bucket upper bounds ("le") and the largest value seen.
+nlohmann::json latency_summaries(const Metrics& metrics) {
+  nlohmann::json out = nlohmann::json::object();
+  auto add = [&](const char* name, const LatencyHistogram& histogram) {
+    const LatencyHistogram::Summary s = histogram.summary();
+    out[name] = {{"count", s.count}, {"p50_le", s.p50_le_ms}, {"p99_le", s.p99_le_ms}, {"p99_9_le", s.p99_9_le_ms}, {"max", s.max_ms}};
+  };
+  add("receive_to_take", metrics.receive_to_take);
+  add("fill", metrics.fill);
+  add("deform", metrics.deform);
+  add("normals", metrics.normals);
+  add("encode", metrics.encode);
+  add("encode_compressed", metrics.encode_compressed);
+  add("receive_to_publish", metrics.receive_to_publish);
+  add("subscriber_queue_wait", metrics.subscriber_queue_wait);
+  add("subscriber_write", metrics.subscriber_write);
+  return out;
+}
+
+}  // namespace
+
+SubjectStream::SubjectStream(SubjectConfig config, const SubjectStreamOptions& options)
+    : config_(std::move(config)),
+      name_(config_.name.empty() ? std::filesystem::path(config_.file).stem().string() : config_.name),
+      subject_(read_subject_file(config_.file)),
+      mailbox_(subject_.model.marker_count(), options.max_frame_wait),
+      deform_cpus_(options.pipeline.deform_cpus),
+      deform_threads_(options.pipeline.deform_threads) {
+  if (!subject_.deformation)
+    spdlog::warn("subject {}: {}: no deformation model (built without --mesh): publishing markers only (MeshInfo with V = 0)",
+                 name_, config_.file);
+  subscriber::MeshInfo mesh_info = mesh_info_of(subject_);
+  mesh_info.subject = name_;
+  hub_ = std::make_unique<SubscriberHub>(metrics_, options.hub, std::move(mesh_info), subject_.deformation.has_value());
+  FrameConsumer* consumer = hub_.get();
+  if (options.multicast) {
+    if (!subject_.deformation)
+      throw ConfigError("multicast sends the parameters of the mesh: subject " + name_ + " (" + config_.file + ") has none (built without --mesh)");
+    multicast_ = std::make_unique<MulticastSender>(*hub_, *options.multicast);
+    consumer = multicast_.get();
+  }
+  try {
+    pipeline_ = std::make_unique<Pipeline>(subject_.model, subject_.deformation ? &*subject_.deformation : nullptr, options.pipeline,
+                                           mailbox_, *consumer, metrics_);
+  } catch (const std::invalid_argument& e) {
+    throw FileError(config_.file, std::string("deformation model unusable: ") + e.what());
+  }
+  hub_->set_encoding_preparer([pipeline = pipeline_.get()](StreamKey key) { pipeline->prepare_encoding(key); });
+  hub_->set_compressed_order(pipeline_->compressed_order());
+  if (const EvaluationModel* evaluation = pipeline_->evaluation_model()) {
+    hub_->set_model_message(std::make_shared<const std::vector<unsigned char>>(subscriber::encode_model(*evaluation)));
+    spdlog::info("subject {}: parameter encoding: Model message of {} bytes ({} parts, {} RBF centres, {} influences)", name_,
+                 hub_->model_message()->size(), evaluation->part_count(), evaluation->member_count(), evaluation->influence_count());
+    if (multicast_) {
+      multicast_->set_model(std::span<const unsigned char>(*hub_->model_message()).subspan(subscriber::kHeaderBytes));
+      pipeline_->prepare_encoding(MulticastSender::sent_key());
+      spdlog::info("subject {}: multicast: every frame's parameters to {}:{} from {} (TTL {}), stream {}, model id {:08x}", name_,
+                   options.multicast->group, options.multicast->port, options.multicast->interface_address, options.multicast->ttl,
+                   options.multicast->stream_id, multicast_->model_id());
+    }
+  }
+}
+
+void SubjectStream::render_multicast_metrics(std::string& out) const {
+  if (multicast_) multicast_->render_prometheus(out);
+}
+
+SubjectStream::~SubjectStream() { stop(); }
+
+void SubjectStream::start() { pipeline_->start(); }
+
+void SubjectStream::stop() { pipeline_->stop(); }
+
+void SubjectStream::post() {
+  metrics_.frames_received.fetch_add(1, std::memory_order_relaxed);
+  const MarkerFrame& frame = mailbox_.writable();
+  if (frame.rejected_points > 0) {
+    metrics_.count_bad_input("rejected_point");
+    bad_input_log_.warn("rejected_point", "subject " + name_ + ", frame " + std::to_string(frame.frame_number) + ": " +
+                                              std::to_string(frame.rejected_points) + " points ignored (not finite, or beyond " +
+                                              std::to_string(MarkerFrame::kMaxUnlabelled) + " unlabelled)");
+  }
+  if (frame.source_rate_hz > 0 && frame.source_rate_hz != source_rate_hz_) {
+    source_rate_hz_ = frame.source_rate_hz;
+    hub_->set_source_rate(static_cast<float>(frame.source_rate_hz));
+  }
+  if (const std::optional<FrameMailbox::Drop> drop = mailbox_.post(generation_)) {
+    // Says which side fell behind: the pipeline (it took nothing for a while), or the source,
+    // whose frames came in a burst longer than the mailbox holds.
+    using Ms = std::chrono::duration<double, std::milli>;
+    const bool full = drop->reason == FrameMailbox::DropReason::kMailboxFull;
+    drop_log_.warn("frame_gave_way",
+                   fmt::format("subject {}: frame {} gave way to newer ones after waiting {:.1f} ms: {}; the pipeline last took a "
+                               "frame {:.1f} ms before ({} dropped in all)",
+                               name_, drop->frame_number, Ms(drop->waited).count(),
+                               full ? "more frames arrived together than the mailbox holds (a burst from the source)"
+                                    : "the pipeline is behind (longer than max_frame_wait_ms)",
+                               Ms(drop->since_last_take).count(), mailbox_.dropped()));
+  }
+}
+
+void SubjectStream::set_presence(bool present, std::string_view detail) {
+  if (present) new_take();  // (back) in the stream: the filler starts afresh
+  {
+    std::lock_guard lock(mutex_);
+    present_ = present;
+    presence_detail_ = std::string(detail);
+  }
+  if (present) spdlog::info("subject {}: {}", name_, detail);
+  else spdlog::warn("subject {}: absent, waiting for it: {}", name_, detail);
+}
+
+bool SubjectStream::present() const {
+  std::lock_guard lock(mutex_);
+  return present_;
+}
+
+void SubjectStream::broadcast_status(SourceState state, std::string_view source_detail) {
+  subscriber::Status status;
+  status.state = code_of(state);
+  status.source_rate_hz = static_cast<float>(source_rate_hz_);
+  status.frames_received = metrics_.frames_received.load();
+  status.frames_published = metrics_.frames_published.load();
+  {
+    std::lock_guard lock(mutex_);
+    status.subject_present = present_;
+    status.detail = present_ || state != SourceState::Streaming
+                        ? std::string(source_detail)
+                        : "subject " + name_ + " absent, waiting for it: " + presence_detail_;
+  }
+  hub_->broadcast_status(status);
+}
+
+std::string SubjectStream::status_line(StatusLine::Clock::time_point now) {
+  uint64_t subscriber_drops = 0;
+  for (const SubscriberMetrics& m : hub_->subscriber_metrics()) subscriber_drops += m.dropped;
+  return status_line_.next(name_, metrics_, hub_->subscriber_count(), subscriber_drops, now);
+}
+
+nlohmann::json SubjectStream::health() const {
+  nlohmann::json out;
+  {
+    std::lock_guard lock(mutex_);
+    // present: in the source's latest frames (the daemon waits for an absent one).
+    out = {{"name", name_}, {"file", config_.file}, {"present", present_}, {"detail", presence_detail_}};
+  }
+  out["markers"] = subject_.model.marker_count();
+  out["vertices"] = pipeline_->vertex_count();
+  out["frames"] = {{"received", metrics_.frames_received.load()},
+                   {"processed", metrics_.frames_processed.load()},
+                   {"published", metrics_.frames_published.load()},
+                   {"dropped", metrics_.frames_dropped.load()},
+                   {"dropped_mailbox_full", metrics_.frames_dropped_mailbox_full.load()}};
+  // Encoded frame buffers created so far: grows only while the pool meets a new high-water
+  // mark of frames in use (bounded by the subscribers' queues), so RSS steps with it.
+  out["frame_buffers_allocated"] = metrics_.frame_buffers_allocated.load();
+  out["frame_buffers_allocated_by_pipeline"] = metrics_.frame_buffers_allocated_by_pipeline.load();
+  out["subscribers"] = hub_->subscriber_count();
+  out["deform"] = {{"threads", deform_threads_}, {"cpus", deform_cpus_}};
+  out["latency_ms"] = latency_summaries(metrics_);
+  if (multicast_) out["multicast"] = multicast_->health();
+  return out;
+}
+
+}  // namespace skinstream::server
