@@ -18,7 +18,6 @@ namespace {
 
 using synth::Body;
 using synth::Bone;
-using synth::Face;
 using synth::Skeleton;
 using synth::SkinWeights;
 
@@ -277,7 +276,7 @@ synth::Body load_makehuman(const MakeHumanFiles& files) {
     throw FileError(files.weights, e.what());
   }
   // Faces counter-clockwise seen from outside.
-  if (synth::signed_volume(body.rest, synth::triangulate(body.faces)) < 0.0)
+  if (signed_volume(body.rest, triangulate(body.faces)) < 0.0)
     for (Face& f : body.faces) {
       if (f[3] >= 0)
         std::swap(f[1], f[3]);

@@ -39,7 +39,7 @@ synth::Body load_makehuman(const std::string& dir);
 // kept, larger polygons fanned). Throws FileError.
 struct ObjMesh {
   std::vector<Vec3> vertices;
-  std::vector<synth::Face> faces;
+  std::vector<Face> faces;
 };
 ObjMesh read_obj(const std::string& path);
 

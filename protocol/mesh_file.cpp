@@ -513,7 +513,7 @@ void write_obj(const std::string& path, const TriangleMesh& mesh) { write_obj(pa
 
 void write_ply(const std::string& path, const std::vector<Vec3>& vertices,
                const std::vector<std::array<int, 3>>& faces) {
-  std::vector<synth::Face> polygons;
+  std::vector<Face> polygons;
   polygons.reserve(faces.size());
   for (const auto& f : faces) polygons.push_back({f[0], f[1], f[2], -1});
   write_ply(path, vertices, polygons);

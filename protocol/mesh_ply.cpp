@@ -19,7 +19,7 @@ void put_le(std::string& out, const void* p, size_t n) {
 }  // namespace
 
 void write_ply(const std::string& path, const std::vector<Vec3>& vertices,
-               const std::vector<synth::Face>& faces) {
+               const std::vector<Face>& faces) {
   for (size_t f = 0; f < faces.size(); ++f) {
     const int k = faces[f][3] < 0 ? 3 : 4;
     for (int i = 0; i < k; ++i)
@@ -41,7 +41,7 @@ void write_ply(const std::string& path, const std::vector<Vec3>& vertices,
     const float xyz[3] = {static_cast<float>(v.x()), static_cast<float>(v.y()), static_cast<float>(v.z())};
     put_le(data, xyz, sizeof xyz);
   }
-  for (const synth::Face& f : faces) {
+  for (const Face& f : faces) {
     const uint8_t k = f[3] < 0 ? 3 : 4;
     put_le(data, &k, 1);
     for (int i = 0; i < k; ++i) {

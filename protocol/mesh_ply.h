@@ -6,18 +6,18 @@
 #include <vector>
 
 #include "core/capture.h"
-#include "core/synth/body.h"
+#include "core/geometry/triangle_mesh.h"
 
 namespace skinstream {
 
 // Throws FileError when the file cannot be written or a face index is out of range.
 void write_ply(const std::string& path, const std::vector<Vec3>& vertices,
-               const std::vector<synth::Face>& faces);
+               const std::vector<Face>& faces);
 
 // Reads back what write_ply writes (binary little-endian, float vertices, uchar/int faces).
 struct PlyMesh {
   std::vector<Vec3> vertices;
-  std::vector<synth::Face> faces;
+  std::vector<Face> faces;
 };
 PlyMesh read_ply(const std::string& path);
 // The same from a whole file's bytes in memory; `name` stands for the path in errors.

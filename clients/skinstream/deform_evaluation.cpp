@@ -10,10 +10,11 @@
 #include "clients/skinstream/json_output.h"
 #include "clients/skinstream/part_file.h"
 #include "core/deform/mesh_deformer.h"
+#include "core/geometry/triangle_mesh.h"
 #include "core/offline/subject_builder.h"
 #include "core/render/software_rasterizer.h"
-#include "protocol/png_file.h"
 #include "core/synth/subdivision.h"
+#include "protocol/png_file.h"
 
 namespace skinstream::cli {
 namespace {
@@ -56,14 +57,14 @@ std::vector<MarkerSiteOnMesh> locate_markers(const std::vector<Vec3>& vertices,
     for (size_t f = 0; f < faces.size(); ++f) {
       const auto& t = faces[f];
       Vec3 bary;
-      const Vec3 p = synth::closest_point_on_triangle(markers[m], vertices[t[0]], vertices[t[1]], vertices[t[2]], &bary);
+      const Vec3 p = closest_point_on_triangle(markers[m], vertices[t[0]], vertices[t[1]], vertices[t[2]], &bary);
       const double d = (p - markers[m]).squaredNorm();
       if (d < best) {
         best = d;
         sites[m].triangle = static_cast<int>(f);
         sites[m].barycentric = bary;
         sites[m].height =
-            (markers[m] - p).dot(synth::triangle_normal(vertices[t[0]], vertices[t[1]], vertices[t[2]]));
+            (markers[m] - p).dot(triangle_normal(vertices[t[0]], vertices[t[1]], vertices[t[2]]));
       }
     }
   }
@@ -80,7 +81,7 @@ Vec3 site_position(const std::vector<float>& positions, const std::vector<std::a
   const auto& t = faces[site.triangle];
   const Vec3 a = vertex_at(positions, t[0]), b = vertex_at(positions, t[1]), c = vertex_at(positions, t[2]);
   const Vec3 on_surface = site.barycentric[0] * a + site.barycentric[1] * b + site.barycentric[2] * c;
-  return on_surface + site.height * synth::triangle_normal(a, b, c);
+  return on_surface + site.height * triangle_normal(a, b, c);
 }
 
 // Vertices the markers cover: within `reach` of the reference marker surface. The dense set has
@@ -90,7 +91,7 @@ std::vector<char> covered_vertices(const DeformationModel& model, const SubjectM
   for (int v = 0; v < model.vertex_count(); ++v) {
     const Vec3& p = model.reference_vertices[v];
     for (const auto& t : subject.triangles) {
-      const Vec3 q = synth::closest_point_on_triangle(p, subject.reference_positions[t[0]],
+      const Vec3 q = closest_point_on_triangle(p, subject.reference_positions[t[0]],
                                                       subject.reference_positions[t[1]], subject.reference_positions[t[2]]);
       if ((q - p).squaredNorm() <= reach * reach) {
         covered[v] = 1;

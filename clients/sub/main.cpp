@@ -193,7 +193,7 @@ int main(int argc, char** argv) {
         std::printf("%s\n", line.dump().c_str());
       }
       if (save_every > 0 && frames % save_every == 0 && !frame.positions.empty()) {
-        std::vector<synth::Face> faces;
+        std::vector<Face> faces;
         for (size_t i = 0; i + 2 < mesh.indices.size(); i += 3)
           faces.push_back({static_cast<int>(mesh.indices[i]), static_cast<int>(mesh.indices[i + 1]), static_cast<int>(mesh.indices[i + 2]), -1});
         char name[64];

@@ -1,12 +1,13 @@
 #include "core/baselines/bone_heat_weights.h"
 
+#include <Eigen/Geometry>  // cross()
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
 #include <algorithm>
 #include <stdexcept>
 #include <string>
 
-#include "core/synth/bvh.h"
+#include "core/geometry/triangle_bvh.h"
 
 namespace skinstream {
 namespace {
@@ -19,10 +20,10 @@ Vec3 closest_on_bone(const HeatBone& bone, const Vec3& p) {
 }
 
 // Cotangent stiffness (positive semi-definite) and lumped vertex areas.
-void cotangent_laplacian(const std::vector<Vec3>& vertices, const std::vector<synth::Triangle>& triangles,
+void cotangent_laplacian(const std::vector<Vec3>& vertices, const std::vector<Triangle>& triangles,
                          std::vector<Eigen::Triplet<double>>& out_stiffness, std::vector<double>& out_area) {
   out_area.assign(vertices.size(), 0.0);
-  for (const synth::Triangle& t : triangles) {
+  for (const Triangle& t : triangles) {
     const double doubled_area = (vertices[t[1]] - vertices[t[0]]).cross(vertices[t[2]] - vertices[t[0]]).norm();
     if (!(doubled_area > 0.0)) continue;  // degenerate: no angle to speak of
     for (int corner = 0; corner < 3; ++corner) {
@@ -40,7 +41,7 @@ void cotangent_laplacian(const std::vector<Vec3>& vertices, const std::vector<sy
 
 }  // namespace
 
-void bone_heat_weights(const std::vector<Vec3>& vertices, const std::vector<synth::Triangle>& triangles,
+void bone_heat_weights(const std::vector<Vec3>& vertices, const std::vector<Triangle>& triangles,
                        const std::vector<HeatBone>& bones, int group_count, const BoneHeatOptions& options,
                        std::vector<int>& out_offsets, std::vector<PartInfluence>& out_weights) {
   if (bones.empty()) throw std::invalid_argument("bone_heat_weights: no bones");
@@ -49,12 +50,12 @@ void bone_heat_weights(const std::vector<Vec3>& vertices, const std::vector<synt
       throw std::invalid_argument("bone_heat_weights: bone group " + std::to_string(b.group) + " outside [0, " +
                                   std::to_string(group_count) + ")");
   const int n = static_cast<int>(vertices.size());
-  for (const synth::Triangle& t : triangles)
+  for (const Triangle& t : triangles)
     for (int v : t)
       if (v < 0 || v >= n) throw std::invalid_argument("bone_heat_weights: triangle index out of range");
 
   // Heat sources: each vertex's nearest bone it can see, and its distance.
-  const synth::TriangleBvh bvh(vertices, triangles);
+  const TriangleBvh bvh(vertices, triangles);
   Eigen::VectorXd heat = Eigen::VectorXd::Zero(n);    // H_jj
   Eigen::MatrixXd source = Eigen::MatrixXd::Zero(n, group_count);  // p, per group
   std::vector<std::pair<double, int>> by_distance(bones.size());

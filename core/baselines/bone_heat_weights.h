@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "core/baselines/segment_skinning.h"
-#include "core/synth/body.h"
+#include "core/geometry/triangle_mesh.h"
 
 namespace skinstream {
 
@@ -32,7 +32,7 @@ struct BoneHeatOptions {
 // Per vertex, the weight of each group (CSR, each vertex sums to 1), in the form SegmentSkinning
 // takes. Throws std::invalid_argument for no bones, a group outside [0, group_count), or a
 // triangle index out of range.
-void bone_heat_weights(const std::vector<Vec3>& vertices, const std::vector<synth::Triangle>& triangles,
+void bone_heat_weights(const std::vector<Vec3>& vertices, const std::vector<Triangle>& triangles,
                        const std::vector<HeatBone>& bones, int group_count, const BoneHeatOptions& options,
                        std::vector<int>& out_offsets, std::vector<PartInfluence>& out_weights);
 

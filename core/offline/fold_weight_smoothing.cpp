@@ -7,19 +7,17 @@
 #include <functional>
 #include <limits>
 #include <queue>
-#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "core/offline/mesh_edges.h"
+#include "core/precondition.h"
 
 namespace skinstream {
 namespace {
 
-void require(bool ok, const std::string& what) {
-  if (!ok) throw std::invalid_argument("fold weight smoothing: " + what);
-}
+constexpr Precondition require{"fold weight smoothing"};
 
 // A vertex's hold on its own weights when nothing else holds it (a piece of mesh in the fold with
 // no vertex around it keeping its weights): small enough not to matter anywhere else.

@@ -3,20 +3,18 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <stdexcept>
 #include <string>
 #include <utility>
 
 #include "core/absolute_orientation.h"
 #include "core/offline/marker_surface_builder.h"
 #include "core/offline/part_motions.h"
+#include "core/precondition.h"
 
 namespace skinstream {
 namespace {
 
-void require(bool ok, const std::string& what) {
-  if (!ok) throw std::invalid_argument("marker part weights: " + what);
-}
+constexpr Precondition require{"marker part weights"};
 
 // Weight given to a marker added to a part only to reach min_members, at least (before the
 // marker's row is renormalised): the part must not get a zero weight.

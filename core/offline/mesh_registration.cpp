@@ -10,18 +10,17 @@
 #include <utility>
 
 #include "core/absolute_orientation.h"
+#include "core/geometry/triangle_bvh.h"
+#include "core/geometry/triangle_mesh.h"
 #include "core/offline/mesh_edges.h"
-#include "core/synth/body.h"
-#include "core/synth/bvh.h"
+#include "core/precondition.h"
 
 namespace skinstream {
 namespace {
 
 using Triangles = std::span<const std::array<int, 3>>;
 
-void require(bool ok, const std::string& what) {
-  if (!ok) throw std::invalid_argument("mesh registration: " + what);
-}
+constexpr Precondition require{"mesh registration"};
 
 void check_points(std::span<const Vec3> points, const char* what) {
   for (size_t i = 0; i < points.size(); ++i)
@@ -39,7 +38,7 @@ void check_mesh(std::span<const Vec3> vertices, Triangles triangles) {
                                    std::to_string(n));
 }
 
-std::vector<synth::Triangle> to_triangles(Triangles triangles) { return {triangles.begin(), triangles.end()}; }
+std::vector<Triangle> to_triangles(Triangles triangles) { return {triangles.begin(), triangles.end()}; }
 
 // Centre and RMS radius of the mesh: the internal coordinates are (p - centre) / scale.
 struct Normalisation {
@@ -123,9 +122,9 @@ std::vector<Vec3> apply_transforms(const std::vector<Vec3>& unit_vertices, const
   return out;
 }
 
-SurfaceDistance distance_stats(const std::vector<Vec3>& points, const std::vector<synth::Triangle>& triangles,
+SurfaceDistance distance_stats(const std::vector<Vec3>& points, const std::vector<Triangle>& triangles,
                                std::span<const Vec3> markers, double offset, double to_mm) {
-  const synth::TriangleBvh bvh(points, triangles);
+  const TriangleBvh bvh(points, triangles);
   SurfaceDistance d;
   if (markers.empty()) return d;
   double sum = 0.0, sum2 = 0.0;
@@ -140,10 +139,10 @@ SurfaceDistance distance_stats(const std::vector<Vec3>& points, const std::vecto
   return d;
 }
 
-std::pair<double, double> landmark_residual(const std::vector<Vec3>& points, const std::vector<synth::Triangle>& triangles,
+std::pair<double, double> landmark_residual(const std::vector<Vec3>& points, const std::vector<Triangle>& triangles,
                                             std::span<const Vec3> markers, std::span<const RegistrationLandmark> landmarks,
                                             double offset, double to_mm) {
-  const std::vector<Vec3> normals = synth::vertex_normals(points, triangles);
+  const std::vector<Vec3> normals = vertex_normals(points, triangles);
   double sum2 = 0.0, max = 0.0;
   for (const RegistrationLandmark& l : landmarks) {
     const double e = (points[l.vertex] - (markers[l.marker] - offset * normals[l.vertex])).norm() * to_mm;
@@ -189,7 +188,7 @@ std::vector<Vec3> register_mesh(std::span<const Vec3> vertices, Triangles triang
   std::vector<Vec3> unit_markers(markers.size());
   for (int i = 0; i < m; ++i) unit_markers[i] = norm.to_unit(markers[i]);
   const double offset = options.marker_offset_mm / norm.scale;
-  const std::vector<synth::Triangle> tris = to_triangles(triangles);
+  const std::vector<Triangle> tris = to_triangles(triangles);
   const std::vector<std::pair<int, int>> edges = unique_edges(triangles);
 
   Eigen::MatrixX3d x = Eigen::MatrixX3d::Zero(4 * n, 3);
@@ -202,7 +201,7 @@ std::vector<Vec3> register_mesh(std::span<const Vec3> vertices, Triangles triang
   // One linear solve with the correspondences of the current deformed mesh.
   auto iterate = [&](double data_weight) {
     const std::vector<Vec3> current = apply_transforms(unit_vertices, x);
-    const std::vector<Vec3> normals = synth::vertex_normals(current, tris);
+    const std::vector<Vec3> normals = vertex_normals(current, tris);
     NormalEquations eq(n);
     // Each term is a mean (per edge, per vertex, per landmark, per marker), so that equal
     // weights mean equal say whatever the mesh resolution and the marker count.
@@ -216,14 +215,14 @@ std::vector<Vec3> register_mesh(std::span<const Vec3> vertices, Triangles triang
       eq.add_point_row<1>(landmark, {l.vertex}, {1.0}, unit_vertices,
                           unit_markers[l.marker] - offset * normals[l.vertex]);
     if (data_weight > 0.0) {
-      const synth::TriangleBvh bvh(current, tris);
+      const TriangleBvh bvh(current, tris);
       for (const Vec3& marker : unit_markers) {
         int t = -1;
         bvh.closest(marker, &t);
-        const synth::Triangle& tri = tris[t];
+        const Triangle& tri = tris[t];
         Vec3 bary;
-        synth::closest_point_on_triangle(marker, current[tri[0]], current[tri[1]], current[tri[2]], &bary);
-        const Vec3 normal = synth::triangle_normal(current[tri[0]], current[tri[1]], current[tri[2]]);
+        closest_point_on_triangle(marker, current[tri[0]], current[tri[1]], current[tri[2]], &bary);
+        const Vec3 normal = triangle_normal(current[tri[0]], current[tri[1]], current[tri[2]]);
         eq.add_point_row<3>(data, tri, {bary[0], bary[1], bary[2]}, unit_vertices, marker - offset * normal);
       }
     }

@@ -3,19 +3,17 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <stdexcept>
 #include <string>
 
 #include <Eigen/Dense>
 
 #include "core/offline/part_motions.h"
+#include "core/precondition.h"
 
 namespace skinstream {
 namespace {
 
-void require(bool ok, const std::string& what) {
-  if (!ok) throw std::invalid_argument("part joints: " + what);
-}
+constexpr Precondition require{"part joints"};
 
 // A weight this close to 1 means the part owns the marker outright.
 constexpr double kOwned = 1.0 - 1e-9;

@@ -7,19 +7,17 @@
 #include <cmath>
 #include <limits>
 #include <map>
-#include <stdexcept>
 #include <string>
 
 #include "core/absolute_orientation.h"
+#include "core/precondition.h"
 
 namespace skinstream {
 namespace {
 
 using Triangles = std::span<const std::array<int, 3>>;
 
-void require(bool ok, const std::string& what) {
-  if (!ok) throw std::invalid_argument("part segmentation: " + what);
-}
+constexpr Precondition require{"part segmentation"};
 
 void check_inputs(std::span<const Vec3> reference, Triangles triangles, std::span<const Vec3> positions, int frame_count,
                   int sample_frames) {

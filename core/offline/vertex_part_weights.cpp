@@ -3,19 +3,17 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
-#include <stdexcept>
 #include <string>
 #include <utility>
 
-#include "core/synth/body.h"
-#include "core/synth/bvh.h"
+#include "core/geometry/triangle_bvh.h"
+#include "core/geometry/triangle_mesh.h"
+#include "core/precondition.h"
 
 namespace skinstream {
 namespace {
 
-void require(bool ok, const std::string& what) {
-  if (!ok) throw std::invalid_argument("vertex part weights: " + what);
-}
+constexpr Precondition require{"vertex part weights"};
 
 // Below this, an interpolated weight counts as zero (a vertex on an edge or a vertex of the
 // triangle gets exactly what its markers have, not a trace of the opposite marker).
@@ -103,9 +101,9 @@ VertexPartWeights vertex_part_weights(std::span<const Vec3> vertices, std::span<
     }
   }
 
-  const std::vector<synth::Triangle> tris(triangles.begin(), triangles.end());
+  const std::vector<Triangle> tris(triangles.begin(), triangles.end());
   const std::vector<Vec3> points(markers.begin(), markers.end());
-  const synth::TriangleBvh bvh(points, tris);
+  const TriangleBvh bvh(points, tris);
 
   // Fold blending: each triangle's main part (largest summed alpha of its markers) and a sphere
   // around it, to skip triangles that cannot be near enough.
@@ -137,9 +135,9 @@ VertexPartWeights vertex_part_weights(std::span<const Vec3> vertices, std::span<
     blend.clear();
     for (const auto& [side, share] : sides) {
       if (side < 0 || !(share > 0.0)) continue;
-      const synth::Triangle& tri = tris[side];
+      const Triangle& tri = tris[side];
       Vec3 bary;
-      synth::closest_point_on_triangle(vertices[j], points[tri[0]], points[tri[1]], points[tri[2]], &bary);
+      closest_point_on_triangle(vertices[j], points[tri[0]], points[tri[1]], points[tri[2]], &bary);
       for (int k = 0; k < 3; ++k) {
         if (!(bary[k] > kZeroWeight)) continue;
         row = alpha[tri[k]];
@@ -190,7 +188,7 @@ VertexPartWeights vertex_part_weights(std::span<const Vec3> vertices, std::span<
       const Vec3 towards_near = (near_point - vertices[j]) / near;
       for (size_t u = 0; u < tris.size(); ++u) {
         if (main_part[u] == main_part[t] || (centre[u] - vertices[j]).norm() - radius[u] >= kFoldRatio * near) continue;
-        const Vec3 q = synth::closest_point_on_triangle(vertices[j], points[tris[u][0]], points[tris[u][1]], points[tris[u][2]]);
+        const Vec3 q = closest_point_on_triangle(vertices[j], points[tris[u][0]], points[tris[u][1]], points[tris[u][2]]);
         const double far = (q - vertices[j]).norm();
         const double share = fold_share(near, far, towards_near.dot((q - vertices[j]) / far));
         if (share > sides[1].second) sides[1] = {static_cast<int>(u), share};
@@ -216,9 +214,9 @@ std::vector<char> vertices_under_markers(std::span<const Vec3> vertices, std::sp
   for (size_t f = 0; f < faces.size(); ++f)
     for (int corner : faces[f])
       require(corner >= 0 && corner < v, "face " + std::to_string(f) + " refers to vertex " + std::to_string(corner) + " of " + std::to_string(v));
-  const std::vector<synth::Triangle> tris(faces.begin(), faces.end());
+  const std::vector<Triangle> tris(faces.begin(), faces.end());
   const std::vector<Vec3> points(vertices.begin(), vertices.end());
-  const synth::TriangleBvh bvh(points, tris);
+  const TriangleBvh bvh(points, tris);
   std::vector<char> under(vertices.size(), 0);
   for (const Vec3& marker : markers) {
     int face = -1;

@@ -1,11 +1,11 @@
 #pragma once
 // A skinned body: rest-pose surface (quads and triangles), its skeleton and skin weights.
 // Units and axes as in skeleton.h: millimetres, Z up, facing +Y, left on -X.
-#include <array>
 #include <utility>
 #include <vector>
 
 #include "core/capture.h"
+#include "core/geometry/triangle_mesh.h"
 #include "core/synth/skeleton.h"
 
 namespace skinstream::synth {
@@ -29,11 +29,6 @@ struct SkinWeights {
                                 int bone_count);
 };
 
-// A polygon of the surface: a quad (a, b, c, d) counter-clockwise seen from outside, or a
-// triangle with d == -1.
-using Face = std::array<int, 4>;
-using Triangle = std::array<int, 3>;
-
 struct Body {
   std::vector<Vec3> rest;  // vertex positions, mm
   std::vector<Face> faces;
@@ -47,22 +42,5 @@ struct Body {
 // a face index out of range or repeated in a face, weights not one row per vertex, a bone
 // index outside the skeleton.
 void validate(const Body& body);
-
-// Splits every quad (a,b,c,d) into (a,b,c), (a,c,d). `face_of` (optional) receives the face
-// of each triangle.
-std::vector<Triangle> triangulate(const std::vector<Face>& faces, std::vector<int>* face_of = nullptr);
-
-// Area-weighted vertex normals (unit; zero for a vertex in no triangle).
-std::vector<Vec3> vertex_normals(const std::vector<Vec3>& points, const std::vector<Triangle>& triangles);
-
-// Unit normal of a triangle (counter-clockwise = outward); zero when degenerate.
-Vec3 triangle_normal(const Vec3& a, const Vec3& b, const Vec3& c);
-
-// The closest point to p on triangle (a, b, c), with its barycentric coordinates.
-Vec3 closest_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c,
-                               Vec3* barycentric = nullptr);
-
-// Signed volume enclosed by a closed triangle surface (positive when faces point outward).
-double signed_volume(const std::vector<Vec3>& points, const std::vector<Triangle>& triangles);
 
 }  // namespace skinstream::synth

@@ -9,7 +9,7 @@
 // `min_cameras` (two) see it.
 #include <vector>
 
-#include "core/synth/bvh.h"
+#include "core/geometry/triangle_bvh.h"
 #include "core/synth/random.h"
 
 namespace skinstream::synth {

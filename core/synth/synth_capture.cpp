@@ -5,7 +5,7 @@
 #include <limits>
 #include <stdexcept>
 
-#include "core/synth/bvh.h"
+#include "core/geometry/triangle_bvh.h"
 #include "core/synth/motion.h"
 #include "core/synth/random.h"
 #include "core/synth/subdivision.h"

@@ -9,7 +9,7 @@ if(TARGET skinstreamd AND TARGET skinstream-sub AND TARGET skinstream-replay)
     ${PROJECT_SOURCE_DIR}/tests/support/loopback_peer.cpp ${PROJECT_SOURCE_DIR}/tests/support/daemon_process.cpp)
   target_include_directories(daemon_tests PRIVATE ${PROJECT_SOURCE_DIR}/tests)
   # skinstream_server for the blocking subscriber client (server/client/) the tests subscribe with.
-  target_link_libraries(daemon_tests PRIVATE skinstream_server skinstream_protocol skinstream_core nlohmann_json::nlohmann_json GTest::gtest_main)
+  target_link_libraries(daemon_tests PRIVATE skinstream_server skinstream_protocol_offline nlohmann_json::nlohmann_json GTest::gtest_main)
   target_compile_definitions(daemon_tests PRIVATE
     SKINSTREAMD="$<TARGET_FILE:skinstreamd>"
     SKINSTREAM_SUB="$<TARGET_FILE:skinstream-sub>"

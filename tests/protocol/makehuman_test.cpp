@@ -12,8 +12,8 @@
 #include <map>
 #include <string>
 
+#include "core/geometry/triangle_bvh.h"
 #include "core/synth/anatomy.h"
-#include "core/synth/bvh.h"
 #include "core/synth/subdivision.h"
 #include "core/synth/synth_capture.h"
 #include "protocol/file_error.h"
@@ -109,7 +109,7 @@ TEST(MakeHumanLoad, BodySkeletonAndWeightsInMillimetresZUp) {
   EXPECT_NEAR(lo.z(), 0.0, 1e-9);          // soles on the floor
   EXPECT_NEAR(hi.z(), 1666.0, 5.0);        // 16.66 MakeHuman decimetres tall
   EXPECT_NEAR(lo.x() + hi.x(), 0.0, 1.0);  // symmetric about x = 0
-  EXPECT_GT(synth::signed_volume(b.rest, synth::triangulate(b.faces)), 0.04e9);  // outward, ~60 litres
+  EXPECT_GT(signed_volume(b.rest, triangulate(b.faces)), 0.04e9);  // outward, ~60 litres
   const synth::Skeleton& sk = b.skeleton;
   EXPECT_LT(sk.bone(sk.require("upperarm01.L")).head.x(), -100.0);  // left on -X
   EXPECT_GT(sk.bone(sk.require("upperarm01.R")).head.x(), 100.0);
@@ -254,15 +254,15 @@ TEST(MakeHumanSynth, TruthMarkersLieOnTheSubdividedTruthMesh) {
   EXPECT_GT(c.mesh_vertex_count(), 53000);
   for (int f : {0, 60, 179}) {
     const std::vector<Vec3> mesh = c.pose_mesh(f);
-    const synth::TriangleBvh bvh(mesh, c.mesh_triangles());
+    const TriangleBvh bvh(mesh, c.mesh_triangles());
     int exact = 0;
     for (int i = 0; i < 350; ++i) {
       const synth::MarkerSite& s = c.markers[static_cast<size_t>(i)];
-      const synth::Triangle& t = c.mesh_triangles()[static_cast<size_t>(s.triangle)];
+      const Triangle& t = c.mesh_triangles()[static_cast<size_t>(s.triangle)];
       const Vec3 &p0 = mesh[static_cast<size_t>(t[0])], &p1 = mesh[static_cast<size_t>(t[1])],
                  &p2 = mesh[static_cast<size_t>(t[2])];
       const Vec3 foot = s.barycentric[0] * p0 + s.barycentric[1] * p1 + s.barycentric[2] * p2;
-      ASSERT_LT((c.truth.at(f, i) - foot - 4.0 * synth::triangle_normal(p0, p1, p2)).norm(), 1e-9);
+      ASSERT_LT((c.truth.at(f, i) - foot - 4.0 * triangle_normal(p0, p1, p2)).norm(), 1e-9);
       const double d = bvh.closest(c.truth.at(f, i));
       ASSERT_LE(d, 4.0 + 1e-9);
       exact += std::abs(d - 4.0) < 0.1;

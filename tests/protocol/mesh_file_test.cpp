@@ -91,7 +91,7 @@ TEST(MeshFile, ReadsTheMakeHumanBodyInFileOrder) {
     ASSERT_EQ(reference.vertices[i], mesh.vertices[i]) << i;
   }
   size_t t = 0;
-  for (const synth::Face& f : reference.faces) {
+  for (const Face& f : reference.faces) {
     ASSERT_EQ(mesh.faces[t++], (std::array<int, 3>{f[0], f[1], f[2]}));
     if (f[3] >= 0) {
       ASSERT_EQ(mesh.faces[t++], (std::array<int, 3>{f[0], f[2], f[3]}));
@@ -126,7 +126,7 @@ TEST(MeshFile, ReadsFromMemoryAsFromTheFile) {
 
 TEST(MeshFile, PlyFromTheGeneratorRoundTripsWithQuadsFanned) {
   const std::vector<Vec3> v = {{0, 0, 0}, {1000.5, 0, 0}, {1000.5, 2000.25, 0}, {0, 2000.25, -3.5}};
-  const std::vector<synth::Face> f = {{0, 1, 2, 3}, {3, 2, 1, -1}};
+  const std::vector<Face> f = {{0, 1, 2, 3}, {3, 2, 1, -1}};
   const std::string path = test::scratch_path("generator.ply");
   write_ply(path, v, f);
   const TriangleMesh m = read_mesh(path);

@@ -56,7 +56,7 @@ TEST(MeshPly, CountsBeyondTheFileAreRefused) {
 
 TEST(MeshPly, ReadsFromMemoryAsFromTheFile) {
   const std::vector<Vec3> v = {{0, 0, 0}, {1000.5, 0, 0}, {1000.5, 2000.25, 0}, {0, 2000.25, -3.5}};
-  const std::vector<synth::Face> f = {{0, 1, 2, 3}, {0, 2, 3, -1}};
+  const std::vector<Face> f = {{0, 1, 2, 3}, {0, 2, 3, -1}};
   const std::string path = test::scratch_path("quad_memory.ply");
   write_ply(path, v, f);
   const std::string bytes = test::read_bytes(path);
@@ -69,7 +69,7 @@ TEST(MeshPly, ReadsFromMemoryAsFromTheFile) {
 
 TEST(MeshPly, QuadsAndTrianglesRoundTrip) {
   const std::vector<Vec3> v = {{0, 0, 0}, {1000.5, 0, 0}, {1000.5, 2000.25, 0}, {0, 2000.25, -3.5}};
-  const std::vector<synth::Face> f = {{0, 1, 2, 3}, {0, 2, 3, -1}};
+  const std::vector<Face> f = {{0, 1, 2, 3}, {0, 2, 3, -1}};
   const std::string path = test::scratch_path("quad.ply");
   write_ply(path, v, f);
   const PlyMesh m = read_ply(path);

@@ -12,7 +12,7 @@ namespace {
 // vertices on the side, one centre vertex per cap.
 struct Tube {
   std::vector<Vec3> vertices;
-  std::vector<synth::Triangle> triangles;
+  std::vector<Triangle> triangles;
   static constexpr int around = 24, along = 41;
   static constexpr double radius = 40.0, length = 400.0;
 
@@ -53,7 +53,7 @@ TEST(BoneHeatWeights, RejectsNoBonesAGroupOutOfRangeAndABadTriangle) {
   std::vector<PartInfluence> weights;
   EXPECT_THROW(bone_heat_weights(tube.vertices, tube.triangles, {}, 1, {}, offsets, weights), std::invalid_argument);
   EXPECT_THROW(bone_heat_weights(tube.vertices, tube.triangles, kElbow, 1, {}, offsets, weights), std::invalid_argument);
-  std::vector<synth::Triangle> bad = tube.triangles;
+  std::vector<Triangle> bad = tube.triangles;
   bad.push_back({0, 1, static_cast<int>(tube.vertices.size())});
   EXPECT_THROW(bone_heat_weights(tube.vertices, bad, kElbow, 2, {}, offsets, weights), std::invalid_argument);
 }

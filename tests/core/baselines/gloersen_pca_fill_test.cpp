@@ -11,7 +11,7 @@
 #include "core/evaluation/gap_plan.h"
 #include "synthetic_walker.h"
 
-// Real data: protocol/c3d.h exists, but core_tests links only skinstream_core, so a CMU
+// Real data: protocol/c3d.h exists, but core_tests links only core/'s libraries, so a CMU
 // comparison cannot live in this suite. The synthetic walker below (41 CMU-named markers on a
 // walking kinematic chain) stands in for it.
 

@@ -6,8 +6,9 @@
 #include <cstdio>
 
 #include "core/deform/mesh_deformer.h"
-#include "core/offline/subject_builder.h"
+#include "core/geometry/triangle_mesh.h"
 #include "core/offline/marker_distance_stats.h"
+#include "core/offline/subject_builder.h"
 #include "core/synth/mannequin.h"
 #include "core/synth/synth_capture.h"
 
@@ -105,7 +106,7 @@ TEST(DeformationBuilder, DeformedFramesMatchTheSyntheticTruth) {
   long covered_count = 0;
   for (int v = 0; v < model.vertex_count(); ++v)
     for (const auto& t : subject.triangles) {
-      const Vec3 q = synth::closest_point_on_triangle(model.reference_vertices[v], subject.reference_positions[t[0]],
+      const Vec3 q = closest_point_on_triangle(model.reference_vertices[v], subject.reference_positions[t[0]],
                                                       subject.reference_positions[t[1]], subject.reference_positions[t[2]]);
       if ((q - model.reference_vertices[v]).norm() <= 30.0) {
         covered[v] = 1;

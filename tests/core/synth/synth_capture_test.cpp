@@ -6,7 +6,7 @@
 
 #include <cmath>
 
-#include "core/synth/bvh.h"
+#include "core/geometry/triangle_bvh.h"
 #include "core/synth/mannequin.h"
 
 namespace skinstream::synth {

@@ -5,9 +5,9 @@
 // as the pose drifts from the one it was built in, so callers rebuild now and then).
 #include <vector>
 
-#include "core/synth/body.h"
+#include "core/geometry/triangle_mesh.h"
 
-namespace skinstream::synth {
+namespace skinstream {
 
 class TriangleBvh {
  public:
@@ -41,4 +41,4 @@ class TriangleBvh {
   std::vector<Node> nodes_;
 };
 
-}  // namespace skinstream::synth
+}  // namespace skinstream

@@ -1,4 +1,4 @@
-#include "core/synth/bvh.h"
+#include "core/geometry/triangle_bvh.h"
 
 #include <gtest/gtest.h>
 
@@ -7,7 +7,7 @@
 #include "core/synth/mannequin.h"
 #include "core/synth/random.h"
 
-namespace skinstream::synth {
+namespace skinstream {
 namespace {
 
 // Brute force: does any triangle cross the segment (beyond skip at both ends)?
@@ -30,15 +30,15 @@ bool brute_blocked(const std::vector<Vec3>& p, const std::vector<Triangle>& tris
   return false;
 }
 
-TEST(SynthBvh, RejectsBadTriangles) {
+TEST(TriangleBvh, RejectsBadTriangles) {
   EXPECT_THROW(TriangleBvh({Vec3::Zero()}, {{0, 1, 2}}), std::invalid_argument);
   TriangleBvh empty({}, {});
   EXPECT_FALSE(empty.segment_blocked(Vec3::Zero(), Vec3::UnitX()));
   EXPECT_EQ(empty.closest(Vec3::Zero()), std::numeric_limits<double>::infinity());
 }
 
-TEST(SynthBvh, SegmentAndClosestQueriesMatchBruteForceAfterRefit) {
-  const Body m = make_mannequin();
+TEST(TriangleBvh, SegmentAndClosestQueriesMatchBruteForceAfterRefit) {
+  const synth::Body m = synth::make_mannequin();
   const std::vector<Triangle> tris = triangulate(m.faces);
   TriangleBvh bvh(m.rest, tris);
   std::vector<Vec3> moved = m.rest;
@@ -46,7 +46,7 @@ TEST(SynthBvh, SegmentAndClosestQueriesMatchBruteForceAfterRefit) {
     p = Vec3(p.x() * 1.1 + 0.05 * p.z(), p.y() - 0.1 * p.x(), p.z());  // deform, then refit
   for (const std::vector<Vec3>* pts : std::vector<const std::vector<Vec3>*>{&m.rest, &moved}) {
     bvh.refit(*pts);
-    Random r(5);
+    synth::Random r(5);
     int blocked = 0;
     for (int i = 0; i < 300; ++i) {
       const Vec3 a(r.uniform(-400, 400), r.uniform(-300, 300), r.uniform(0, 1800));
@@ -74,4 +74,4 @@ TEST(SynthBvh, SegmentAndClosestQueriesMatchBruteForceAfterRefit) {
 }
 
 }  // namespace
-}  // namespace skinstream::synth
+}  // namespace skinstream

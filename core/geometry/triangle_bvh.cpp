@@ -1,12 +1,13 @@
-#include "core/synth/bvh.h"
+#include "core/geometry/triangle_bvh.h"
 
+#include <Eigen/Geometry>  // cross()
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
 #include <string>
 
-namespace skinstream::synth {
+namespace skinstream {
 
 namespace {
 
@@ -213,4 +214,4 @@ double TriangleBvh::closest(const Vec3& p, int* triangle, Vec3* point) const {
   return std::sqrt(best2);
 }
 
-}  // namespace skinstream::synth
+}  // namespace skinstream

@@ -1,0 +1,87 @@
+#include "core/geometry/triangle_mesh.h"
+
+#include <Eigen/Geometry>  // cross()
+
+namespace skinstream {
+
+std::vector<Triangle> triangulate(const std::vector<Face>& faces, std::vector<int>* face_of) {
+  std::vector<Triangle> out;
+  out.reserve(faces.size() * 2);
+  if (face_of) face_of->clear();
+  for (size_t f = 0; f < faces.size(); ++f) {
+    const Face& q = faces[f];
+    out.push_back({q[0], q[1], q[2]});
+    if (face_of) face_of->push_back(static_cast<int>(f));
+    if (q[3] >= 0) {
+      out.push_back({q[0], q[2], q[3]});
+      if (face_of) face_of->push_back(static_cast<int>(f));
+    }
+  }
+  return out;
+}
+
+Vec3 triangle_normal(const Vec3& a, const Vec3& b, const Vec3& c) {
+  const Vec3 n = (b - a).cross(c - a);
+  const double len = n.norm();
+  return len > 0.0 ? Vec3(n / len) : Vec3(Vec3::Zero());
+}
+
+std::vector<Vec3> vertex_normals(const std::vector<Vec3>& points, const std::vector<Triangle>& triangles) {
+  std::vector<Vec3> n(points.size(), Vec3::Zero());
+  for (const Triangle& t : triangles) {
+    const Vec3 area_n = (points[static_cast<size_t>(t[1])] - points[static_cast<size_t>(t[0])])
+                            .cross(points[static_cast<size_t>(t[2])] - points[static_cast<size_t>(t[0])]);
+    for (int i : t) n[static_cast<size_t>(i)] += area_n;
+  }
+  for (Vec3& v : n) {
+    const double len = v.norm();
+    if (len > 0.0) v /= len;
+  }
+  return n;
+}
+
+Vec3 closest_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c,
+                               Vec3* barycentric) {
+  // Ericson, Real-Time Collision Detection, 5.1.5.
+  const Vec3 ab = b - a, ac = c - a, ap = p - a;
+  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+  auto done = [&](double u, double v, double w) {
+    if (barycentric) *barycentric = Vec3(u, v, w);
+    return Vec3(u * a + v * b + w * c);
+  };
+  if (d1 <= 0.0 && d2 <= 0.0) return done(1, 0, 0);
+  const Vec3 bp = p - b;
+  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0.0 && d4 <= d3) return done(0, 1, 0);
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) {
+    const double v = d1 / (d1 - d3);
+    return done(1 - v, v, 0);
+  }
+  const Vec3 cp = p - c;
+  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0.0 && d5 <= d6) return done(0, 0, 1);
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) {
+    const double w = d2 / (d2 - d6);
+    return done(1 - w, 0, w);
+  }
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0) {
+    const double w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+    return done(0, 1 - w, w);
+  }
+  const double denom = 1.0 / (va + vb + vc);
+  const double v = vb * denom, w = vc * denom;
+  return done(1 - v - w, v, w);
+}
+
+double signed_volume(const std::vector<Vec3>& points, const std::vector<Triangle>& triangles) {
+  double v = 0.0;
+  for (const Triangle& t : triangles)
+    v += points[static_cast<size_t>(t[0])].dot(
+        points[static_cast<size_t>(t[1])].cross(points[static_cast<size_t>(t[2])]));
+  return v / 6.0;
+}
+
+}  // namespace skinstream

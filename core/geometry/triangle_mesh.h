@@ -1,0 +1,34 @@
+#pragma once
+// Triangle meshes: the faces of a surface, its normals, closest points and enclosed volume.
+// Shared by the subject builders (core/offline), the synthetic bodies (core/synth) and the mesh
+// files.
+#include <array>
+#include <vector>
+
+#include "core/capture.h"
+
+namespace skinstream {
+
+// A polygon of the surface: a quad (a, b, c, d) counter-clockwise seen from outside, or a
+// triangle with d == -1.
+using Face = std::array<int, 4>;
+using Triangle = std::array<int, 3>;
+
+// Splits every quad (a,b,c,d) into (a,b,c), (a,c,d). `face_of` (optional) receives the face
+// of each triangle.
+std::vector<Triangle> triangulate(const std::vector<Face>& faces, std::vector<int>* face_of = nullptr);
+
+// Area-weighted vertex normals (unit; zero for a vertex in no triangle).
+std::vector<Vec3> vertex_normals(const std::vector<Vec3>& points, const std::vector<Triangle>& triangles);
+
+// Unit normal of a triangle (counter-clockwise = outward); zero when degenerate.
+Vec3 triangle_normal(const Vec3& a, const Vec3& b, const Vec3& c);
+
+// The closest point to p on triangle (a, b, c), with its barycentric coordinates.
+Vec3 closest_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c,
+                               Vec3* barycentric = nullptr);
+
+// Signed volume enclosed by a closed triangle surface (positive when faces point outward).
+double signed_volume(const std::vector<Vec3>& points, const std::vector<Triangle>& triangles);
+
+}  // namespace skinstream
