@@ -24,6 +24,7 @@
 
 #include "server/client/subscriber_client.h"
 #include "support/daemon_process.h"
+#include "support/loopback_peer.h"  // eventually()
 #include "support/test_data.h"
 
 namespace skinstream::test {
@@ -79,16 +80,6 @@ class ReplayProcess {
   pid_t pid_ = -1;
   std::string out_path_;
 };
-
-// Polls `condition` every 20 ms for up to `limit`: a bound on a hang, not a timing assertion.
-inline bool eventually(const std::function<bool()>& condition, std::chrono::seconds limit = std::chrono::seconds(20)) {
-  const auto end = std::chrono::steady_clock::now() + limit;
-  while (std::chrono::steady_clock::now() < end) {
-    if (condition()) return true;
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
-  }
-  return condition();
-}
 
 // A subscriber on its own thread that keeps every Status and counts frames, until stopped.
 class BackgroundSubscriber {
