@@ -440,6 +440,7 @@ std::string Daemon::health_json() const {
       {"source", source},
       {"subjects", subjects},
       {"subscribers", subscribers},
+      {"frame_pool", first["frame_pool"]},
       {"subscriber_limits",
        {{"max_subscribers", config_.max_subscribers},
         {"max_subscribers_per_address", config_.max_subscribers_per_address},

@@ -73,7 +73,6 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
       if (admission->token_required()) {
         const std::optional<std::string> token = query_parameter(std::string_view(request_.target().data(), request_.target().size()), "token");
         if (token && !admission->token_matches(*token)) {
-          hub_.metrics().subscribers_refused_token.fetch_add(1, std::memory_order_relaxed);
           return refuse(http::status::forbidden, "wrong token");
         }
         if (!token) token_check = routes_->stream_admission;  // then Hello version 2 must carry it

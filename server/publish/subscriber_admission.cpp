@@ -66,7 +66,9 @@ bool SubscriberAdmission::token_matches(std::string_view given) const {
     const unsigned char b = i < given.size() ? static_cast<unsigned char>(given[i]) : 0;
     difference |= static_cast<unsigned char>(a ^ b);
   }
-  return difference == 0 && !expected.empty();
+  const bool matches = difference == 0 && !expected.empty();
+  if (!matches) metrics_.subscribers_refused_token.fetch_add(1, std::memory_order_relaxed);
+  return matches;
 }
 
 int SubscriberAdmission::admitted() const {

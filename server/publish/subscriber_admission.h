@@ -39,12 +39,13 @@ class SubscriberAdmission : public std::enable_shared_from_this<SubscriberAdmiss
     std::string reason;  // one line, for the peer and the log
   };
 
-  // Refusals are counted in `metrics` (subscribers_refused_not_allowed, _limit).
+  // Refusals are counted in `metrics` (subscribers_refused_not_allowed, _limit, _token).
   SubscriberAdmission(AdmissionOptions options, Metrics& metrics);
 
   Decision admit(const asio::ip::address& peer);
   bool token_required() const { return !options_.token.empty(); }
-  // Compares in time that depends on the lengths only, not on where the bytes first differ.
+  // Compares in time that depends on the lengths only, not on where the bytes first differ. A
+  // mismatch is a refusal, counted (subscribers_refused_token) for the whole daemon.
   bool token_matches(std::string_view given) const;
 
   const AdmissionOptions& options() const { return options_; }

@@ -110,7 +110,6 @@ void SubscriberSession::on_hello(const subscriber::Hello& hello) {
   if (!refusal_.empty()) return refuse(refusal_);
   if (token_check_) {
     if (!token_check_->token_matches(hello.token)) {
-      hub_->metrics().subscribers_refused_token.fetch_add(1, std::memory_order_relaxed);
       return refuse(hello.token.empty() ? "this daemon asks for a token (Hello version 2's token field, or ?token= on the WebSocket URL)"
                                         : "wrong token");
     }

@@ -145,7 +145,7 @@ std::unique_ptr<test::DaemonProcess> start_demo_daemon(const nlohmann::json& key
   const std::string demo = SKINSTREAM_DEMO_DIR;
   const std::string config = test::scratch_path("demo_" + std::to_string(getpid()) + "_" + std::to_string(configs++) + ".json");
   std::ofstream(config) << keys.dump();
-  return std::make_unique<test::DaemonProcess>(SKINSTREAMD, "--config " + config + " --subject " + demo + "/subject.sksubj --replay " +
+  return std::make_unique<test::DaemonProcess>("--config " + config + " --subject " + demo + "/subject.sksubj --replay " +
                                                                 demo + "/live.c3d --loop");
 }
 
@@ -163,7 +163,7 @@ class DaemonAdmission : public ::testing::Test {
   std::unique_ptr<test::DaemonProcess> start(const nlohmann::json& keys) {
     const std::string config = test::scratch_path("admission_" + std::to_string(getpid()) + "_" + std::to_string(configs_++) + ".json");
     std::ofstream(config) << keys.dump();
-    return std::make_unique<test::DaemonProcess>(SKINSTREAMD, "--config " + config + " --subject " + subject_ + " --replay " +
+    return std::make_unique<test::DaemonProcess>("--config " + config + " --subject " + subject_ + " --replay " +
                                                                   test::source_path("replay_data/cmu/85_12.c3d") + " --loop");
   }
   static inline std::string subject_;
