@@ -1,5 +1,5 @@
 # skinstream on Debian 12, built with the same scripts the README uses: the daemon replaying the
-# bundled 350-marker capture with the demo subject, the web viewer on 8480, TCP subscribers on
+# 25 s 350-marker demo capture (several motions, made by make-demo.sh) with the demo subject, the web viewer on 8480, TCP subscribers on
 # 8481. docker run -p 8480:8480 -p 8481:8481 skinstream, then open http://localhost:8480/.
 FROM debian:12
 WORKDIR /src/skinstream
@@ -16,5 +16,5 @@ RUN cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DSKINSTREAM_BUILD_T
  && bash scripts/make-demo.sh build/bin/skinstream build/demo
 ENV PATH=/src/skinstream/build/bin:$PATH
 EXPOSE 8480 8481
-CMD ["skinstreamd", "--subject", "build/demo/subject.sksubj", "--replay", "build/demo/live.c3d", "--loop", \
+CMD ["skinstreamd", "--subject", "build/demo/subject.sksubj", "--replay", "build/demo/medley.c3d", "--loop", \
      "--web-root", "build/web", "--bind", "0.0.0.0", "--http-port", "8480", "--sub-port", "8481"]
