@@ -1,22 +1,14 @@
-// skinstream convert IN OUT: C3D <-> TRC by extension.
-#include <CLI/CLI.hpp>
-#include <cstdio>
+#include "clients/skinstream/cmd_convert.h"
 
-#include "clients/skinstream/commands.h"
 #include "protocol/capture_file.h"
 
 namespace skinstream::cli {
 
-void add_convert(CLI::App& app) {
-  auto* cmd = app.add_subcommand("convert", "Convert a capture between C3D and TRC (format from the extensions)");
-  static std::string in, out;
-  cmd->add_option("IN", in, "input capture")->required();
-  cmd->add_option("OUT", out, "output capture")->required();
-  cmd->callback([] {
-    const Capture capture = read_capture(in);
-    write_capture(capture, out);
-    std::printf("wrote %s: %d channels, %d frames\n", out.c_str(), capture.point_count(), capture.frame_count);
-  });
+int run_convert(const ConvertOptions& o, std::FILE* out) {
+  const Capture capture = read_capture(o.in_path);
+  write_capture(capture, o.out_path);
+  std::fprintf(out, "wrote %s: %d channels, %d frames\n", o.out_path.c_str(), capture.point_count(), capture.frame_count);
+  return 0;
 }
 
 }  // namespace skinstream::cli

@@ -1,33 +1,36 @@
 // skinstream: offline tools around the skin capture pipeline (inspect, convert, build a
-// subject model, fill gaps, evaluate). Errors print one line to stderr and exit non-zero.
-#include <CLI/CLI.hpp>
+// subject model, fill gaps, evaluate). Arguments, then the command. Errors print one line to
+// stderr and exit non-zero.
 #include <cstdio>
 #include <exception>
+#include <stdexcept>
 
-#include "clients/skinstream/commands.h"
+#include "clients/skinstream/command_line.h"
 
-namespace skinstream::cli {
-int exit_code = 0;
+namespace {
+
+int run_command(const skinstream::cli::CommandLine& c, std::FILE* out) {
+  using namespace skinstream::cli;
+  if (c.command == "info") return run_info(c.info, out);
+  if (c.command == "convert") return run_convert(c.convert, out);
+  if (c.command == "build-subject") return run_build_subject(c.build_subject, out);
+  if (c.command == "fill") return run_fill(c.fill, out);
+  if (c.command == "eval-fill") return run_eval_fill(c.eval_fill, out);
+  if (c.command == "synth") return run_synth(c.synth, out);
+  if (c.command == "eval-deform") return run_eval_deform(c.eval_deform, out);
+  if (c.command == "deform") return run_deform(c.deform, out);
+  throw std::logic_error("no command " + c.command);
 }
 
+}  // namespace
+
 int main(int argc, char** argv) {
-  CLI::App app{"skinstream: dense marker capture to deforming skin (Park & Hodgins 2006)"};
-  app.require_subcommand(1);
-  skinstream::cli::add_info(app);
-  skinstream::cli::add_convert(app);
-  skinstream::cli::add_build_subject(app);
-  skinstream::cli::add_fill(app);
-  skinstream::cli::add_eval_fill(app);
-  skinstream::cli::add_synth(app);
-  skinstream::cli::add_eval_deform(app);
-  skinstream::cli::add_deform(app);
   try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    skinstream::cli::CommandLine command_line;
+    if (const auto exit_code = skinstream::cli::parse_command_line(argc, argv, command_line)) return *exit_code;
+    return run_command(command_line, stdout);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "skinstream: error: %s\n", e.what());
     return 1;
   }
-  return skinstream::cli::exit_code;
 }

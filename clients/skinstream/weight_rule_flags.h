@@ -1,13 +1,9 @@
 #pragma once
 // The switches of the weight rules this build adds to the paper's (section 5.2), shared by
-// build-subject and eval-deform so both spell them, and their help, the same way. Each flag
+// build-subject and eval-deform (command_line.cpp spells them once for both). Each flag
 // gives back an earlier rule; all of them together (--boundary-rings 0 --no-joint-split
 // --no-fold-blend) give the paper's rule alone.
 #include "core/offline/deformation_builder.h"
-
-namespace CLI {
-class App;
-}
 
 namespace skinstream::cli {
 
@@ -18,10 +14,6 @@ struct WeightRuleFlags {
   bool no_fold_smoothing = false;  // the fold blend's weights not smoothed over the mesh
   int boundary_rings = MarkerWeightOptions{}.boundary_rings;  // marker weights' boundary widened
 };
-
-// Adds --no-joint-split, --no-joint-blend, --no-fold-blend, --no-fold-smoothing and
-// --boundary-rings, stored in `flags` (which must outlive the parse).
-void add_weight_rule_flags(CLI::App& command, WeightRuleFlags& flags);
 
 // Sets the rules of `build` the flags name.
 void apply_weight_rules(const WeightRuleFlags& flags, DeformationBuildOptions& build);
