@@ -43,16 +43,15 @@ void LatencyHistogram::observe_ns(int64_t ns) {
   }
 }
 
-double LatencyHistogram::quantile_upper_bound_ms(double q, uint64_t total, int64_t max_ns) const {
-  const double max_ms = max_ns * 1e-6;
+double LatencyHistogram::quantile_upper_bound_ms(const Buckets& counts, uint64_t total, double q, double beyond_ms) {
   // The rank of the quantile's observation, 1-based (nearest rank).
   const uint64_t rank = std::max<uint64_t>(1, static_cast<uint64_t>(std::ceil(q * static_cast<double>(total))));
   uint64_t cumulative = 0;
   for (size_t b = 0; b < kBounds.size(); ++b) {
-    cumulative += buckets_[b].load(std::memory_order_relaxed);
-    if (cumulative >= rank) return std::min(kBounds[b] * 1e3, max_ms);
+    cumulative += counts[b];
+    if (cumulative >= rank) return kBounds[b] * 1e3;
   }
-  return max_ms;  // beyond the last bound
+  return beyond_ms;
 }
 
 LatencyHistogram::Buckets LatencyHistogram::bucket_counts() const {
@@ -65,11 +64,12 @@ LatencyHistogram::Summary LatencyHistogram::summary() const {
   Summary s;
   s.count = count_.load(std::memory_order_relaxed);
   if (s.count == 0) return s;
-  const int64_t max_ns = max_ns_.load(std::memory_order_relaxed);
-  s.max_ms = max_ns * 1e-6;
-  s.p50_le_ms = quantile_upper_bound_ms(0.5, s.count, max_ns);
-  s.p99_le_ms = quantile_upper_bound_ms(0.99, s.count, max_ns);
-  s.p99_9_le_ms = quantile_upper_bound_ms(0.999, s.count, max_ns);
+  s.max_ms = max_ns_.load(std::memory_order_relaxed) * 1e-6;
+  // The largest value observed also bounds each quantile, within the buckets or beyond them.
+  const Buckets counts = bucket_counts();
+  s.p50_le_ms = std::min(quantile_upper_bound_ms(counts, s.count, 0.5, s.max_ms), s.max_ms);
+  s.p99_le_ms = std::min(quantile_upper_bound_ms(counts, s.count, 0.99, s.max_ms), s.max_ms);
+  s.p99_9_le_ms = std::min(quantile_upper_bound_ms(counts, s.count, 0.999, s.max_ms), s.max_ms);
   return s;
 }
 

@@ -37,10 +37,12 @@ class LatencyHistogram {
   // Each bucket's count now (not cumulative): the difference of two gives an interval's histogram.
   using Buckets = std::array<uint64_t, kBounds.size()>;
   Buckets bucket_counts() const;
+  // The q-quantile (nearest rank) of `total` observations, `counts` of them in the buckets, as
+  // the upper bound in ms of the bucket it falls in; `beyond_ms` when it falls beyond the last
+  // bound (observations no bucket holds). /health's summary and the status line both use it.
+  static double quantile_upper_bound_ms(const Buckets& counts, uint64_t total, double q, double beyond_ms);
 
  private:
-  double quantile_upper_bound_ms(double q, uint64_t total, int64_t max_ns) const;
-
   std::array<std::atomic<uint64_t>, kBounds.size()> buckets_{};  // non-cumulative
   std::atomic<uint64_t> count_{0};
   std::atomic<int64_t> sum_ns_{0};

@@ -1,23 +1,20 @@
 #include "server/metrics/status_line.h"
 
-#include <cmath>
 #include <cstdio>
 
 namespace skinstream::server {
 namespace {
 
-// The interval's p99 as its bucket's upper bound (ms); 0 without observations.
+// The interval's p99 as its bucket's upper bound (ms); 0 without observations. Observations
+// beyond the last bound are not in the buckets and not counted.
 double p99_upper_bound_ms(const LatencyHistogram::Buckets& now, const LatencyHistogram::Buckets& before) {
+  LatencyHistogram::Buckets interval;
   uint64_t total = 0;
-  for (size_t b = 0; b < now.size(); ++b) total += now[b] - before[b];
-  if (total == 0) return 0.0;
-  const auto rank = static_cast<uint64_t>(std::ceil(0.99 * static_cast<double>(total)));
-  uint64_t cumulative = 0;
   for (size_t b = 0; b < now.size(); ++b) {
-    cumulative += now[b] - before[b];
-    if (cumulative >= rank) return LatencyHistogram::kBounds[b] * 1e3;
+    interval[b] = now[b] - before[b];
+    total += interval[b];
   }
-  return LatencyHistogram::kBounds.back() * 1e3;
+  return total == 0 ? 0.0 : LatencyHistogram::quantile_upper_bound_ms(interval, total, 0.99, LatencyHistogram::kBounds.back() * 1e3);
 }
 
 }  // namespace

@@ -70,6 +70,20 @@ TEST(LatencyHistogram, SummaryGivesEachQuantileAsItsBucketsBoundCappedByTheMaxim
   EXPECT_DOUBLE_EQ(s.max_ms, 3000.0);
 }
 
+// The quantile over any bucket counts (an interval's, for the status line): the bound of the
+// bucket holding the nearest-rank observation, or the caller's figure past the last bucket.
+TEST(LatencyHistogram, QuantileOverBucketCountsIsItsBucketsBound) {
+  LatencyHistogram::Buckets counts{};
+  counts[6] = 98;  // (0.3, 0.5] ms
+  counts[17] = 2;  // (7.5, 10] ms
+  EXPECT_DOUBLE_EQ(LatencyHistogram::quantile_upper_bound_ms(counts, 100, 0.5, -1.0), 0.5);
+  EXPECT_DOUBLE_EQ(LatencyHistogram::quantile_upper_bound_ms(counts, 100, 0.98, -1.0), 0.5);
+  EXPECT_DOUBLE_EQ(LatencyHistogram::quantile_upper_bound_ms(counts, 100, 0.99, -1.0), 10.0);
+  // Two more observations beyond the last bound: the 101st of 102 is one of them.
+  EXPECT_DOUBLE_EQ(LatencyHistogram::quantile_upper_bound_ms(counts, 102, 0.99, 3000.0), 3000.0);
+  EXPECT_DOUBLE_EQ(LatencyHistogram::quantile_upper_bound_ms(counts, 102, 0.98, 3000.0), 10.0);
+}
+
 TEST(Metrics, BadInputIsCountedByCategoryAndLabelValuesAreEscaped) {
   Metrics source;
   source.count_bad_input("nan");
