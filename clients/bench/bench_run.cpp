@@ -22,7 +22,6 @@
 
 #include "clients/bench/hostile_waves.h"
 #include "clients/bench/latency_samples.h"
-#include "clients/bench/process_usage.h"
 #include "clients/bench/replay_engine.h"
 #include "clients/bench/send_times.h"
 #include "clients/bench/shaped_link.h"
@@ -31,6 +30,7 @@
 #include "protocol/capture_file.h"
 #include "protocol/file_error.h"
 #include "server/client/daemon_process.h"
+#include "server/client/process_usage.h"
 #include "server/tcp_congestion.h"
 
 namespace skinstream::bench {
@@ -235,9 +235,9 @@ nlohmann::json run_bench(const BenchOptions& o, const std::atomic<bool>& stop) {
   send_times.start_counting(period_ns, &stalls);
   const uint64_t sent_before = replay.frames_sent();
   const uint64_t replay_dropped_before = replay.frames_dropped();
-  const double cpu_before = cpu_seconds(daemon.pid());
-  const std::map<std::string, double> thread_cpu_before = thread_cpu_seconds(daemon.pid());
-  const double own_cpu_before = cpu_seconds(getpid());
+  const double cpu_before = server::cpu_seconds(daemon.pid());
+  const std::map<std::string, double> thread_cpu_before = server::thread_cpu_seconds(daemon.pid());
+  const double own_cpu_before = server::cpu_seconds(getpid());
   window.start_ns = window_start_ns;
   const Clock::time_point deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(o.seconds));
 
@@ -245,7 +245,7 @@ nlohmann::json run_bench(const BenchOptions& o, const std::atomic<bool>& stop) {
   if (o.hostile_waves) {
     waves.emplace(HostileWaveOptions{daemon.sub_port(), daemon.http_port(), std::chrono::seconds(o.wave_seconds),
                                      std::chrono::seconds(o.calm_seconds)},
-                  [pid = daemon.pid()] { return resident_kb(pid); });
+                  [pid = daemon.pid()] { return server::resident_kb(pid); });
     waves->start();
   }
   // RSS once a second: the first sample after warm-up against the last.
@@ -254,7 +254,7 @@ nlohmann::json run_bench(const BenchOptions& o, const std::atomic<bool>& stop) {
   uint64_t buffers_after_1s = 0;  // the daemon's encoded frame buffers: RSS steps when they grow
   for (auto next = Clock::now() + std::chrono::seconds(1); next < deadline; next += std::chrono::seconds(1)) {
     sleep_until_or_stop(next, stop);
-    rss_samples.push_back(resident_kb(daemon.pid()));
+    rss_samples.push_back(server::resident_kb(daemon.pid()));
     // Every step of RSS, with its time on the stall log's clock: a leak climbs steadily, memory
     // touched for the first time (a backlog reaching buffers never used before) steps once.
     if (rss_samples.size() > 1 && rss_samples.back() != rss_samples[rss_samples.size() - 2])
@@ -268,10 +268,10 @@ nlohmann::json run_bench(const BenchOptions& o, const std::atomic<bool>& stop) {
   const nlohmann::json health = daemon.health();
   const uint64_t sent = replay.frames_sent() - sent_before;
   const uint64_t replay_dropped = replay.frames_dropped() - replay_dropped_before;
-  const double cpu = cpu_seconds(daemon.pid()) - cpu_before;
-  const std::map<std::string, double> thread_cpu_after = thread_cpu_seconds(daemon.pid());
-  const long peak_rss_kb = peak_resident_kb(daemon.pid());
-  const double own_cpu = cpu_seconds(getpid()) - own_cpu_before;
+  const double cpu = server::cpu_seconds(daemon.pid()) - cpu_before;
+  const std::map<std::string, double> thread_cpu_after = server::thread_cpu_seconds(daemon.pid());
+  const long peak_rss_kb = server::peak_resident_kb(daemon.pid());
+  const double own_cpu = server::cpu_seconds(getpid()) - own_cpu_before;
   std::this_thread::sleep_for(std::chrono::milliseconds(500));  // the window's last frames still on their way
   window.closed = true;
   for (std::thread& t : threads) t.join();

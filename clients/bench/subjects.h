@@ -3,7 +3,7 @@
 // each copy moved `spacing` along x and named Actor1..ActorN, and the daemon follows each by name.
 // The daemon's threads are told apart by name (pipeline-K and deform-K-N belong to subject K;
 // pipeline and deform-N when there is one), so each subject's CPU is the sum of its threads'
-// (thread_cpu_seconds, clients/bench/process_usage.h).
+// (thread_cpu_seconds, server/client/process_usage.h).
 #include <sys/types.h>
 
 #include <map>

@@ -23,6 +23,7 @@
 #include <mutex>
 
 #include "server/client/health_probe.h"
+#include "server/client/process_usage.h"
 #include "protocol/capture_file.h"
 #include "protocol/point_cache.h"
 #include "server/client/subscriber_client.h"
@@ -42,6 +43,7 @@ using test::ProgramRun;
 using test::ReplayProcess;
 using test::connect_loopback;
 using test::http_get_within;
+using server::cpu_seconds;
 ProgramRun run(const std::string& command_line) { return test::run_program(command_line); }
 
 class DaemonProgram : public ::testing::Test {
@@ -202,16 +204,6 @@ TEST_F(DaemonProgram, SigtermStopsCleanlyWithMarkersOnly) {
   EXPECT_NE(sub.output.find("\"frames\": 20"), std::string::npos) << sub.output;
   EXPECT_EQ(daemon.stop(), 0) << daemon.log();
   EXPECT_NE(daemon.log().find("no deformation model"), std::string::npos) << daemon.log();
-}
-
-// The CPU time a process has used so far (user + system), in seconds, from /proc/PID/stat.
-double cpu_seconds(pid_t pid) {
-  std::ifstream in("/proc/" + std::to_string(pid) + "/stat");
-  std::string stat((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  std::istringstream fields(stat.substr(stat.rfind(')') + 2));  // after "pid (name) "
-  std::vector<std::string> field{std::istream_iterator<std::string>(fields), std::istream_iterator<std::string>()};
-  if (field.size() < 13) return -1.0;
-  return (std::stod(field[11]) + std::stod(field[12])) / static_cast<double>(sysconf(_SC_CLK_TCK));  // utime, stime
 }
 
 long count_lines_with(const std::string& text, const std::string& needle) {

@@ -1,4 +1,4 @@
-#include "clients/bench/process_usage.h"
+#include "server/client/process_usage.h"
 
 #include <unistd.h>
 
@@ -8,7 +8,7 @@
 #include <sstream>
 #include <string>
 
-namespace skinstream::bench {
+namespace skinstream::server {
 namespace {
 
 long status_field_kb(pid_t pid, const std::string& key) {
@@ -57,4 +57,4 @@ std::map<std::string, double> thread_cpu_seconds(pid_t pid) {
 long resident_kb(pid_t pid) { return status_field_kb(pid, "VmRSS:"); }
 long peak_resident_kb(pid_t pid) { return status_field_kb(pid, "VmHWM:"); }
 
-}  // namespace skinstream::bench
+}  // namespace skinstream::server

@@ -1,12 +1,12 @@
 #pragma once
 // A running process's cost, read from /proc: CPU seconds (user + system), resident set now and
-// its peak.
+// its peak. For the benchmark and the end-to-end tests, which watch the daemon they started.
 #include <sys/types.h>
 
 #include <map>
 #include <string>
 
-namespace skinstream::bench {
+namespace skinstream::server {
 
 double cpu_seconds(pid_t pid);
 // CPU seconds (user + system) in the text of a /proc/PID/stat or /proc/PID/task/TID/stat.
@@ -16,4 +16,4 @@ std::map<std::string, double> thread_cpu_seconds(pid_t pid);
 long resident_kb(pid_t pid);       // VmRSS: sampled through a run to show whether memory stays flat
 long peak_resident_kb(pid_t pid);  // VmHWM
 
-}  // namespace skinstream::bench
+}  // namespace skinstream::server
