@@ -69,27 +69,17 @@ int run_build_subject(const BuildSubjectOptions& o, std::FILE* out) {
                                         {"markers_never_complete", report.markers_never_complete}};
   if (deformation_model) {
     const DeformationBuildReport& d = deformation_report;
-    report_json["mesh"] = {{"vertices", deformation_model->vertex_count()},
-                           {"faces", deformation_model->face_count()},
-                           {"registered", d.registered},
-                           {"landmarks", d.landmarks},
-                           {"marker_surface_rms_before_mm", d.registration.before.rms},
-                           {"marker_surface_rms_after_mm", d.registration.after.rms},
-                           {"marker_surface_max_after_mm", d.registration.after.max},
-                           {"parts", d.parts},
-                           {"mean_shift_groups", d.mean_shift_groups},
-                           {"max_part_rigid_rms_mm", d.max_part_rigid_rms_mm},
-                           {"part_sizes", part_sizes_json(d, *deformation_model)},
-                           {"part_file_unused_parts", d.unused_parts},
-                           {"boundary_rings", deformation.weights.boundary_rings},
-                           {"boundary_markers", d.boundary_markers},
-                           {"mean_parts_per_vertex", d.mean_influences_per_vertex},
-                           {"fold_smoothed_vertices", d.fold_smoothed_vertices},
-                           {"fold_band_mm", d.fold_band_mm},
-                           {"joints", joints_json(d.joints)},
-                           {"joint_blend_mm", d.joint_blend_mm},
-                           {"part_quadratic_ridges", to_json(d.part_quadratic_ridges)},
-                           {"part_rbf_ridges", to_json(d.part_ridges)}};
+    nlohmann::ordered_json mesh = {{"vertices", deformation_model->vertex_count()},
+                                   {"faces", deformation_model->face_count()},
+                                   {"registered", d.registered},
+                                   {"landmarks", d.landmarks},
+                                   {"marker_surface_rms_before_mm", d.registration.before.rms},
+                                   {"marker_surface_rms_after_mm", d.registration.after.rms},
+                                   {"marker_surface_max_after_mm", d.registration.after.max},
+                                   {"parts", d.parts},
+                                   {"mean_shift_groups", d.mean_shift_groups}};
+    add_parts_and_weights_json(mesh, d, *deformation_model, deformation.weights.boundary_rings);
+    report_json["mesh"] = mesh;
   }
   std::fprintf(out, "%s\n", report_json.dump(2).c_str());
   return 0;

@@ -60,18 +60,7 @@ int run_eval_deform(const EvalDeformOptions& o, std::FILE* out) {
                             {"vertex_error_vs_truth_mm", setup.registration_vertex_error_mm},
                             {"iterations", setup.registration.iterations},
                             {"used_for_deformation", o.evaluation.deform_registered_mesh}};
-  result["max_part_rigid_rms_mm"] = setup.build.max_part_rigid_rms_mm;
-  result["part_sizes"] = part_sizes_json(setup.build, setup.deformation);
-  result["part_file_unused_parts"] = setup.build.unused_parts;
-  result["boundary_rings"] = o.evaluation.weight_rules.boundary_rings;
-  result["boundary_markers"] = setup.build.boundary_markers;
-  result["mean_parts_per_vertex"] = setup.build.mean_influences_per_vertex;
-  result["fold_smoothed_vertices"] = setup.build.fold_smoothed_vertices;
-  result["fold_band_mm"] = setup.build.fold_band_mm;
-  result["joints"] = joints_json(setup.build.joints);
-  result["joint_blend_mm"] = setup.build.joint_blend_mm;
-  result["part_quadratic_ridges"] = to_json(setup.build.part_quadratic_ridges);
-  result["part_rbf_ridges"] = to_json(setup.build.part_ridges);
+  add_parts_and_weights_json(result, setup.build, setup.deformation, o.evaluation.weight_rules.boundary_rings);
   result["build_seconds"] = setup.build_seconds;
   result["takes"] = nlohmann::ordered_json::array();
   for (const std::string& motion : split_list(o.motions)) {

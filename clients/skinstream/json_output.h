@@ -51,4 +51,22 @@ inline nlohmann::json part_sizes_json(const DeformationBuildReport& report, cons
   return out;
 }
 
+// The parts and vertex weights of a deformation build, in the order build-subject and
+// eval-deform both report them. `boundary_rings`: the rule the build was given.
+inline void add_parts_and_weights_json(nlohmann::ordered_json& out, const DeformationBuildReport& report,
+                                       const DeformationModel& model, int boundary_rings) {
+  out["max_part_rigid_rms_mm"] = report.max_part_rigid_rms_mm;
+  out["part_sizes"] = part_sizes_json(report, model);
+  out["part_file_unused_parts"] = report.unused_parts;
+  out["boundary_rings"] = boundary_rings;
+  out["boundary_markers"] = report.boundary_markers;
+  out["mean_parts_per_vertex"] = report.mean_influences_per_vertex;
+  out["fold_smoothed_vertices"] = report.fold_smoothed_vertices;
+  out["fold_band_mm"] = report.fold_band_mm;
+  out["joints"] = joints_json(report.joints);
+  out["joint_blend_mm"] = report.joint_blend_mm;
+  out["part_quadratic_ridges"] = to_json(report.part_quadratic_ridges);
+  out["part_rbf_ridges"] = to_json(report.part_ridges);
+}
+
 }  // namespace skinstream::cli
