@@ -165,13 +165,9 @@ void SubjectStream::broadcast_status(SourceState state, std::string_view source_
   status.frames_published = metrics_.frames_published.load();
   {
     std::lock_guard lock(mutex_);
-    const auto now = std::chrono::steady_clock::now();
-    const double seconds = std::chrono::duration<double>(now - sampled_at_).count();
-    if (seconds >= 0.5) {
-      published_fps_ = static_cast<double>(status.frames_published - published_at_sample_) / seconds;
-      published_at_sample_ = status.frames_published;
-      sampled_at_ = now;
-    }
+    const auto now = RateSampler::Clock::now();
+    if (published_rate_.seconds_since_sample(now) >= 0.5)
+      published_fps_ = published_rate_.sample(status.frames_published, now).per_second();
     status.subject_present = present_;
     status.detail = present_ || state != SourceState::Streaming
                         ? std::string(source_detail)

@@ -21,6 +21,7 @@
 #include "server/ingest/subject_router.h"
 #include "server/logging.h"
 #include "server/metrics/metrics.h"
+#include "server/metrics/rate_sampler.h"
 #include "server/metrics/status_line.h"
 #include "server/pipeline/frame_mailbox.h"
 #include "server/pipeline/pipeline.h"
@@ -101,8 +102,7 @@ class SubjectStream {
   std::string presence_detail_ = "no frame from the source yet";
   // Frames published per second between the last two samples at least half a second apart.
   double published_fps_ = 0.0;
-  uint64_t published_at_sample_ = 0;
-  std::chrono::steady_clock::time_point sampled_at_ = std::chrono::steady_clock::now();
+  RateSampler published_rate_;
 };
 
 }  // namespace skinstream::server

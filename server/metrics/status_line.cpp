@@ -24,20 +24,17 @@ std::string StatusLine::next(std::string_view subject, const Metrics& metrics, s
   const uint64_t received = metrics.frames_received.load(), published = metrics.frames_published.load();
   const uint64_t dropped = metrics.frames_dropped.load();
   const LatencyHistogram::Buckets processing = metrics.receive_to_publish.bucket_counts();
-  const double seconds = std::chrono::duration<double>(now - last_).count();
-  const uint64_t out = published - published_;
+  const RateSampler::Interval out = published_.sample(published, now);
   const uint64_t new_subscriber_drops = subscriber_drops > subscriber_drops_ ? subscriber_drops - subscriber_drops_ : 0;
   char line[256];
   std::snprintf(line, sizeof line,
                 "status %.*s: %llu frames in, %llu out (%.1f/s) in %.0f s; processing p99 <= %.2f ms; %zu subscribers; dropped %llu in "
                 "the pipeline, %llu for subscribers",
                 static_cast<int>(subject.size()), subject.data(), static_cast<unsigned long long>(received - received_),
-                static_cast<unsigned long long>(out), seconds > 0 ? out / seconds : 0.0, seconds,
+                static_cast<unsigned long long>(out.count), out.per_second(), out.seconds,
                 p99_upper_bound_ms(processing, processing_), subscribers, static_cast<unsigned long long>(dropped - dropped_),
                 static_cast<unsigned long long>(new_subscriber_drops));
-  last_ = now;
   received_ = received;
-  published_ = published;
   dropped_ = dropped;
   processing_ = processing;
   subscriber_drops_ = subscriber_drops;
