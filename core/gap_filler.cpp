@@ -599,8 +599,14 @@ void GapFiller::check_carries() {
 }
 
 // Marker i's regional PCA opinion from the observed members of its region (region_pca_fit.h).
-bool GapFiller::region_estimate(int i, Vec3& out, double& out_variance) {
+// Not asked for when the other opinions' variance is so much smaller than the least the region
+// can claim (its residual, calibrated) that it would weigh under 5%: the common case of a short
+// gap in a well seen neighbourhood, where it would cost the frame time and change nothing.
+bool GapFiller::region_estimate(int i, double other_variance, Vec3& out, double& out_variance) {
   if (!options_.use_regions || !options_.use_pca || !options_.weight_by_variance || !model_.has_regions()) return false;
+  constexpr double kNegligibleShare = 0.05;
+  const MarkerPcaModel& region = model_.region_pca[i];
+  if (other_variance < kNegligibleShare * region.residual_variance * region.slot_calibration(0)) return false;
   const int first = model_.region_offsets[i], size = model_.region_offsets[i + 1] - first;
   for (int k = 0; k < size; ++k) {
     const int member = model_.region[first + k];
@@ -625,23 +631,26 @@ void GapFiller::fill_missing() {
     Vec3 carried;
     double carried_variance = 0.0;
     const bool carry = carry_on && carried_from_gap_start(i, carried, carried_variance);
-    Vec3 regional;
-    double regional_variance = 0.0;
-    const bool region = region_estimate(i, regional, regional_variance);
+    // The neighbours' opinions (PCA, else eq. 2) with the carry, then the region's weighed in.
     Vec3 fused;
     double variance = 0.0;
-    if (options_.use_pca && pca_estimate(i, fused, &variance) > 0) {
-      current_[i] = carry ? combine(fused, variance, carried, carried_variance) : fused;
-      if (region) current_[i] = combine(current_[i], carry ? combined_variance(variance, carried_variance) : variance, regional,
-                                        regional_variance);
-      status_[i] = MarkerStatus::FilledPca;
-    } else if (estimated_[i]) {
-      const double rigid_variance = model_.pca[i].rigid_variance * model_.ring_size(i) / std::max(1, rigid_support_[i]);
-      current_[i] = carry ? combine(estimate_[i], rigid_variance, carried, carried_variance) : estimate_[i];
-      if (region)
-        current_[i] = combine(current_[i], carry ? combined_variance(rigid_variance, carried_variance) : rigid_variance,
-                              regional, regional_variance);
-      status_[i] = MarkerStatus::FilledRigid;
+    const bool pca = options_.use_pca && pca_estimate(i, fused, &variance) > 0;
+    if (!pca && estimated_[i]) {
+      fused = estimate_[i];
+      variance = model_.pca[i].rigid_variance * model_.ring_size(i) / std::max(1, rigid_support_[i]);
+    }
+    const bool near = pca || estimated_[i];
+    if (near && carry) {
+      fused = combine(fused, variance, carried, carried_variance);
+      variance = combined_variance(variance, carried_variance);
+    }
+    Vec3 regional;
+    double regional_variance = 0.0;
+    const double other_variance = near ? variance : carry ? carried_variance : std::numeric_limits<double>::infinity();
+    const bool region = region_estimate(i, other_variance, regional, regional_variance);
+    if (near) {
+      current_[i] = region ? combine(fused, variance, regional, regional_variance) : fused;
+      status_[i] = pca ? MarkerStatus::FilledPca : MarkerStatus::FilledRigid;
     } else if (region) {
       current_[i] = carry ? combine(regional, regional_variance, carried, carried_variance) : regional;
       status_[i] = MarkerStatus::FilledPca;

@@ -199,7 +199,7 @@ class GapFiller {
   std::vector<uint32_t> pattern_mask_;
   std::vector<int> pattern_offset_;
   std::vector<double> pattern_factor_;
-  bool region_estimate(int i, Vec3& out, double& out_variance);
+  bool region_estimate(int i, double other_variance, Vec3& out, double& out_variance);
   RegionPcaFit region_fit_;
   std::vector<Vec3> region_positions_;
   std::vector<char> region_observed_;

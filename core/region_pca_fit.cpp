@@ -26,15 +26,24 @@ bool RegionPcaFit::estimate(const MarkerPcaModel& model, std::span<const Vec3> p
     ++count;
   }
   if (count < 3 || !align_and_fit(model, count, count)) return false;
-  // The missing members as reconstructed join the alignment, after the observed ones.
-  int all = count;
-  for (int k = 0; k < size; ++k) {
-    if (k > 0 && observed[k]) continue;
-    world_[all] = to_region_.apply_inverse(fit_.reconstruct(model, k));
-    mean_[all] = model.mean.segment<3>(3 * k);
-    ++all;
+  // Alignment and coefficients depend on each other (a pose's change can look like a turn of the
+  // observed part): alternate, the missing members as reconstructed joining the alignment after
+  // the observed ones, until the estimate moves less than kConverged.
+  Vec3 last = to_region_.apply_inverse(fit_.reconstruct(model, 0));
+  for (int round = 0; round < kMaxAlignments; ++round) {
+    int all = count;
+    for (int k = 0; k < size; ++k) {
+      if (k > 0 && observed[k]) continue;
+      world_[all] = to_region_.apply_inverse(fit_.reconstruct(model, k));
+      mean_[all] = model.mean.segment<3>(3 * k);
+      ++all;
+    }
+    if (!align_and_fit(model, all, count)) return false;
+    const Vec3 now = to_region_.apply_inverse(fit_.reconstruct(model, 0));
+    const bool converged = (now - last).squaredNorm() < kConverged * kConverged;
+    last = now;
+    if (converged) break;
   }
-  if (!align_and_fit(model, all, count)) return false;
   out = to_region_.apply_inverse(fit_.reconstruct(model, 0));
   // A pose unlike any in training shows as observed members the model does not fit: its claim
   // is then worth as much less as they miss by more than its residual.

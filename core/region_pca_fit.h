@@ -8,8 +8,10 @@
 // moves in the gait).
 //   1. Align the observed members with the mean shape (Horn): the region's frame.
 //   2. Fit the coefficients to them (pca_fit.h: least squares with the PCA prior).
-//   3. Align once more on every member, the missing ones as just reconstructed (training aligned
-//      complete shapes), and fit again.
+//   3. Align again on every member, the missing ones as just reconstructed (training aligned
+//      complete shapes), and fit again; repeat until the estimate settles (at most 10 rounds:
+//      on a walk's two legs, where the legs' opposite swing looks like a turn of the whole, one
+//      round left 34 mm of error on a synthetic foot and ten 5 mm).
 // The estimate is member 0's reconstruction carried back to the world; its variance per
 // coordinate the fit's predictive variance times the calibration of slot 0. Allocation-free.
 
@@ -33,6 +35,8 @@ class RegionPcaFit {
  private:
   bool align_and_fit(const MarkerPcaModel& model, int aligned, int fitted);
 
+  static constexpr int kMaxAlignments = 10;
+  static constexpr double kConverged = 0.5;  // mm
   PcaFit fit_;
   RigidTransform to_region_;  // world -> the region's frame
   std::array<Vec3, SubjectModel::kMaxRing> world_, mean_, local_;

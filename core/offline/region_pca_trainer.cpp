@@ -1,11 +1,11 @@
 #include "core/offline/region_pca_trainer.h"
 
-#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <numeric>
 
 #include "core/absolute_orientation.h"
+#include "core/offline/marker_pca_trainer.h"
 #include "core/region_pca_fit.h"
 
 namespace skinstream {
@@ -43,20 +43,8 @@ MarkerPcaModel fit_model(const Capture& capture, const std::vector<int>& members
   model.training_frames = count;
   model.mean = samples.rowwise().mean();
   samples.colwise() -= model.mean;
-  const Eigen::MatrixXd covariance = samples * samples.transpose() / static_cast<double>(count);
-  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(covariance);
-  const Eigen::VectorXd values = eig.eigenvalues().reverse().cwiseMax(0.0);
-  const double total = values.sum(), floor = options.noise_floor_mm * options.noise_floor_mm;
-  constexpr double kNumericalZero = 1e-6;  // mm^2: round-off, not motion
-  int kept = 0;
-  double explained = 0.0;
-  while (kept < dims && values(kept) > kNumericalZero && explained < options.variance_kept * total) {
-    explained += values(kept);
-    ++kept;
-  }
-  model.basis = eig.eigenvectors().rowwise().reverse().leftCols(kept);
-  model.variance = values.head(kept).cwiseMax(floor);
-  model.residual_variance = std::max(floor, kept < dims ? (total - explained) / (dims - kept) : 0.0);
+  const double floor = options.noise_floor_mm * options.noise_floor_mm;
+  keep_principal_components(samples * samples.transpose() / static_cast<double>(count), options.variance_kept, floor, model);
   model.slot_calibration = Eigen::VectorXd::Ones(size);
   model.rigid_variance = floor;  // not used by a region
   return model;
