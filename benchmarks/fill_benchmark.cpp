@@ -4,6 +4,7 @@
 //   350 markers, synthetic punch: the generator's 5 s punching take as a capture system
 //     delivers it (occlusion, broken and mislabelled trajectories, unlabelled fragments,
 //     ghosts), subject trained on its 20 s range-of-motion take.
+// Argument regions: 1 with each missing marker's regional PCA opinion (the default), 0 without.
 // Each iteration fills one frame; p50/p99 come from the per-frame times of the run: wall
 // clock (p50_us, p99_us: what the daemon's frame waits) and the thread's CPU time (cpu_p50_us,
 // cpu_p99_us: the filler's own work, without the time the OS gave other processes, which is
@@ -53,7 +54,9 @@ double thread_cpu_micros() {
 
 void run(benchmark::State& state, const Scenario& s) {
   const int n = s.model.marker_count();
-  GapFiller filler(s.model);
+  GapFillerOptions options;
+  options.use_regions = state.range(0) != 0;
+  GapFiller filler(s.model, options);
   const std::vector<int> channel_of = map_channels_to_markers(s.model, s.gapped);
   std::vector<int> free_channels;
   for (int c = 0; c < s.gapped.point_count(); ++c)
@@ -133,9 +136,9 @@ void BM_Fill350MarkersSyntheticPunch(benchmark::State& state) {
   run(state, s);
 }
 
-BENCHMARK(BM_Fill350MarkersSyntheticPunch)->Unit(benchmark::kMicrosecond)->MinTime(2.0);
-BENCHMARK(BM_Fill41MarkersCmu)->Unit(benchmark::kMicrosecond)->MinTime(2.0);
-BENCHMARK(BM_Fill350MarkersDense)->Unit(benchmark::kMicrosecond)->MinTime(2.0);
+BENCHMARK(BM_Fill350MarkersSyntheticPunch)->ArgName("regions")->Arg(1)->Arg(0)->Unit(benchmark::kMicrosecond)->MinTime(2.0);
+BENCHMARK(BM_Fill41MarkersCmu)->ArgName("regions")->Arg(1)->Arg(0)->Unit(benchmark::kMicrosecond)->MinTime(2.0);
+BENCHMARK(BM_Fill350MarkersDense)->ArgName("regions")->Arg(1)->Arg(0)->Unit(benchmark::kMicrosecond)->MinTime(2.0);
 
 }  // namespace
 }  // namespace skinstream

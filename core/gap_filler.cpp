@@ -77,6 +77,8 @@ GapFiller::GapFiller(const SubjectModel& model, const GapFillerOptions& options)
   scratch_source_.assign(scratch, Vec3::Zero());
   scratch_target_.assign(scratch, Vec3::Zero());
   scratch_index_.assign(scratch, 0);
+  region_positions_.assign(SubjectModel::kMaxRing, Vec3::Zero());
+  region_observed_.assign(SubjectModel::kMaxRing, 0);
 }
 
 // For every ring member of every model, the PCA reconstruction when that member alone is
@@ -596,6 +598,25 @@ void GapFiller::check_carries() {
   }
 }
 
+// Marker i's regional PCA opinion from the observed members of its region (region_pca_fit.h).
+// Not asked for when the other opinions' variance is so much smaller than the least the region
+// can claim (its residual, calibrated) that it would weigh under 5%: the common case of a short
+// gap in a well seen neighbourhood, where it would cost the frame time and change nothing.
+bool GapFiller::region_estimate(int i, double other_variance, Vec3& out, double& out_variance) {
+  if (!options_.use_regions || !options_.use_pca || !options_.weight_by_variance || !model_.has_regions()) return false;
+  constexpr double kNegligibleShare = 0.05;
+  const MarkerPcaModel& region = model_.region_pca[i];
+  if (other_variance < kNegligibleShare * region.residual_variance * region.slot_calibration(0)) return false;
+  const int first = model_.region_offsets[i], size = model_.region_offsets[i + 1] - first;
+  for (int k = 0; k < size; ++k) {
+    const int member = model_.region[first + k];
+    region_positions_[k] = current_[member];
+    region_observed_[k] = observed_[member];
+  }
+  return region_fit_.estimate(model_.region_pca[i], {region_positions_.data(), static_cast<size_t>(size)},
+                              {region_observed_.data(), static_cast<size_t>(size)}, out, out_variance);
+}
+
 void GapFiller::fill_missing() {
   const double decay_frames = options_.continuity_seconds * options_.rate_hz;
   const bool carry_on = options_.carry_from_gap_start && options_.weight_by_variance;
@@ -603,21 +624,37 @@ void GapFiller::fill_missing() {
   auto combine = [](const Vec3& a, double variance_a, const Vec3& b, double variance_b) {
     return (a * variance_b + b * variance_a) / (variance_a + variance_b);
   };
+  auto combined_variance = [](double variance_a, double variance_b) { return variance_a * variance_b / (variance_a + variance_b); };
   for (int i : missing_) {
     if (observed_[i]) continue;  // relabelled
     if (has_previous_ && is_observed(previous_status_[i])) remember_gap_start(i);
     Vec3 carried;
     double carried_variance = 0.0;
     const bool carry = carry_on && carried_from_gap_start(i, carried, carried_variance);
+    // The neighbours' opinions (PCA, else eq. 2) with the carry, then the region's weighed in.
     Vec3 fused;
     double variance = 0.0;
-    if (options_.use_pca && pca_estimate(i, fused, &variance) > 0) {
-      current_[i] = carry ? combine(fused, variance, carried, carried_variance) : fused;
+    const bool pca = options_.use_pca && pca_estimate(i, fused, &variance) > 0;
+    if (!pca && estimated_[i]) {
+      fused = estimate_[i];
+      variance = model_.pca[i].rigid_variance * model_.ring_size(i) / std::max(1, rigid_support_[i]);
+    }
+    const bool near = pca || estimated_[i];
+    if (near && carry) {
+      fused = combine(fused, variance, carried, carried_variance);
+      variance = combined_variance(variance, carried_variance);
+    }
+    Vec3 regional;
+    double regional_variance = 0.0;
+    const double other_variance = near ? variance : carry ? carried_variance : std::numeric_limits<double>::infinity();
+    const bool region = region_estimate(i, other_variance, regional, regional_variance);
+    if (near) {
+      current_[i] = region ? combine(fused, variance, regional, regional_variance) : fused;
+      status_[i] = pca ? MarkerStatus::FilledPca : MarkerStatus::FilledRigid;
+    } else if (region) {
+      current_[i] = carry ? combine(regional, regional_variance, carried, carried_variance) : regional;
       status_[i] = MarkerStatus::FilledPca;
-    } else if (estimated_[i]) {
-      const double rigid_variance = model_.pca[i].rigid_variance * model_.ring_size(i) / std::max(1, rigid_support_[i]);
-      current_[i] = carry ? combine(estimate_[i], rigid_variance, carried, carried_variance) : estimate_[i];
-      status_[i] = MarkerStatus::FilledRigid;
+      continue;  // no neighbourhood rotation for the continuity offset
     } else {
       // Held: carried with the rigid motion of the anchors (since the gap started, else since
       // the last frame), else kept where it was.

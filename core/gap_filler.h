@@ -18,7 +18,9 @@
 //      neighbour's observed one-ring (regularised least squares on the coefficients); the
 //      estimates are averaged, each weighted by the inverse of its predictive variance
 //      (calibrated on the training take), together with the rigid estimate weighed likewise. Without one, the rigid estimate; without that, held relative to
-//      the marker's anchors.
+//      the marker's anchors. The marker's regional PCA (region_pca_fit.h), aligned on whichever
+//      members of its region are seen, joins as one more opinion weighed by its calibrated
+//      variance: it holds where the marker's own neighbourhood is gone.
 //   5. Continuity: at the start of a gap, the difference between where the marker's last
 //      measurement moved with its neighbours and the estimate is kept in the local frame and
 //      decays over `continuity_seconds`, so a gap does not start with a jump.
@@ -34,6 +36,7 @@
 #include "core/absolute_orientation.h"
 #include "core/marker_status.h"
 #include "core/pca_fit.h"
+#include "core/region_pca_fit.h"
 #include "core/subject_model.h"
 
 namespace skinstream {
@@ -51,6 +54,9 @@ struct GapFillerOptions {
   // hold when nothing else is known).
   bool carry_from_gap_start = true;
   bool check_labels = true;
+  // With weighting: each missing marker's regional PCA (region_pca_fit.h, when the subject has
+  // regions) is one more weighed opinion, and the estimate when nothing nearer is known.
+  bool use_regions = true;
 };
 
 struct FrameInput {
@@ -193,6 +199,10 @@ class GapFiller {
   std::vector<uint32_t> pattern_mask_;
   std::vector<int> pattern_offset_;
   std::vector<double> pattern_factor_;
+  bool region_estimate(int i, double other_variance, Vec3& out, double& out_variance);
+  RegionPcaFit region_fit_;
+  std::vector<Vec3> region_positions_;
+  std::vector<char> region_observed_;
   std::vector<Vec3> scratch_source_, scratch_target_;
   std::vector<int> scratch_index_;
   FillStats stats_;

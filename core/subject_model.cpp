@@ -51,6 +51,25 @@ std::string SubjectModel::validate() const {
              !(m.residual_variance > 0) || !(m.variance.array() > 0).all())
       why << "marker " << marker_names[i] << " PCA has non-finite values; ";
   }
+  if (has_regions()) {
+    if (region_pca.size() != n || region_offsets.size() != n + 1 || region_offsets.front() != 0 ||
+        region_offsets.back() != static_cast<int>(region.size()))
+      return why.str() + "regions inconsistent";
+    for (int j : region)
+      if (j < 0 || j >= static_cast<int>(n)) return why.str() + "region index out of range";
+    for (size_t i = 0; i < n; ++i) {
+      const int64_t size = int64_t{region_offsets[i + 1]} - region_offsets[i];
+      const MarkerPcaModel& m = region_pca[i];
+      if (size < 1 || size > kMaxRing || region[region_offsets[i]] != static_cast<int>(i))
+        why << "marker " << marker_names[i] << " region malformed; ";
+      else if (m.mean.size() != 3 * size || m.basis.rows() != 3 * size || m.basis.cols() != m.variance.size() ||
+               m.slot_calibration.size() != size)
+        why << "marker " << marker_names[i] << " region PCA shape does not match its region; ";
+      else if (!m.mean.allFinite() || !m.basis.allFinite() || !(m.variance.array() > 0).all() ||
+               !(m.residual_variance > 0) || !std::isfinite(m.residual_variance) || !(m.slot_calibration.array() > 0).all())
+        why << "marker " << marker_names[i] << " region PCA has non-finite or non-positive values; ";
+    }
+  }
   for (int j : ring)
     if (j < 0 || j >= static_cast<int>(n)) return why.str() + "one-ring index out of range";
   for (int j : anchors)

@@ -54,10 +54,18 @@ struct SubjectModel {
   std::vector<int> anchors;
 
   std::vector<MarkerPcaModel> pca;  // one per marker
+
+  // Each marker's region (CSR, the marker first, then its nearest by skin distance) and the
+  // region's PCA, in the region's aligned frame (region_pca_fit.h). Empty: no regional models
+  // (a subject file before version 5).
+  std::vector<int> region_offsets;
+  std::vector<int> region;
+  std::vector<MarkerPcaModel> region_pca;
   FillParameters parameters;
 
   int marker_count() const { return static_cast<int>(marker_names.size()); }
   int ring_size(int i) const { return ring_offsets[i + 1] - ring_offsets[i]; }
+  bool has_regions() const { return !region_pca.empty(); }
   // Average distance from marker i to its one-ring in the reference pose (eq. 3 denominator).
   double neighbour_distance(int i) const;
   int marker_index(const std::string& name) const;  // -1 when absent

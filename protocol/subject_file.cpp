@@ -30,6 +30,55 @@ std::vector<int> get_ints(ByteReader& r) {
   return v;
 }
 
+void encode(const MarkerPcaModel& p, ByteWriter& w) {
+  w.put<uint32_t>(static_cast<uint32_t>(p.mean.size()));
+  w.put<uint32_t>(static_cast<uint32_t>(p.variance.size()));
+  w.put<int32_t>(p.training_frames);
+  w.put<double>(p.residual_variance);
+  for (Eigen::Index k = 0; k < p.mean.size(); ++k) w.put<double>(p.mean(k));
+  for (Eigen::Index k = 0; k < p.variance.size(); ++k) w.put<double>(p.variance(k));
+  for (Eigen::Index k = 0; k < p.basis.size(); ++k) w.put<double>(p.basis.data()[k]);
+  for (Eigen::Index k = 0; k < p.slot_calibration.size(); ++k) w.put<double>(p.slot_calibration(k));
+  w.put<double>(p.rigid_variance);
+}
+
+MarkerPcaModel decode_pca(ByteReader& r, const std::string& what) {
+  MarkerPcaModel p;
+  const uint32_t dims = r.get<uint32_t>(), components = r.get<uint32_t>();
+  if (dims > 3 * SubjectModel::kMaxRing || dims % 3 != 0 || components > dims)
+    throw std::out_of_range(what + " has implausible shape");
+  p.training_frames = r.get<int32_t>();
+  p.residual_variance = r.get<double>();
+  p.mean.resize(dims);
+  p.variance.resize(components);
+  p.basis.resize(dims, components);
+  for (uint32_t k = 0; k < dims; ++k) p.mean(k) = r.get<double>();
+  for (uint32_t k = 0; k < components; ++k) p.variance(k) = r.get<double>();
+  for (Eigen::Index k = 0; k < p.basis.size(); ++k) p.basis.data()[k] = r.get<double>();
+  p.slot_calibration.resize(dims / 3);
+  for (uint32_t k = 0; k < dims / 3; ++k) p.slot_calibration(k) = r.get<double>();
+  p.rigid_variance = r.get<double>();
+  return p;
+}
+
+// Version 5: the regions and their PCA models, after the deformation model (a count of 0: none).
+void encode_regions(const SubjectModel& m, ByteWriter& w) {
+  w.put<uint32_t>(static_cast<uint32_t>(m.region_pca.size()));
+  if (m.region_pca.empty()) return;
+  put_ints(w, m.region_offsets);
+  put_ints(w, m.region);
+  for (const MarkerPcaModel& p : m.region_pca) encode(p, w);
+}
+
+void decode_regions(ByteReader& r, SubjectModel& m) {
+  const uint32_t count = r.get<uint32_t>();
+  if (count == 0) return;
+  if (count != static_cast<uint32_t>(m.marker_count())) throw std::out_of_range("region models for " + std::to_string(count) + " markers");
+  m.region_offsets = get_ints(r);
+  m.region = get_ints(r);
+  for (uint32_t i = 0; i < count; ++i) m.region_pca.push_back(decode_pca(r, "region PCA model of marker " + std::to_string(i)));
+}
+
 void encode(const SubjectModel& m, ByteWriter& w) {
   w.put<uint32_t>(static_cast<uint32_t>(m.marker_count()));
   for (int i = 0; i < m.marker_count(); ++i) {
@@ -46,17 +95,7 @@ void encode(const SubjectModel& m, ByteWriter& w) {
     for (int k = 0; k < 9; ++k) w.put<double>(r.data()[k]);
   put_ints(w, m.anchor_offsets);
   put_ints(w, m.anchors);
-  for (const MarkerPcaModel& p : m.pca) {
-    w.put<uint32_t>(static_cast<uint32_t>(p.mean.size()));
-    w.put<uint32_t>(static_cast<uint32_t>(p.variance.size()));
-    w.put<int32_t>(p.training_frames);
-    w.put<double>(p.residual_variance);
-    for (Eigen::Index k = 0; k < p.mean.size(); ++k) w.put<double>(p.mean(k));
-    for (Eigen::Index k = 0; k < p.variance.size(); ++k) w.put<double>(p.variance(k));
-    for (Eigen::Index k = 0; k < p.basis.size(); ++k) w.put<double>(p.basis.data()[k]);
-    for (Eigen::Index k = 0; k < p.slot_calibration.size(); ++k) w.put<double>(p.slot_calibration(k));
-    w.put<double>(p.rigid_variance);
-  }
+  for (const MarkerPcaModel& p : m.pca) encode(p, w);
   w.put<double>(m.parameters.alpha1);
   w.put<double>(m.parameters.alpha2);
 }
@@ -145,24 +184,7 @@ SubjectModel decode(ByteReader& r) {
   }
   m.anchor_offsets = get_ints(r);
   m.anchors = get_ints(r);
-  for (uint32_t i = 0; i < n; ++i) {
-    MarkerPcaModel p;
-    const uint32_t dims = r.get<uint32_t>(), components = r.get<uint32_t>();
-    if (dims > 3 * SubjectModel::kMaxRing || dims % 3 != 0 || components > dims)
-      throw std::out_of_range("PCA model of marker " + std::to_string(i) + " has implausible shape");
-    p.training_frames = r.get<int32_t>();
-    p.residual_variance = r.get<double>();
-    p.mean.resize(dims);
-    p.variance.resize(components);
-    p.basis.resize(dims, components);
-    for (uint32_t k = 0; k < dims; ++k) p.mean(k) = r.get<double>();
-    for (uint32_t k = 0; k < components; ++k) p.variance(k) = r.get<double>();
-    for (Eigen::Index k = 0; k < p.basis.size(); ++k) p.basis.data()[k] = r.get<double>();
-    p.slot_calibration.resize(dims / 3);
-    for (uint32_t k = 0; k < dims / 3; ++k) p.slot_calibration(k) = r.get<double>();
-    p.rigid_variance = r.get<double>();
-    m.pca.push_back(std::move(p));
-  }
+  for (uint32_t i = 0; i < n; ++i) m.pca.push_back(decode_pca(r, "PCA model of marker " + std::to_string(i)));
   m.parameters.alpha1 = r.get<double>();
   m.parameters.alpha2 = r.get<double>();
   return m;
@@ -182,6 +204,7 @@ void write_subject(const SubjectModel& model, const DeformationModel* deformatio
   ByteWriter payload_writer;
   encode(model, payload_writer);
   encode(deformation, payload_writer);
+  encode_regions(model, payload_writer);
   const std::vector<unsigned char>& payload = payload_writer.bytes();
   ByteWriter w;
   w.put_bytes(kMagic, sizeof kMagic);
@@ -223,6 +246,7 @@ SubjectFile read_subject_bytes(std::span<const unsigned char> bytes, const std::
     ByteReader r(payload, size);
     file.model = decode(r);
     if (version >= 2) file.deformation = decode_deformation(r, version);
+    if (version >= 5) decode_regions(r, file.model);
     if (r.remaining() != 0) throw std::out_of_range(std::to_string(r.remaining()) + " unexpected bytes after the model");
   } catch (const std::out_of_range& e) {
     throw FileError(path, std::string("corrupt subject payload: ") + e.what());

@@ -8,7 +8,10 @@
 //               anchors, PCA models, fill parameters (see subject_file.cpp, in that order);
 //               version 2 adds a flag byte and, when set, the deformation model of section 5
 //               (registered mesh, parts with marker weights, vertex weights); version 3
-//               appends to it each part's ridge of eq. 7 (a count, then doubles)
+//               appends to it each part's ridge of eq. 7 (a count, then doubles), version 4
+//               each part's quadratic ridge; version 5 appends, after the deformation model, the
+//               regions and their PCA models (a count of markers, 0 for none; then the region
+//               offsets and members, and one PCA model per marker as the one-ring models are)
 //   last 4      u32 CRC-32 of the payload
 //
 // Another version, a bad magic, a size or CRC mismatch or an inconsistent model is rejected
@@ -23,8 +26,8 @@
 
 namespace skinstream {
 
-// Reads 1 (no deformation model), 2 (no ridges), 3 (no quadratic ridges) and 4.
-inline constexpr uint32_t kSubjectFileVersion = 4;
+// Reads 1 (no deformation model), 2 (no ridges), 3 (no quadratic ridges), 4 (no regions) and 5.
+inline constexpr uint32_t kSubjectFileVersion = 5;
 
 struct SubjectFile {
   SubjectModel model;

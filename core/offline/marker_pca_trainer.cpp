@@ -63,6 +63,24 @@ void calibrate(const Capture& capture, int marker, const std::vector<int>& ring,
 
 }  // namespace
 
+void keep_principal_components(const Eigen::MatrixXd& covariance, double variance_kept, double floor, MarkerPcaModel& model) {
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(covariance);
+  const Eigen::VectorXd values = eig.eigenvalues().reverse().cwiseMax(0.0);
+  const int dims = static_cast<int>(covariance.rows());
+  const double total = values.sum();
+  // Components below a micrometre of spread are round-off, not deformation.
+  constexpr double kNumericalZero = 1e-6;  // mm^2
+  int kept = 0;
+  double explained = 0.0;
+  while (kept < dims && values(kept) > kNumericalZero && explained < variance_kept * total) {
+    explained += values(kept);
+    ++kept;
+  }
+  model.basis = eig.eigenvectors().rowwise().reverse().leftCols(kept);
+  model.variance = values.head(kept).cwiseMax(floor);
+  model.residual_variance = std::max(floor, kept < dims ? (total - explained) / (dims - kept) : 0.0);
+}
+
 MarkerPcaModel train_marker_pca(const Capture& capture, int marker, const std::vector<int>& ring,
                                 const std::vector<Vec3>& ring_local_reference, const PcaTrainingOptions& options) {
   const int d = static_cast<int>(ring.size());
@@ -105,21 +123,7 @@ MarkerPcaModel train_marker_pca(const Capture& capture, int marker, const std::v
   samples.conservativeResize(Eigen::NoChange, columns);
   model.mean = samples.rowwise().mean();
   samples.colwise() -= model.mean;
-  const Eigen::MatrixXd covariance = samples * samples.transpose() / static_cast<double>(columns);
-  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(covariance);
-  const Eigen::VectorXd values = eig.eigenvalues().reverse().cwiseMax(0.0);
-  const double total = values.sum();
-  // Components below a micrometre of spread are round-off, not deformation.
-  constexpr double kNumericalZero = 1e-6;  // mm^2
-  int kept = 0;
-  double explained = 0.0;
-  while (kept < dims && values(kept) > kNumericalZero && explained < options.variance_kept * total) {
-    explained += values(kept);
-    ++kept;
-  }
-  model.basis = eig.eigenvectors().rowwise().reverse().leftCols(kept);
-  model.variance = values.head(kept).cwiseMax(floor);
-  model.residual_variance = std::max(floor, kept < dims ? (total - explained) / (dims - kept) : 0.0);
+  keep_principal_components(samples * samples.transpose() / static_cast<double>(columns), options.variance_kept, floor, model);
   calibrate(capture, marker, ring, ring_local_reference, usable, options, model);
   return model;
 }

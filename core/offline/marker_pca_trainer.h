@@ -18,6 +18,11 @@ struct PcaTrainingOptions {
   int calibration_frames = 300;       // frames used to calibrate the predictive variances
 };
 
+// From the covariance of centred samples (mm^2): the fewest leading components that explain
+// `variance_kept` (round-off ones never), their variances and the residual per dimension, none
+// below `floor` (mm^2), into `model`'s basis, variance and residual_variance.
+void keep_principal_components(const Eigen::MatrixXd& covariance, double variance_kept, double floor, MarkerPcaModel& model);
+
 // `marker` and `ring` are channel indices of `capture`; `ring_local_reference` the eq. 1 positions.
 MarkerPcaModel train_marker_pca(const Capture& capture, int marker, const std::vector<int>& ring,
                                 const std::vector<Vec3>& ring_local_reference, const PcaTrainingOptions& options);

