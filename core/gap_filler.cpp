@@ -8,7 +8,6 @@
 namespace skinstream {
 namespace {
 
-
 }  // namespace
 
 GapFiller::GapFiller(const SubjectModel& model, const GapFillerOptions& options)
@@ -56,6 +55,7 @@ GapFiller::GapFiller(const SubjectModel& model, const GapFillerOptions& options)
   rotation_.assign(n_, Eigen::Matrix3d::Identity());
   available_neighbours_.assign(n_, 0);
   missing_.reserve(n_);
+  rigid_queue_.reserve(n_ + predictor_marker_.size());  // every marker once, then once per count raised
   free_points_.assign(kMaxFreePoints, Vec3::Zero());
   free_ids_.assign(kMaxFreePoints, 0);
   free_used_.assign(kMaxFreePoints, 0);
@@ -203,11 +203,14 @@ bool GapFiller::carried_position(int i, Vec3& out) const {
 // A correctly labelled point moves with its neighbours: within a frame its offset from them
 // changes by millimetres, while a swapped or mislabelled point is off by about the marker
 // spacing. A labelled point farther than eps2 from where its marker was carried is suspect, and
-// held back from the estimates until judged.
+// held back from the estimates until judged. With fewer than two ring members seen (where skin
+// touches skin, or a limb is hidden) it is compared with the marker's last position instead:
+// a label that jumps by more than eps2 in one frame is just as suspect.
 void GapFiller::find_suspect_labels() {
   for (int i = 0; i < n_; ++i) {
     Vec3 expected;
-    if (!observed_[i] || previous_status_[i] == MarkerStatus::Held || !carried_position(i, expected)) continue;
+    if (!observed_[i] || previous_status_[i] == MarkerStatus::Held) continue;
+    if (!carried_position(i, expected)) expected = previous_[i];
     if ((current_[i] - expected).norm() > eps2_[i]) suspects_.push_back(i);
   }
   for (int i : suspects_) observed_[i] = 0;
@@ -216,18 +219,21 @@ void GapFiller::find_suspect_labels() {
 // Being off is not proof: a fast limb at a low frame rate, or the end of a gap whose estimate
 // was poor, puts a true measurement beyond eps2 too, and so does a rejected point that another
 // marker took last frame and carried along. A suspect point is judged against estimates made
-// this frame from the other markers alone. It stands when its own estimate agrees (within
-// eps2); it is taken as unlabelled when another marker explains it clearly better (a swap), or
-// when it was tracked last frame and its own estimate disagrees as well (two independent
-// estimates, the motion of its ring and the shape of its neighbourhood, against it).
-// Otherwise the measurement stands.
+// this frame from the other markers alone. It stands when its own estimate agrees (within eps2
+// and within four of its calibrated standard deviations); it is taken as unlabelled when
+// another marker explains it clearly better (a swap), or when it was tracked last frame and its
+// own estimate disagrees by more than eps2 as well (two independent estimates, the motion of its
+// ring and the shape of its neighbourhood, against it). Otherwise the measurement stands.
 void GapFiller::judge_suspect_labels() {
   for (int i : suspects_) {
     Vec3 own;
-    const bool has_own = expected_position(i, own);
+    double own_variance = 0.0;
+    const bool has_own = expected_position(i, own, &own_variance);
     const double own_distance = has_own ? (current_[i] - own).norm() : std::numeric_limits<double>::infinity();
-    const bool reject = own_distance > eps2_[i] &&
-                        (explained_by_another(i, own_distance) || (has_own && is_observed(previous_status_[i])));
+    const bool own_confident = has_own && own_distance * own_distance > kConfidentMiss * own_variance;
+    const bool reject = (own_distance > eps2_[i] || own_confident) &&
+                        (explained_by_another(i, own_distance) ||
+                         (has_own && own_distance > eps2_[i] && is_observed(previous_status_[i])));
     if (reject) {
       add_free_point(current_[i], -(i + 1));
       ++stats_.rejected_labels;
@@ -239,19 +245,20 @@ void GapFiller::judge_suspect_labels() {
   refresh_estimates();
 }
 
-// Whether a missing (or suspect) marker near i is expected within eps1 of i's labelled point and
-// at most half as far from it as i's own estimate.
+// Whether another missing (or suspect) marker is expected within eps1 of i's labelled point and
+// at most half as far from it as i's own estimate: a swap, or a point where skin touches skin.
+// Any marker may be the other, not only i's neighbours: skin that touches is rarely neighbouring
+// on the marker surface.
 bool GapFiller::explained_by_another(int i, double own_distance) {
-  auto explains = [&](int j) {
+  for (int j : missing_) {
+    if (observed_[j] || j == i || !estimated_[j]) continue;
+    const double reach = kPrefilterReach * eps1_[j];
+    if ((current_[i] - estimate_[j]).squaredNorm() > reach * reach) continue;
     Vec3 expected;
-    if (observed_[j] || j == i || !expected_position(j, expected)) return false;
+    if (!expected_position(j, expected)) continue;
     const double d = (current_[i] - expected).norm();
-    return d <= eps1_[j] && d <= 0.5 * own_distance;
-  };
-  for (int k = model_.ring_offsets[i]; k < model_.ring_offsets[i + 1]; ++k)
-    if (explains(model_.ring[k])) return true;
-  for (int p = predictor_offsets_[i]; p < predictor_offsets_[i + 1]; ++p)
-    if (explains(predictor_marker_[p])) return true;
+    if (d <= eps1_[j] && d <= 0.5 * own_distance) return true;
+  }
   return false;
 }
 
@@ -269,17 +276,27 @@ void GapFiller::estimate_rigid() {
     for (int k = model_.ring_offsets[i]; k < model_.ring_offsets[i + 1]; ++k) count += estimated_[model_.ring[k]];
     available_neighbours_[i] = count;
   }
-  for (;;) {
-    int best = -1, best_count = 2;
-    for (int i : missing_)
-      if (!estimated_[i] && available_neighbours_[i] > best_count) {
-        best = i;
-        best_count = available_neighbours_[i];
-      }
-    if (best < 0) break;
-    fit_rigid_estimate(best);
-    for (int p = predictor_offsets_[best]; p < predictor_offsets_[best + 1]; ++p)
-      ++available_neighbours_[predictor_marker_[p]];
+  // The marker with the most available neighbours first, the lowest index among equals: a heap
+  // of (count, marker) entries, a stale one (its marker since estimated, or counted higher) skipped.
+  auto before = [](const RigidQueueEntry& a, const RigidQueueEntry& b) {
+    return a.count != b.count ? a.count < b.count : a.marker > b.marker;
+  };
+  rigid_queue_.clear();
+  for (int i : missing_)
+    if (available_neighbours_[i] >= kRigidSupport) rigid_queue_.push_back({available_neighbours_[i], i});
+  std::make_heap(rigid_queue_.begin(), rigid_queue_.end(), before);
+  while (!rigid_queue_.empty()) {
+    std::pop_heap(rigid_queue_.begin(), rigid_queue_.end(), before);
+    const RigidQueueEntry next = rigid_queue_.back();
+    rigid_queue_.pop_back();
+    if (estimated_[next.marker] || available_neighbours_[next.marker] != next.count) continue;
+    fit_rigid_estimate(next.marker);
+    for (int p = predictor_offsets_[next.marker]; p < predictor_offsets_[next.marker + 1]; ++p) {
+      const int j = predictor_marker_[p];
+      if (estimated_[j] || ++available_neighbours_[j] < kRigidSupport) continue;
+      rigid_queue_.push_back({available_neighbours_[j], j});
+      std::push_heap(rigid_queue_.begin(), rigid_queue_.end(), before);
+    }
   }
 }
 
@@ -508,11 +525,16 @@ int GapFiller::pca_estimate(int i, Vec3& out, double* out_variance) {
 // Where the relabeller expects a missing marker: its best estimate from the neighbours alone.
 // Not the continuity offset: that comes from the marker's own past, and a fragment drifting
 // away would drag it along and be taken back. False when there is no estimate.
-bool GapFiller::expected_position(int i, Vec3& out) {
-  if (options_.use_pca && pca_estimate(i, out) > 0) return true;
+bool GapFiller::expected_position(int i, Vec3& out, double* out_variance) {
+  if (options_.use_pca && pca_estimate(i, out, out_variance) > 0) return true;
   if (!estimated_[i]) return false;
   out = estimate_[i];
+  if (out_variance) *out_variance = rigid_estimate_variance(i);
   return true;
+}
+
+double GapFiller::rigid_estimate_variance(int i) const {
+  return model_.pca[i].rigid_variance * model_.ring_size(i) / std::max(1, rigid_support_[i]);
 }
 
 // At the first frame of a gap: where the marker and its anchors were last frame.
@@ -615,8 +637,7 @@ void GapFiller::fill_missing() {
       current_[i] = carry ? combine(fused, variance, carried, carried_variance) : fused;
       status_[i] = MarkerStatus::FilledPca;
     } else if (estimated_[i]) {
-      const double rigid_variance = model_.pca[i].rigid_variance * model_.ring_size(i) / std::max(1, rigid_support_[i]);
-      current_[i] = carry ? combine(estimate_[i], rigid_variance, carried, carried_variance) : estimate_[i];
+      current_[i] = carry ? combine(estimate_[i], rigid_estimate_variance(i), carried, carried_variance) : estimate_[i];
       status_[i] = MarkerStatus::FilledRigid;
     } else {
       // Held: carried with the rigid motion of the anchors (since the gap started, else since

@@ -4,10 +4,12 @@
 //
 //   1. Label check: a labelled point that did not move with its one-ring since the last frame
 //      (off by more than eps2) is suspect: that is how swapped and mislabelled fragments look,
-//      but also a true measurement after a gap whose estimate was poor. It is treated as
-//      unlabelled only on strong evidence, judged against this frame's estimates from the other
-//      markers: another missing marker explains it clearly better (a swap), or it was tracked
-//      and its neighbourhood's estimate disagrees too. Otherwise the measurement stands.
+//      but also a true measurement after a gap whose estimate was poor (with its ring unseen,
+//      against its last position). It is treated as unlabelled only on strong evidence, judged
+//      against this frame's estimates from the other markers: any missing marker explains it
+//      clearly better while its own confident estimate disagrees (a swap, or skin touching
+//      skin), or it was tracked and its neighbourhood's estimate disagrees too. Otherwise the
+//      measurement stands.
 //   2. Rigid estimates (eq. 2, Horn), greedy: the missing marker with the most available
 //      neighbours first, reusing earlier estimates.
 //   3. Relabelling: a tracked fragment stays with its marker while within eps2 (alpha2) of
@@ -109,7 +111,8 @@ class GapFiller {
   bool carry_rigidly(int i, const Vec3& from_position, std::span<const Vec3> from_anchors,
                      std::span<const char> from_seen, Vec3& out, double& out_residual);
   void check_carries();
-  bool expected_position(int i, Vec3& out);
+  bool expected_position(int i, Vec3& out, double* out_variance = nullptr);
+  double rigid_estimate_variance(int i) const;
   void take_free_point(int marker, int point);
   bool free_point_near(const Vec3& p, double reach) const;
   void refresh_estimates();
@@ -130,6 +133,9 @@ class GapFiller {
   // Carried from frame to frame.
   static constexpr int kRelabelRounds = 3;
   static constexpr double kPrefilterReach = 3.0;  // in eps1, around the rigid estimate
+  // A labelled point this many variances (squared distance over the calibrated predictive
+  // variance) from its own estimate is confidently not where the marker is expected.
+  static constexpr double kConfidentMiss = 16.0;
   bool has_previous_ = false;
   long frame_ = 0;
   long solve_stamp_ = 0;  // this frame's: a PCA solve made in it stands until its ring changes (refresh_estimates)
@@ -166,6 +172,12 @@ class GapFiller {
   std::vector<Vec3> estimate_;
   std::vector<Eigen::Matrix3d> rotation_;
   std::vector<int> available_neighbours_, missing_;
+  static constexpr int kRigidSupport = 3;  // known ring members eq. 2 needs
+  struct RigidQueueEntry {
+    int count;
+    int marker;
+  };
+  std::vector<RigidQueueEntry> rigid_queue_;
   std::vector<Vec3> free_points_;
   std::vector<int> free_ids_;
   std::vector<char> free_used_;
