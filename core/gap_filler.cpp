@@ -31,6 +31,9 @@ GapFiller::GapFiller(const SubjectModel& model, const GapFillerOptions& options)
   previous_.assign(n_, Vec3::Zero());
   previous_status_.assign(n_, MarkerStatus::Held);
   assigned_id_.assign(n_, kNoFragment);
+  probation_start_.assign(n_, -1);
+  refused_id_.assign(n_, kNoFragment);
+  revoked_.assign(n_, 0);
   gap_offset_.assign(n_, Vec3::Zero());
   gap_age_.assign(n_, 0);
   gap_start_known_.assign(n_, 0);
@@ -111,6 +114,8 @@ void GapFiller::precompute_single_gaps() {
 void GapFiller::reset() {
   has_previous_ = false;
   std::fill(assigned_id_.begin(), assigned_id_.end(), kNoFragment);
+  std::fill(probation_start_.begin(), probation_start_.end(), -1);
+  std::fill(refused_id_.begin(), refused_id_.end(), kNoFragment);
   std::fill(gap_age_.begin(), gap_age_.end(), 0);
   std::fill(gap_offset_.begin(), gap_offset_.end(), Vec3::Zero());
   std::fill(gap_start_known_.begin(), gap_start_known_.end(), 0);
@@ -134,6 +139,7 @@ FillStats GapFiller::run(const FrameInput& in, const FrameOutput& out) {
   stats_ = FillStats{};
   if (static_cast<int>(in.labelled.size()) != n_ || static_cast<int>(out.positions.size()) != n_ ||
       static_cast<int>(out.status.size()) != n_ || (!out.fragments.empty() && static_cast<int>(out.fragments.size()) != n_) ||
+      (!out.revoked.empty() && static_cast<int>(out.revoked.size()) != n_) ||
       (!in.unlabelled_ids.empty() && in.unlabelled_ids.size() != in.unlabelled.size())) {
     stats_.ok = false;
     return stats_;
@@ -157,8 +163,13 @@ FillStats GapFiller::run(const FrameInput& in, const FrameOutput& out) {
   if (options_.check_labels && has_previous_) find_suspect_labels();
   estimate_rigid();
   if (!suspects_.empty()) judge_suspect_labels();
+  std::fill(revoked_.begin(), revoked_.end(), 0);
   for (int i = 0; i < n_; ++i)
-    if (observed_[i]) assigned_id_[i] = kNoFragment;  // the capture system has it again
+    if (observed_[i]) {  // the capture system has it again
+      assigned_id_[i] = kNoFragment;
+      probation_start_[i] = -1;
+      refused_id_[i] = kNoFragment;
+    }
 
   relabel();
   fill_missing();
@@ -168,6 +179,7 @@ FillStats GapFiller::run(const FrameInput& in, const FrameOutput& out) {
     out.positions[i] = current_[i];
     out.status[i] = status_[i];
     if (!out.fragments.empty()) out.fragments[i] = status_[i] == MarkerStatus::Relabelled ? assigned_id_[i] : kNoFragment;
+    if (!out.revoked.empty()) out.revoked[i] = revoked_[i];
     if (is_present(in.labelled[i]) && current_[i] != in.labelled[i]) ++stats_.changed_measured;
     previous_[i] = current_[i];
     previous_status_[i] = status_[i];
@@ -247,19 +259,29 @@ void GapFiller::judge_suspect_labels() {
 
 // Whether another missing (or suspect) marker is expected within eps1 of i's labelled point and
 // at most half as far from it as i's own estimate: a swap, or a point where skin touches skin.
-// Any marker may be the other, not only i's neighbours: skin that touches is rarely neighbouring
-// on the marker surface.
 bool GapFiller::explained_by_another(int i, double own_distance) {
+  const OtherExplanation other = other_explanation(i, current_[i]);
+  return other.distance <= 0.5 * own_distance;
+}
+
+// The other missing markers whose estimates are within eps1 of point p: the nearest of them,
+// and the smallest squared distance over the estimate's variance. Any marker may be the other,
+// not only i's neighbours: skin that touches is rarely neighbouring on the marker surface.
+GapFiller::OtherExplanation GapFiller::other_explanation(int i, const Vec3& p) {
+  OtherExplanation best;
   for (int j : missing_) {
     if (observed_[j] || j == i || !estimated_[j]) continue;
     const double reach = kPrefilterReach * eps1_[j];
-    if ((current_[i] - estimate_[j]).squaredNorm() > reach * reach) continue;
+    if ((p - estimate_[j]).squaredNorm() > reach * reach) continue;
     Vec3 expected;
-    if (!expected_position(j, expected)) continue;
-    const double d = (current_[i] - expected).norm();
-    if (d <= eps1_[j] && d <= 0.5 * own_distance) return true;
+    double variance = 0.0;
+    if (!expected_position(j, expected, &variance)) continue;
+    const double d = (p - expected).norm();
+    if (d > eps1_[j]) continue;
+    best.distance = std::min(best.distance, d);
+    best.misfit = std::min(best.misfit, d * d / variance);
   }
-  return false;
+  return best;
 }
 
 // Eq. 2, greedy: repeatedly estimate the missing marker with the most available neighbours
@@ -322,23 +344,32 @@ void GapFiller::fit_rigid_estimate(int i) {
 }
 
 void GapFiller::relabel() {
-  // Fragments already standing for a marker stay while within eps2 of where it is expected.
+  // Fragments already standing for a marker stay while within eps2 of where it is expected; one
+  // still on probation (taken less than confirm_frames ago) only while it passes the taking test.
   for (int i : missing_) {
     const int id = assigned_id_[i];
+    if (refused_id_[i] != kNoFragment && find_free_point(refused_id_[i]) < 0) refused_id_[i] = kNoFragment;
     if (id == kNoFragment) continue;
-    int found = -1;
-    for (int p = 0; p < free_count_; ++p)
-      if (!free_used_[p] && free_ids_[p] == id) {
-        found = p;
-        break;
-      }
+    const int found = find_free_point(id);
     Vec3 expected;
     if (found >= 0 && !expected_position(i, expected)) expected = previous_[i];  // no estimate: continuity
-    if (found >= 0 && (free_points_[found] - expected).norm() <= eps2_[i]) {
+    const double distance = found >= 0 ? (free_points_[found] - expected).norm() : 0.0;
+    const bool on_probation = probation_start_[i] >= 0;
+    const bool keep = found >= 0 && (on_probation ? ambiguity_free_match(i, found, distance) : distance <= eps2_[i]);
+    if (keep) {
       take_free_point(i, found);
-    } else {
-      assigned_id_[i] = kNoFragment;
+      if (on_probation && frame_ - probation_start_[i] >= options_.confirm_frames) probation_start_[i] = -1;
+      continue;
     }
+    // Not confirmed (a fragment that merely ends says nothing against it): the frames since it
+    // was taken are given back as estimates, and the fragment is not taken for this marker again.
+    if (on_probation && found >= 0) {
+      revoked_[i] = static_cast<int>(frame_ - probation_start_[i]);
+      refused_id_[i] = id;
+      probation_start_[i] = -1;
+      previous_status_[i] = MarkerStatus::FilledRigid;  // still in its gap: no continuity from the fragment
+    }
+    assigned_id_[i] = kNoFragment;
   }
   refresh_estimates();
   // New matches: each still-missing marker's nearest free point within eps1 of where it is
@@ -356,14 +387,14 @@ void GapFiller::relabel() {
       int best = -1;
       double best_distance = eps1_[i];
       for (int p = 0; p < free_count_; ++p) {
-        if (free_used_[p]) continue;
+        if (free_used_[p] || free_ids_[p] == refused_id_[i]) continue;
         const double d = (free_points_[p] - expected).norm();
         if (d <= best_distance) {
           best = p;
           best_distance = d;
         }
       }
-      if (best >= 0) candidates_.push_back({best_distance, i, best});
+      if (best >= 0 && ambiguity_free_match(i, best, best_distance)) candidates_.push_back({best_distance, i, best});
     }
     if (candidates_.empty()) break;
     std::sort(candidates_.begin(), candidates_.end(),
@@ -372,9 +403,26 @@ void GapFiller::relabel() {
       if (free_used_[c.point] || observed_[c.marker]) continue;
       take_free_point(c.marker, c.point);
       assigned_id_[c.marker] = free_ids_[c.point];
+      if (options_.confirm_frames > 0) probation_start_[c.marker] = frame_;
     }
     refresh_estimates();
   }
+}
+
+// Eq. 3's test for free point p at `distance` from where marker i is expected: within eps1, and
+// no other missing marker expected nearly as close (within twice the distance). Where two
+// estimates both reach a point (skin touching skin, neighbours close together) it is taken for
+// neither until the motion tells them apart.
+bool GapFiller::ambiguity_free_match(int i, int p, double distance) {
+  if (distance > eps1_[i]) return false;
+  if (free_ids_[p] == -(i + 1)) return true;  // its own labelled point, held back by the label check
+  return other_explanation(i, free_points_[p]).distance >= 2.0 * distance;
+}
+
+int GapFiller::find_free_point(int id) const {
+  for (int p = 0; p < free_count_; ++p)
+    if (!free_used_[p] && free_ids_[p] == id) return p;
+  return -1;
 }
 
 bool GapFiller::free_point_near(const Vec3& p, double reach) const {

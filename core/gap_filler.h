@@ -53,6 +53,11 @@ struct GapFillerOptions {
   // hold when nothing else is known).
   bool carry_from_gap_start = true;
   bool check_labels = true;
+  // A new relabel stays on probation for this many frames: while it is, the fragment must pass
+  // the taking test (eq. 3, unambiguous) every frame, else the relabel is revoked for all the
+  // frames since it was taken (FrameOutput::revoked; GapEndBlender, holding those frames, gives
+  // them back as estimates). The lookahead (CaptureFillOptions::lookahead) sets it; 0: none.
+  int confirm_frames = 0;
 };
 
 struct FrameInput {
@@ -71,6 +76,9 @@ struct FrameOutput {
   // for it (a source trajectory id, or -(j + 1) for the point labelled j that was rejected);
   // kNoFragment otherwise. What merging trajectories statistics are made of.
   std::span<int> fragments = {};
+  // Optional (empty = not wanted): per marker, in how many frames before this one its relabel was
+  // revoked (0: none). Only with GapFillerOptions::confirm_frames.
+  std::span<int> revoked = {};
 };
 
 struct FillStats {
@@ -99,6 +107,11 @@ class GapFiller {
   void find_suspect_labels();
   void judge_suspect_labels();
   bool explained_by_another(int i, double own_distance);
+  struct OtherExplanation {
+    double distance = std::numeric_limits<double>::infinity();
+    double misfit = std::numeric_limits<double>::infinity();  // squared distance / variance
+  };
+  OtherExplanation other_explanation(int i, const Vec3& p);
   bool carried_position(int i, Vec3& out) const;
   void estimate_rigid();
   void fit_rigid_estimate(int i);
@@ -114,6 +127,8 @@ class GapFiller {
   bool expected_position(int i, Vec3& out, double* out_variance = nullptr);
   double rigid_estimate_variance(int i) const;
   void take_free_point(int marker, int point);
+  bool ambiguity_free_match(int i, int p, double distance);
+  int find_free_point(int id) const;
   bool free_point_near(const Vec3& p, double reach) const;
   void refresh_estimates();
   void fill_missing();
@@ -142,6 +157,9 @@ class GapFiller {
   std::vector<Vec3> previous_;
   std::vector<MarkerStatus> previous_status_;
   std::vector<int> assigned_id_;      // free-point trajectory currently standing for marker i
+  std::vector<long> probation_start_;  // frame its relabel was taken while still on probation, else -1
+  std::vector<int> refused_id_;        // a fragment whose relabel was revoked, not taken again while it lasts
+  std::vector<int> revoked_;           // this frame's FrameOutput::revoked
   std::vector<Vec3> gap_offset_;      // continuity offset in the local frame
   std::vector<int> gap_age_;
   // At the start of each marker's gap: its last position and its anchors' (parallel to

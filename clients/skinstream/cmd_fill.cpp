@@ -19,7 +19,7 @@ void add_fill(CLI::App& app) {
   cmd->add_option("--subject", subject_path, "subject file from build-subject")->required();
   cmd->add_option("IN", in_path, "capture with gaps")->required();
   cmd->add_option("--out", out_path, "filled capture to write")->required();
-  cmd->add_option("--lookahead", options.lookahead, "frames of lookahead for the gap-end blend (0 = causal)")
+  cmd->add_option("--lookahead", options.lookahead, "frames of lookahead: the gap-end blend, and new relabels confirmed over them (0 = causal)")
       ->check(CLI::Range(0, 240))->capture_default_str();
   cmd->add_option("--smooth", smoothing, "local-frame smoothing: none, online (adds its lookahead), offline")
       ->check(CLI::IsMember({"none", "online", "offline"}))->capture_default_str();

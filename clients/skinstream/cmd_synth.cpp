@@ -3,6 +3,7 @@
 //
 //   skinstream synth --motion rom --seconds 20 --seed 7 --markers 350 --out take.c3d
 //                    --truth take_truth.c3d [--mesh-out-every 10 meshes/] [--subdivided] [--stats]
+//                    [--lookahead L]
 //
 // The body is read from --body DIR, else $SKINSTREAM_MAKEHUMAN_DIR, else
 // $SKINSTREAM_SHARED_DIR/data/meshes/makehuman, else ../shared/data/meshes/makehuman next to the
@@ -38,6 +39,7 @@ void add_synth(CLI::App& app) {
   static std::vector<std::string> mesh_out;
   static bool stats = false, no_deform = false;
   static double train_seconds = 20.0;
+  static int lookahead = 0;
   static uint64_t seed = 1;
   std::string motions;
   for (const auto& m : synth::motion_names()) motions += (motions.empty() ? "" : ", ") + m;
@@ -76,6 +78,9 @@ void add_synth(CLI::App& app) {
                 "(subject trained on a range-of-motion take of the same seed)");
   cmd->add_option("--train-seconds", train_seconds, "with --stats: length of the range-of-motion training take")
       ->check(CLI::Range(1.0, 600.0))
+      ->capture_default_str();
+  cmd->add_option("--lookahead", lookahead, "with --stats: frames of lookahead for the fill (new relabels confirmed over them)")
+      ->check(CLI::Range(0, 240))
       ->capture_default_str();
   cmd->callback([] {
     int mesh_every = 0;
@@ -129,7 +134,7 @@ void add_synth(CLI::App& app) {
       synth::SynthOptions rom = options;
       rom.motion = "rom";
       rom.seconds = train_seconds;
-      j["skinstream"] = evaluate_on_synthetic(result, synth::generate(body, rom));
+      j["skinstream"] = evaluate_on_synthetic(result, synth::generate(body, rom), lookahead);
       std::printf("%s\n", j.dump(2).c_str());
     } else {
       std::printf(
