@@ -260,28 +260,24 @@ void GapFiller::judge_suspect_labels() {
 // Whether another missing (or suspect) marker is expected within eps1 of i's labelled point and
 // at most half as far from it as i's own estimate: a swap, or a point where skin touches skin.
 bool GapFiller::explained_by_another(int i, double own_distance) {
-  const OtherExplanation other = other_explanation(i, current_[i]);
-  return other.distance <= 0.5 * own_distance;
+  return nearest_other_expected(i, current_[i]) <= 0.5 * own_distance;
 }
 
-// The other missing markers whose estimates are within eps1 of point p: the nearest of them,
-// and the smallest squared distance over the estimate's variance. Any marker may be the other,
-// not only i's neighbours: skin that touches is rarely neighbouring on the marker surface.
-GapFiller::OtherExplanation GapFiller::other_explanation(int i, const Vec3& p) {
-  OtherExplanation best;
+// The distance from point p to the nearest estimate of another missing marker that is within
+// eps1 of it (infinity: none). Any marker may be the other, not only i's neighbours: skin that
+// touches is rarely neighbouring on the marker surface.
+double GapFiller::nearest_other_expected(int i, const Vec3& p) {
+  double nearest = std::numeric_limits<double>::infinity();
   for (int j : missing_) {
     if (observed_[j] || j == i || !estimated_[j]) continue;
     const double reach = kPrefilterReach * eps1_[j];
     if ((p - estimate_[j]).squaredNorm() > reach * reach) continue;
     Vec3 expected;
-    double variance = 0.0;
-    if (!expected_position(j, expected, &variance)) continue;
+    if (!expected_position(j, expected)) continue;
     const double d = (p - expected).norm();
-    if (d > eps1_[j]) continue;
-    best.distance = std::min(best.distance, d);
-    best.misfit = std::min(best.misfit, d * d / variance);
+    if (d <= eps1_[j]) nearest = std::min(nearest, d);
   }
-  return best;
+  return nearest;
 }
 
 // Eq. 2, greedy: repeatedly estimate the missing marker with the most available neighbours
@@ -416,7 +412,7 @@ void GapFiller::relabel() {
 bool GapFiller::ambiguity_free_match(int i, int p, double distance) {
   if (distance > eps1_[i]) return false;
   if (free_ids_[p] == -(i + 1)) return true;  // its own labelled point, held back by the label check
-  return other_explanation(i, free_points_[p]).distance >= 2.0 * distance;
+  return nearest_other_expected(i, free_points_[p]) >= 2.0 * distance;
 }
 
 int GapFiller::find_free_point(int id) const {

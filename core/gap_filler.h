@@ -107,11 +107,7 @@ class GapFiller {
   void find_suspect_labels();
   void judge_suspect_labels();
   bool explained_by_another(int i, double own_distance);
-  struct OtherExplanation {
-    double distance = std::numeric_limits<double>::infinity();
-    double misfit = std::numeric_limits<double>::infinity();  // squared distance / variance
-  };
-  OtherExplanation other_explanation(int i, const Vec3& p);
+  double nearest_other_expected(int i, const Vec3& p);
   bool carried_position(int i, Vec3& out) const;
   void estimate_rigid();
   void fit_rigid_estimate(int i);
