@@ -37,6 +37,7 @@ Capture fill_capture(const SubjectModel& model, const Capture& input, const Capt
 
   GapFillerOptions filler_options = options.filler;
   filler_options.rate_hz = input.rate_hz > 0 ? input.rate_hz : filler_options.rate_hz;
+  filler_options.confirm_frames = options.lookahead;  // relabels confirmed within the lookahead
   GapFiller filler(model, filler_options);
   GapEndBlender blender(model, options.lookahead);
   OnlineSmoother smoother(model, options.smoothing_options);
@@ -46,8 +47,8 @@ Capture fill_capture(const SubjectModel& model, const Capture& input, const Capt
   std::vector<Vec3> measured(n), filled_frame(n), free_points, stage_positions(n), final_positions(n);
   std::vector<int> free_ids;
   std::vector<MarkerStatus> frame_status(n), stage_status(n), final_status(n);
-  std::vector<int> frame_fragments(n);
-  const FrameOutput filler_out{filled_frame, frame_status, frame_fragments};
+  std::vector<int> frame_fragments(n), frame_revoked(n);
+  const FrameOutput filler_out{filled_frame, frame_status, frame_fragments, frame_revoked};
   if (out_fragments) out_fragments->assign(static_cast<size_t>(input.frame_count) * n, -1);
   const FrameOutput stage_out{stage_positions, stage_status};
   const FrameOutput final_out{final_positions, final_status};
@@ -88,7 +89,7 @@ Capture fill_capture(const SubjectModel& model, const Capture& input, const Capt
         (*out_fragments)[static_cast<size_t>(f) * n + m] = id == kNoFragment ? -1 : id >= 0 ? id : channel_of[-id - 1];
       }
     long released;
-    if (blender.push(filled_frame, frame_status, f, stage_out, released)) after_blend(released);
+    if (blender.push(filled_frame, frame_status, f, stage_out, released, frame_revoked)) after_blend(released);
   }
   long released;
   while (blender.drain(stage_out, released)) after_blend(released);

@@ -17,7 +17,7 @@ enum class SmoothingMode { None, Online, Offline };
 
 struct CaptureFillOptions {
   GapFillerOptions filler;
-  int lookahead = 0;  // frames; the gap-end blend (0 = strictly causal)
+  int lookahead = 0;  // frames; the gap-end blend and the confirmation of new relabels (0 = strictly causal)
   SmoothingMode smoothing = SmoothingMode::None;
   SmoothingOptions smoothing_options;
 };

@@ -35,14 +35,45 @@ void GapEndBlender::blend_gap_end(int marker) {
   }
 }
 
+// The held frames in which `marker` stood on a fragment now revoked (the `frames` before the
+// newest): estimates instead, its place relative to its neighbourhood (eq. 2's rigid fit)
+// interpolated from the frame before them (when still held) to the newest frame, which the
+// filler already filled.
+void GapEndBlender::give_back(int marker, int frames) {
+  const int span = std::min(frames, held_ - 1);
+  const int before_age = span + 1 < held_ ? span + 1 : 0;  // the newest again when not held
+  RigidTransform t_now, t_before;
+  if (!neighbourhood_transform(model_, marker, frame(0), {}, t_now) ||
+      !neighbourhood_transform(model_, marker, frame(before_age), {}, t_before))
+    t_now = t_before = RigidTransform{};  // no neighbourhood: in world coordinates
+  const Vec3 local_now = t_now.apply_inverse(frame(0)[marker]);
+  const Vec3 local_before = t_before.apply_inverse(frame(before_age)[marker]);
+  for (int age = 1; age <= span; ++age) {
+    const size_t base = static_cast<size_t>(slot(age)) * n_;
+    if (status_[base + marker] != MarkerStatus::Relabelled) continue;
+    RigidTransform t;
+    if (!neighbourhood_transform(model_, marker, frame(age), {}, t)) t = t_now;
+    const double w = static_cast<double>(age) / (span + 1);  // 0 at the newest, 1 at the frame before
+    positions_[base + marker] = t.apply((1.0 - w) * local_now + w * local_before);
+    status_[base + marker] = MarkerStatus::FilledRigid;
+  }
+}
+
+std::span<const Vec3> GapEndBlender::frame(int age) const {
+  return {&positions_[static_cast<size_t>(slot(age)) * n_], static_cast<size_t>(n_)};
+}
+
 bool GapEndBlender::push(std::span<const Vec3> positions, std::span<const MarkerStatus> status, long frame_number,
-                         const FrameOutput& out, long& out_frame_number) {
+                         const FrameOutput& out, long& out_frame_number, std::span<const int> revoked) {
   newest_ = (newest_ + 1) % capacity_;
   const size_t base = static_cast<size_t>(newest_) * n_;
   std::copy(positions.begin(), positions.end(), positions_.begin() + base);
   std::copy(status.begin(), status.end(), status_.begin() + base);
   frame_numbers_[newest_] = frame_number;
   held_ = std::min(held_ + 1, capacity_);
+  if (static_cast<int>(revoked.size()) == n_)
+    for (int i = 0; i < n_; ++i)
+      if (revoked[i] > 0) give_back(i, revoked[i]);
 
   if (lookahead_ > 0 && held_ > 1) {
     const size_t previous = static_cast<size_t>(slot(1)) * n_;

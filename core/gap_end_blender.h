@@ -3,7 +3,9 @@
 // after it arrived; when a marker reappears, the frames of its gap still held here are pulled
 // towards the measurement: the jump between the last estimate and the new measurement, in the
 // marker's local frame (eq. 2), is spread back over them, full next to the measurement and
-// fading linearly. Costs L frames of latency (L / rate seconds). L = 0 passes frames through.
+// fading linearly. It also takes back the relabels the filler revoked within its window
+// (GapFillerOptions::confirm_frames = L). Costs L frames of latency (L / rate seconds). L = 0
+// passes frames through.
 
 #include <span>
 #include <vector>
@@ -20,8 +22,10 @@ class GapEndBlender {
   int lookahead() const { return lookahead_; }
 
   // Adds the newest filled frame; when a frame is due, writes it (and its number) and returns true.
+  // `revoked` (empty, or one per marker: FrameOutput::revoked from the filler): the relabels of
+  // that many frames before this one, still held here, are given back as estimates.
   bool push(std::span<const Vec3> positions, std::span<const MarkerStatus> status, long frame_number,
-            const FrameOutput& out, long& out_frame_number);
+            const FrameOutput& out, long& out_frame_number, std::span<const int> revoked = {});
   // At the end of a take: releases the frames still held, oldest first, one per call.
   bool drain(const FrameOutput& out, long& out_frame_number);
   void reset() { held_ = 0; }
@@ -29,6 +33,8 @@ class GapEndBlender {
  private:
   int slot(int age) const;  // age 0 = newest
   void blend_gap_end(int marker);
+  void give_back(int marker, int frames);
+  std::span<const Vec3> frame(int age) const;
 
   const SubjectModel& model_;
   int lookahead_;

@@ -8,7 +8,6 @@
 namespace skinstream {
 namespace {
 
-
 }  // namespace
 
 GapFiller::GapFiller(const SubjectModel& model, const GapFillerOptions& options)
@@ -32,6 +31,9 @@ GapFiller::GapFiller(const SubjectModel& model, const GapFillerOptions& options)
   previous_.assign(n_, Vec3::Zero());
   previous_status_.assign(n_, MarkerStatus::Held);
   assigned_id_.assign(n_, kNoFragment);
+  probation_start_.assign(n_, -1);
+  refused_id_.assign(n_, kNoFragment);
+  revoked_.assign(n_, 0);
   gap_offset_.assign(n_, Vec3::Zero());
   gap_age_.assign(n_, 0);
   gap_start_known_.assign(n_, 0);
@@ -56,6 +58,7 @@ GapFiller::GapFiller(const SubjectModel& model, const GapFillerOptions& options)
   rotation_.assign(n_, Eigen::Matrix3d::Identity());
   available_neighbours_.assign(n_, 0);
   missing_.reserve(n_);
+  rigid_queue_.reserve(n_ + predictor_marker_.size());  // every marker once, then once per count raised
   free_points_.assign(kMaxFreePoints, Vec3::Zero());
   free_ids_.assign(kMaxFreePoints, 0);
   free_used_.assign(kMaxFreePoints, 0);
@@ -113,6 +116,8 @@ void GapFiller::precompute_single_gaps() {
 void GapFiller::reset() {
   has_previous_ = false;
   std::fill(assigned_id_.begin(), assigned_id_.end(), kNoFragment);
+  std::fill(probation_start_.begin(), probation_start_.end(), -1);
+  std::fill(refused_id_.begin(), refused_id_.end(), kNoFragment);
   std::fill(gap_age_.begin(), gap_age_.end(), 0);
   std::fill(gap_offset_.begin(), gap_offset_.end(), Vec3::Zero());
   std::fill(gap_start_known_.begin(), gap_start_known_.end(), 0);
@@ -136,6 +141,7 @@ FillStats GapFiller::run(const FrameInput& in, const FrameOutput& out) {
   stats_ = FillStats{};
   if (static_cast<int>(in.labelled.size()) != n_ || static_cast<int>(out.positions.size()) != n_ ||
       static_cast<int>(out.status.size()) != n_ || (!out.fragments.empty() && static_cast<int>(out.fragments.size()) != n_) ||
+      (!out.revoked.empty() && static_cast<int>(out.revoked.size()) != n_) ||
       (!in.unlabelled_ids.empty() && in.unlabelled_ids.size() != in.unlabelled.size())) {
     stats_.ok = false;
     return stats_;
@@ -159,8 +165,13 @@ FillStats GapFiller::run(const FrameInput& in, const FrameOutput& out) {
   if (options_.check_labels && has_previous_) find_suspect_labels();
   estimate_rigid();
   if (!suspects_.empty()) judge_suspect_labels();
+  std::fill(revoked_.begin(), revoked_.end(), 0);
   for (int i = 0; i < n_; ++i)
-    if (observed_[i]) assigned_id_[i] = kNoFragment;  // the capture system has it again
+    if (observed_[i]) {  // the capture system has it again
+      assigned_id_[i] = kNoFragment;
+      probation_start_[i] = -1;
+      refused_id_[i] = kNoFragment;
+    }
 
   relabel();
   fill_missing();
@@ -170,6 +181,7 @@ FillStats GapFiller::run(const FrameInput& in, const FrameOutput& out) {
     out.positions[i] = current_[i];
     out.status[i] = status_[i];
     if (!out.fragments.empty()) out.fragments[i] = status_[i] == MarkerStatus::Relabelled ? assigned_id_[i] : kNoFragment;
+    if (!out.revoked.empty()) out.revoked[i] = revoked_[i];
     if (is_present(in.labelled[i]) && current_[i] != in.labelled[i]) ++stats_.changed_measured;
     previous_[i] = current_[i];
     previous_status_[i] = status_[i];
@@ -205,11 +217,14 @@ bool GapFiller::carried_position(int i, Vec3& out) const {
 // A correctly labelled point moves with its neighbours: within a frame its offset from them
 // changes by millimetres, while a swapped or mislabelled point is off by about the marker
 // spacing. A labelled point farther than eps2 from where its marker was carried is suspect, and
-// held back from the estimates until judged.
+// held back from the estimates until judged. With fewer than two ring members seen (where skin
+// touches skin, or a limb is hidden) it is compared with the marker's last position instead:
+// a label that jumps by more than eps2 in one frame is just as suspect.
 void GapFiller::find_suspect_labels() {
   for (int i = 0; i < n_; ++i) {
     Vec3 expected;
-    if (!observed_[i] || previous_status_[i] == MarkerStatus::Held || !carried_position(i, expected)) continue;
+    if (!observed_[i] || previous_status_[i] == MarkerStatus::Held) continue;
+    if (!carried_position(i, expected)) expected = previous_[i];
     if ((current_[i] - expected).norm() > eps2_[i]) suspects_.push_back(i);
   }
   for (int i : suspects_) observed_[i] = 0;
@@ -218,18 +233,21 @@ void GapFiller::find_suspect_labels() {
 // Being off is not proof: a fast limb at a low frame rate, or the end of a gap whose estimate
 // was poor, puts a true measurement beyond eps2 too, and so does a rejected point that another
 // marker took last frame and carried along. A suspect point is judged against estimates made
-// this frame from the other markers alone. It stands when its own estimate agrees (within
-// eps2); it is taken as unlabelled when another marker explains it clearly better (a swap), or
-// when it was tracked last frame and its own estimate disagrees as well (two independent
-// estimates, the motion of its ring and the shape of its neighbourhood, against it).
-// Otherwise the measurement stands.
+// this frame from the other markers alone. It stands when its own estimate agrees (within eps2
+// and within four of its calibrated standard deviations); it is taken as unlabelled when
+// another marker explains it clearly better (a swap), or when it was tracked last frame and its
+// own estimate disagrees by more than eps2 as well (two independent estimates, the motion of its
+// ring and the shape of its neighbourhood, against it). Otherwise the measurement stands.
 void GapFiller::judge_suspect_labels() {
   for (int i : suspects_) {
     Vec3 own;
-    const bool has_own = expected_position(i, own);
+    double own_variance = 0.0;
+    const bool has_own = expected_position(i, own, &own_variance);
     const double own_distance = has_own ? (current_[i] - own).norm() : std::numeric_limits<double>::infinity();
-    const bool reject = own_distance > eps2_[i] &&
-                        (explained_by_another(i, own_distance) || (has_own && is_observed(previous_status_[i])));
+    const bool own_confident = has_own && own_distance * own_distance > kConfidentMiss * own_variance;
+    const bool reject = (own_distance > eps2_[i] || own_confident) &&
+                        (explained_by_another(i, own_distance) ||
+                         (has_own && own_distance > eps2_[i] && is_observed(previous_status_[i])));
     if (reject) {
       add_free_point(current_[i], -(i + 1));
       ++stats_.rejected_labels;
@@ -241,20 +259,27 @@ void GapFiller::judge_suspect_labels() {
   refresh_estimates();
 }
 
-// Whether a missing (or suspect) marker near i is expected within eps1 of i's labelled point and
-// at most half as far from it as i's own estimate.
+// Whether another missing (or suspect) marker is expected within eps1 of i's labelled point and
+// at most half as far from it as i's own estimate: a swap, or a point where skin touches skin.
 bool GapFiller::explained_by_another(int i, double own_distance) {
-  auto explains = [&](int j) {
+  return nearest_other_expected(i, current_[i]) <= 0.5 * own_distance;
+}
+
+// The distance from point p to the nearest estimate of another missing marker that is within
+// eps1 of it (infinity: none). Any marker may be the other, not only i's neighbours: skin that
+// touches is rarely neighbouring on the marker surface.
+double GapFiller::nearest_other_expected(int i, const Vec3& p) {
+  double nearest = std::numeric_limits<double>::infinity();
+  for (int j : missing_) {
+    if (observed_[j] || j == i || !estimated_[j]) continue;
+    const double reach = kPrefilterReach * eps1_[j];
+    if ((p - estimate_[j]).squaredNorm() > reach * reach) continue;
     Vec3 expected;
-    if (observed_[j] || j == i || !expected_position(j, expected)) return false;
-    const double d = (current_[i] - expected).norm();
-    return d <= eps1_[j] && d <= 0.5 * own_distance;
-  };
-  for (int k = model_.ring_offsets[i]; k < model_.ring_offsets[i + 1]; ++k)
-    if (explains(model_.ring[k])) return true;
-  for (int p = predictor_offsets_[i]; p < predictor_offsets_[i + 1]; ++p)
-    if (explains(predictor_marker_[p])) return true;
-  return false;
+    if (!expected_position(j, expected)) continue;
+    const double d = (p - expected).norm();
+    if (d <= eps1_[j]) nearest = std::min(nearest, d);
+  }
+  return nearest;
 }
 
 // Eq. 2, greedy: repeatedly estimate the missing marker with the most available neighbours
@@ -271,17 +296,27 @@ void GapFiller::estimate_rigid() {
     for (int k = model_.ring_offsets[i]; k < model_.ring_offsets[i + 1]; ++k) count += estimated_[model_.ring[k]];
     available_neighbours_[i] = count;
   }
-  for (;;) {
-    int best = -1, best_count = 2;
-    for (int i : missing_)
-      if (!estimated_[i] && available_neighbours_[i] > best_count) {
-        best = i;
-        best_count = available_neighbours_[i];
-      }
-    if (best < 0) break;
-    fit_rigid_estimate(best);
-    for (int p = predictor_offsets_[best]; p < predictor_offsets_[best + 1]; ++p)
-      ++available_neighbours_[predictor_marker_[p]];
+  // The marker with the most available neighbours first, the lowest index among equals: a heap
+  // of (count, marker) entries, a stale one (its marker since estimated, or counted higher) skipped.
+  auto before = [](const RigidQueueEntry& a, const RigidQueueEntry& b) {
+    return a.count != b.count ? a.count < b.count : a.marker > b.marker;
+  };
+  rigid_queue_.clear();
+  for (int i : missing_)
+    if (available_neighbours_[i] >= kRigidSupport) rigid_queue_.push_back({available_neighbours_[i], i});
+  std::make_heap(rigid_queue_.begin(), rigid_queue_.end(), before);
+  while (!rigid_queue_.empty()) {
+    std::pop_heap(rigid_queue_.begin(), rigid_queue_.end(), before);
+    const RigidQueueEntry next = rigid_queue_.back();
+    rigid_queue_.pop_back();
+    if (estimated_[next.marker] || available_neighbours_[next.marker] != next.count) continue;
+    fit_rigid_estimate(next.marker);
+    for (int p = predictor_offsets_[next.marker]; p < predictor_offsets_[next.marker + 1]; ++p) {
+      const int j = predictor_marker_[p];
+      if (estimated_[j] || ++available_neighbours_[j] < kRigidSupport) continue;
+      rigid_queue_.push_back({available_neighbours_[j], j});
+      std::push_heap(rigid_queue_.begin(), rigid_queue_.end(), before);
+    }
   }
 }
 
@@ -307,23 +342,32 @@ void GapFiller::fit_rigid_estimate(int i) {
 }
 
 void GapFiller::relabel() {
-  // Fragments already standing for a marker stay while within eps2 of where it is expected.
+  // Fragments already standing for a marker stay while within eps2 of where it is expected; one
+  // still on probation (taken less than confirm_frames ago) only while it passes the taking test.
   for (int i : missing_) {
     const int id = assigned_id_[i];
+    if (refused_id_[i] != kNoFragment && find_free_point(refused_id_[i]) < 0) refused_id_[i] = kNoFragment;
     if (id == kNoFragment) continue;
-    int found = -1;
-    for (int p = 0; p < free_count_; ++p)
-      if (!free_used_[p] && free_ids_[p] == id) {
-        found = p;
-        break;
-      }
+    const int found = find_free_point(id);
     Vec3 expected;
     if (found >= 0 && !expected_position(i, expected)) expected = previous_[i];  // no estimate: continuity
-    if (found >= 0 && (free_points_[found] - expected).norm() <= eps2_[i]) {
+    const double distance = found >= 0 ? (free_points_[found] - expected).norm() : 0.0;
+    const bool on_probation = probation_start_[i] >= 0;
+    const bool keep = found >= 0 && (on_probation ? ambiguity_free_match(i, found, distance) : distance <= eps2_[i]);
+    if (keep) {
       take_free_point(i, found);
-    } else {
-      assigned_id_[i] = kNoFragment;
+      if (on_probation && frame_ - probation_start_[i] >= options_.confirm_frames) probation_start_[i] = -1;
+      continue;
     }
+    // Not confirmed (a fragment that merely ends says nothing against it): the frames since it
+    // was taken are given back as estimates, and the fragment is not taken for this marker again.
+    if (on_probation && found >= 0) {
+      revoked_[i] = static_cast<int>(frame_ - probation_start_[i]);
+      refused_id_[i] = id;
+      probation_start_[i] = -1;
+      previous_status_[i] = MarkerStatus::FilledRigid;  // still in its gap: no continuity from the fragment
+    }
+    assigned_id_[i] = kNoFragment;
   }
   refresh_estimates();
   // New matches: each still-missing marker's nearest free point within eps1 of where it is
@@ -341,14 +385,14 @@ void GapFiller::relabel() {
       int best = -1;
       double best_distance = eps1_[i];
       for (int p = 0; p < free_count_; ++p) {
-        if (free_used_[p]) continue;
+        if (free_used_[p] || free_ids_[p] == refused_id_[i]) continue;
         const double d = (free_points_[p] - expected).norm();
         if (d <= best_distance) {
           best = p;
           best_distance = d;
         }
       }
-      if (best >= 0) candidates_.push_back({best_distance, i, best});
+      if (best >= 0 && ambiguity_free_match(i, best, best_distance)) candidates_.push_back({best_distance, i, best});
     }
     if (candidates_.empty()) break;
     std::sort(candidates_.begin(), candidates_.end(),
@@ -357,9 +401,26 @@ void GapFiller::relabel() {
       if (free_used_[c.point] || observed_[c.marker]) continue;
       take_free_point(c.marker, c.point);
       assigned_id_[c.marker] = free_ids_[c.point];
+      if (options_.confirm_frames > 0) probation_start_[c.marker] = frame_;
     }
     refresh_estimates();
   }
+}
+
+// Eq. 3's test for free point p at `distance` from where marker i is expected: within eps1, and
+// no other missing marker expected nearly as close (within twice the distance). Where two
+// estimates both reach a point (skin touching skin, neighbours close together) it is taken for
+// neither until the motion tells them apart.
+bool GapFiller::ambiguity_free_match(int i, int p, double distance) {
+  if (distance > eps1_[i]) return false;
+  if (free_ids_[p] == -(i + 1)) return true;  // its own labelled point, held back by the label check
+  return nearest_other_expected(i, free_points_[p]) >= 2.0 * distance;
+}
+
+int GapFiller::find_free_point(int id) const {
+  for (int p = 0; p < free_count_; ++p)
+    if (!free_used_[p] && free_ids_[p] == id) return p;
+  return -1;
 }
 
 bool GapFiller::free_point_near(const Vec3& p, double reach) const {
@@ -510,11 +571,16 @@ int GapFiller::pca_estimate(int i, Vec3& out, double* out_variance) {
 // Where the relabeller expects a missing marker: its best estimate from the neighbours alone.
 // Not the continuity offset: that comes from the marker's own past, and a fragment drifting
 // away would drag it along and be taken back. False when there is no estimate.
-bool GapFiller::expected_position(int i, Vec3& out) {
-  if (options_.use_pca && pca_estimate(i, out) > 0) return true;
+bool GapFiller::expected_position(int i, Vec3& out, double* out_variance) {
+  if (options_.use_pca && pca_estimate(i, out, out_variance) > 0) return true;
   if (!estimated_[i]) return false;
   out = estimate_[i];
+  if (out_variance) *out_variance = rigid_estimate_variance(i);
   return true;
+}
+
+double GapFiller::rigid_estimate_variance(int i) const {
+  return model_.pca[i].rigid_variance * model_.ring_size(i) / std::max(1, rigid_support_[i]);
 }
 
 // At the first frame of a gap: where the marker and its anchors were last frame.
@@ -637,7 +703,7 @@ void GapFiller::fill_missing() {
     const bool pca = options_.use_pca && pca_estimate(i, fused, &variance) > 0;
     if (!pca && estimated_[i]) {
       fused = estimate_[i];
-      variance = model_.pca[i].rigid_variance * model_.ring_size(i) / std::max(1, rigid_support_[i]);
+      variance = rigid_estimate_variance(i);
     }
     const bool near = pca || estimated_[i];
     if (near && carry) {

@@ -4,16 +4,21 @@
 //
 //   1. Label check: a labelled point that did not move with its one-ring since the last frame
 //      (off by more than eps2) is suspect: that is how swapped and mislabelled fragments look,
-//      but also a true measurement after a gap whose estimate was poor. It is treated as
-//      unlabelled only on strong evidence, judged against this frame's estimates from the other
-//      markers: another missing marker explains it clearly better (a swap), or it was tracked
-//      and its neighbourhood's estimate disagrees too. Otherwise the measurement stands.
+//      but also a true measurement after a gap whose estimate was poor (with its ring unseen,
+//      against its last position). It is treated as unlabelled only on strong evidence, judged
+//      against this frame's estimates from the other markers: any missing marker explains it
+//      clearly better while its own confident estimate disagrees (a swap, or skin touching
+//      skin), or it was tracked and its neighbourhood's estimate disagrees too. Otherwise the
+//      measurement stands.
 //   2. Rigid estimates (eq. 2, Horn), greedy: the missing marker with the most available
 //      neighbours first, reusing earlier estimates.
 //   3. Relabelling: a tracked fragment stays with its marker while within eps2 (alpha2) of
 //      where the marker is expected (its best estimate from the neighbours, step 4's fusion);
-//      a new one is taken when within eps1 (alpha1) of it (eq. 3), closest pairs first, in up
-//      to three rounds, estimates redone after each with the points taken.
+//      a new one is taken when within eps1 (alpha1) of it (eq. 3) and no other missing marker is
+//      expected within twice that distance of it (ambiguous points wait), closest pairs first,
+//      in up to three rounds, estimates redone after each with the points taken. With
+//      `confirm_frames` a new relabel must pass that test again each frame of its probation,
+//      else it is revoked (FrameOutput::revoked).
 //   4. PCA fill: every observed neighbour's PCA model reconstructs the missing marker from that
 //      neighbour's observed one-ring (regularised least squares on the coefficients); the
 //      estimates are averaged, each weighted by the inverse of its predictive variance
@@ -57,6 +62,11 @@ struct GapFillerOptions {
   // With weighting: each missing marker's regional PCA (region_pca_fit.h, when the subject has
   // regions) is one more weighed opinion, and the estimate when nothing nearer is known.
   bool use_regions = true;
+  // A new relabel stays on probation for this many frames: while it is, the fragment must pass
+  // the taking test (eq. 3, unambiguous) every frame, else the relabel is revoked for all the
+  // frames since it was taken (FrameOutput::revoked; GapEndBlender, holding those frames, gives
+  // them back as estimates). The lookahead (CaptureFillOptions::lookahead) sets it; 0: none.
+  int confirm_frames = 0;
 };
 
 struct FrameInput {
@@ -75,6 +85,9 @@ struct FrameOutput {
   // for it (a source trajectory id, or -(j + 1) for the point labelled j that was rejected);
   // kNoFragment otherwise. What merging trajectories statistics are made of.
   std::span<int> fragments = {};
+  // Optional (empty = not wanted): per marker, in how many frames before this one its relabel was
+  // revoked (0: none). Only with GapFillerOptions::confirm_frames.
+  std::span<int> revoked = {};
 };
 
 struct FillStats {
@@ -103,6 +116,7 @@ class GapFiller {
   void find_suspect_labels();
   void judge_suspect_labels();
   bool explained_by_another(int i, double own_distance);
+  double nearest_other_expected(int i, const Vec3& p);
   bool carried_position(int i, Vec3& out) const;
   void estimate_rigid();
   void fit_rigid_estimate(int i);
@@ -115,8 +129,11 @@ class GapFiller {
   bool carry_rigidly(int i, const Vec3& from_position, std::span<const Vec3> from_anchors,
                      std::span<const char> from_seen, Vec3& out, double& out_residual);
   void check_carries();
-  bool expected_position(int i, Vec3& out);
+  bool expected_position(int i, Vec3& out, double* out_variance = nullptr);
+  double rigid_estimate_variance(int i) const;
   void take_free_point(int marker, int point);
+  bool ambiguity_free_match(int i, int p, double distance);
+  int find_free_point(int id) const;
   bool free_point_near(const Vec3& p, double reach) const;
   void refresh_estimates();
   void fill_missing();
@@ -136,12 +153,18 @@ class GapFiller {
   // Carried from frame to frame.
   static constexpr int kRelabelRounds = 3;
   static constexpr double kPrefilterReach = 3.0;  // in eps1, around the rigid estimate
+  // A labelled point this many variances (squared distance over the calibrated predictive
+  // variance) from its own estimate is confidently not where the marker is expected.
+  static constexpr double kConfidentMiss = 16.0;
   bool has_previous_ = false;
   long frame_ = 0;
   long solve_stamp_ = 0;  // this frame's: a PCA solve made in it stands until its ring changes (refresh_estimates)
   std::vector<Vec3> previous_;
   std::vector<MarkerStatus> previous_status_;
   std::vector<int> assigned_id_;      // free-point trajectory currently standing for marker i
+  std::vector<long> probation_start_;  // frame its relabel was taken while still on probation, else -1
+  std::vector<int> refused_id_;        // a fragment whose relabel was revoked, not taken again while it lasts
+  std::vector<int> revoked_;           // this frame's FrameOutput::revoked
   std::vector<Vec3> gap_offset_;      // continuity offset in the local frame
   std::vector<int> gap_age_;
   // At the start of each marker's gap: its last position and its anchors' (parallel to
@@ -172,6 +195,12 @@ class GapFiller {
   std::vector<Vec3> estimate_;
   std::vector<Eigen::Matrix3d> rotation_;
   std::vector<int> available_neighbours_, missing_;
+  static constexpr int kRigidSupport = 3;  // known ring members eq. 2 needs
+  struct RigidQueueEntry {
+    int count;
+    int marker;
+  };
+  std::vector<RigidQueueEntry> rigid_queue_;
   std::vector<Vec3> free_points_;
   std::vector<int> free_ids_;
   std::vector<char> free_used_;

@@ -305,7 +305,7 @@ std::optional<CommandLine> parse_command_line(int argc, const char* const* argv,
   auto* http_port = app.add_option("--http-port", flags.http_port, "HTTP/WebSocket port (0 = ephemeral)");
   auto* sub_port = app.add_option("--sub-port", flags.sub_port, "TCP subscriber port (0 = ephemeral)");
   auto* web_root = app.add_option("--web-root", flags.web_root, "folder of static files served at /");
-  auto* lookahead = app.add_option("--lookahead", flags.lookahead, "gap-end blend lookahead in frames (adds latency)");
+  auto* lookahead = app.add_option("--lookahead", flags.lookahead, "lookahead in frames: the gap-end blend and the confirmation of new relabels (adds latency)");
   auto* max_wait = app.add_option("--max-frame-wait-ms", flags.max_frame_wait_ms,
                                   "a frame that waited this long for the pipeline or a subscriber gives way to a newer one "
                                   "(0 = newest frame wins)");

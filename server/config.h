@@ -42,7 +42,7 @@ struct DaemonConfig {
   int http_port = 8480;           // 0 = ephemeral
   int sub_port = 8481;            // 0 = ephemeral
   std::string web_root;           // static files served at /; empty = none
-  int lookahead = 0;              // gap-end blend lookahead, frames
+  int lookahead = 0;              // frames: gap-end blend and confirmation of new relabels
   int max_frame_wait_ms = 25;     // a frame that waited this long (for the pipeline, for a subscriber) gives way to a newer one
   int deform_threads = 2;         // the pipeline thread plus deform_threads - 1 workers
   std::string deform_cpus = "auto";  // "auto", "off" or "2,3": server/pipeline/deform_cpus.h

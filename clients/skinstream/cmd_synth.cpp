@@ -49,7 +49,7 @@ int run_synth(const SynthOptions& o, std::FILE* out) {
     synth::SynthOptions rom = take;
     rom.motion = "rom";
     rom.seconds = o.train_seconds;
-    j["skinstream"] = evaluate_on_synthetic(result, synth::generate(body, rom));
+    j["skinstream"] = evaluate_on_synthetic(result, synth::generate(body, rom), o.lookahead);
     std::fprintf(out, "%s\n", j.dump(2).c_str());
     return 0;
   }

@@ -4,6 +4,7 @@
 //
 //   skinstream synth --motion rom --seconds 20 --seed 7 --markers 350 --out take.c3d
 //                    --truth take_truth.c3d [--mesh-out-every 10 meshes/] [--subdivided] [--stats]
+//                    [--lookahead L]
 //
 // The body is read from --body DIR, else default_body_dir() (default_paths.h). Meshes are binary
 // PLY, DIR/mesh_<frame>.ply (frame index from 0, millimetres, Z up, the same vertex order every
@@ -24,6 +25,7 @@ struct SynthOptions {
   std::string body_dir;  // the MakeHuman files; empty: default_body_dir()
   bool stats = false;    // the counts as JSON, and skinstream's relabelling and filling judged
   double train_seconds = 20.0;  // with stats: the range-of-motion training take
+  int lookahead = 0;            // with stats: frames of lookahead for the fill
 };
 
 // Writes the captures (and meshes) and prints what was written, or the statistics as JSON, to

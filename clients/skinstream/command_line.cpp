@@ -69,7 +69,7 @@ void add_fill(CLI::App& app, FillOptions& o) {
   cmd->add_option("--subject", o.subject_path, "subject file from build-subject")->required();
   cmd->add_option("IN", o.in_path, "capture with gaps")->required();
   cmd->add_option("--out", o.out_path, "filled capture to write")->required();
-  cmd->add_option("--lookahead", o.fill.lookahead, "frames of lookahead for the gap-end blend (0 = causal)")
+  cmd->add_option("--lookahead", o.fill.lookahead, "frames of lookahead: the gap-end blend, and new relabels confirmed over them (0 = causal)")
       ->check(CLI::Range(0, 240))->capture_default_str();
   cmd->add_option_function<std::string>(
          "--smooth",
@@ -155,6 +155,9 @@ void add_synth(CLI::App& app, SynthOptions& o) {
                 "(subject trained on a range-of-motion take of the same seed)");
   cmd->add_option("--train-seconds", o.train_seconds, "with --stats: length of the range-of-motion training take")
       ->check(CLI::Range(1.0, 600.0))
+      ->capture_default_str();
+  cmd->add_option("--lookahead", o.lookahead, "with --stats: frames of lookahead for the fill (new relabels confirmed over them)")
+      ->check(CLI::Range(0, 240))
       ->capture_default_str();
 }
 

@@ -21,7 +21,7 @@ std::string synthetic_region(const std::string& name) {
 
 }  // namespace
 
-nlohmann::ordered_json evaluate_on_synthetic(const synth::SynthCapture& take, const synth::SynthCapture& training) {
+nlohmann::ordered_json evaluate_on_synthetic(const synth::SynthCapture& take, const synth::SynthCapture& training, int lookahead) {
   const auto start = std::chrono::steady_clock::now();
   SubjectBuildReport build;
   const SubjectModel model = build_subject(training.truth, SubjectBuildOptions{}, nullptr, &build);
@@ -31,7 +31,9 @@ nlohmann::ordered_json evaluate_on_synthetic(const synth::SynthCapture& take, co
   std::vector<int> fragments;
   CaptureFillReport report;
   const auto fill_start = std::chrono::steady_clock::now();
-  const Capture filled = fill_capture(model, take.capture, CaptureFillOptions{}, &status, &report, &fragments);
+  CaptureFillOptions fill_options;
+  fill_options.lookahead = lookahead;
+  const Capture filled = fill_capture(model, take.capture, fill_options, &status, &report, &fragments);
   const double fill_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - fill_start).count();
   const MergeStats merge = merge_stats(take.capture, take.source, map_channels_to_markers(model, take.capture), status, fragments);
 
@@ -85,6 +87,7 @@ nlohmann::ordered_json evaluate_on_synthetic(const synth::SynthCapture& take, co
                    {"mean_ring_size", build.mean_ring_size},
                    {"mean_pca_components", build.mean_pca_components},
                    {"seconds", build_seconds}};
+  j["lookahead_frames"] = lookahead;
   j["trajectories_before_merging"] = merge.fragments;
   j["trajectories_after_merging"] = merge.trajectories_after;
   j["after_per_marker"] = static_cast<double>(merge.trajectories_after) / n;

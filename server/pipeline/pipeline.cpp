@@ -70,13 +70,13 @@ Pipeline::Pipeline(const SubjectModel& model, const DeformationModel* deformatio
   filled_.resize(n);
   released_positions_.resize(n);
   filled_status_.resize(n);
+  filled_revoked_.resize(n);
   released_status_.resize(n);
   held_.resize(static_cast<size_t>(options.lookahead) + 1);
   marker_floats_.resize(3 * static_cast<size_t>(n));
   marker_status_bytes_.resize(n);
-  GapFillerOptions filler_options = options.filler;
-  filler_rate_hz_ = filler_options.rate_hz = options.default_rate_hz;
-  filler_.emplace(model_, filler_options);
+  filler_rate_hz_ = options.default_rate_hz;
+  filler_.emplace(model_, filler_options(filler_rate_hz_));
   if (deformation) {
     deformer_ = std::make_unique<MeshDeformer>(*deformation, model);
     positions_.resize(3 * static_cast<size_t>(deformer_->vertex_count()));
@@ -96,6 +96,14 @@ Pipeline::Pipeline(const SubjectModel& model, const DeformationModel* deformatio
 }
 
 Pipeline::~Pipeline() { stop(); }
+
+// As core/capture_filler.cpp runs it: new relabels confirmed within the lookahead.
+GapFillerOptions Pipeline::filler_options(double rate_hz) const {
+  GapFillerOptions o = options_.filler;
+  o.rate_hz = rate_hz;
+  o.confirm_frames = options_.lookahead;
+  return o;
+}
 
 void Pipeline::start() {
   if (running_.exchange(true)) return;
@@ -139,9 +147,8 @@ void Pipeline::process(const MarkerFrame& frame, uint64_t generation) {
   }
   if (frame.source_rate_hz > 0 && std::abs(frame.source_rate_hz - filler_rate_hz_) > 1e-6) {
     // Rare (the rate becomes known): rebuilding allocates, which is fine here.
-    GapFillerOptions filler_options = options_.filler;
-    filler_rate_hz_ = filler_options.rate_hz = frame.source_rate_hz;
-    filler_.emplace(model_, filler_options);
+    filler_rate_hz_ = frame.source_rate_hz;
+    filler_.emplace(model_, filler_options(filler_rate_hz_));
     blender_.reset();
     spdlog::info("pipeline: source rate {} Hz", frame.source_rate_hz);
   }
@@ -152,7 +159,7 @@ void Pipeline::process(const MarkerFrame& frame, uint64_t generation) {
   const size_t free_count = static_cast<size_t>(std::clamp(frame.unlabelled_count, 0, MarkerFrame::kMaxUnlabelled));
   const FrameInput input{frame.labelled, std::span(frame.unlabelled).first(free_count),
                          std::span(frame.unlabelled_ids).first(free_count)};
-  const FillStats stats = filler_->run(input, {filled_, filled_status_});
+  const FillStats stats = filler_->run(input, {filled_, filled_status_, {}, filled_revoked_});
   metrics_.fill.observe_ns(since_ns(fill_start));
   if (!stats.ok) {
     metrics_.count_bad_input("wrong_marker_count");
@@ -168,7 +175,7 @@ void Pipeline::process(const MarkerFrame& frame, uint64_t generation) {
                                                         clamp16(stats.filled + stats.held), clamp16(stats.relabelled),
                                                         frame_timecode(frame.timecode), frame.timecode.valid};
   long released = 0;
-  if (blender_.push(filled_, filled_status_, sequence, {released_positions_, released_status_}, released))
+  if (blender_.push(filled_, filled_status_, sequence, {released_positions_, released_status_}, released, filled_revoked_))
     publish(held_[static_cast<size_t>(released) % held_.size()], released_positions_, released_status_);
 }
 

@@ -96,6 +96,7 @@ class Pipeline {
     bool has_timecode = false;
   };
   void run();
+  GapFillerOptions filler_options(double rate_hz) const;
   void process(const MarkerFrame& frame, uint64_t generation);
   void publish(const Released& meta, std::span<const Vec3> positions, std::span<const MarkerStatus> status);
   FrameRef encode(const StreamKeySet& keys, subscriber::FrameInfo info, bool has_timecode, const subscriber::CompressedBlocks& compressed);
@@ -121,6 +122,7 @@ class Pipeline {
 
   std::vector<Vec3> filled_, released_positions_;
   std::vector<MarkerStatus> filled_status_, released_status_;
+  std::vector<int> filled_revoked_;  // FrameOutput::revoked, for the blender
   std::vector<Released> held_;  // lookahead + 1 frames of metadata, by sequence number
   long sequence_ = 0;
   uint64_t generation_ = 0;

@@ -201,6 +201,25 @@ TEST(SkinstreamCli, SynthStatsOnAShortFlexTakeMeetTheRelabelAndFillTargets) {
   EXPECT_LE(s["deleted_then_filled_error"]["normalised"]["mean"].get<double>(), 0.015);
 }
 
+// The relabel target of the accuracy issue (wrongly labelled fragments at most 0.3%) on the
+// measured configuration (`synth --motion M --seed 1 --stats`: 5 s takes, subject trained on the
+// 20 s range of motion), causal (lookahead 0), per motion it asserts. Before the relabel changes
+// of this test's commit: punch 0.83%, golf 1.11%; when written: punch 0.28%, golf 0.29%. The
+// range of motion (1.17%) does not meet it yet and is not asserted.
+TEST(SkinstreamCli, SynthStatsRelabelAtMostThreePerMilleOnFastMotions) {
+  for (const std::string motion : {"punch", "golf"}) {
+    SCOPED_TRACE(motion);
+    const ProgramRun r = run("synth --motion " + motion + " --seed 1 --stats --out " + test::scratch_path(motion + ".c3d") +
+                             " --body " + std::string(SKINSTREAM_SHARED_DIR) + "/data/meshes/makehuman");
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    const auto s = nlohmann::json::parse(r.output)["skinstream"];
+    EXPECT_EQ(s["lookahead_frames"], 0);
+    EXPECT_GT(s["trajectories_before_merging"].get<int>(), 1000);
+    EXPECT_LE(s["wrongly_labelled_rate"].get<double>(), 0.003) << s["wrongly_labelled_by"];
+    EXPECT_LE(s["after_per_marker"].get<double>(), 1.2);
+  }
+}
+
 // eval-deform names where each method's maximum comes from: its worst covered vertices, the
 // first of which carries the row's maximum, with the frame, the distance to the nearest marker
 // and (part-based methods only) the vertex's part weights.

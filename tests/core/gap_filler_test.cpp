@@ -269,10 +269,15 @@ TEST(GapFiller, NeverOutputsNaN) {
   }
 }
 
+// Also with new relabels on probation (confirm_frames 6) and the fragments and revocations asked for.
 TEST(GapFiller, AllocatesNothingPerFrame) {
   Fixture fx;
-  GapFiller filler(fx.model);
+  GapFillerOptions options;
+  options.confirm_frames = 6;
+  GapFiller filler(fx.model, options);
   Frame frame(fx.model.marker_count());
+  std::vector<int> fragments(fx.model.marker_count()), revoked(fx.model.marker_count());
+  auto run = [&] { filler.run({frame.labelled, frame.unlabelled, frame.ids}, {frame.positions, frame.status, fragments, revoked}); };
   frame.unlabelled.reserve(8);
   frame.ids.reserve(8);
   const int b = fx.model.ring[fx.model.ring_offsets[kOther]];
@@ -290,12 +295,12 @@ TEST(GapFiller, AllocatesNothingPerFrame) {
   };
   for (int f = 0; f < 10; ++f) {
     make(f);
-    frame.run(filler);
+    run();
   }
   test::CountAllocations counter;
   for (int f = 10; f < 200; ++f) {
     make(f);
-    frame.run(filler);
+    run();
   }
   EXPECT_EQ(counter.count(), 0u);
 }
