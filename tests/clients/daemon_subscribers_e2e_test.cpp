@@ -55,6 +55,18 @@ class RawSubscriber {
     if (!read_exactly(message.payload.data(), message.payload.size(), limit)) return std::nullopt;
     return message;
   }
+  // Reads whole messages until a Frame begins, then only that Frame's header, and stops there: the
+  // daemon's write of that frame stays under way (true), holding its pooled frame.
+  bool read_into_a_frame() {
+    for (;;) {
+      unsigned char header[subscriber::kHeaderBytes];
+      if (!read_exactly(header, sizeof header, std::chrono::seconds(20))) return false;
+      const subscriber::MessageHeader decoded = subscriber::decode_header(header);
+      if (decoded.type == subscriber::MessageType::Frame) return true;
+      std::vector<unsigned char> skipped(decoded.payload_bytes);
+      if (!read_exactly(skipped.data(), skipped.size(), std::chrono::seconds(20))) return false;
+    }
+  }
   // Reads until the daemon closes the connection (true) or `limit` passes (false).
   bool closed_by_daemon(std::chrono::seconds limit = std::chrono::seconds(20)) {
     unsigned char sink[65536];
@@ -270,11 +282,12 @@ TEST(DaemonDemoSubscribers, ASubscriberWhoseWriteStallsIsDropped) {
   EXPECT_EQ(daemon.stop(), 0) << daemon.log();
 }
 
-// 60 subscribers from 8 hosts that stop reading hold frames of the pool (the daemon grows it
-// for them off the pipeline thread: /health's promise of 0 frame buffers made there holds);
-// once they leave, the pool is back to what the one good subscriber needs, and RSS comes down
-// within a generous bound.
-TEST(DaemonDemoSubscribers, ThePoolComesBackAfterStalledSubscribersLeave) {
+// 60 subscribers from 8 hosts that stop reading in the middle of a frame each hold that frame
+// (the daemon grows the pool for them off the pipeline thread: /health's promise of 0 frame
+// buffers made there holds); once they leave, the pool shrinks back to its high water mark (the
+// most frames in use at once since the last Status tick) plus the frames it keeps free, and RSS
+// comes down within a generous bound.
+TEST(DaemonDemoSubscribers, ThePoolShrinksBackToItsHighWaterMarkAfterStalledSubscribersLeave) {
   const auto started = start_demo_daemon();
   test::DaemonProcess& daemon = *started;
   ASSERT_GT(daemon.sub_port, 0);
@@ -284,31 +297,37 @@ TEST(DaemonDemoSubscribers, ThePoolComesBackAfterStalledSubscribersLeave) {
   const nlohmann::json before = health_of(daemon.http_port)["frame_pool"];
   ASSERT_TRUE(before.is_object()) << health_of(daemon.http_port).dump();
   const long rss_before = resident_kb(daemon.pid());
+  nlohmann::json during;
   {
     std::vector<std::unique_ptr<RawSubscriber>> stalled;
     for (int i = 0; i < 60; ++i) {
       stalled.push_back(std::make_unique<RawSubscriber>(daemon.sub_port, "127.0.0." + std::to_string(2 + i % 8), 4096));
       ASSERT_TRUE(stalled.back()->say(subscriber::Hello{0}));
+      ASSERT_TRUE(stalled.back()->read_into_a_frame());
+      for (int frames = 0; frames < 2; ++frames) ASSERT_TRUE(good.next());  // the next one stalls in a later frame
     }
-    // They stall within a frame or two; the good one reads on meanwhile.
-    const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(3);
+    const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(2);
     while (std::chrono::steady_clock::now() < until) ASSERT_TRUE(good.next());
-    const nlohmann::json during = health_of(daemon.http_port);
+    during = health_of(daemon.http_port);
     std::printf("pool before %s, with 60 stalled %s; RSS %ld kB before, %ld kB with them\n", before.dump().c_str(),
                 during["frame_pool"].dump().c_str(), rss_before, resident_kb(daemon.pid()));
+    EXPECT_GE(during["frame_pool"]["in_use"].get<int>(), 30) << "the stalled subscribers hold their frames";
     EXPECT_GT(during["frame_pool"]["frames"].get<int>(), before["frames"].get<int>());
   }
-  // Gone: within a few seconds the pool is as before (the good subscriber's share and the
-  // pipeline's own frames), its frames freed.
+  // Gone: within a few Status ticks the pool is its high water mark (the good subscriber's
+  // frames and those queued for it) plus the frames kept free.
+  nlohmann::json after;
   auto pool_back = [&] {
     for (int i = 0; i < 10; ++i) good.next(std::chrono::seconds(1));  // keep reading
-    return health_of(daemon.http_port)["frame_pool"]["frames"] == before["frames"];
+    after = health_of(daemon.http_port);
+    const nlohmann::json& pool = after["frame_pool"];
+    return pool["frames"].get<int>() == pool["in_use_high_water"].get<int>() + pool["kept_free"].get<int>() &&
+           pool["in_use_high_water"].get<int>() < 30;
   };
-  EXPECT_TRUE(eventually(pool_back)) << health_of(daemon.http_port)["frame_pool"].dump();
-  const nlohmann::json after = health_of(daemon.http_port);
+  EXPECT_TRUE(eventually(pool_back)) << after["frame_pool"].dump();
   EXPECT_EQ(after["frame_buffers_allocated_by_pipeline"], 0) << after.dump();
   const long rss_after = resident_kb(daemon.pid());
-  std::printf("RSS %ld kB after they left\n", rss_after);
+  std::printf("pool after they left %s; RSS %ld kB\n", after["frame_pool"].dump().c_str(), rss_after);
   EXPECT_LT(rss_after, rss_before + 64 * 1024) << "the stalled subscribers' memory did not come back";
   EXPECT_EQ(daemon.stop(), 0) << daemon.log();
 }
