@@ -186,6 +186,13 @@ nlohmann::json to_json(const DaemonConfig& c) {
           {"subscriber_token", c.subscriber_token}};
 }
 
+nlohmann::json printable(const DaemonConfig& c) {
+  nlohmann::json json = to_json(c);
+  if (!c.subscriber_token.empty())
+    json["subscriber_token"] = "(set, " + std::to_string(c.subscriber_token.size()) + " bytes, not shown)";
+  return json;
+}
+
 void validate(const DaemonConfig& c) {
   auto fail = [](const std::string& what) { throw ConfigError("configuration: " + what); };
   if (!c.replay.empty() + !c.vicon.empty() + !c.vicon_multicast.empty() + !c.qtm.empty() + !c.natnet.empty() > 1)

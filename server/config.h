@@ -85,6 +85,9 @@ class ConfigError : public std::runtime_error {
 void apply_json(const nlohmann::json& json, DaemonConfig& config, const std::string& origin);
 DaemonConfig load_config_file(const std::string& path);  // throws ConfigError
 nlohmann::json to_json(const DaemonConfig& config);
+// to_json with the subscriber token left out (whether one is set, and its length, shown): what
+// --print-config prints, so the token does not reach a terminal, a log or a ticket.
+nlohmann::json printable(const DaemonConfig& config);
 // Range and consistency checks; throws ConfigError.
 void validate(const DaemonConfig& config);
 

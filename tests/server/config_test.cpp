@@ -197,6 +197,18 @@ TEST(Config, SubscriberAdmissionComesFromTheFileAndBadNetworksAreNamed) {
   }
 }
 
+// --print-config shows that a token is set, never the token.
+TEST(Config, ThePrintedConfigurationHidesTheToken) {
+  const std::string path = write_file("token.json", R"({"subscriber_token": "stage-secret-42"})");
+  const auto parsed = parse({"--config", path, "--print-config"});
+  ASSERT_TRUE(parsed);
+  const std::string printed = printable(parsed->config).dump(2);
+  EXPECT_EQ(printed.find("stage-secret-42"), std::string::npos) << printed;
+  EXPECT_EQ(printable(parsed->config)["subscriber_token"], "(set, 15 bytes, not shown)");
+  EXPECT_EQ(printable(parsed->config)["max_subscribers"], 256) << "the rest as it is";
+  EXPECT_EQ(printable(DaemonConfig{})["subscriber_token"], "") << "none set: nothing to hide";
+}
+
 TEST(Config, OutOfRangeValuesAndConflictsAreErrors) {
   EXPECT_NE(error_of([] { parse({"--deform-threads", "0"}); }).find("deform_threads"), std::string::npos);
   EXPECT_NE(error_of([] { parse({"--deform-cpus", "1;2"}); }).find("deform_cpus must be"), std::string::npos);
