@@ -72,6 +72,8 @@ struct DaemonConfig {
   int subscriber_write_stall_ms = 10000;  // a write without progress this long closes the subscriber; 0 = never
   std::vector<std::string> allow_subscribers;  // CIDR networks subscribers may connect from; empty = any
   std::string subscriber_token;           // asked of every subscriber (Hello version 2, ?token=); empty = none
+  // Bytes a subscriber's socket may hold not yet sent (TCP_NOTSENT_LOWAT); 0 = the system's (no limit).
+  int subscriber_unsent_kb = 128;
 };
 
 // Thrown for a bad config file, a bad key or value, or conflicting flags: one line, says which.
