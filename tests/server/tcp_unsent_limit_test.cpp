@@ -2,15 +2,13 @@
 // socket takes about the limit, not the megabytes of its send buffer.
 #include "server/tcp_unsent_limit.h"
 
-#include <arpa/inet.h>
-#include <fcntl.h>
 #include <gtest/gtest.h>
-#include <netinet/in.h>
 #include <sys/socket.h>
-#include <unistd.h>
 
 #include <cerrno>
 #include <vector>
+
+#include "server/asio.h"
 
 namespace skinstream::server {
 namespace {
@@ -18,27 +16,17 @@ namespace {
 // A connected pair on 127.0.0.1: the sending end non-blocking, the receiving end with a small
 // receive buffer and never read.
 struct LoopbackPair {
-  int sender = -1, receiver = -1;
+  asio::io_context io;
+  tcp::socket receiver{io}, sender_socket{io};
+  int sender = -1;
   LoopbackPair() {
-    const int listener = socket(AF_INET, SOCK_STREAM, 0);
-    sockaddr_in address{};
-    address.sin_family = AF_INET;
-    address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    socklen_t size = sizeof address;
-    bind(listener, reinterpret_cast<sockaddr*>(&address), sizeof address);
-    listen(listener, 1);
-    getsockname(listener, reinterpret_cast<sockaddr*>(&address), &size);
-    receiver = socket(AF_INET, SOCK_STREAM, 0);
-    const int small = 4096;
-    setsockopt(receiver, SOL_SOCKET, SO_RCVBUF, &small, sizeof small);
-    connect(receiver, reinterpret_cast<sockaddr*>(&address), sizeof address);
-    sender = accept(listener, nullptr, nullptr);
-    close(listener);
-    fcntl(sender, F_SETFL, fcntl(sender, F_GETFL) | O_NONBLOCK);
-  }
-  ~LoopbackPair() {
-    close(sender);
-    close(receiver);
+    tcp::acceptor acceptor(io, tcp::endpoint(asio::ip::make_address("127.0.0.1"), 0));
+    receiver.open(tcp::v4());
+    receiver.set_option(asio::socket_base::receive_buffer_size(4096));
+    receiver.connect(acceptor.local_endpoint());
+    acceptor.accept(sender_socket);
+    sender_socket.non_blocking(true);
+    sender = sender_socket.native_handle();
   }
   // What the sending end takes before it would block.
   size_t bytes_taken() const {
