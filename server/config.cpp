@@ -61,7 +61,8 @@ void apply_json(const nlohmann::json& json, DaemonConfig& c, const std::string& 
                                       "subscriber_queue_frames", "subscriber_tcp_congestion", "publish_threads", "status_interval_ms", "status_log_seconds", "default_rate_hz",
                                       "compressed_key_interval", "multicast", "multicast_interface", "multicast_ttl", "source_max_subjects", "source_max_markers_per_subject",
                                       "source_max_name_bytes", "max_subscribers", "max_subscribers_per_address",
-                                      "subscriber_write_stall_ms", "allow_subscribers", "subscriber_token"};
+                                      "subscriber_write_stall_ms", "allow_subscribers", "subscriber_token",
+                                      "subscriber_unsent_kb"};
   for (const auto& [key, value] : json.items()) {
     bool known = false;
     for (const char* k : kKeys) known = known || key == k;
@@ -120,6 +121,7 @@ void apply_json(const nlohmann::json& json, DaemonConfig& c, const std::string& 
   take(json, "subscriber_write_stall_ms", c.subscriber_write_stall_ms, origin);
   take(json, "allow_subscribers", c.allow_subscribers, origin);
   take(json, "subscriber_token", c.subscriber_token, origin);
+  take(json, "subscriber_unsent_kb", c.subscriber_unsent_kb, origin);
 }
 
 DaemonConfig load_config_file(const std::string& path) {
@@ -183,7 +185,15 @@ nlohmann::json to_json(const DaemonConfig& c) {
           {"max_subscribers_per_address", c.max_subscribers_per_address},
           {"subscriber_write_stall_ms", c.subscriber_write_stall_ms},
           {"allow_subscribers", c.allow_subscribers},
-          {"subscriber_token", c.subscriber_token}};
+          {"subscriber_token", c.subscriber_token},
+          {"subscriber_unsent_kb", c.subscriber_unsent_kb}};
+}
+
+nlohmann::json printable(const DaemonConfig& c) {
+  nlohmann::json json = to_json(c);
+  if (!c.subscriber_token.empty())
+    json["subscriber_token"] = "(set, " + std::to_string(c.subscriber_token.size()) + " bytes, not shown)";
+  return json;
 }
 
 void validate(const DaemonConfig& c) {
@@ -225,6 +235,8 @@ void validate(const DaemonConfig& c) {
   if (c.max_subscribers < 0) fail("max_subscribers must be >= 0 (0 = no limit)");
   if (c.max_subscribers_per_address < 0) fail("max_subscribers_per_address must be >= 0 (0 = no limit)");
   if (c.subscriber_write_stall_ms < 0) fail("subscriber_write_stall_ms must be >= 0 (0 = never)");
+  if (c.subscriber_unsent_kb < 0 || c.subscriber_unsent_kb > 1024 * 1024)
+    fail("subscriber_unsent_kb must be 0-1048576 (0 = the system's)");
   for (const std::string& network : c.allow_subscribers)
     if (!SubscriberNetwork::parse(network))
       fail("allow_subscribers: \"" + network + "\" is not a network such as 10.0.0.0/8, 192.168.1.20 or fd00::/8");

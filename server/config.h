@@ -72,6 +72,8 @@ struct DaemonConfig {
   int subscriber_write_stall_ms = 10000;  // a write without progress this long closes the subscriber; 0 = never
   std::vector<std::string> allow_subscribers;  // CIDR networks subscribers may connect from; empty = any
   std::string subscriber_token;           // asked of every subscriber (Hello version 2, ?token=); empty = none
+  // Bytes a subscriber's socket may hold not yet sent (TCP_NOTSENT_LOWAT); 0 = the system's (no limit).
+  int subscriber_unsent_kb = 128;
 };
 
 // Thrown for a bad config file, a bad key or value, or conflicting flags: one line, says which.
@@ -85,6 +87,9 @@ class ConfigError : public std::runtime_error {
 void apply_json(const nlohmann::json& json, DaemonConfig& config, const std::string& origin);
 DaemonConfig load_config_file(const std::string& path);  // throws ConfigError
 nlohmann::json to_json(const DaemonConfig& config);
+// to_json with the subscriber token left out (whether one is set, and its length, shown): what
+// --print-config prints, so the token does not reach a terminal, a log or a ticket.
+nlohmann::json printable(const DaemonConfig& config);
 // Range and consistency checks; throws ConfigError.
 void validate(const DaemonConfig& config);
 

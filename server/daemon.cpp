@@ -232,7 +232,7 @@ Daemon::Daemon(const DaemonConfig& config)
     subscriber->set_admission(std::move(admitted), ask_token ? admission_ : nullptr);
     hub.add(subscriber);
     asio::post(placed.io, [subscriber] { subscriber->start(); });
-  }, ListenerOptions{config.subscriber_tcp_congestion, &source_metrics_, &descriptor_reserve_, false});
+  }, ListenerOptions{config.subscriber_tcp_congestion, &source_metrics_, &descriptor_reserve_, false, config.subscriber_unsent_kb * 1024});
   HttpRoutes routes;
   routes.stream_admission = admission_;
   routes.health_json = [this] { return health_json(); };
@@ -242,7 +242,8 @@ Daemon::Daemon(const DaemonConfig& config)
     throw FileError(config.web_root, "web root is not a directory");
   // Out of descriptors, the HTTP port spends the reserve: /health answers while subscribers hold the rest.
   http_ = std::make_unique<HttpServer>(io_, config.bind_address, config.http_port, subject(0).hub(), std::move(routes),
-                                       ListenerOptions{config.subscriber_tcp_congestion, &source_metrics_, &descriptor_reserve_, true});
+                                       ListenerOptions{config.subscriber_tcp_congestion, &source_metrics_, &descriptor_reserve_, true,
+                                                       config.subscriber_unsent_kb * 1024});
 }
 
 Daemon::~Daemon() { stop(); }
@@ -445,6 +446,7 @@ std::string Daemon::health_json() const {
        {{"max_subscribers", config_.max_subscribers},
         {"max_subscribers_per_address", config_.max_subscribers_per_address},
         {"write_stall_ms", config_.subscriber_write_stall_ms},
+        {"unsent_kb", config_.subscriber_unsent_kb},
         {"allow_subscribers", allowed},
         {"token_required", admission_->token_required()},
         {"admitted", admission_->admitted()},

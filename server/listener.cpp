@@ -7,6 +7,7 @@
 
 #include "server/descriptor_reserve.h"
 #include "server/metrics/metrics.h"
+#include "server/tcp_unsent_limit.h"
 
 namespace skinstream::server {
 namespace {
@@ -59,6 +60,9 @@ void Listener::accept_next(bool take_reserve_back) {
     boost::system::error_code ignored;
     socket.set_option(tcp::no_delay(true), ignored);
     congestion_.apply(socket.native_handle());
+    if (options_.unsent_limit_bytes > 0)
+      if (const std::string why = set_tcp_unsent_limit(socket.native_handle(), options_.unsent_limit_bytes); !why.empty())
+        log_.warn(name_ + " unsent limit", "cannot limit an accepted socket's unsent bytes: " + why);
     on_accept_(std::move(socket));
     accept_next();
   });

@@ -1,9 +1,10 @@
 #pragma once
 // Accepts TCP connections on one port and hands each socket to a callback (io thread). Binding
 // happens in the constructor, so a port in use fails at startup with a clear message. Accepted
-// sockets get TCP_NODELAY and, when one is named, that TCP congestion control
-// (server/tcp_congestion.h); when it cannot be set, the listener says so once and goes on with
-// the system's.
+// sockets get TCP_NODELAY, when one is named that TCP congestion control
+// (server/tcp_congestion.h), and when one is given a limit of unsent bytes
+// (server/tcp_unsent_limit.h); when either cannot be set, the listener says so (rate-limited) and
+// goes on with the system's.
 //
 // Out of file descriptors (EMFILE, ENFILE; ENOBUFS, ENOMEM alike) the waiting connection stays
 // in the kernel's queue and every accept would fail at once: the listener pauses instead, 10 ms
@@ -29,6 +30,7 @@ struct ListenerOptions {
   Metrics* metrics = nullptr;         // counts accepts that failed for lack of descriptors
   DescriptorReserve* reserve = nullptr;  // taken back before every accept
   bool accept_on_reserve = false;     // out of descriptors, spend the reserve on the waiting connection
+  int unsent_limit_bytes = 0;         // set on every accepted socket (server/tcp_unsent_limit.h); 0: none
 };
 
 class Listener {

@@ -12,7 +12,13 @@ void set_log_level(const std::string& level) {
   spdlog::set_level(parsed);
 }
 
-bool RateLimitedLog::warn(std::string_view category, std::string_view detail) {
+bool RateLimitedLog::warn(std::string_view category, std::string_view detail) { return log(true, category, detail); }
+
+bool RateLimitedLog::info(std::string_view category, std::string_view detail) { return log(false, category, detail); }
+
+bool RateLimitedLog::log(bool warning, std::string_view category, std::string_view detail) {
+  // A line that would not be printed at this level is not counted either (nor formatted).
+  if (!spdlog::should_log(warning ? spdlog::level::warn : spdlog::level::info)) return false;
   const auto now = std::chrono::steady_clock::now();
   long suppressed = 0;
   {
@@ -28,10 +34,11 @@ bool RateLimitedLog::warn(std::string_view category, std::string_view detail) {
     e.suppressed = 0;
     e.last = now;
   }
+  const spdlog::level::level_enum level = warning ? spdlog::level::warn : spdlog::level::info;
   if (suppressed > 0)
-    spdlog::warn("{}: {} ({} more like it in the last second)", category, detail, suppressed);
+    spdlog::log(level, "{}: {} ({} more like it in the last second)", category, detail, suppressed);
   else
-    spdlog::warn("{}: {}", category, detail);
+    spdlog::log(level, "{}: {}", category, detail);
   return true;
 }
 

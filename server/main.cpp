@@ -18,7 +18,7 @@ int main(int argc, char** argv) {
     const std::optional<CommandLine> command_line = parse_command_line(argc, argv, exit_code);
     if (!command_line) return exit_code;
     if (command_line->print_config) {
-      std::printf("%s\n", to_json(command_line->config).dump(2).c_str());
+      std::printf("%s\n", printable(command_line->config).dump(2).c_str());
       return 0;
     }
     set_log_level(command_line->config.log_level);

@@ -84,10 +84,7 @@ SubjectStream::SubjectStream(SubjectConfig config, const SubjectStreamOptions& o
   } catch (const std::invalid_argument& e) {
     throw FileError(config_.file, std::string("deformation model unusable: ") + e.what());
   }
-  hub_->set_encoding_preparer([pipeline = pipeline_.get(), hub = hub_.get()](StreamKey key) {
-    pipeline->prepare_encoding(key);
-    pipeline->size_pool_for(hub->active_count() + 1);  // this one is about to be active
-  });
+  hub_->set_encoding_preparer([pipeline = pipeline_.get()](StreamKey key) { pipeline->prepare_encoding(key); });
   hub_->set_compressed_order(pipeline_->compressed_order());
   if (const EvaluationModel* evaluation = pipeline_->evaluation_model()) {
     hub_->set_model_message(std::make_shared<const std::vector<unsigned char>>(subscriber::encode_model(*evaluation)));
@@ -178,7 +175,7 @@ void SubjectStream::broadcast_status(SourceState state, std::string_view source_
 
 void SubjectStream::tend_subscribers(std::chrono::milliseconds write_stall) {
   if (write_stall.count() > 0) hub_->drop_stalled_writers(write_stall);
-  pipeline_->size_pool_for(hub_->active_count());
+  pipeline_->trim_pool();
 }
 
 std::string SubjectStream::status_line(StatusLine::Clock::time_point now) {
@@ -208,9 +205,13 @@ nlohmann::json SubjectStream::health() const {
   out["subscribers"] = hub_->subscriber_count();
   out["deform"] = {{"threads", deform_threads_}, {"cpus", deform_cpus_}};
   out["latency_ms"] = latency_summaries(metrics_);
-  // Frames in the pool and held by subscribers now: back to what the subscribers need within a
-  // Status tick of stalled ones leaving.
-  out["frame_pool"] = {{"frames", pipeline_->pool_frames()}, {"in_use", pipeline_->pool_frames_in_use()}};
+  // Frames in the pool and held by subscribers now, and the most held at once since the last
+  // Status tick: within two ticks of stalled subscribers leaving, the pool is back to that high
+  // water mark plus the frames kept free.
+  out["frame_pool"] = {{"frames", pipeline_->pool_frames()},
+                       {"in_use", pipeline_->pool_frames_in_use()},
+                       {"in_use_high_water", pipeline_->pool_frames_in_use_high_water()},
+                       {"kept_free", Pipeline::pool_frames_kept_free()}};
   if (multicast_) out["multicast"] = multicast_->health();
   return out;
 }

@@ -55,6 +55,22 @@ std::optional<int> parse_bench_options(int argc, char** argv, BenchOptions& o) {
   app.add_option("--calm-seconds", o.calm_seconds, "--hostile-waves: the calm after each wave, at whose end RSS is noted")
       ->check(CLI::Range(1, 3600))
       ->capture_default_str();
+  // How many of each hostile peer a wave opens (0: none of that kind).
+  HostilePeers& peers = o.hostile_peers;
+  const struct {
+    const char* flag;
+    int* count;
+    const char* what;
+  } hostile_counts[] = {
+      {"--stallers", &peers.stallers, "TCP subscribers that say Hello and never read, all connecting at once"},
+      {"--websocket-stallers", &peers.websocket_stallers, "WebSocket subscribers that never read"},
+      {"--garbage-flooders", &peers.garbage_flooders, "connections sending bytes that are no protocol"},
+      {"--hello-flooders", &peers.hello_flooders, "subscribers sending Hello after Hello"},
+      {"--churn-per-second", &peers.churn_per_second, "connections a second that say Hello and hang up"}};
+  for (const auto& kind : hostile_counts)
+    app.add_option(kind.flag, *kind.count, std::string("--hostile-waves, per wave: ") + kind.what)
+        ->check(CLI::Range(0, 4096))
+        ->capture_default_str();
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -4,6 +4,7 @@
 #include <optional>
 #include <string>
 
+#include "clients/bench/hostile_waves.h"
 #include "clients/bench/replay_engine.h"
 #include "skinstream/client.h"
 
@@ -36,6 +37,7 @@ struct BenchOptions {
   // The soak: hostile peers connect and leave in waves while the subscribers measure (loopback only).
   bool hostile_waves = false;
   int wave_seconds = 60, calm_seconds = 60;
+  HostilePeers hostile_peers;
   bool json = false;
 };
 

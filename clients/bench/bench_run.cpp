@@ -244,7 +244,7 @@ nlohmann::json run_bench(const BenchOptions& o, const std::atomic<bool>& stop) {
   std::optional<HostileWaves> waves;
   if (o.hostile_waves) {
     waves.emplace(HostileWaveOptions{daemon.sub_port(), daemon.http_port(), std::chrono::seconds(o.wave_seconds),
-                                     std::chrono::seconds(o.calm_seconds)},
+                                     std::chrono::seconds(o.calm_seconds), o.hostile_peers},
                   [pid = daemon.pid()] { return server::resident_kb(pid); });
     waves->start();
   }

@@ -73,11 +73,11 @@ nlohmann::json HostileWaves::report() const {
           {"per_wave",
            {{"seconds", options_.wave.count()},
             {"calm_seconds", options_.calm.count()},
-            {"stallers", options_.stallers},
-            {"websocket_stallers", options_.websocket_stallers},
-            {"garbage_flooders", options_.garbage_flooders},
-            {"hello_flooders", options_.hello_flooders},
-            {"churn_per_second", options_.churn_per_second}}}};
+            {"stallers", options_.peers.stallers},
+            {"websocket_stallers", options_.peers.websocket_stallers},
+            {"garbage_flooders", options_.peers.garbage_flooders},
+            {"hello_flooders", options_.peers.hello_flooders},
+            {"churn_per_second", options_.peers.churn_per_second}}}};
 }
 
 bool HostileWaves::sleep_unless_stopped(std::chrono::milliseconds duration) {
@@ -103,7 +103,7 @@ void HostileWaves::wave(nlohmann::json& out) {
   std::vector<int> stallers, websockets, garbage, hellos;
   std::deque<int> churn;
   const std::vector<unsigned char> positions = hello_bytes(0);
-  for (int i = 0; i < options_.stallers; ++i) {
+  for (int i = 0; i < options_.peers.stallers; ++i) {
     const int fd = connect_from_host(options_.sub_port, i, 4096);
     if (fd >= 0 && send_now(fd, positions.data(), positions.size())) ++connections;
     stallers.push_back(fd);
@@ -111,18 +111,19 @@ void HostileWaves::wave(nlohmann::json& out) {
   const std::string upgrade =
       "GET /stream HTTP/1.1\r\nHost: 127.0.0.1\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"
       "Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\nSec-WebSocket-Version: 13\r\n\r\n";
-  for (int i = 0; i < options_.websocket_stallers; ++i) {
+  for (int i = 0; i < options_.peers.websocket_stallers; ++i) {
     const int fd = connect_from_host(options_.http_port, i, 4096);
     if (fd >= 0 && send_now(fd, upgrade.data(), upgrade.size())) ++connections;
     websockets.push_back(fd);
   }
-  garbage.assign(static_cast<size_t>(options_.garbage_flooders), -1);
-  hellos.assign(static_cast<size_t>(options_.hello_flooders), -1);
+  garbage.assign(static_cast<size_t>(options_.peers.garbage_flooders), -1);
+  hellos.assign(static_cast<size_t>(options_.peers.hello_flooders), -1);
   std::vector<unsigned char> noise(16384);
   for (size_t i = 0; i < noise.size(); ++i) noise[i] = static_cast<unsigned char>(i * 131 + 7);
   const auto end = std::chrono::steady_clock::now() + options_.wave;
   const auto tick = std::chrono::milliseconds(50);
-  const int churn_per_tick = std::max(1, options_.churn_per_second / 20);
+  // Rounded up to one a tick unless no churn is asked for.
+  const int churn_per_tick = options_.peers.churn_per_second > 0 ? std::max(1, options_.peers.churn_per_second / 20) : 0;
   uint32_t wants = 0;
   for (int n = 0; !stop_.load() && std::chrono::steady_clock::now() < end; ++n) {
     for (size_t i = 0; i < garbage.size(); ++i) {

@@ -22,11 +22,16 @@
 
 namespace skinstream::bench {
 
+// How many of each kind a wave opens (skinstream-bench --stallers etc.).
+struct HostilePeers {
+  int stallers = 40, websocket_stallers = 20, garbage_flooders = 10, hello_flooders = 10;
+  int churn_per_second = 20;
+};
+
 struct HostileWaveOptions {
   int sub_port = 0, http_port = 0;
   std::chrono::seconds wave{60}, calm{60};
-  int stallers = 40, websocket_stallers = 20, garbage_flooders = 10, hello_flooders = 10;
-  int churn_per_second = 20;
+  HostilePeers peers;
 };
 
 class HostileWaves {

@@ -52,6 +52,7 @@ FrameRef FramePool::acquire() {
   {
     std::lock_guard lock(mutex_);
     frame = free_.empty() ? create_locked() : free_.pop();
+    in_use_high_water_ = std::max(in_use_high_water_, all_.size() - free_.size());
   }
   frame->encoded = {};
   return FrameRef(frame);
@@ -107,15 +108,26 @@ size_t FramePool::in_use() const {
   return all_.size() - free_.size();
 }
 
-size_t FramePool::resize(size_t frames) {
+size_t FramePool::free_count() const {
+  std::lock_guard lock(mutex_);
+  return free_.size();
+}
+
+size_t FramePool::in_use_high_water() const {
+  std::lock_guard lock(mutex_);
+  return in_use_high_water_;
+}
+
+size_t FramePool::keep_free(size_t free_frames) {
   std::lock_guard serial(prepare_mutex_);
   std::array<size_t, EncodedFrame::kEncodings> bytes{};
   size_t missing = 0;
   {
     std::lock_guard lock(mutex_);
     bytes = prepared_bytes_;
-    missing = frames > all_.size() ? frames - all_.size() : 0;
+    missing = free_frames > free_.size() ? free_frames - free_.size() : 0;
   }
+  if (missing == 0) return 0;
   // Made outside the lock, every page touched here (value-initialised), as prepare() does.
   std::vector<EncodedFrame*> made(missing);
   size_t buffers = 0;
@@ -128,23 +140,29 @@ size_t FramePool::resize(size_t frames) {
         ++buffers;
       }
   }
+  std::lock_guard lock(mutex_);
+  // The ring grows to hold every frame, its free frames kept in order.
+  std::vector<EncodedFrame*> free_frames_now;
+  while (!free_.empty()) free_frames_now.push_back(free_.pop());
+  free_.reset(all_.size() + made.size());
+  for (EncodedFrame* frame : free_frames_now) free_.push(frame);
+  for (EncodedFrame* frame : made) {
+    all_.push_back(frame);
+    free_.push(frame);
+    for (size_t key = 0; key < bytes.size(); ++key) sized_[key] += bytes[key] > 0;
+  }
+  return buffers;
+}
+
+size_t FramePool::trim(size_t free_frames) {
+  std::lock_guard serial(prepare_mutex_);
   std::vector<EncodedFrame*> doomed;
   {
     std::lock_guard lock(mutex_);
-    if (!made.empty()) {
-      // The ring grows to hold every frame, its free frames kept in order.
-      std::vector<EncodedFrame*> free_frames;
-      while (!free_.empty()) free_frames.push_back(free_.pop());
-      free_.reset(all_.size() + made.size());
-      for (EncodedFrame* frame : free_frames) free_.push(frame);
-      for (EncodedFrame* frame : made) {
-        all_.push_back(frame);
-        free_.push(frame);
-        for (size_t key = 0; key < bytes.size(); ++key) sized_[key] += bytes[key] > 0;
-      }
-    }
+    const size_t keep = in_use_high_water_ + free_frames;
+    in_use_high_water_ = all_.size() - free_.size();  // the next trim looks at what comes after this one
     // The oldest free frames go first; their prepared buffers beyond the frames left go too.
-    while (all_.size() > frames && !free_.empty()) {
+    while (all_.size() > keep && !free_.empty()) {
       EncodedFrame* frame = free_.pop();
       all_.erase(std::find(all_.begin(), all_.end(), frame));
       for (size_t key = 0; key < frame->messages.size(); ++key) sized_[key] -= frame->messages[key].capacity() > 0;
@@ -157,7 +175,7 @@ size_t FramePool::resize(size_t frames) {
   // Buffers of 640 kB may sit in malloc's heap rather than in mappings of their own (its
   // threshold rises as it frees them): hand the freed pages back to the system too.
   if (!doomed.empty()) malloc_trim(0);
-  return buffers;
+  return doomed.size();
 }
 
 void FramePool::release(EncodedFrame* frame) {

@@ -89,13 +89,18 @@ class FramePool {
   // Pipeline thread: gives frame.messages[key] `bytes` bytes, within its capacity, or from a
   // prepared buffer when one is ready. Returns true when it had to allocate here instead.
   bool size_message(EncodedFrame& frame, StreamKey key, size_t bytes);
-  // Any thread but the pipeline's: brings the pool to `frames` frames. New frames get a buffer
-  // of every encoding prepared so far, made here, so the pipeline does not make them when
-  // subscribers hold more frames; free frames beyond `frames` are freed, so the memory that
-  // stalled subscribers held comes back once they leave (frames in use are kept). Returns the
-  // number of buffers it made.
-  size_t resize(size_t frames);
+  // Any thread but the pipeline's: grows the pool until at least `free_frames` frames are free.
+  // New frames get a buffer of every encoding prepared so far, made here, so the pipeline does
+  // not make them when subscribers hold more frames. Returns the number of buffers it made.
+  size_t keep_free(size_t free_frames);
+  // Any thread but the pipeline's: frees the free frames beyond the most in use at once since
+  // the last trim plus `free_frames` (the oldest first; frames in use stay), so the memory that
+  // stalled subscribers held comes back once they leave. Returns the number of frames freed.
+  size_t trim(size_t free_frames);
   size_t in_use() const;
+  size_t free_count() const;
+  // The most frames in use at once since the last trim().
+  size_t in_use_high_water() const;
 
  private:
   friend class FrameRef;
@@ -106,6 +111,7 @@ class FramePool {
   mutable std::mutex mutex_;
   std::vector<EncodedFrame*> all_;
   BoundedRing<EncodedFrame*> free_;  // room for all_: release() never allocates
+  size_t in_use_high_water_ = 0;
   // Per encoding: buffers made by prepare() and not yet taken, and how many frames already
   // hold a buffer of that encoding (so prepare() knows how many are missing).
   std::array<std::vector<std::vector<unsigned char>>, EncodedFrame::kEncodings> ready_;

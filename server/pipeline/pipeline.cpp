@@ -65,6 +65,8 @@ Pipeline::Pipeline(const SubjectModel& model, const DeformationModel* deformatio
       mailbox_(mailbox),
       consumer_(consumer),
       metrics_(metrics),
+      pool_keeper_("frame-pool",
+                   [this] { metrics_.frame_buffers_allocated.fetch_add(pool_.keep_free(kFreeFrames), std::memory_order_relaxed); }),
       blender_(model, options.lookahead) {
   const int n = model.marker_count();
   filled_.resize(n);
@@ -196,10 +198,7 @@ void Pipeline::prepare_encoding(StreamKey key) {
   if ((stream_flags(key) & subscriber::kFrameCompressed) && compressed_) compressed_->request_key();
 }
 
-void Pipeline::size_pool_for(size_t subscribers) {
-  const size_t made = pool_.resize(kPooledFrames + kFramesPerSubscriber * subscribers);
-  metrics_.frame_buffers_allocated.fetch_add(made, std::memory_order_relaxed);
-}
+void Pipeline::trim_pool() { pool_.trim(kFreeFrames); }
 
 void Pipeline::publish(const Released& meta, std::span<const Vec3> positions, std::span<const MarkerStatus> status) {
   const StreamKeySet wanted = consumer_.wanted_encodings();
@@ -258,6 +257,7 @@ void Pipeline::publish(const Released& meta, std::span<const Vec3> positions, st
 FrameRef Pipeline::encode(const StreamKeySet& keys, subscriber::FrameInfo info, bool has_timecode,
                           const subscriber::CompressedBlocks& compressed) {
   FrameRef ref = pool_.acquire();
+  if (pool_.free_count() < kFreeFrames) pool_keeper_.wake();  // more made off this thread
   EncodedFrame& out = *ref.mutable_frame();
   out.frame_number = info.frame_number;
   keys.for_each([&](StreamKey key) {

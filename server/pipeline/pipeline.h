@@ -24,6 +24,7 @@
 #include "server/pipeline/deform_workers.h"
 #include "server/pipeline/encoded_frame.h"
 #include "server/pipeline/frame_mailbox.h"
+#include "server/pipeline/on_demand_thread.h"
 #include "server/pipeline/stream_key.h"
 #include "protocol/compressed_vertices.h"
 
@@ -74,14 +75,14 @@ class Pipeline {
   // 640 kB each) on the pipeline thread. For the compressed encoding, the next frame becomes a
   // key frame, so the new subscriber need not wait for one.
   void prepare_encoding(StreamKey key);
-  // Any thread but the pipeline's: sizes the frame pool for this many subscribers, each of which
-  // may hold kFramesPerSubscriber frames (the one it is writing, the newest in its queue) beyond
-  // the kPooledFrames the pipeline itself cycles through. Called as subscribers come (so the
-  // pipeline does not make frames because they hold some) and once a second (so the frames that
-  // stalled subscribers held are freed once they leave).
-  void size_pool_for(size_t subscribers);
+  // Any thread but the pipeline's (the daemon's 1 Hz tick): frees the pooled frames beyond the
+  // most in use at once since the last call plus the kFreeFrames kept ahead, so the frames that
+  // stalled subscribers held are freed once they leave.
+  void trim_pool();
   size_t pool_frames() const { return pool_.allocated(); }
   size_t pool_frames_in_use() const { return pool_.in_use(); }
+  size_t pool_frames_in_use_high_water() const { return pool_.in_use_high_water(); }
+  static constexpr size_t pool_frames_kept_free() { return kFreeFrames; }
 
  private:
   // A Frame message of this key: its size, or for the compressed encoding the most it can take.
@@ -107,12 +108,18 @@ class Pipeline {
   FrameMailbox& mailbox_;
   FrameConsumer& consumer_;
   Metrics& metrics_;
-  // Frames alive at once: the one being encoded and those queued or being written for the
-  // subscribers (one or two in steady state; more after a burst or behind a slow subscriber, and
-  // then the pool grows). Made up front; their buffers come from prepare_encoding().
-  static constexpr int kPooledFrames = 8;
-  static constexpr int kFramesPerSubscriber = 2;
-  FramePool pool_{kPooledFrames};
+  // Frames alive at once: the one being encoded, those queued for the subscribers (the frames
+  // of the last max_wait, shared by them all) and one more for each subscriber whose write of
+  // an older one is under way. A subscriber that stalls holds at most that one, so the frames in
+  // use grow by at most one a frame; the pool keeps kFreeFrames free ahead of them, topped up on
+  // pool_keeper_'s thread as soon as fewer are free (8 frames: 67 ms at 120 Hz to make more
+  // before the pipeline would have to). Measured with 255 subscribers connecting at once and
+  // never reading (they stall in their MeshInfo and hold no frame): the pool sized 2 frames a
+  // subscriber as each came made 1,048 frame buffers (RSS 687 MB) on the threads that write to
+  // the subscribers; this way, 48 (RSS 67 MB).
+  static constexpr size_t kFreeFrames = 8;
+  FramePool pool_{static_cast<int>(kFreeFrames)};
+  OnDemandThread pool_keeper_;
 
   std::optional<GapFiller> filler_;
   double filler_rate_hz_ = 0.0;

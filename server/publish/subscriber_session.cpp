@@ -12,7 +12,10 @@
 namespace skinstream::server {
 namespace {
 std::atomic<uint64_t> next_id{1};
-}
+// What each connection says as it comes, says Hello and goes: rate-limited, since hundreds
+// connect and leave at once (a wall of renderers restarting, or a flood).
+RateLimitedLog connection_log;
+}  // namespace
 
 SubscriberSession::SubscriberSession(asio::io_context& io, SubscriberHub& hub, std::string transport, std::string remote)
     : io_(io),
@@ -73,8 +76,8 @@ void SubscriberSession::start_hello_timer(std::chrono::milliseconds timeout) {
   hello_timer_.expires_after(timeout);
   hello_timer_.async_wait([self = shared_from_this()](const boost::system::error_code& ec) {
     if (ec || self->greeted_ || self->closed_) return;
-    spdlog::info("subscriber {} ({} {}): no Hello within the timeout, sending positions only", self->id_, self->transport_,
-                 self->remote_);
+    connection_log.info("subscriber_no_hello", fmt::format("subscriber {} ({} {}): no Hello within the timeout, sending positions only",
+                                                           self->id_, self->transport_, self->remote_));
     self->on_hello(subscriber::Hello{});
   });
 }
@@ -156,11 +159,11 @@ void SubscriberSession::on_hello(const subscriber::Hello& hello) {
   offer_control(hub_->status_message(key));
   if (!notice.empty()) {
     offer_control(hub_->status_message(key, notice, subscriber::SourceStateCode::Streaming));
-    spdlog::info("subscriber {} ({} {}): {}", id_, transport_, remote_, notice);
+    connection_log.info("subscriber_notice", fmt::format("subscriber {} ({} {}): {}", id_, transport_, remote_, notice));
   }
   hub_->activate(*this, key);
-  spdlog::info("subscriber {} ({} {}): protocol {}, wants {:#x}, frame flags {:#x}", id_, transport_, remote_, hello.version,
-               hello.wants, flags);
+  connection_log.info("subscriber_hello", fmt::format("subscriber {} ({} {}): protocol {}, wants {:#x}, frame flags {:#x}", id_,
+                                                      transport_, remote_, hello.version, hello.wants, flags));
 }
 
 bool SubscriberSession::join_subject(const std::string& subject) {
@@ -207,8 +210,8 @@ void SubscriberSession::on_disconnected(const std::string& reason) {
   if (closed_) return;
   closed_ = true;
   hello_timer_.cancel();
-  spdlog::info("subscriber {} ({} {}) gone: {} (sent {}, dropped {})", id_, transport_, remote_, reason, sent_.load(),
-               queue_.frames_dropped());
+  connection_log.info("subscriber_gone", fmt::format("subscriber {} ({} {}) gone: {} (sent {}, dropped {})", id_, transport_, remote_,
+                                                     reason, sent_.load(), queue_.frames_dropped()));
   write_progress_ns_.store(0, std::memory_order_relaxed);
   admission_.reset();
   hub_->remove(*this);

@@ -10,6 +10,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include "protocol/printable_text.h"
 #include "protocol/qtm_capture_encoder.h"
 #include "protocol/qtm_command.h"
 #include "protocol/qtm_packet_framer.h"
@@ -179,7 +180,7 @@ struct QtmServer::State : std::enable_shared_from_this<QtmServer::State> {
           streaming = false;
           break;
         case Kind::Other:
-          refuse("Command not supported by skinstream-replay: " + command.word);
+          refuse("Command not supported by skinstream-replay: " + quoted_text(command.word));
           break;
       }
       return true;
@@ -206,7 +207,7 @@ struct QtmServer::State : std::enable_shared_from_this<QtmServer::State> {
         const auto address = command.udp_address.empty() ? socket.remote_endpoint(ec).address()
                                                           : asio::ip::make_address(command.udp_address, ec);
         if (ec) {
-          refuse("StreamFrames: bad UDP address " + command.udp_address);
+          refuse("StreamFrames: bad UDP address " + quoted_text(command.udp_address));
           return;
         }
         udp_destination = udp::endpoint(address, command.udp_port);

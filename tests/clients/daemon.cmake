@@ -35,6 +35,12 @@ if(TARGET skinstreamd AND TARGET skinstream-sub AND TARGET skinstream-replay)
   add_test(NAME daemon.bad_tcp_congestion_name COMMAND skinstreamd --subscriber-tcp-congestion "Not A Name" --print-config)
   set_tests_properties(daemon.unknown_flag daemon.without_subject daemon.vicon_without_port sub.without_address sub.bad_address
     daemon.deform_cpus_twice daemon.bad_tcp_congestion_name PROPERTIES WILL_FAIL TRUE LABELS clients)
+  # --print-config says that a subscriber token is set, never what it is.
+  file(WRITE ${CMAKE_BINARY_DIR}/test_tmp/daemon/token_config.json "{\"subscriber_token\": \"stage-secret-42\"}")
+  add_test(NAME daemon.print_config_hides_token
+    COMMAND skinstreamd --config ${CMAKE_BINARY_DIR}/test_tmp/daemon/token_config.json --print-config)
+  set_tests_properties(daemon.print_config_hides_token PROPERTIES PASS_REGULAR_EXPRESSION "\"subscriber_token\": \"\\(set, 15 bytes, not shown\\)\""
+    FAIL_REGULAR_EXPRESSION "stage-secret" LABELS clients)
   # A CPU the process may not use is refused at start with the reason (a daemon that started
   # anyway would run until the timeout and fail this).
   add_test(NAME daemon.deform_cpu_not_allowed COMMAND skinstreamd --subject ${CMAKE_BINARY_DIR}/demo/subject.sksubj

@@ -177,8 +177,10 @@ TEST(Config, SubscriberAdmissionComesFromTheFileAndBadNetworksAreNamed) {
   const DaemonConfig defaults;
   EXPECT_TRUE(defaults.allow_subscribers.empty());
   EXPECT_TRUE(defaults.subscriber_token.empty());
+  EXPECT_EQ(defaults.subscriber_unsent_kb, 128);
   const std::string path = write_file("admission.json", R"({"max_subscribers": 8, "max_subscribers_per_address": 2,
-      "subscriber_write_stall_ms": 3000, "allow_subscribers": ["10.0.0.0/8", "fd00::/8"], "subscriber_token": "t"})");
+      "subscriber_write_stall_ms": 3000, "allow_subscribers": ["10.0.0.0/8", "fd00::/8"], "subscriber_token": "t",
+      "subscriber_unsent_kb": 64})");
   const auto parsed = parse({"--config", path});
   ASSERT_TRUE(parsed);
   EXPECT_EQ(parsed->config.max_subscribers, 8);
@@ -186,7 +188,9 @@ TEST(Config, SubscriberAdmissionComesFromTheFileAndBadNetworksAreNamed) {
   EXPECT_EQ(parsed->config.subscriber_write_stall_ms, 3000);
   EXPECT_EQ(parsed->config.allow_subscribers, (std::vector<std::string>{"10.0.0.0/8", "fd00::/8"}));
   EXPECT_EQ(parsed->config.subscriber_token, "t");
+  EXPECT_EQ(parsed->config.subscriber_unsent_kb, 64);
   const std::pair<const char*, const char*> bad[] = {
+      {R"({"subscriber_unsent_kb": -1})", "subscriber_unsent_kb must be 0-1048576"},
       {R"({"allow_subscribers": ["10.0.0.0/40"]})", "allow_subscribers: \"10.0.0.0/40\" is not a network"},
       {R"({"allow_subscribers": "10.0.0.0/8"})", "\"allow_subscribers\" has the wrong type"},
       {R"({"max_subscribers": -1})", "max_subscribers must be >= 0"},
@@ -195,6 +199,18 @@ TEST(Config, SubscriberAdmissionComesFromTheFileAndBadNetworksAreNamed) {
     const std::string bad_path = write_file("bad_admission.json", json);
     EXPECT_NE(error_of([&] { parse({"--config", bad_path}); }).find(message), std::string::npos) << json;
   }
+}
+
+// --print-config shows that a token is set, never the token.
+TEST(Config, ThePrintedConfigurationHidesTheToken) {
+  const std::string path = write_file("token.json", R"({"subscriber_token": "stage-secret-42"})");
+  const auto parsed = parse({"--config", path, "--print-config"});
+  ASSERT_TRUE(parsed);
+  const std::string printed = printable(parsed->config).dump(2);
+  EXPECT_EQ(printed.find("stage-secret-42"), std::string::npos) << printed;
+  EXPECT_EQ(printable(parsed->config)["subscriber_token"], "(set, 15 bytes, not shown)");
+  EXPECT_EQ(printable(parsed->config)["max_subscribers"], 256) << "the rest as it is";
+  EXPECT_EQ(printable(DaemonConfig{})["subscriber_token"], "") << "none set: nothing to hide";
 }
 
 TEST(Config, OutOfRangeValuesAndConflictsAreErrors) {

@@ -57,40 +57,66 @@ TEST(FramePool, PreparedBuffersAreTakenWithoutAllocating) {
   EXPECT_EQ(pool.prepare(EncodedFrame::kEncodings, 1000), 0u) << "no such encoding";
 }
 
-// Frames held by subscribers that stalled (the pool grew on the pipeline thread to 40) are
-// freed once they come back, down to what the subscribers left need; frames still held stay.
-TEST(FramePool, ResizeFreesTheFramesStalledSubscribersHeldOnceTheyAreBack) {
+// Frames held by subscribers that stalled (the pool grew to 40) are freed once they come back,
+// down to the most in use at once since the last trim plus the free frames asked for; frames
+// still held stay.
+TEST(FramePool, TrimFreesTheFramesStalledSubscribersHeldOnceTheyAreBack) {
   FramePool pool(8);
   pool.prepare(3, 1000);
   std::vector<FrameRef> held;
   for (int i = 0; i < 40; ++i) held.push_back(pool.acquire());
   ASSERT_EQ(pool.allocated(), 40u);
+  EXPECT_EQ(pool.in_use_high_water(), 40u);
   held.resize(12);  // 28 come back
-  EXPECT_EQ(pool.resize(8), 0u);
-  EXPECT_EQ(pool.allocated(), 12u) << "frames in use were freed, or free ones kept";
+  EXPECT_EQ(pool.trim(4), 0u) << "40 were in use since the last trim: all are kept";
+  EXPECT_EQ(pool.in_use_high_water(), 12u) << "the high water mark starts again from the frames in use";
+  EXPECT_EQ(pool.trim(4), 24u);
+  EXPECT_EQ(pool.allocated(), 16u) << "12 in use and 4 free";
   EXPECT_EQ(pool.in_use(), 12u);
   held.clear();
-  pool.resize(8);
-  EXPECT_EQ(pool.allocated(), 8u);
+  pool.trim(4);
+  EXPECT_EQ(pool.allocated(), 16u) << "12 in use since the last trim";
+  pool.trim(4);
+  EXPECT_EQ(pool.allocated(), 4u);
   EXPECT_EQ(pool.in_use(), 0u);
+}
+
+// A frame taken and given back between two trims counts in the high water mark: a subscriber's
+// frame in flight at the moment of the trim, or between two, is not freed under the pool's feet.
+TEST(FramePool, TheHighWaterMarkCountsFramesHeldBetweenTrims) {
+  FramePool pool(2);
+  {
+    std::vector<FrameRef> burst;
+    for (int i = 0; i < 10; ++i) burst.push_back(pool.acquire());
+  }
+  EXPECT_EQ(pool.in_use(), 0u);
+  EXPECT_EQ(pool.trim(2), 0u);
+  EXPECT_EQ(pool.allocated(), 10u);
+  EXPECT_EQ(pool.trim(2), 8u);
+  EXPECT_EQ(pool.allocated(), 2u);
 }
 
 // Grown ahead of the subscribers off the pipeline thread, the pool's new frames carry every
 // prepared encoding: taking them allocates nothing there.
-TEST(FramePool, ResizeGrowsWithThePreparedEncodingsSoThePipelineMakesNone) {
+TEST(FramePool, KeepFreeGrowsWithThePreparedEncodingsSoThePipelineMakesNone) {
   FramePool pool(2);
   pool.prepare(3, 1000);
   pool.prepare(5, 2000);
-  EXPECT_EQ(pool.resize(6), 8u);  // 4 new frames, 2 buffers each
-  ASSERT_EQ(pool.allocated(), 6u);
+  FrameRef held = pool.acquire();
+  EXPECT_EQ(pool.keep_free(6), 10u);  // 5 new frames, 2 buffers each
+  ASSERT_EQ(pool.allocated(), 7u);
+  EXPECT_EQ(pool.free_count(), 6u);
+  EXPECT_EQ(pool.keep_free(6), 0u) << "6 are free already";
   std::vector<FrameRef> frames;
-  for (int i = 0; i < 6; ++i) frames.push_back(pool.acquire());
+  frames.reserve(6);
   const test::CountAllocations allocations;
-  for (FrameRef& frame : frames) {
-    EXPECT_FALSE(pool.size_message(*frame.mutable_frame(), 3, 1000));
-    EXPECT_FALSE(pool.size_message(*frame.mutable_frame(), 5, 2000));
+  for (int i = 0; i < 6; ++i) {
+    frames.push_back(pool.acquire());
+    EXPECT_FALSE(pool.size_message(*frames.back().mutable_frame(), 3, 1000));
+    EXPECT_FALSE(pool.size_message(*frames.back().mutable_frame(), 5, 2000));
   }
   EXPECT_EQ(allocations.count(), 0u);
+  EXPECT_EQ(pool.allocated(), 7u);
 }
 
 }  // namespace
