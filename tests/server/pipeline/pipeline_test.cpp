@@ -139,6 +139,10 @@ TEST(Pipeline, AllocatesNothingPerFrameFromMailboxToSubscriber) {
   PipelineOptions options;
   options.deform_threads = 2;
   Pipeline pipeline(subject, &deformation, options, mailbox, consumer, metrics);
+  // As the daemon's hub does when a subscriber says Hello (here it said it before the pipeline
+  // existed): the pool's buffers for what it wants are made off the pipeline thread, and so are
+  // those of every frame the pool adds later, whenever the machine's load makes it add one.
+  hub.wanted_encodings().for_each([&](StreamKey key) { pipeline.prepare_encoding(key); });
   pipeline.start();
   for (int f = 0; f < kFrames; ++f) {
     MarkerFrame& frame = mailbox.writable();
