@@ -16,6 +16,19 @@
 namespace skinstream {
 namespace {
 
+// Every PCA model read back as written (the one-ring models and the regions' alike).
+void expect_same_pca_models(const std::vector<MarkerPcaModel>& back, const std::vector<MarkerPcaModel>& written) {
+  ASSERT_EQ(back.size(), written.size());
+  for (size_t i = 0; i < back.size(); ++i) {
+    EXPECT_EQ(back[i].mean, written[i].mean) << i;
+    EXPECT_EQ(back[i].basis, written[i].basis) << i;
+    EXPECT_EQ(back[i].variance, written[i].variance) << i;
+    EXPECT_EQ(back[i].slot_calibration, written[i].slot_calibration) << i;
+    EXPECT_EQ(back[i].rigid_variance, written[i].rigid_variance) << i;
+    EXPECT_EQ(back[i].training_frames, written[i].training_frames) << i;
+  }
+}
+
 std::vector<char> slurp(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
@@ -125,14 +138,7 @@ TEST_F(SubjectFile, RoundTripsExactly) {
   EXPECT_EQ(back.ring_offsets, model_.ring_offsets);
   EXPECT_EQ(back.ring_local_reference, model_.ring_local_reference);
   EXPECT_EQ(back.anchors, model_.anchors);
-  ASSERT_EQ(back.pca.size(), model_.pca.size());
-  for (size_t i = 0; i < back.pca.size(); ++i) {
-    EXPECT_EQ(back.pca[i].mean, model_.pca[i].mean);
-    EXPECT_EQ(back.pca[i].basis, model_.pca[i].basis);
-    EXPECT_EQ(back.pca[i].variance, model_.pca[i].variance);
-    EXPECT_EQ(back.pca[i].slot_calibration, model_.pca[i].slot_calibration);
-    EXPECT_EQ(back.pca[i].rigid_variance, model_.pca[i].rigid_variance);
-  }
+  expect_same_pca_models(back.pca, model_.pca);
   EXPECT_EQ(back.parameters.alpha1, model_.parameters.alpha1);
 }
 
@@ -210,12 +216,7 @@ TEST_F(SubjectFile, RegionsRoundTrip) {
   const SubjectModel back = read_subject(path_);
   EXPECT_EQ(back.region_offsets, model_.region_offsets);
   EXPECT_EQ(back.region, model_.region);
-  ASSERT_EQ(back.region_pca.size(), model_.region_pca.size());
-  for (size_t i = 0; i < back.region_pca.size(); ++i) {
-    EXPECT_EQ(back.region_pca[i].basis, model_.region_pca[i].basis);
-    EXPECT_EQ(back.region_pca[i].slot_calibration, model_.region_pca[i].slot_calibration);
-    EXPECT_EQ(back.region_pca[i].training_frames, model_.region_pca[i].training_frames);
-  }
+  expect_same_pca_models(back.region_pca, model_.region_pca);
 }
 
 // A version 4 file (before the regions) reads with none: the filler then has no regional opinion.
