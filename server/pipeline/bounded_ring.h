@@ -27,6 +27,7 @@ class BoundedRing {
   }
 
   const T& front() const { return items_[head_]; }  // the oldest; the ring must not be empty
+  const T& at(size_t i) const { return items_[(head_ + i) % items_.size()]; }  // i-th oldest, i < size()
   size_t size() const { return count_; }
   bool empty() const { return count_ == 0; }
   bool full() const { return count_ == items_.size(); }

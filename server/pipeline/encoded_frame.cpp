@@ -70,6 +70,7 @@ size_t FramePool::prepare(StreamKey key, size_t bytes) {
   {
     std::lock_guard lock(mutex_);
     prepared_bytes_[key] = bytes;
+    last_wanted_[key] = std::chrono::steady_clock::now();
     const size_t covered = sized_[key] + ready_[key].size();
     missing = all_.size() > covered ? all_.size() - covered : 0;
   }
@@ -176,6 +177,37 @@ size_t FramePool::trim(size_t free_frames) {
   // threshold rises as it frees them): hand the freed pages back to the system too.
   if (!doomed.empty()) malloc_trim(0);
   return doomed.size();
+}
+
+size_t FramePool::release_unwanted(const StreamKeySet& wanted, std::chrono::steady_clock::time_point now,
+                                   std::chrono::steady_clock::duration hold_off) {
+  // Serial with prepare(): a subscriber asking for an encoding while this runs either comes
+  // first (and its fresh last_wanted_ keeps the buffers) or after (and makes them again).
+  std::lock_guard serial(prepare_mutex_);
+  std::vector<std::vector<unsigned char>> doomed;  // freed outside the lock
+  {
+    std::lock_guard lock(mutex_);
+    for (StreamKey key = 0; key < EncodedFrame::kEncodings; ++key) {
+      if (wanted.has(key)) {
+        last_wanted_[key] = now;
+        continue;
+      }
+      if (now - last_wanted_[key] < hold_off || (sized_[key] == 0 && ready_[key].empty())) continue;
+      prepared_bytes_[key] = 0;
+      for (auto& buffer : ready_[key]) doomed.push_back(std::move(buffer));
+      ready_[key].clear();
+      for (size_t i = 0; i < free_.size(); ++i) {
+        std::vector<unsigned char>& message = free_.at(i)->messages[key];
+        if (message.capacity() == 0) continue;
+        doomed.emplace_back().swap(message);
+        --sized_[key];
+      }
+    }
+  }
+  const size_t freed = doomed.size();
+  doomed.clear();
+  if (freed > 0) malloc_trim(0);  // the pages back to the system too, as trim() does
+  return freed;
 }
 
 void FramePool::release(EncodedFrame* frame) {

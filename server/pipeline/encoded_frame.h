@@ -97,6 +97,14 @@ class FramePool {
   // the last trim plus `free_frames` (the oldest first; frames in use stay), so the memory that
   // stalled subscribers held comes back once they leave. Returns the number of frames freed.
   size_t trim(size_t free_frames);
+  // Any thread but the pipeline's: frees the buffers of every encoding outside `wanted` that no
+  // subscriber has asked for (prepare()) or held (`wanted` of an earlier call) within `hold_off`
+  // before `now`: those of the free frames and the prepared ones; keep_free() no longer makes
+  // them. A frame in use keeps its buffer until a later call finds it free. A subscriber that
+  // asks for the encoding again gets new buffers from prepare(), off the pipeline thread, as the
+  // first did. Returns the number of buffers freed.
+  size_t release_unwanted(const StreamKeySet& wanted, std::chrono::steady_clock::time_point now,
+                          std::chrono::steady_clock::duration hold_off);
   size_t in_use() const;
   size_t free_count() const;
   // The most frames in use at once since the last trim().
@@ -117,6 +125,8 @@ class FramePool {
   std::array<std::vector<std::vector<unsigned char>>, EncodedFrame::kEncodings> ready_;
   std::array<size_t, EncodedFrame::kEncodings> sized_{};
   std::array<size_t, EncodedFrame::kEncodings> prepared_bytes_{};  // per encoding, from prepare()
+  // Per encoding: when a subscriber last asked for it or was seen holding it.
+  std::array<std::chrono::steady_clock::time_point, EncodedFrame::kEncodings> last_wanted_{};
   std::mutex prepare_mutex_;  // one prepare() at a time, so two cannot both make the missing ones
 };
 

@@ -198,7 +198,10 @@ void Pipeline::prepare_encoding(StreamKey key) {
   if ((stream_flags(key) & subscriber::kFrameCompressed) && compressed_) compressed_->request_key();
 }
 
-void Pipeline::trim_pool() { pool_.trim(kFreeFrames); }
+void Pipeline::trim_pool() {
+  pool_.release_unwanted(consumer_.wanted_encodings(), std::chrono::steady_clock::now(), kUnwantedHoldOff);
+  pool_.trim(kFreeFrames);
+}
 
 void Pipeline::publish(const Released& meta, std::span<const Vec3> positions, std::span<const MarkerStatus> status) {
   const StreamKeySet wanted = consumer_.wanted_encodings();

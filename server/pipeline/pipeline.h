@@ -8,6 +8,7 @@
 // Allocates nothing per frame in steady state; never waits for a subscriber.
 
 #include <atomic>
+#include <chrono>
 #include <memory>
 #include <optional>
 #include <string>
@@ -77,7 +78,9 @@ class Pipeline {
   void prepare_encoding(StreamKey key);
   // Any thread but the pipeline's (the daemon's 1 Hz tick): frees the pooled frames beyond the
   // most in use at once since the last call plus the kFreeFrames kept ahead, so the frames that
-  // stalled subscribers held are freed once they leave.
+  // stalled subscribers held are freed once they leave; and frees the buffers of every encoding
+  // no subscriber has wanted for kUnwantedHoldOff, so a burst of Hellos asking for every
+  // combination of flags does not keep its memory for good.
   void trim_pool();
   size_t pool_frames() const { return pool_.allocated(); }
   size_t pool_frames_in_use() const { return pool_.in_use(); }
@@ -118,6 +121,9 @@ class Pipeline {
   // subscriber as each came made 1,048 frame buffers (RSS 687 MB) on the threads that write to
   // the subscribers; this way, 48 (RSS 67 MB).
   static constexpr size_t kFreeFrames = 8;
+  // Long enough that a subscriber that reconnects (a tablet on Wi-Fi) finds its buffers still
+  // made; short enough that memory comes back well within a minute of a flood ending.
+  static constexpr std::chrono::seconds kUnwantedHoldOff{10};
   FramePool pool_{static_cast<int>(kFreeFrames)};
   OnDemandThread pool_keeper_;
 

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <thread>
 #include <vector>
 
@@ -117,6 +118,41 @@ TEST(FramePool, KeepFreeGrowsWithThePreparedEncodingsSoThePipelineMakesNone) {
   }
   EXPECT_EQ(allocations.count(), 0u);
   EXPECT_EQ(pool.allocated(), 7u);
+}
+
+// An encoding asked for once (a Hello flooder cycling through the flags) keeps its buffers only
+// while someone wants it and for the hold-off after: then those of the free frames and the
+// prepared ones are freed, keep_free() stops making them, a frame still held keeps its own until
+// it is free, and asking again makes them anew off the pipeline thread.
+TEST(FramePool, BuffersOfAnEncodingNobodyWantsAreFreedAfterTheHoldOff) {
+  using namespace std::chrono_literals;
+  constexpr StreamKey kWanted = 3, kDropped = 5;
+  constexpr auto kHoldOff = 10s;
+  FramePool pool(4);
+  pool.prepare(kWanted, 1000);
+  pool.prepare(kDropped, 2000);
+  FrameRef held = pool.acquire();
+  ASSERT_FALSE(pool.size_message(*held.mutable_frame(), kDropped, 2000));
+  StreamKeySet wanted;
+  wanted.add(kWanted);
+  const auto now = std::chrono::steady_clock::now();
+  EXPECT_EQ(pool.release_unwanted(wanted, now, kHoldOff), 0u) << "asked for just now";
+  EXPECT_EQ(pool.release_unwanted(wanted, now + 11s, kHoldOff), 3u) << "the 3 prepared for the free frames";
+  EXPECT_EQ(pool.keep_free(8), 5u) << "5 new frames, each with the wanted encoding only";
+  held.reset();
+  EXPECT_EQ(pool.release_unwanted(wanted, now + 12s, kHoldOff), 1u) << "the held frame's, now that it is free";
+  EXPECT_EQ(pool.release_unwanted(wanted, now + 60s, kHoldOff), 0u) << "the wanted encoding keeps its buffers";
+  EXPECT_EQ(pool.prepare(kDropped, 2000), 9u) << "asked for again: made for every frame";
+  EXPECT_EQ(pool.release_unwanted(wanted, std::chrono::steady_clock::now() + 1s, kHoldOff), 0u);
+  std::vector<FrameRef> frames;
+  frames.reserve(9);
+  const test::CountAllocations allocations;
+  for (int i = 0; i < 9; ++i) {
+    frames.push_back(pool.acquire());
+    EXPECT_FALSE(pool.size_message(*frames.back().mutable_frame(), kWanted, 1000));
+    EXPECT_FALSE(pool.size_message(*frames.back().mutable_frame(), kDropped, 2000));
+  }
+  EXPECT_EQ(allocations.count(), 0u);
 }
 
 }  // namespace
