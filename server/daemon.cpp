@@ -462,6 +462,7 @@ std::string Daemon::health_json() const {
       {"frames", first["frames"]},
       {"frame_buffers_allocated", first["frame_buffers_allocated"]},
       {"frame_buffers_allocated_by_pipeline", first["frame_buffers_allocated_by_pipeline"]},
+      {"frame_buffers_released", first["frame_buffers_released"]},
       {"source_limits",
        {{"max_subjects", config_.source_max_subjects},
         {"max_markers_per_subject", config_.source_max_markers_per_subject},

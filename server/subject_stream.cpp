@@ -199,9 +199,11 @@ nlohmann::json SubjectStream::health() const {
                    {"dropped", metrics_.frames_dropped.load()},
                    {"dropped_mailbox_full", metrics_.frames_dropped_mailbox_full.load()}};
   // Encoded frame buffers created so far: grows only while the pool meets a new high-water
-  // mark of frames in use (bounded by the subscribers' queues), so RSS steps with it.
+  // mark of frames in use (bounded by the subscribers' queues) or an encoding is asked for
+  // again after its buffers were released, so RSS steps with it.
   out["frame_buffers_allocated"] = metrics_.frame_buffers_allocated.load();
   out["frame_buffers_allocated_by_pipeline"] = metrics_.frame_buffers_allocated_by_pipeline.load();
+  out["frame_buffers_released"] = metrics_.frame_buffers_released.load();
   out["subscribers"] = hub_->subscriber_count();
   out["deform"] = {{"threads", deform_threads_}, {"cpus", deform_cpus_}};
   out["latency_ms"] = latency_summaries(metrics_);
@@ -211,7 +213,8 @@ nlohmann::json SubjectStream::health() const {
   out["frame_pool"] = {{"frames", pipeline_->pool_frames()},
                        {"in_use", pipeline_->pool_frames_in_use()},
                        {"in_use_high_water", pipeline_->pool_frames_in_use_high_water()},
-                       {"kept_free", Pipeline::pool_frames_kept_free()}};
+                       {"kept_free", Pipeline::pool_frames_kept_free()},
+                       {"unwanted_encoding_hold_off_s", Pipeline::unwanted_encoding_hold_off().count()}};
   if (multicast_) out["multicast"] = multicast_->health();
   return out;
 }

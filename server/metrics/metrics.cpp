@@ -150,10 +150,12 @@ std::string render_prometheus(const Metrics& source, const std::vector<SubjectMe
   per_subject("subscribers_refused_total", "Subscribers refused after their Hello (unknown subject, ...).", &Metrics::subscribers_refused);
   per_subject("subscribers_dropped_write_stall_total", "Subscribers closed because a write to them did not progress for subscriber_write_stall_ms.",
               &Metrics::subscribers_dropped_write_stall);
-  per_subject("frame_buffers_allocated_total", "Encoded frame buffers created (steady state: constant).", &Metrics::frame_buffers_allocated);
+  per_subject("frame_buffers_allocated_total", "Encoded frame buffers created (steady state: constant; more when a released encoding is asked for again).", &Metrics::frame_buffers_allocated);
   per_subject("frame_buffers_allocated_by_pipeline_total",
               "Of those, created on the pipeline thread because none was prepared when the subscriber asked (expected: 0).",
               &Metrics::frame_buffers_allocated_by_pipeline);
+  per_subject("frame_buffers_released_total", "Encoded frame buffers freed because no subscriber wanted their encoding any more.",
+              &Metrics::frame_buffers_released);
   header(out, "bad_input_total", "Input dropped, by category: the source's without a subject label, a subject's pipeline's with one.", "counter");
   for (const auto& [category, count] : source.bad_input_counts())
     out += "skinstream_bad_input_total{category=\"" + label_value(category) + "\"} " + std::to_string(count) + "\n";

@@ -76,6 +76,7 @@ class Metrics {
   std::atomic<uint64_t> accepts_failed_no_descriptor{0};  // both ports: each pauses that port's accepts (server/listener.h)
   std::atomic<uint64_t> frame_buffers_allocated{0};              // every encoded frame buffer made
   std::atomic<uint64_t> frame_buffers_allocated_by_pipeline{0};  // of those, made on the 120 Hz thread (none prepared)
+  std::atomic<uint64_t> frame_buffers_released{0};               // of an encoding nobody wanted for the hold-off
 
   // receive_to_take: waiting in the mailbox, the pipeline thread's wake-up included.
   LatencyHistogram receive_to_take, fill, deform, normals, encode, encode_compressed, receive_to_publish;

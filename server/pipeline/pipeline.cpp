@@ -199,7 +199,8 @@ void Pipeline::prepare_encoding(StreamKey key) {
 }
 
 void Pipeline::trim_pool() {
-  pool_.release_unwanted(consumer_.wanted_encodings(), std::chrono::steady_clock::now(), kUnwantedHoldOff);
+  const size_t released = pool_.release_unwanted(consumer_.wanted_encodings(), std::chrono::steady_clock::now(), kUnwantedHoldOff);
+  metrics_.frame_buffers_released.fetch_add(released, std::memory_order_relaxed);
   pool_.trim(kFreeFrames);
 }
 

@@ -86,6 +86,7 @@ class Pipeline {
   size_t pool_frames_in_use() const { return pool_.in_use(); }
   size_t pool_frames_in_use_high_water() const { return pool_.in_use_high_water(); }
   static constexpr size_t pool_frames_kept_free() { return kFreeFrames; }
+  static constexpr std::chrono::seconds unwanted_encoding_hold_off() { return kUnwantedHoldOff; }
 
  private:
   // A Frame message of this key: its size, or for the compressed encoding the most it can take.

@@ -334,6 +334,47 @@ TEST(DaemonDemoSubscribers, ThePoolShrinksBackToItsHighWaterMarkAfterStalledSubs
   EXPECT_EQ(daemon.stop(), 0) << daemon.log();
 }
 
+// Subscribers that each ask for another format once (as a Hello flood cycling through the flags
+// does) and leave: every pooled frame gets a buffer of each format, and before the hold-off those
+// stayed for good (the soak's first wave left RSS at +102%). Once nobody has wanted a format for
+// the hold-off (10 s), its buffers are freed on the 1 Hz tick, never on the pipeline thread, and
+// RSS comes back, while the good subscriber is served throughout.
+TEST(DaemonDemoSubscribers, BuffersOfFormatsNobodyWantsAnyMoreAreFreed) {
+  const auto started = start_demo_daemon();
+  test::DaemonProcess& daemon = *started;
+  ASSERT_GT(daemon.sub_port, 0);
+  RawSubscriber good(daemon.sub_port);
+  ASSERT_TRUE(good.say(subscriber::Hello{0}));
+  ASSERT_TRUE(served(good));
+  const long rss_before = resident_kb(daemon.pid());
+  const uint32_t formats[] = {subscriber::kFrameNormals, subscriber::kFrameNormals | subscriber::kFrameMarkers,
+                              subscriber::kFrameNormals | subscriber::kFrameQuantised, subscriber::kFrameMarkers};
+  for (const uint32_t flags : formats) {
+    RawSubscriber once(daemon.sub_port);
+    ASSERT_TRUE(once.say(subscriber::Hello{flags}));
+    ASSERT_TRUE(served(once));
+    ASSERT_TRUE(once.next()) << "a frame in format " << flags;
+    for (int frames = 0; frames < 4; ++frames) ASSERT_TRUE(good.next());
+  }
+  const long rss_with = resident_kb(daemon.pid());
+  const nlohmann::json with = health_of(daemon.http_port);
+  ASSERT_TRUE(with["frame_pool"].is_object()) << with.dump();
+  const int pool_frames = with["frame_pool"]["frames"].get<int>();
+  nlohmann::json after;
+  auto released = [&] {
+    for (int i = 0; i < 10; ++i) good.next(std::chrono::seconds(1));  // keep reading
+    after = health_of(daemon.http_port);
+    return after["frame_buffers_released"].get<int>() >= 4 * pool_frames;
+  };
+  EXPECT_TRUE(eventually(released, std::chrono::seconds(40))) << after.dump();
+  EXPECT_EQ(after["frame_buffers_allocated_by_pipeline"], 0) << after.dump();
+  const long rss_after = resident_kb(daemon.pid());
+  std::printf("RSS %ld kB before, %ld kB with 4 more formats, %ld kB once nobody wanted them (%d pooled frames)\n", rss_before,
+              rss_with, rss_after, pool_frames);
+  EXPECT_LT(rss_after, rss_with - 16 * 1024) << "the formats' buffers did not come back";
+  EXPECT_EQ(daemon.stop(), 0) << daemon.log();
+}
+
 // 300 subscribers from 8 hosts connect at once, say Hello and never read (the first 255 are
 // admitted, the rest refused by max_subscribers). The daemon writes each its 1.35 MB MeshInfo
 // and frames until their sockets hold subscriber_unsent_kb unsent: before that limit, filling
