@@ -84,6 +84,7 @@ void RegionOnlineStatistics::learn_region(int i, std::span<const Vec3> positions
   // every region is seen (a region seen again after a gap is one sample, not the gap's worth).
   const long elapsed = r.learned_frame < 0 ? nominal_frames_ : frame_ - r.learned_frame;
   r.learned_frame = frame_;
+  ++r.updates;
   const double decay = std::exp(-static_cast<double>(elapsed) / options_.rate_hz / options_.memory_seconds);
   const double seconds = static_cast<double>(std::min(elapsed, nominal_frames_)) / options_.rate_hz;
   r.evidence = decay * r.evidence + seconds;

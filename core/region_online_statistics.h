@@ -49,6 +49,8 @@ class RegionOnlineStatistics {
   const RegionShapeGaussian& blended(int i);
   // Member 0's calibration in the blend, without forming it.
   double calibration(int i) const;
+  // Changes whenever region i learns (what a RegionFactor kept for it depends on).
+  long version(int i) const { return regions_[i].updates; }
   // Seconds of evidence region i learned from, after forgetting.
   double evidence_seconds(int i) const { return regions_[i].evidence; }
   void reset();
@@ -61,6 +63,7 @@ class RegionOnlineStatistics {
     size_t matrix_at = 0;  // 9 * size^2 values (column-major) in offline_covariance_ and scatter_
     double evidence = 0.0;  // seconds
     long learned_frame = -1;  // the frame it last learned from
+    long updates = 0;
     double squared_miss = 0.0, claimed = 0.0;  // the prequential calibration's sums, forgetting too
   };
   double weight(const Region& r) const { return r.evidence / (r.evidence + options_.prior_seconds); }

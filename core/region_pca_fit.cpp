@@ -11,7 +11,20 @@ void RegionPcaFit::align_and_condition(const RegionShapeGaussian& shape, int ali
   weights_.resize(3 * observed_count_);
   for (int o = 0; o < observed_count_; ++o)
     weights_.segment<3>(3 * o) = to_region_.apply(world_[o]) - shape.mean.segment<3>(3 * slots_[o]);
-  observed_covariance_.solveInPlace(weights_);
+  lower_->triangularView<Eigen::Lower>().solveInPlace(weights_);
+  lower_->triangularView<Eigen::Lower>().transpose().solveInPlace(weights_);
+}
+
+bool RegionPcaFit::factor(const RegionShapeGaussian& shape, uint32_t mask, RegionFactor& out) {
+  const int count = observed_count_;
+  PcaMatrix& covariance = out.lower;
+  covariance.resize(3 * count, 3 * count);
+  for (int a = 0; a < count; ++a)
+    for (int b = 0; b < count; ++b) covariance.block<3, 3>(3 * a, 3 * b) = shape.covariance.block<3, 3>(3 * slots_[a], 3 * slots_[b]);
+  covariance.diagonal().array() += shape.residual_variance;
+  const Eigen::LLT<Eigen::Ref<PcaMatrix>> llt(covariance);  // in place
+  out.observed_mask = llt.info() == Eigen::Success ? mask : 0;
+  return out.observed_mask != 0;
 }
 
 // E[member `slot` | observed] in the region's frame: mean + C(slot, observed) weights_.
@@ -30,7 +43,7 @@ bool RegionPcaFit::estimate(const MarkerPcaModel& model, std::span<const Vec3> p
 }
 
 bool RegionPcaFit::estimate(const RegionShapeGaussian& shape, std::span<const Vec3> positions, std::span<const char> observed,
-                            Vec3& out, double& out_variance) {
+                            Vec3& out, double& out_variance, RegionFactor* kept, long shape_version) {
   const int size = shape.members();
   if (static_cast<int>(positions.size()) != size || static_cast<int>(observed.size()) != size) return false;
   int count = 0;
@@ -44,12 +57,14 @@ bool RegionPcaFit::estimate(const RegionShapeGaussian& shape, std::span<const Ve
   if (count < 3) return false;
   observed_count_ = count;
   // The observed members' covariance depends only on which are observed: factored once.
-  PcaMatrix covariance(3 * count, 3 * count);
-  for (int a = 0; a < count; ++a)
-    for (int b = 0; b < count; ++b) covariance.block<3, 3>(3 * a, 3 * b) = shape.covariance.block<3, 3>(3 * slots_[a], 3 * slots_[b]);
-  covariance.diagonal().array() += shape.residual_variance;
-  observed_covariance_.compute(covariance);
-  if (observed_covariance_.info() != Eigen::Success) return false;
+  uint32_t mask = 0;
+  for (int o = 0; o < count; ++o) mask |= 1u << slots_[o];
+  RegionFactor& use = kept ? *kept : own_factor_;
+  if (!kept || use.observed_mask != mask || use.shape_version != shape_version) {
+    use.shape_version = shape_version;
+    if (!factor(shape, mask, use)) return false;
+  }
+  lower_ = &use.lower;
   align_and_condition(shape, count);
   // Alignment and estimate depend on each other (a pose's change can look like a turn of the
   // observed part): alternate, the missing members as estimated joining the alignment after the
@@ -73,7 +88,7 @@ bool RegionPcaFit::estimate(const RegionShapeGaussian& shape, std::span<const Ve
   // Conditional variance of member 0 per coordinate: (trace C_00 - |L^-1 C_o0|^2) / 3 + residual.
   cross_.resize(3 * count, 3);
   for (int o = 0; o < count; ++o) cross_.middleRows<3>(3 * o) = shape.covariance.block<3, 3>(3 * slots_[o], 0);
-  observed_covariance_.matrixL().solveInPlace(cross_);
+  lower_->triangularView<Eigen::Lower>().solveInPlace(cross_);
   const double variance =
       std::max(0.0, shape.covariance.topLeftCorner<3, 3>().trace() - cross_.squaredNorm()) / 3.0 + shape.residual_variance;
   // A pose unlike any the shape has seen shows as observed members it does not explain: their

@@ -18,6 +18,7 @@
 // coordinate the conditional variance times the calibration. Allocation-free.
 
 #include <array>
+#include <cstdint>
 #include <span>
 
 #include "core/absolute_orientation.h"
@@ -27,13 +28,24 @@
 
 namespace skinstream {
 
+// The Cholesky factor of a region's observed members' covariance, kept by a caller from frame
+// to frame: it depends only on which members are observed and on the shape, and while neither
+// changes (a region in a gap does not learn) it is reused.
+struct RegionFactor {
+  uint32_t observed_mask = 0;  // 0: nothing kept
+  long shape_version = -1;
+  PcaMatrix lower;
+};
+
 class RegionPcaFit {
  public:
   // `positions` and `observed` are parallel to the region's members (slot 0: the marker to
   // estimate, whose own position is not used). False when fewer than three other members are
   // observed or the observed members' covariance cannot be factored.
+  // With `kept`, the factor is taken from it when made for these members and `shape_version`,
+  // else made there.
   bool estimate(const RegionShapeGaussian& shape, std::span<const Vec3> positions, std::span<const char> observed,
-                Vec3& out, double& out_variance);
+                Vec3& out, double& out_variance, RegionFactor* kept = nullptr, long shape_version = 0);
   // The same from the offline model (false too when it was never trained).
   bool estimate(const MarkerPcaModel& model, std::span<const Vec3> positions, std::span<const char> observed,
                 Vec3& out, double& out_variance);
@@ -48,8 +60,11 @@ class RegionPcaFit {
   RigidTransform to_region_;  // world -> the region's frame
   std::array<Vec3, SubjectModel::kMaxRing> world_, mean_;
   std::array<int, SubjectModel::kMaxRing> slots_;
-  Eigen::LLT<PcaMatrix> observed_covariance_;  // of the observed members, residual included
-  PcaVector weights_;  // observed_covariance_^-1 (observed in the region's frame - their mean)
+  bool factor(const RegionShapeGaussian& shape, uint32_t mask, RegionFactor& out);
+
+  RegionFactor own_factor_;
+  const PcaMatrix* lower_ = nullptr;  // L of the observed members' covariance (residual included) = L L^T
+  PcaVector weights_;  // (L L^T)^-1 (observed in the region's frame - their mean)
   PcaMatrix cross_;    // scratch: covariance of member 0 with the observed members
   RegionShapeGaussian from_model_;
 };
