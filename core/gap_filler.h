@@ -22,13 +22,18 @@
 //   4. PCA fill: every observed neighbour's PCA model reconstructs the missing marker from that
 //      neighbour's observed one-ring (regularised least squares on the coefficients); the
 //      estimates are averaged, each weighted by the inverse of its predictive variance
-//      (calibrated on the training take), together with the rigid estimate weighed likewise. Without one, the rigid estimate; without that, held relative to
-//      the marker's anchors. The marker's regional PCA (region_pca_fit.h), aligned on whichever
-//      members of its region are seen, joins as one more opinion weighed by its calibrated
-//      variance: it holds where the marker's own neighbourhood is gone.
+//      (calibrated on the training take), together with the rigid estimate weighed likewise.
+//      Each variance is grown by its model's misfit to what it was fitted to this frame
+//      (novelty_factor, pca_fit.h): a pose training never showed makes its claim worth less.
+//      Without one, the rigid estimate; without that, held relative to the marker's anchors.
+//      The marker's regional PCA (region_pca_fit.h), aligned on whichever members of its region
+//      are seen, joins as one more opinion weighed by its calibrated variance: it holds where the
+//      marker's own neighbourhood is gone. The regions learn from the frames in which they are
+//      measured whole (region_online_statistics.h).
 //   5. Continuity: at the start of a gap, the difference between where the marker's last
-//      measurement moved with its neighbours and the estimate is kept in the local frame and
-//      decays over `continuity_seconds`, so a gap does not start with a jump.
+//      measurement moved with its neighbours (those seen in both frames) and the estimate is
+//      kept in the local frame and decays over `continuity_seconds`, so a gap does not start
+//      with a jump.
 //
 // All buffers are sized in the constructor; run() allocates nothing.
 
@@ -41,6 +46,7 @@
 #include "core/absolute_orientation.h"
 #include "core/marker_status.h"
 #include "core/pca_fit.h"
+#include "core/region_online_statistics.h"
 #include "core/region_pca_fit.h"
 #include "core/subject_model.h"
 
@@ -62,6 +68,9 @@ struct GapFillerOptions {
   // With weighting: each missing marker's regional PCA (region_pca_fit.h, when the subject has
   // regions) is one more weighed opinion, and the estimate when nothing nearer is known.
   bool use_regions = true;
+  // With regions: each region also learns from the frames in which it is measured whole, and its
+  // opinion blends that with the offline model (region_online_statistics.h).
+  bool learn_regions = true;
   // A new relabel stays on probation for this many frames: while it is, the fragment must pass
   // the taking test (eq. 3, unambiguous) every frame, else the relabel is revoked for all the
   // frames since it was taken (FrameOutput::revoked; GapEndBlender, holding those frames, gives
@@ -123,14 +132,14 @@ class GapFiller {
   void relabel();
   void precompute_single_gaps();
   bool solve_pca(int j);
-  int pca_estimate(int i, Vec3& out, double* out_variance = nullptr);
+  int pca_estimate(int i, Vec3& out, double* out_variance = nullptr, bool misfit = false);
   void remember_gap_start(int i);
   bool carried_from_gap_start(int i, Vec3& out, double& out_variance);
   bool carry_rigidly(int i, const Vec3& from_position, std::span<const Vec3> from_anchors,
                      std::span<const char> from_seen, Vec3& out, double& out_residual);
   void check_carries();
   bool expected_position(int i, Vec3& out, double* out_variance = nullptr);
-  double rigid_estimate_variance(int i) const;
+  double rigid_estimate_variance(int i, bool misfit = false) const;
   void take_free_point(int marker, int point);
   bool ambiguity_free_match(int i, int p, double distance);
   int find_free_point(int id) const;
@@ -217,10 +226,13 @@ class GapFiller {
   PcaFit pca_fit_;
   std::vector<Vec3> pca_slot_local_;       // parallel to model.ring: reconstruction in the local frame
   std::vector<double> pca_slot_variance_;  // parallel to model.ring: calibrated predictive variance (mm^2)
+  std::vector<double> pca_novelty_;        // per model: novelty_factor of this frame's solve
   std::vector<int> rigid_support_;         // observed ring members behind each rigid estimate
-  // One ring member missing, per ring entry: the reconstruction's linear map (3 x 3(d-1),
-  // row-major, at single_gap_offset_) and its calibrated variance.
-  std::vector<double> single_gap_gain_;
+  std::vector<double> rigid_novelty_;      // novelty_factor of each rigid estimate's fit
+  // One ring member missing, per ring entry: the coefficients' linear map (components x 3(d-1),
+  // row-major, at single_gap_offset_) and the reconstruction's calibrated variance.
+  std::vector<double> single_gap_map_;
+  PcaVector single_gap_deviation_, single_gap_coefficients_;
   std::vector<int> single_gap_offset_;
   std::vector<double> single_gap_variance_;
   // Several ring members missing: per model, the observed slots (a bit each) its factor below
@@ -230,6 +242,8 @@ class GapFiller {
   std::vector<double> pattern_factor_;
   bool region_estimate(int i, double other_variance, Vec3& out, double& out_variance);
   RegionPcaFit region_fit_;
+  RegionOnlineStatistics region_statistics_;
+  std::vector<RegionFactor> region_factors_;  // per marker's region, reused while its members seen do not change
   std::vector<Vec3> region_positions_;
   std::vector<char> region_observed_;
   std::vector<Vec3> scratch_source_, scratch_target_;

@@ -52,6 +52,12 @@ Vec3 PcaFit::reconstruct(const MarkerPcaModel& model, int slot) const {
   return p;
 }
 
+double PcaFit::squared_miss(const MarkerPcaModel& model, std::span<const int> slots, std::span<const Vec3> local) const {
+  double miss = 0.0;
+  for (size_t o = 0; o < slots.size(); ++o) miss += (local[o] - reconstruct(model, slots[o])).squaredNorm();
+  return miss;
+}
+
 double PcaFit::predictive_variance(const MarkerPcaModel& model, int slot) const {
   if (coefficients_.size() == 0) return model.residual_variance;
   // trace(B_s A^-1 B_s^T) = |L^-1 B_s^T|^2 with A = L L^T: one triangular solve.

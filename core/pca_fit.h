@@ -18,6 +18,14 @@ constexpr int kMaxRingDims = 3 * SubjectModel::kMaxRing;
 using PcaMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxRingDims, kMaxRingDims>;
 using PcaVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxRingDims, 1>;
 
+// How much less a model's claim is worth on a pose unlike those it was trained on: the observed
+// members' squared miss against the model's own estimate of them, over what its residual leads
+// one to expect (three coordinates a member); at least 1.
+inline double novelty_factor(double squared_miss, int observed, double residual_variance) {
+  const double expected = 3.0 * observed * residual_variance;
+  return expected > 0.0 && squared_miss > expected ? squared_miss / expected : 1.0;
+}
+
 class PcaFit {
  public:
   // `slots`: indices of the observed ring members; `local`: their positions in the marker's
@@ -39,6 +47,8 @@ class PcaFit {
   double predictive_variance(const MarkerPcaModel& model, int slot) const;
 
   const PcaVector& coefficients() const { return coefficients_; }
+  // Sum over the observed members of |local - reconstruction|^2 (mm^2): what novelty_factor reads.
+  double squared_miss(const MarkerPcaModel& model, std::span<const int> slots, std::span<const Vec3> local) const;
 
  private:
   PcaVector coefficients_;

@@ -69,13 +69,14 @@ int run_eval_fill(const EvalFillOptions& o, std::FILE* out) {
   for (int m = 0; m < model.marker_count(); ++m) normaliser[m] = model.neighbour_distance(m);
 
   auto skinstream_fill = [&](CaptureFillOptions fill) { return [&model, fill](const Capture& c) { return fill_capture(model, c, fill); }; };
-  CaptureFillOptions online, ahead, no_pca, no_continuity, plain_average, no_rigid_fusion, no_carry;
+  CaptureFillOptions online, ahead, no_pca, no_continuity, plain_average, no_rigid_fusion, no_carry, no_learning;
   ahead.lookahead = o.lookahead;
   no_pca.filler.use_pca = false;
   no_continuity.filler.continuity_seconds = 0.0;
   plain_average.filler.weight_by_variance = false;
   no_rigid_fusion.filler.fuse_rigid = false;
   no_carry.filler.carry_from_gap_start = false;
+  no_learning.filler.learn_regions = false;
   std::vector<Method> methods = {
       {"linear", "linear interpolation (offline)", fill_linear},
       {"spline", "cubic spline (offline)", [](const Capture& c) { return fill_cubic_spline(c); }},
@@ -89,6 +90,7 @@ int run_eval_fill(const EvalFillOptions& o, std::FILE* out) {
     methods.push_back({"skinstream_plain_average", "skinstream online, neighbours' PCA estimates averaged unweighted (as the paper)", skinstream_fill(plain_average)});
     methods.push_back({"skinstream_pca_only", "skinstream online, PCA estimates weighted, rigid estimate not fused", skinstream_fill(no_rigid_fusion)});
     methods.push_back({"skinstream_no_carry", "skinstream online, no carry from the gap start by the steadiest anchors", skinstream_fill(no_carry)});
+    methods.push_back({"skinstream_no_region_learning", "skinstream online, regions as trained offline (nothing learned online)", skinstream_fill(no_learning)});
   }
 
   long gap_samples = 0;

@@ -58,13 +58,15 @@ double calibration(const MarkerPcaModel& model, const Capture& capture, const st
   std::vector<char> observed(size, 1);
   for (int k = 0; k < std::min(3, size); ++k) observed[k] = 0;
   RegionPcaFit fit;
+  RegionShapeGaussian shape;  // made once: every frame asks the same model
+  region_gaussian_from_pca(model, shape);
   double squared_error = 0.0, claimed = 0.0;
   const int step = std::max<int>(1, static_cast<int>(frames.size()) / std::max(1, samples));
   for (size_t u = 0; u < frames.size(); u += step) {
     const std::vector<Vec3> truth = shape_at(capture, members, frames[u]);
     Vec3 estimate;
     double variance = 0.0;
-    if (!fit.estimate(model, truth, observed, estimate, variance)) continue;
+    if (!fit.estimate(shape, truth, observed, estimate, variance)) continue;
     squared_error += (estimate - truth[0]).squaredNorm() / 3.0;
     claimed += variance;
   }
