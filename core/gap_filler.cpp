@@ -30,8 +30,6 @@ GapFiller::GapFiller(const SubjectModel& model, const GapFillerOptions& options)
 
   previous_.assign(n_, Vec3::Zero());
   previous_status_.assign(n_, MarkerStatus::Held);
-  before_previous_.assign(n_, Vec3::Zero());
-  before_previous_status_.assign(n_, MarkerStatus::Held);
   assigned_id_.assign(n_, kNoFragment);
   probation_start_.assign(n_, -1);
   refused_id_.assign(n_, kNoFragment);
@@ -185,8 +183,6 @@ FillStats GapFiller::run(const FrameInput& in, const FrameOutput& out) {
     if (!out.fragments.empty()) out.fragments[i] = status_[i] == MarkerStatus::Relabelled ? assigned_id_[i] : kNoFragment;
     if (!out.revoked.empty()) out.revoked[i] = revoked_[i];
     if (is_present(in.labelled[i]) && current_[i] != in.labelled[i]) ++stats_.changed_measured;
-    before_previous_[i] = previous_[i];
-    before_previous_status_[i] = has_previous_ ? previous_status_[i] : MarkerStatus::Held;
     previous_[i] = current_[i];
     previous_status_[i] = status_[i];
     switch (status_[i]) {
@@ -222,14 +218,13 @@ bool GapFiller::carried_position(int i, Vec3& out) const {
 // changes by millimetres, while a swapped or mislabelled point is off by about the marker
 // spacing. A labelled point farther than eps2 from where its marker was carried is suspect, and
 // held back from the estimates until judged. With fewer than two ring members seen (where skin
-// touches skin, or a limb is hidden) it is compared with where its own recent velocity takes it
-// (else its last position) instead: a label that jumps by more than eps2 is just as suspect.
+// touches skin, or a limb is hidden) it is compared with the marker's last position instead:
+// a label that jumps by more than eps2 in one frame is just as suspect.
 void GapFiller::find_suspect_labels() {
   for (int i = 0; i < n_; ++i) {
     Vec3 expected;
     if (!observed_[i] || previous_status_[i] == MarkerStatus::Held) continue;
-    if (!carried_position(i, expected))
-      expected = tracked_two_frames(i) ? Vec3(2.0 * previous_[i] - before_previous_[i]) : previous_[i];
+    if (!carried_position(i, expected)) expected = previous_[i];
     if ((current_[i] - expected).norm() > eps2_[i]) suspects_.push_back(i);
   }
   for (int i : suspects_) observed_[i] = 0;
@@ -238,19 +233,21 @@ void GapFiller::find_suspect_labels() {
 // Being off is not proof: a fast limb at a low frame rate, or the end of a gap whose estimate
 // was poor, puts a true measurement beyond eps2 too, and so does a rejected point that another
 // marker took last frame and carried along. A suspect point is judged against estimates made
-// this frame, and only on strong evidence: its own estimate (own_estimate) must disagree by more
-// than four of its calibrated standard deviations, and either another marker explains the point
-// clearly better (a swap), or it was tracked last frame, its own estimate disagrees by more than
-// eps2 as well, and it left its own track (off_own_track). Otherwise the measurement stands.
+// this frame from the other markers alone. It stands when its own estimate agrees (within eps2
+// and within four of its calibrated standard deviations); it is taken as unlabelled when
+// another marker explains it clearly better (a swap), or when it was tracked last frame and its
+// own estimate disagrees by more than eps2 as well (two independent estimates, the motion of its
+// ring and the shape of its neighbourhood, against it). Otherwise the measurement stands.
 void GapFiller::judge_suspect_labels() {
   for (int i : suspects_) {
     Vec3 own;
     double own_variance = 0.0;
-    const bool has_own = own_estimate(i, own, own_variance);
-    const double own_distance = has_own ? (current_[i] - own).norm() : 0.0;
+    const bool has_own = expected_position(i, own, &own_variance);
+    const double own_distance = has_own ? (current_[i] - own).norm() : std::numeric_limits<double>::infinity();
     const bool own_confident = has_own && own_distance * own_distance > kConfidentMiss * own_variance;
-    const bool reject = own_confident && (explained_by_another(i, own_distance) ||
-                                          (own_distance > eps2_[i] && is_observed(previous_status_[i]) && off_own_track(i)));
+    const bool reject = (own_distance > eps2_[i] || own_confident) &&
+                        (explained_by_another(i, own_distance) ||
+                         (has_own && own_distance > eps2_[i] && is_observed(previous_status_[i])));
     if (reject) {
       add_free_point(current_[i], -(i + 1));
       ++stats_.rejected_labels;
@@ -262,66 +259,25 @@ void GapFiller::judge_suspect_labels() {
   refresh_estimates();
 }
 
-// Where marker i is expected, for the label check: the neighbours' opinions (expected_position)
-// when a PCA model speaks or the rigid fit rests on kRigidSupport observed ring members; else its
-// last measurement carried from the start of its gap by its anchors, with the variance its drift
-// gives it; only then a rigid fit on estimates of missing members, which carries their errors
-// with a variance that does not show them (seen: 97 mm off a returning wrist marker of the
-// tennis serve, claiming 9 mm, where the carry was 99 mm off claiming 56). False: no estimate.
-bool GapFiller::own_estimate(int i, Vec3& out, double& out_variance) {
-  if (options_.use_pca && pca_estimate(i, out, &out_variance) > 0) return true;
-  const bool rigid_on_observed = estimated_[i] && rigid_support_[i] >= kRigidSupport;
-  if (!rigid_on_observed && options_.carry_from_gap_start && options_.weight_by_variance &&
-      carried_from_gap_start(i, out, out_variance))
-    return true;
-  if (!estimated_[i]) return false;
-  out = estimate_[i];
-  out_variance = rigid_estimate_variance(i);
-  return true;
-}
-
-bool GapFiller::tracked_two_frames(int i) const {
-  return is_observed(previous_status_[i]) && is_observed(before_previous_status_[i]);
-}
-
-// Whether labelled point i left the marker's own track: farther from where its last velocity
-// takes it than eps2 plus the last frame's displacement. A limb turning on an arc leaves the
-// straight line by up to the distance it travels in a frame (a serving hand at 50 Hz: 140 mm
-// off the line, 230 mm a frame), while a label moved to another fragment jumps by the marker
-// spacing whatever the speed. Unknown (true) unless tracked in the last two frames.
-bool GapFiller::off_own_track(int i) const {
-  if (!tracked_two_frames(i)) return true;
-  const Vec3 velocity = previous_[i] - before_previous_[i];
-  return (current_[i] - previous_[i] - velocity).norm() > eps2_[i] + velocity.norm();
-}
-
-// Whether another missing (or suspect) marker is expected within eps1 of i's labelled point, at
-// most half as far from it as i's own estimate and within four of that estimate's calibrated
-// standard deviations: a swap, or a point where skin touches skin. An estimate that misses the
-// point by more than it can miss explains nothing (seen: a returning HDM05 hand marker 108 mm
-// from a neighbour's estimate claiming 10 mm, taken from its own label).
+// Whether another missing (or suspect) marker is expected within eps1 of i's labelled point and
+// at most half as far from it as i's own estimate: a swap, or a point where skin touches skin.
 bool GapFiller::explained_by_another(int i, double own_distance) {
-  double variance = 0.0;
-  const double other = nearest_other_expected(i, current_[i], &variance);
-  return std::isfinite(other) && other <= 0.5 * own_distance && other * other <= kConfidentMiss * variance;
+  return nearest_other_expected(i, current_[i]) <= 0.5 * own_distance;
 }
 
 // The distance from point p to the nearest estimate of another missing marker that is within
-// eps1 of it (infinity: none), and that estimate's calibrated variance. Any marker may be the
-// other, not only i's neighbours: skin that touches is rarely neighbouring on the marker surface.
-double GapFiller::nearest_other_expected(int i, const Vec3& p, double* out_variance) {
+// eps1 of it (infinity: none). Any marker may be the other, not only i's neighbours: skin that
+// touches is rarely neighbouring on the marker surface.
+double GapFiller::nearest_other_expected(int i, const Vec3& p) {
   double nearest = std::numeric_limits<double>::infinity();
   for (int j : missing_) {
     if (observed_[j] || j == i || !estimated_[j]) continue;
     const double reach = kPrefilterReach * eps1_[j];
     if ((p - estimate_[j]).squaredNorm() > reach * reach) continue;
     Vec3 expected;
-    double variance = 0.0;
-    if (!expected_position(j, expected, &variance)) continue;
+    if (!expected_position(j, expected)) continue;
     const double d = (p - expected).norm();
-    if (d > eps1_[j] || d >= nearest) continue;
-    nearest = d;
-    if (out_variance) *out_variance = variance;
+    if (d <= eps1_[j]) nearest = std::min(nearest, d);
   }
   return nearest;
 }

@@ -5,11 +5,10 @@
 //   1. Label check: a labelled point that did not move with its one-ring since the last frame
 //      (off by more than eps2) is suspect: that is how swapped and mislabelled fragments look,
 //      but also a true measurement after a gap whose estimate was poor (with its ring unseen,
-//      against where its own velocity takes it). It is treated as unlabelled only on strong
-//      evidence: its own estimate, standing on observed markers, disagrees by more than four
-//      calibrated standard deviations, and either another missing marker's estimate explains it
-//      clearly better and within its own calibrated reach (a swap, or skin touching skin), or it
-//      was tracked, is beyond eps2 of that estimate and left its own track. Otherwise the
+//      against its last position). It is treated as unlabelled only on strong evidence, judged
+//      against this frame's estimates from the other markers: any missing marker explains it
+//      clearly better while its own confident estimate disagrees (a swap, or skin touching
+//      skin), or it was tracked and its neighbourhood's estimate disagrees too. Otherwise the
 //      measurement stands.
 //   2. Rigid estimates (eq. 2, Horn), greedy: the missing marker with the most available
 //      neighbours first, reusing earlier estimates.
@@ -116,11 +115,8 @@ class GapFiller {
  private:
   void find_suspect_labels();
   void judge_suspect_labels();
-  bool own_estimate(int i, Vec3& out, double& out_variance);
-  bool tracked_two_frames(int i) const;
-  bool off_own_track(int i) const;
   bool explained_by_another(int i, double own_distance);
-  double nearest_other_expected(int i, const Vec3& p, double* out_variance = nullptr);
+  double nearest_other_expected(int i, const Vec3& p);
   bool carried_position(int i, Vec3& out) const;
   void estimate_rigid();
   void fit_rigid_estimate(int i);
@@ -165,8 +161,6 @@ class GapFiller {
   long solve_stamp_ = 0;  // this frame's: a PCA solve made in it stands until its ring changes (refresh_estimates)
   std::vector<Vec3> previous_;
   std::vector<MarkerStatus> previous_status_;
-  std::vector<Vec3> before_previous_;  // two frames ago, for the marker's own velocity
-  std::vector<MarkerStatus> before_previous_status_;
   std::vector<int> assigned_id_;      // free-point trajectory currently standing for marker i
   std::vector<long> probation_start_;  // frame its relabel was taken while still on probation, else -1
   std::vector<int> refused_id_;        // a fragment whose relabel was revoked, not taken again while it lasts
