@@ -96,6 +96,7 @@ nlohmann::ordered_json evaluate_on_synthetic(const synth::SynthCapture& take, co
   j["wrongly_labelled_rate"] = merge.wrong_rate();
   j["wrongly_labelled_by"] = {{"measured", merge.wrong_measured_fragments}, {"relabelled", merge.wrong_relabelled_fragments}};
   j["wrongly_labelled_samples"] = merge.wrong_samples;
+  j["true_labels_not_kept"] = merge.true_labels_not_kept;
   j["samples"] = {{"measured", report.measured}, {"relabelled", report.relabelled}, {"filled", report.filled},
                   {"held", report.held}, {"rejected_labels", report.rejected_labels},
                   {"changed_measured", report.changed_measured}};

@@ -53,6 +53,14 @@ MergeStats merge_stats(const Capture& delivered, const std::vector<int>& true_ma
       s.wrong_relabelled_fragments += wrong_relabelled;
     }
   }
+  for (int m = 0; m < markers; ++m) {
+    const int c = channel_of[m];
+    if (c < 0 || c >= channels) continue;
+    for (int f = 0; f < frames; ++f) {
+      const size_t at = static_cast<size_t>(f) * channels + c;
+      s.true_labels_not_kept += delivered.present(f, c) && true_marker[at] == m && taken_by[at] != m;
+    }
+  }
   for (char seen : marker_seen) s.trajectories_after += seen;
   s.trajectories_after += s.unmerged_fragments;
   return s;

@@ -20,6 +20,9 @@ struct MergeStats {
   int wrong_measured_fragments = 0;
   int wrong_relabelled_fragments = 0;
   long wrong_samples = 0;
+  // Samples a labelled channel delivered of its own marker (the label was right) that the marker
+  // did not keep: a true measurement the label check rejected and nobody gave back.
+  long true_labels_not_kept = 0;
   double wrong_rate() const { return fragments ? static_cast<double>(wrong_fragments) / fragments : 0.0; }
 };
 

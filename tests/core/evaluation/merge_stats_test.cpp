@@ -55,5 +55,28 @@ TEST(MergeStats, CountsMergedUnmergedAndWrongFragments) {
   EXPECT_EQ(s.wrong_relabelled_fragments, 1);
 }
 
+// a's own channel delivers a's point in frames 0-2; the filler kept frame 0, rejected frame 1 and
+// gave it back as a relabel (the rejected point of marker a is its own channel), and rejected
+// frame 2 for good (filled): one true label not kept. b's mislabelled sample in frame 2 is not a
+// true label, so b filled there does not count.
+TEST(MergeStats, CountsTrueLabelsNotKept) {
+  Capture c({"a", "b"}, 3, 120.0);
+  std::vector<int> truth(3 * 2, -2);
+  for (int f = 0; f < 3; ++f) {
+    c.at(f, 0) = Vec3(f, 0, 0);
+    truth[f * 2 + 0] = 0;
+    c.at(f, 1) = Vec3(f, 1, 0);
+    truth[f * 2 + 1] = f == 2 ? 0 : 1;
+  }
+  std::vector<MarkerStatus> status(3 * 2, MarkerStatus::Measured);
+  std::vector<int> fragments(3 * 2, -1);
+  status[1 * 2 + 0] = MarkerStatus::Relabelled;
+  fragments[1 * 2 + 0] = 0;
+  status[2 * 2 + 0] = MarkerStatus::FilledPca;
+  status[2 * 2 + 1] = MarkerStatus::FilledPca;
+  const MergeStats s = merge_stats(c, truth, {0, 1}, status, fragments);
+  EXPECT_EQ(s.true_labels_not_kept, 1);
+}
+
 }  // namespace
 }  // namespace skinstream
