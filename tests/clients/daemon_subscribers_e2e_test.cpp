@@ -114,6 +114,12 @@ subscriber::Hello hello_v2(std::string token = "") {
   return ::testing::AssertionSuccess();
 }
 
+// The subscriber says `hello` and is served.
+::testing::AssertionResult served(RawSubscriber& peer, const subscriber::Hello& hello) {
+  if (!peer.say(hello)) return ::testing::AssertionFailure() << "the Hello could not be sent";
+  return served(peer);
+}
+
 // The subscriber is told it is refused (a Status whose detail holds `why`), then closed.
 ::testing::AssertionResult refused(RawSubscriber& peer, const std::string& why) {
   const std::optional<Message> first = peer.next();
@@ -294,8 +300,7 @@ TEST(DaemonDemoSubscribers, ThePoolShrinksBackToItsHighWaterMarkAfterStalledSubs
   test::DaemonProcess& daemon = *started;
   ASSERT_GT(daemon.sub_port, 0);
   RawSubscriber good(daemon.sub_port);
-  ASSERT_TRUE(good.say(subscriber::Hello{0}));
-  ASSERT_TRUE(served(good));
+  ASSERT_TRUE(served(good, subscriber::Hello{0}));
   const nlohmann::json before = health_of(daemon.http_port)["frame_pool"];
   ASSERT_TRUE(before.is_object()) << health_of(daemon.http_port).dump();
   const long rss_before = resident_kb(daemon.pid());
@@ -344,15 +349,13 @@ TEST(DaemonDemoSubscribers, BuffersOfFormatsNobodyWantsAnyMoreAreFreed) {
   test::DaemonProcess& daemon = *started;
   ASSERT_GT(daemon.sub_port, 0);
   RawSubscriber good(daemon.sub_port);
-  ASSERT_TRUE(good.say(subscriber::Hello{0}));
-  ASSERT_TRUE(served(good));
+  ASSERT_TRUE(served(good, subscriber::Hello{0}));
   const long rss_before = resident_kb(daemon.pid());
   const uint32_t formats[] = {subscriber::kFrameNormals, subscriber::kFrameNormals | subscriber::kFrameMarkers,
                               subscriber::kFrameNormals | subscriber::kFrameQuantised, subscriber::kFrameMarkers};
   for (const uint32_t flags : formats) {
     RawSubscriber once(daemon.sub_port);
-    ASSERT_TRUE(once.say(subscriber::Hello{flags}));
-    ASSERT_TRUE(served(once));
+    ASSERT_TRUE(served(once, subscriber::Hello{flags}));
     ASSERT_TRUE(once.next()) << "a frame in format " << flags;
     for (int frames = 0; frames < 4; ++frames) ASSERT_TRUE(good.next());
   }
@@ -393,8 +396,7 @@ TEST(DaemonDemoSubscribers, ThreeHundredStalledSubscribersConnectingAtOnceDoNotS
   test::DaemonProcess& daemon = *started;
   ASSERT_GT(daemon.sub_port, 0);
   RawSubscriber good(daemon.sub_port);
-  ASSERT_TRUE(good.say(subscriber::Hello{0}));
-  ASSERT_TRUE(served(good));
+  ASSERT_TRUE(served(good, subscriber::Hello{0}));
   ASSERT_TRUE(good.next());  // a first Frame or Status: it is streaming
   const uint64_t pipeline_dropped_before = health_of(daemon.http_port)["frames"]["dropped"].get<uint64_t>();
 
