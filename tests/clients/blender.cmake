@@ -13,7 +13,7 @@ elseif(TARGET skinstreamd)
     --python ${CMAKE_CURRENT_LIST_DIR}/blender/addon_test.py -- ${addon_zip})
   set_tests_properties(blender.addon PROPERTIES
     ENVIRONMENT "BLENDER_USER_SCRIPTS=${CMAKE_BINARY_DIR}/test_tmp/blender/scripts;SKINSTREAMD=$<TARGET_FILE:skinstreamd>;SKINSTREAM_CLI=$<TARGET_FILE:skinstream>;SKINSTREAM_DEMO_DIR=${CMAKE_BINARY_DIR}/demo;SKINSTREAM_TEST_TMP_DIR=${CMAKE_BINARY_DIR}/test_tmp/blender"
-    FIXTURES_REQUIRED "blender_addon;demo_subject" LABELS clients TIMEOUT 600)
+    FIXTURES_REQUIRED "blender_addon;demo_subject" LABELS clients TIMEOUT ${time_limit_600})
   if(TARGET skinstream_client)  # the fast path for the parameters the carried package finds
     set_property(TEST blender.addon APPEND PROPERTY ENVIRONMENT SKINSTREAM_CLIENT_LIBRARY=$<TARGET_FILE:skinstream_client>)
   endif()

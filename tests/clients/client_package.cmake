@@ -7,5 +7,5 @@ if(TARGET skinstream_client AND TARGET skinstreamd AND SKINSTREAM_PYTHON)
     COMMAND ${SKINSTREAM_PYTHON} ${CMAKE_CURRENT_LIST_DIR}/cpp/package_test.py ${CMAKE_BINARY_DIR} ${PROJECT_SOURCE_DIR}
       $<TARGET_FILE:skinstreamd> ${CMAKE_BINARY_DIR}/demo ${CMAKE_BINARY_DIR}/test_tmp/client_package)
   set_tests_properties(client_package.install_build_and_run_example PROPERTIES
-    FIXTURES_REQUIRED demo_subject LABELS clients TIMEOUT 600)
+    FIXTURES_REQUIRED demo_subject LABELS clients TIMEOUT ${time_limit_600})
 endif()

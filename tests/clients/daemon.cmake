@@ -20,10 +20,10 @@ if(TARGET skinstreamd AND TARGET skinstream-sub AND TARGET skinstream-replay)
     SKINSTREAM_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
     SKINSTREAM_TEST_TMP_DIR="${CMAKE_BINARY_DIR}/test_tmp/daemon")
   add_dependencies(daemon_tests skinstreamd skinstream-sub skinstream-replay skinstream)
-  gtest_discover_tests(daemon_tests TEST_FILTER "-DaemonDemo*" DISCOVERY_TIMEOUT 60 PROPERTIES LABELS clients TIMEOUT 120)
+  gtest_discover_tests(daemon_tests TEST_FILTER "-DaemonDemo*" DISCOVERY_TIMEOUT 60 PROPERTIES LABELS clients TIMEOUT ${time_limit_120})
   # The demo subject's tests need the demo_subject fixture (tests/clients/CMakeLists.txt).
   gtest_discover_tests(daemon_tests TEST_FILTER "DaemonDemo*" DISCOVERY_TIMEOUT 60
-    PROPERTIES LABELS clients TIMEOUT 300 FIXTURES_REQUIRED demo_subject)
+    PROPERTIES LABELS clients TIMEOUT ${time_limit_300} FIXTURES_REQUIRED demo_subject)
 
   # Usage errors of the programs themselves.
   add_test(NAME daemon.unknown_flag COMMAND skinstreamd --no-such-flag)
@@ -46,5 +46,5 @@ if(TARGET skinstreamd AND TARGET skinstream-sub AND TARGET skinstream-replay)
   add_test(NAME daemon.deform_cpu_not_allowed COMMAND skinstreamd --subject ${CMAKE_BINARY_DIR}/demo/subject.sksubj
     --deform-cpus 0,4095 --http-port 0 --sub-port 0)
   set_tests_properties(daemon.deform_cpu_not_allowed PROPERTIES
-    PASS_REGULAR_EXPRESSION "CPU 4095 is not one this process may run on" TIMEOUT 60 LABELS clients FIXTURES_REQUIRED demo_subject)
+    PASS_REGULAR_EXPRESSION "CPU 4095 is not one this process may run on" TIMEOUT ${time_limit_60} LABELS clients FIXTURES_REQUIRED demo_subject)
 endif()

@@ -13,7 +13,7 @@ if(NOT SKINSTREAM_NODE)
   message(STATUS "QTM client test: node not found (apt-get install nodejs npm); qtm.qualisys_rt not added")
 else()
   add_test(NAME qtm.install_qualisys_rt COMMAND ${PROJECT_SOURCE_DIR}/tests/clients/qualisys_rt/install.sh)
-  set_tests_properties(qtm.install_qualisys_rt PROPERTIES FIXTURES_SETUP qualisys_rt LABELS clients TIMEOUT 600)
+  set_tests_properties(qtm.install_qualisys_rt PROPERTIES FIXTURES_SETUP qualisys_rt LABELS clients TIMEOUT ${time_limit_600})
   add_test(NAME qtm.recordings_as_trc COMMAND bash -c [=["$0" convert "$1" "$3/dense.trc" && "$0" convert "$2" "$3/cmu.trc"]=]
     $<TARGET_FILE:skinstream> ${qtm_dense} ${qtm_cmu} ${qtm_tmp})
   set_tests_properties(qtm.recordings_as_trc PROPERTIES FIXTURES_SETUP qtm_recordings LABELS clients)
@@ -21,7 +21,7 @@ else()
     ${PROJECT_SOURCE_DIR}/tests/clients/qualisys_rt/qtm_client_test.js $<TARGET_FILE:skinstream-replay>
     ${qtm_dense}:${qtm_tmp}/dense.trc ${qtm_cmu}:${qtm_tmp}/cmu.trc)
   set_tests_properties(qtm.qualisys_rt_reads_replay PROPERTIES FIXTURES_REQUIRED "qualisys_rt;qtm_recordings"
-    LABELS clients TIMEOUT 120 PASS_REGULAR_EXPRESSION "qualisys-rt received 810 frames of 391 labels")
+    LABELS clients TIMEOUT ${time_limit_120} PASS_REGULAR_EXPRESSION "qualisys-rt received 810 frames of 391 labels")
 endif()
 
 # skinstream-replay's QTM RT and NatNet modes: bad command lines fail with one error line.

@@ -36,7 +36,7 @@ wait $pid
 echo "exit $?"
 rm -f "$out"
 ]=] $<TARGET_FILE:skinstream-replay> ${replay_capture})
-set_tests_properties(replay.serves_a_tcp_client PROPERTIES TIMEOUT 60
+set_tests_properties(replay.serves_a_tcp_client PROPERTIES TIMEOUT ${time_limit_60}
   PASS_REGULAR_EXPRESSION "01 00 2b 1a 2c 00 00 00 a1 86 01 00[^!]*exit 0")
 
 # Bad paths: a non-zero exit, and the error line naming the problem.

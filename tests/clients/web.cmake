@@ -11,15 +11,15 @@ elseif(NOT SKINSTREAM_NODE)
   message(STATUS "browser test: node not found (apt-get install nodejs npm); the web tests are not added")
 else()
   add_test(NAME web.bundle COMMAND ${PROJECT_SOURCE_DIR}/clients/web/build.sh ${CMAKE_BINARY_DIR}/web)
-  set_tests_properties(web.bundle PROPERTIES FIXTURES_SETUP web_bundle LABELS browser TIMEOUT 600)
+  set_tests_properties(web.bundle PROPERTIES FIXTURES_SETUP web_bundle LABELS browser TIMEOUT ${time_limit_600})
 
   set(web_tests ${CMAKE_CURRENT_SOURCE_DIR}/web)
   add_test(NAME web.units COMMAND ${SKINSTREAM_NODE} --test ${web_tests}/protocol_test.mjs ${web_tests}/model_message_test.mjs
     ${web_tests}/compressed_decoder_test.mjs ${web_tests}/evaluation_tables_test.mjs)
-  set_tests_properties(web.units PROPERTIES FIXTURES_REQUIRED web_bundle TIMEOUT 300)
+  set_tests_properties(web.units PROPERTIES FIXTURES_REQUIRED web_bundle TIMEOUT ${time_limit_300})
 
   add_test(NAME web.bad_input COMMAND ${SKINSTREAM_NODE} ${web_tests}/viewer_bad_input_test.mjs --web-root ${CMAKE_BINARY_DIR}/web)
-  set_tests_properties(web.bad_input PROPERTIES FIXTURES_REQUIRED web_bundle LABELS browser TIMEOUT 600 PROCESSORS 2)
+  set_tests_properties(web.bad_input PROPERTIES FIXTURES_REQUIRED web_bundle LABELS browser TIMEOUT ${time_limit_600} PROCESSORS 2)
 
   add_test(NAME web.viewer COMMAND ${SKINSTREAM_NODE} ${web_tests}/viewer_test.mjs
     --daemon $<TARGET_FILE:skinstreamd>
@@ -30,5 +30,5 @@ else()
     --out ${CMAKE_BINARY_DIR}/test_tmp/web)
   # Chromium with SwiftShader keeps both cores busy: let ctest -j count it as two.
   set_tests_properties(web.viewer PROPERTIES FIXTURES_REQUIRED "web_bundle;demo_subject"
-    LABELS browser TIMEOUT 600 PROCESSORS 2)
+    LABELS browser TIMEOUT ${time_limit_600} PROCESSORS 2)
 endif()
