@@ -184,7 +184,18 @@ size_t FramePool::release_unwanted(const StreamKeySet& wanted, std::chrono::stea
   // Serial with prepare(): a subscriber asking for an encoding while this runs either comes
   // first (and its fresh last_wanted_ keeps the buffers) or after (and makes them again).
   std::lock_guard serial(prepare_mutex_);
-  std::vector<std::vector<unsigned char>> doomed;  // freed outside the lock
+  // Freed outside the lock, and sized before it: the pipeline takes mutex_ for every frame, so
+  // nothing here may allocate while holding it. Under prepare_mutex_ the buffers of an encoding,
+  // held by frames or ready, can only move between the two (size_message), never grow.
+  std::vector<std::vector<unsigned char>> doomed;
+  {
+    size_t most = 0;
+    {
+      std::lock_guard lock(mutex_);
+      for (size_t key = 0; key < ready_.size(); ++key) most += sized_[key] + ready_[key].size();
+    }
+    doomed.reserve(most);
+  }
   {
     std::lock_guard lock(mutex_);
     for (StreamKey key = 0; key < EncodedFrame::kEncodings; ++key) {

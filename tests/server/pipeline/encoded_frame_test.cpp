@@ -155,5 +155,25 @@ TEST(FramePool, BuffersOfAnEncodingNobodyWantsAreFreedAfterTheHoldOff) {
   EXPECT_EQ(allocations.count(), 0u);
 }
 
+// The pipeline takes the pool's lock for every frame: release_unwanted() sizes its list of
+// buffers to free before it takes that lock, so it allocates once however many it frees
+// (growing the list inside the lock took one allocation per doubling, each under the lock).
+TEST(FramePool, ReleasingUnwantedBuffersAllocatesOnceBeforeTakingTheLock) {
+  using namespace std::chrono_literals;
+  constexpr StreamKey kDropped = 5;
+  FramePool pool(40);
+  pool.prepare(kDropped, 100);
+  const auto now = std::chrono::steady_clock::now();
+  size_t freed = 0;
+  size_t allocated = 0;
+  {
+    const test::CountAllocations allocations;
+    freed = pool.release_unwanted(StreamKeySet{}, now + 11s, 10s);
+    allocated = allocations.count();
+  }
+  EXPECT_EQ(freed, 40u);
+  EXPECT_EQ(allocated, 1u);
+}
+
 }  // namespace
 }  // namespace skinstream::server
