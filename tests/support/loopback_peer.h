@@ -1,10 +1,11 @@
 #pragma once
 // Raw loopback peers for end-to-end tests: a TCP connection from a chosen 127.x address (so one
-// machine can play several subscriber hosts), an HTTP GET with a deadline, and a wait on a
-// condition that bounds a hang without timing anything.
+// machine can play several subscriber hosts) and an HTTP GET with a deadline.
 #include <chrono>
 #include <functional>
 #include <string>
+
+#include "support/eventually.h"  // the end-to-end tests wait with it too
 
 namespace skinstream::test {
 
@@ -18,8 +19,5 @@ int connect_loopback(int port, const std::string& from = "", int receive_buffer_
 std::string http_exchange_within(int port, const std::string& request, std::chrono::seconds limit, const std::string& from = "");
 // GET `target` with Connection: close.
 std::string http_get_within(int port, const std::string& target, std::chrono::seconds limit);
-
-// Polls `condition` every 20 ms for up to `limit`: a bound on a hang, not a timing assertion.
-bool eventually(const std::function<bool()>& condition, std::chrono::seconds limit = std::chrono::seconds(20));
 
 }  // namespace skinstream::test

@@ -12,20 +12,11 @@
 
 #include "server/asio.h"
 #include "server/ingest/source_frame.h"
+#include "support/eventually.h"  // for conditions no sink call announces (a server's counter)
 
 namespace skinstream::test {
 
 constexpr auto kPatience = std::chrono::seconds(20);  // bounds a failing wait; passing ones are quick
-
-// Polls a condition that no sink call announces (a server's counter), every 10 ms.
-inline bool eventually(const std::function<bool()>& done) {
-  const auto deadline = std::chrono::steady_clock::now() + kPatience;
-  while (!done()) {
-    if (std::chrono::steady_clock::now() > deadline) return false;
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
-  }
-  return true;
-}
 
 class IoThread {
  public:
