@@ -1,6 +1,6 @@
 #pragma once
-// For tests of the ingest sources: an io_context on its own thread, and a SourceSink that keeps
-// copies of everything a source hands on, with waits bounded in time.
+// For tests of the ingest sources: a SourceSink that keeps copies of everything a source hands
+// on, with waits bounded in time (the sources run on support/io_thread.h's IoThread).
 #include <chrono>
 #include <condition_variable>
 #include <functional>
@@ -13,33 +13,11 @@
 #include "server/asio.h"
 #include "server/ingest/source_frame.h"
 #include "support/eventually.h"  // for conditions no sink call announces (a server's counter)
+#include "support/io_thread.h"
 
 namespace skinstream::test {
 
 constexpr auto kPatience = std::chrono::seconds(20);  // bounds a failing wait; passing ones are quick
-
-class IoThread {
- public:
-  IoThread() : guard_(server::asio::make_work_guard(io)), thread_([this] { io.run(); }) {}
-  ~IoThread() {
-    guard_.reset();
-    io.stop();
-    thread_.join();
-  }
-  // Runs f on the io thread and returns its result.
-  template <typename F>
-  auto call(F&& f) {
-    std::packaged_task<decltype(f())()> task(std::forward<F>(f));
-    auto result = task.get_future();
-    server::asio::post(io, [&task] { task(); });
-    return result.get();
-  }
-  server::asio::io_context io;
-
- private:
-  server::asio::executor_work_guard<server::asio::io_context::executor_type> guard_;
-  std::thread thread_;
-};
 
 class SourceSinkRecorder : public server::SourceSink {
  public:
