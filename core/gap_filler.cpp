@@ -493,7 +493,7 @@ bool GapFiller::solve_pca(int j) {
     int missing_slot = 0;
     while (observed_[model_.ring[first + missing_slot]]) ++missing_slot;
     const int at = first + missing_slot;
-    const double* map = &single_gap_map_[single_gap_offset_[at]];
+    const double* map = single_gap_map_.data() + single_gap_offset_[at];  // empty when the model has no components
     const int columns = 3 * count, components = static_cast<int>(m.variance.size());
     for (int o = 0; o < count; ++o)
       single_gap_deviation_.segment<3>(3 * o) = scratch_source_[o] - m.mean.segment<3>(3 * scratch_index_[o]);
