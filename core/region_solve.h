@@ -35,7 +35,10 @@ struct RegionSolve {
   double calibration = 1.0;
   double residual_variance = 0.0;
 
-  bool matches(uint32_t mask, long version) const { return observed_mask == mask && shape_version == version; }
+  // Whether this holds a solve for these members seen and this shape (never after a failed prepare).
+  bool matches(uint32_t mask, long version) const {
+    return observed_mask != 0 && observed_mask == mask && shape_version == version;
+  }
 };
 
 // Which of members 1.. are observed, as a RegionSolve's mask (member 0's own flag is not read).

@@ -121,6 +121,12 @@ TEST(RegionSolve, NeedsThreeObservedMembers) {
   EXPECT_EQ(solve.observed, 3);
   EXPECT_EQ(solve.hidden, kMembers - 3);
   EXPECT_EQ(solve.hidden_slots[0], 0);
+  EXPECT_TRUE(solve.matches(region_observed_mask(observed), 0));
+  // A failed prepare keeps nothing: no later mask matches it, not even that of no member seen.
+  const std::vector<char> none(kMembers, 0);
+  EXPECT_FALSE(prepare_region_solve(s.shape, region_observed_mask(none), 0, solve));
+  EXPECT_FALSE(solve.matches(region_observed_mask(none), 0));
+  EXPECT_FALSE(solve.matches(region_observed_mask(observed), 0));
 }
 
 }  // namespace
