@@ -1,7 +1,5 @@
 #include "core/region_pca_fit.h"
 
-#include <algorithm>
-
 namespace skinstream {
 
 // Aligns the first `aligned` of world_ with mean_, then conditions the shape on the observed
