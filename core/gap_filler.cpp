@@ -88,7 +88,7 @@ GapFiller::GapFiller(const SubjectModel& model, const GapFillerOptions& options)
   single_gap_deviation_.resize(kMaxRingDims);
   region_positions_.assign(SubjectModel::kMaxRing, Vec3::Zero());
   region_observed_.assign(SubjectModel::kMaxRing, 0);
-  region_factors_.resize(model.has_regions() ? n_ : 0);
+  region_solves_.resize(model.has_regions() ? n_ : 0);
 }
 
 // For every ring member of every model, the PCA coefficients when that member alone is missing
@@ -131,7 +131,7 @@ void GapFiller::reset() {
   std::fill(carry_drift_.begin(), carry_drift_.end(), 0.0);
   std::fill(carry_checks_.begin(), carry_checks_.end(), 0);
   region_statistics_.reset();
-  for (RegionFactor& f : region_factors_) f.observed_mask = 0;
+  for (RegionSolve& solve : region_solves_) solve.observed_mask = 0;
 }
 
 void GapFiller::add_free_point(const Vec3& p, int id) {
@@ -712,9 +712,12 @@ bool GapFiller::region_estimate(int i, double other_variance, Vec3& out, double&
     region_positions_[k] = current_[member];
     region_observed_[k] = observed_[member];
   }
-  return region_fit_.estimate(region_statistics_.blended(i), {region_positions_.data(), static_cast<size_t>(size)},
-                              {region_observed_.data(), static_cast<size_t>(size)}, out, out_variance, &region_factors_[i],
-                              region_statistics_.version(i));
+  RegionSolve& solve = region_solves_[i];
+  const uint32_t mask = region_observed_mask({region_observed_.data(), static_cast<size_t>(size)});
+  const long version = region_statistics_.version(i);
+  if (!solve.matches(mask, version) && !prepare_region_solve(region_statistics_.blended(i), mask, version, solve)) return false;
+  region_fit_.estimate(solve, {region_positions_.data(), static_cast<size_t>(size)}, out, out_variance);
+  return true;
 }
 
 void GapFiller::fill_missing() {

@@ -243,7 +243,7 @@ class GapFiller {
   bool region_estimate(int i, double other_variance, Vec3& out, double& out_variance);
   RegionPcaFit region_fit_;
   RegionOnlineStatistics region_statistics_;
-  std::vector<RegionFactor> region_factors_;  // per marker's region, reused while its members seen do not change
+  std::vector<RegionSolve> region_solves_;  // per marker's region, kept while its members seen and its shape do not change
   std::vector<Vec3> region_positions_;
   std::vector<char> region_observed_;
   std::vector<Vec3> scratch_source_, scratch_target_;

@@ -49,7 +49,7 @@ class RegionOnlineStatistics {
   const RegionShapeGaussian& blended(int i);
   // Member 0's calibration in the blend, without forming it.
   double calibration(int i) const;
-  // Changes whenever region i learns (what a RegionFactor kept for it depends on).
+  // Changes whenever region i learns (what a RegionSolve kept for it depends on).
   long version(int i) const { return regions_[i].updates; }
   // Seconds of evidence region i learned from, after forgetting.
   double evidence_seconds(int i) const { return regions_[i].evidence; }

@@ -15,57 +15,45 @@
 //      rounds: on a walk's two legs, where the legs' opposite swing looks like a turn of the
 //      whole, one round left 34 mm of error on a synthetic foot and ten 5 mm).
 // The estimate is member 0's conditional mean carried back to the world; its variance per
-// coordinate the conditional variance times the calibration. Allocation-free.
+// coordinate the conditional variance times the calibration. What depends only on the shape and
+// on which members are seen (region_solve.h) a caller may keep across frames. Allocation-free.
 
 #include <array>
-#include <cstdint>
 #include <span>
 
 #include "core/absolute_orientation.h"
 #include "core/pca_fit.h"
 #include "core/region_shape_gaussian.h"
+#include "core/region_solve.h"
 #include "core/subject_model.h"
 
 namespace skinstream {
-
-// The Cholesky factor of a region's observed members' covariance, kept by a caller from frame
-// to frame: it depends only on which members are observed and on the shape, and while neither
-// changes (a region in a gap does not learn) it is reused.
-struct RegionFactor {
-  uint32_t observed_mask = 0;  // 0: nothing kept
-  long shape_version = -1;
-  PcaMatrix lower;
-};
 
 class RegionPcaFit {
  public:
   // `positions` and `observed` are parallel to the region's members (slot 0: the marker to
   // estimate, whose own position is not used). False when fewer than three other members are
   // observed or the observed members' covariance cannot be factored.
-  // With `kept`, the factor is taken from it when made for these members and `shape_version`,
-  // else made there.
   bool estimate(const RegionShapeGaussian& shape, std::span<const Vec3> positions, std::span<const char> observed,
-                Vec3& out, double& out_variance, RegionFactor* kept = nullptr, long shape_version = 0);
+                Vec3& out, double& out_variance);
+  // The same from a solve prepared for the members observed now (region_solve.h), kept by the
+  // caller while they and the shape stay the same; `positions` parallel to the members.
+  void estimate(const RegionSolve& solve, std::span<const Vec3> positions, Vec3& out, double& out_variance);
   // The same from the offline model (false too when it was never trained).
   bool estimate(const MarkerPcaModel& model, std::span<const Vec3> positions, std::span<const char> observed,
                 Vec3& out, double& out_variance);
 
  private:
-  void align_and_condition(const RegionShapeGaussian& shape, int aligned);
-  Vec3 conditional_mean(const RegionShapeGaussian& shape, int slot) const;
+  void align_and_condition(const RegionSolve& solve, int aligned);
 
   static constexpr int kMaxAlignments = 10;
   static constexpr double kConverged = 0.5;  // mm
-  int observed_count_ = 0;
   RigidTransform to_region_;  // world -> the region's frame
   std::array<Vec3, SubjectModel::kMaxRing> world_, mean_;
-  std::array<int, SubjectModel::kMaxRing> slots_;
-  bool factor(const RegionShapeGaussian& shape, uint32_t mask, RegionFactor& out);
+  std::array<Vec3, SubjectModel::kMaxRing> hidden_;  // the hidden members' conditional means, region's frame
+  PcaVector deviation_;  // observed members in the region's frame less their mean
 
-  RegionFactor own_factor_;
-  const PcaMatrix* lower_ = nullptr;  // L of the observed members' covariance (residual included) = L L^T
-  PcaVector weights_;  // (L L^T)^-1 (observed in the region's frame - their mean)
-  PcaMatrix cross_;    // scratch: covariance of member 0 with the observed members
+  RegionSolve own_solve_;
   RegionShapeGaussian from_model_;
 };
 
