@@ -32,6 +32,8 @@ GapFiller::GapFiller(const SubjectModel& model, const GapFillerOptions& options)
   }
 
   previous_.assign(n_, Vec3::Zero());
+  before_previous_.assign(n_, Vec3::Zero());
+  before_previous_seen_.assign(n_, 0);
   previous_status_.assign(n_, MarkerStatus::Held);
   assigned_id_.assign(n_, kNoFragment);
   probation_start_.assign(n_, -1);
@@ -121,6 +123,7 @@ void GapFiller::precompute_single_gaps() {
 
 void GapFiller::reset() {
   has_previous_ = false;
+  std::fill(before_previous_seen_.begin(), before_previous_seen_.end(), 0);
   std::fill(assigned_id_.begin(), assigned_id_.end(), kNoFragment);
   std::fill(probation_start_.begin(), probation_start_.end(), -1);
   std::fill(refused_id_.begin(), refused_id_.end(), kNoFragment);
@@ -191,6 +194,8 @@ FillStats GapFiller::run(const FrameInput& in, const FrameOutput& out) {
     if (!out.fragments.empty()) out.fragments[i] = status_[i] == MarkerStatus::Relabelled ? assigned_id_[i] : kNoFragment;
     if (!out.revoked.empty()) out.revoked[i] = revoked_[i];
     if (is_present(in.labelled[i]) && current_[i] != in.labelled[i]) ++stats_.changed_measured;
+    before_previous_[i] = previous_[i];
+    before_previous_seen_[i] = has_previous_ && is_observed(previous_status_[i]);
     previous_[i] = current_[i];
     previous_status_[i] = status_[i];
     switch (status_[i]) {
@@ -254,9 +259,11 @@ void GapFiller::judge_suspect_labels() {
     const bool has_own = expected_position(i, own, &own_variance);
     const double own_distance = has_own ? (current_[i] - own).norm() : std::numeric_limits<double>::infinity();
     const bool own_confident = has_own && own_distance * own_distance > kConfidentMiss * own_variance;
-    const bool reject = (own_distance > eps2_[i] || own_confident) &&
-                        (explained_by_another(i, own_distance) ||
-                         (has_own && own_distance > eps2_[i] && is_observed(previous_status_[i])));
+    // With no estimate of its own, the point's own track is the evidence left.
+    const bool reject = has_own ? (own_distance > eps2_[i] || own_confident) &&
+                                      (explained_by_another(i, own_distance) ||
+                                       (own_distance > eps2_[i] && is_observed(previous_status_[i])))
+                                : explained_by_another(i, own_distance) || off_own_track(i);
     if (reject) {
       add_free_point(current_[i], -(i + 1));
       ++stats_.rejected_labels;
@@ -271,7 +278,19 @@ void GapFiller::judge_suspect_labels() {
 // Whether another missing (or suspect) marker is expected within eps1 of i's labelled point and
 // at most half as far from it as i's own estimate: a swap, or a point where skin touches skin.
 bool GapFiller::explained_by_another(int i, double own_distance) {
-  return nearest_other_expected(i, current_[i]) <= 0.5 * own_distance;
+  // No other marker reaching the point explains nothing, even when i has no estimate of its
+  // own (infinity against infinity would otherwise reject every such point).
+  const double nearest = nearest_other_expected(i, current_[i]);
+  return std::isfinite(nearest) && nearest <= 0.5 * own_distance;
+}
+
+// Whether marker i, measured in the last two frames, is now farther from where its own velocity
+// takes it than eps2 plus a frame's travel: a label that jumps off its track (a swap, a ghost),
+// where a fast limb at a low frame rate stays near it (a serve's hand: 240 mm a frame at 50 Hz).
+bool GapFiller::off_own_track(int i) const {
+  if (!before_previous_seen_[i] || !is_observed(previous_status_[i])) return false;
+  const Vec3 velocity = previous_[i] - before_previous_[i];
+  return (current_[i] - previous_[i] - velocity).norm() > eps2_[i] + velocity.norm();
 }
 
 // The distance from point p to the nearest estimate of another missing marker that is within

@@ -125,6 +125,7 @@ class GapFiller {
   void find_suspect_labels();
   void judge_suspect_labels();
   bool explained_by_another(int i, double own_distance);
+  bool off_own_track(int i) const;
   double nearest_other_expected(int i, const Vec3& p);
   bool carried_position(int i, Vec3& out) const;
   void estimate_rigid();
@@ -170,6 +171,8 @@ class GapFiller {
   long solve_stamp_ = 0;  // this frame's: a PCA solve made in it stands until its ring changes (refresh_estimates)
   std::vector<Vec3> previous_;
   std::vector<MarkerStatus> previous_status_;
+  std::vector<Vec3> before_previous_;       // two frames back, for a marker's own track
+  std::vector<char> before_previous_seen_;  // measured (or relabelled) two frames back
   std::vector<int> assigned_id_;      // free-point trajectory currently standing for marker i
   std::vector<long> probation_start_;  // frame its relabel was taken while still on probation, else -1
   std::vector<int> refused_id_;        // a fragment whose relabel was revoked, not taken again while it lasts
