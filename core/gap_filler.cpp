@@ -259,11 +259,13 @@ void GapFiller::judge_suspect_labels() {
     const bool has_own = expected_position(i, own, &own_variance);
     const double own_distance = has_own ? (current_[i] - own).norm() : std::numeric_limits<double>::infinity();
     const bool own_confident = has_own && own_distance * own_distance > kConfidentMiss * own_variance;
-    // With no estimate of its own, the point's own track is the evidence left.
+    // With no estimate of its own, the point's own track is the evidence left: where its motion
+    // takes it, and whether another marker's estimate or track reaches the point clearly better.
     const bool reject = has_own ? (own_distance > eps2_[i] || own_confident) &&
                                       (explained_by_another(i, own_distance) ||
                                        (own_distance > eps2_[i] && is_observed(previous_status_[i])))
-                                : explained_by_another(i, own_distance) || off_own_track(i);
+                                : explained_by_another(i, (current_[i] - track_prediction(i)).norm()) ||
+                                      off_own_track(i);
     if (reject) {
       add_free_point(current_[i], -(i + 1));
       ++stats_.rejected_labels;
@@ -277,11 +279,20 @@ void GapFiller::judge_suspect_labels() {
 
 // Whether another missing (or suspect) marker is expected within eps1 of i's labelled point and
 // at most half as far from it as i's own estimate: a swap, or a point where skin touches skin.
+// Where no other marker has an estimate (a hidden patch, every label in it suspect at once), each
+// one's own track stands in for it: two labels swapped on returning from a gap are each near
+// where the other one was.
 bool GapFiller::explained_by_another(int i, double own_distance) {
-  // No other marker reaching the point explains nothing, even when i has no estimate of its
-  // own (infinity against infinity would otherwise reject every such point).
-  const double nearest = nearest_other_expected(i, current_[i]);
+  const double nearest = std::min(nearest_other_expected(i, current_[i]), nearest_other_on_track(i, current_[i]));
   return std::isfinite(nearest) && nearest <= 0.5 * own_distance;
+}
+
+// Where marker i's own motion takes it this frame: its last position moved on by its last
+// frame's velocity when it was measured in the last two frames, else its last position (its
+// estimate, during a gap).
+Vec3 GapFiller::track_prediction(int i) const {
+  if (!before_previous_seen_[i] || !is_observed(previous_status_[i])) return previous_[i];
+  return 2.0 * previous_[i] - before_previous_[i];
 }
 
 // Whether marker i, measured in the last two frames, is now farther from where its own velocity
@@ -289,8 +300,21 @@ bool GapFiller::explained_by_another(int i, double own_distance) {
 // where a fast limb at a low frame rate stays near it (a serve's hand: 240 mm a frame at 50 Hz).
 bool GapFiller::off_own_track(int i) const {
   if (!before_previous_seen_[i] || !is_observed(previous_status_[i])) return false;
-  const Vec3 velocity = previous_[i] - before_previous_[i];
-  return (current_[i] - previous_[i] - velocity).norm() > eps2_[i] + velocity.norm();
+  const double travel = (previous_[i] - before_previous_[i]).norm();
+  return (current_[i] - track_prediction(i)).norm() > eps2_[i] + travel;
+}
+
+// The distance from point p to the track prediction of the nearest other missing (or suspect)
+// marker that has no estimate this frame and a position last frame, within eps1 (infinity: none).
+double GapFiller::nearest_other_on_track(int i, const Vec3& p) {
+  double nearest = std::numeric_limits<double>::infinity();
+  Vec3 unused;
+  for (int j : missing_) {
+    if (observed_[j] || j == i || previous_status_[j] == MarkerStatus::Held) continue;
+    const double d = (p - track_prediction(j)).norm();
+    if (d <= eps1_[j] && d < nearest && !expected_position(j, unused)) nearest = d;
+  }
+  return nearest;
 }
 
 // The distance from point p to the nearest estimate of another missing marker that is within

@@ -125,8 +125,10 @@ class GapFiller {
   void find_suspect_labels();
   void judge_suspect_labels();
   bool explained_by_another(int i, double own_distance);
+  Vec3 track_prediction(int i) const;
   bool off_own_track(int i) const;
   double nearest_other_expected(int i, const Vec3& p);
+  double nearest_other_on_track(int i, const Vec3& p);
   bool carried_position(int i, Vec3& out) const;
   void estimate_rigid();
   void fit_rigid_estimate(int i);

@@ -264,6 +264,37 @@ TEST(GapFiller, KeepsAFastMarkerNothingElseCanEstimate) {
   EXPECT_GE(fast_frames, 15) << "the marker must move more than eps2 a frame for this test";
 }
 
+// Two neighbours return from a gap with their labels swapped, at a frame where the rest of the limb
+// is hidden: neither has an estimate, so only their tracks speak. Each point is next to where
+// the other marker was last estimated and a marker spacing from its own: both are rejected.
+// Once, a point with no estimate of its own stood unless another marker's estimate reached it.
+TEST(GapFiller, RejectsTwoLabelsSwappedWhereNeitherHasAnEstimate) {
+  Fixture fx;
+  GapFiller filler(fx.model);
+  Frame frame(fx.model.marker_count());
+  const int neighbour = fx.model.ring[fx.model.ring_offsets[kMiddle]];
+  const double eps2 = fx.model.parameters.alpha2 * std::max(fx.model.neighbour_distance(kMiddle), fx.model.neighbour_distance(neighbour));
+  for (int f = 0; f <= 30; ++f) {
+    load(fx.truth, f, frame);
+    if (f >= 20) frame.labelled[kMiddle] = frame.labelled[neighbour] = missing_point();
+    if (f == 30) {
+      for (int j = 0; j < fx.model.marker_count(); ++j) frame.labelled[j] = missing_point();
+      frame.labelled[kMiddle] = fx.truth.at(f, neighbour);
+      frame.labelled[neighbour] = fx.truth.at(f, kMiddle);
+      ASSERT_GT((fx.truth.at(f, kMiddle) - fx.truth.at(f, neighbour)).norm(), eps2) << "the swapped labels must be suspect";
+    }
+    const FillStats s = frame.run(filler);
+    if (f == 29) {
+      ASSERT_NE(frame.status[kMiddle], MarkerStatus::Held) << "estimated during the gap";
+      ASSERT_NE(frame.status[neighbour], MarkerStatus::Held);
+    }
+    if (f < 30) continue;
+    EXPECT_EQ(s.rejected_labels, 2);
+    EXPECT_NE(frame.positions[kMiddle], frame.labelled[kMiddle]);
+    EXPECT_NE(frame.positions[neighbour], frame.labelled[neighbour]);
+  }
+}
+
 // A marker comes back from a gap under the label of a neighbour that was itself missing: the
 // point is far from the neighbour's estimate and next to the estimate of the marker it really
 // is, which is missing. That explains it: it goes to that marker, and the neighbour is filled.
