@@ -249,9 +249,10 @@ void GapFiller::find_suspect_labels() {
 // marker took last frame and carried along. A suspect point is judged against estimates made
 // this frame from the other markers alone. It stands when its own estimate agrees (within eps2
 // and within four of its calibrated standard deviations); it is taken as unlabelled when
-// another marker explains it clearly better (a swap), or when it was tracked last frame and its
-// own estimate disagrees by more than eps2 as well (two independent estimates, the motion of its
-// ring and the shape of its neighbourhood, against it). Otherwise the measurement stands.
+// another marker explains it clearly better (a swap), or when its own estimate disagrees by more
+// than eps2 and it left its own track as well (measured in the last two frames and now off where
+// its velocity takes it): a point that keeps to its track is the marker the capture system was
+// following, whatever its neighbourhood's estimate says. Otherwise the measurement stands.
 void GapFiller::judge_suspect_labels() {
   for (int i : suspects_) {
     Vec3 own;
@@ -263,7 +264,7 @@ void GapFiller::judge_suspect_labels() {
     // takes it, and whether another marker's estimate or track reaches the point clearly better.
     const bool reject = has_own ? (own_distance > eps2_[i] || own_confident) &&
                                       (explained_by_another(i, own_distance) ||
-                                       (own_distance > eps2_[i] && is_observed(previous_status_[i])))
+                                       (own_distance > eps2_[i] && off_own_track(i)))
                                 : explained_by_another(i, (current_[i] - track_prediction(i)).norm()) ||
                                       off_own_track(i);
     if (reject) {

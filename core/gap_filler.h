@@ -8,8 +8,9 @@
 //      against its last position). It is treated as unlabelled only on strong evidence, judged
 //      against this frame's estimates from the other markers: any missing marker explains it
 //      clearly better while its own confident estimate disagrees (a swap, or skin touching
-//      skin), or it was tracked and its neighbourhood's estimate disagrees too. Otherwise the
-//      measurement stands.
+//      skin; with no estimates, the markers' own tracks), or its neighbourhood's estimate
+//      disagrees and it left its own track (velocity prediction). Otherwise the measurement
+//      stands.
 //   2. Rigid estimates (eq. 2, Horn), greedy: the missing marker with the most available
 //      neighbours first, reusing earlier estimates.
 //   3. Relabelling: a tracked fragment stays with its marker while within eps2 (alpha2) of

@@ -264,6 +264,31 @@ TEST(GapFiller, KeepsAFastMarkerNothingElseCanEstimate) {
   EXPECT_GE(fast_frames, 15) << "the marker must move more than eps2 a frame for this test";
 }
 
+// A tracked marker that speeds away from its ring (a hand at a low frame rate moves more between
+// frames than its neighbourhood model allows) is suspect, and its own estimate, from a ring seen
+// whole, disagrees confidently. But it keeps to its own track, so nothing says it is another
+// marker: the measurement stands. Once, a tracked point was rejected on its estimate alone.
+TEST(GapFiller, KeepsATrackedMarkerOnItsOwnTrackItsEstimateDisagreesWith) {
+  Fixture fx;
+  GapFiller filler(fx.model);
+  Frame frame(fx.model.marker_count());
+  const double eps2 = fx.model.parameters.alpha2 * fx.model.neighbour_distance(kMiddle);
+  const Vec3 out = (fx.truth.at(0, kMiddle) - fx.truth.at(0, kOther)).normalized();
+  double travelled = 0.0;
+  for (int f = 0; f < 30; ++f) {
+    load(fx.truth, f, frame);
+    if (f >= 20) {
+      travelled += std::min(f - 19, 5) * 0.3 * eps2;  // speeding up to 1.5 eps2 a frame
+      frame.labelled[kMiddle] += travelled * out;
+    }
+    const FillStats s = frame.run(filler);
+    if (f < 20) continue;
+    EXPECT_EQ(frame.status[kMiddle], MarkerStatus::Measured) << "frame " << f;
+    EXPECT_EQ(s.changed_measured, 0) << "frame " << f;
+  }
+  EXPECT_GT(travelled, 3.0 * eps2) << "its estimate must disagree by more than eps2 for this test";
+}
+
 // Two neighbours return from a gap with their labels swapped, at a frame where the rest of the limb
 // is hidden: neither has an estimate, so only their tracks speak. Each point is next to where
 // the other marker was last estimated and a marker spacing from its own: both are rejected.
