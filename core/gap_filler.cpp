@@ -32,6 +32,8 @@ GapFiller::GapFiller(const SubjectModel& model, const GapFillerOptions& options)
   }
 
   previous_.assign(n_, Vec3::Zero());
+  before_previous_.assign(n_, Vec3::Zero());
+  before_previous_seen_.assign(n_, 0);
   previous_status_.assign(n_, MarkerStatus::Held);
   assigned_id_.assign(n_, kNoFragment);
   probation_start_.assign(n_, -1);
@@ -121,6 +123,7 @@ void GapFiller::precompute_single_gaps() {
 
 void GapFiller::reset() {
   has_previous_ = false;
+  std::fill(before_previous_seen_.begin(), before_previous_seen_.end(), 0);
   std::fill(assigned_id_.begin(), assigned_id_.end(), kNoFragment);
   std::fill(probation_start_.begin(), probation_start_.end(), -1);
   std::fill(refused_id_.begin(), refused_id_.end(), kNoFragment);
@@ -191,6 +194,8 @@ FillStats GapFiller::run(const FrameInput& in, const FrameOutput& out) {
     if (!out.fragments.empty()) out.fragments[i] = status_[i] == MarkerStatus::Relabelled ? assigned_id_[i] : kNoFragment;
     if (!out.revoked.empty()) out.revoked[i] = revoked_[i];
     if (is_present(in.labelled[i]) && current_[i] != in.labelled[i]) ++stats_.changed_measured;
+    before_previous_[i] = previous_[i];
+    before_previous_seen_[i] = has_previous_ && is_observed(previous_status_[i]);
     previous_[i] = current_[i];
     previous_status_[i] = status_[i];
     switch (status_[i]) {
@@ -244,9 +249,10 @@ void GapFiller::find_suspect_labels() {
 // marker took last frame and carried along. A suspect point is judged against estimates made
 // this frame from the other markers alone. It stands when its own estimate agrees (within eps2
 // and within four of its calibrated standard deviations); it is taken as unlabelled when
-// another marker explains it clearly better (a swap), or when it was tracked last frame and its
-// own estimate disagrees by more than eps2 as well (two independent estimates, the motion of its
-// ring and the shape of its neighbourhood, against it). Otherwise the measurement stands.
+// another marker explains it clearly better (a swap), or when its own estimate disagrees by more
+// than eps2 and it left its own track as well (measured in the last two frames and now off where
+// its velocity takes it): a point that keeps to its track is the marker the capture system was
+// following, whatever its neighbourhood's estimate says. Otherwise the measurement stands.
 void GapFiller::judge_suspect_labels() {
   for (int i : suspects_) {
     Vec3 own;
@@ -254,9 +260,13 @@ void GapFiller::judge_suspect_labels() {
     const bool has_own = expected_position(i, own, &own_variance);
     const double own_distance = has_own ? (current_[i] - own).norm() : std::numeric_limits<double>::infinity();
     const bool own_confident = has_own && own_distance * own_distance > kConfidentMiss * own_variance;
-    const bool reject = (own_distance > eps2_[i] || own_confident) &&
-                        (explained_by_another(i, own_distance) ||
-                         (has_own && own_distance > eps2_[i] && is_observed(previous_status_[i])));
+    // With no estimate of its own, the point's own track is the evidence left: where its motion
+    // takes it, and whether another marker's estimate or track reaches the point clearly better.
+    const bool reject = has_own ? (own_distance > eps2_[i] || own_confident) &&
+                                      (explained_by_another(i, own_distance) ||
+                                       (own_distance > eps2_[i] && off_own_track(i)))
+                                : explained_by_another(i, (current_[i] - track_prediction(i)).norm()) ||
+                                      off_own_track(i);
     if (reject) {
       add_free_point(current_[i], -(i + 1));
       ++stats_.rejected_labels;
@@ -270,8 +280,42 @@ void GapFiller::judge_suspect_labels() {
 
 // Whether another missing (or suspect) marker is expected within eps1 of i's labelled point and
 // at most half as far from it as i's own estimate: a swap, or a point where skin touches skin.
+// Where no other marker has an estimate (a hidden patch, every label in it suspect at once), each
+// one's own track stands in for it: two labels swapped on returning from a gap are each near
+// where the other one was.
 bool GapFiller::explained_by_another(int i, double own_distance) {
-  return nearest_other_expected(i, current_[i]) <= 0.5 * own_distance;
+  const double nearest = std::min(nearest_other_expected(i, current_[i]), nearest_other_on_track(i, current_[i]));
+  return std::isfinite(nearest) && nearest <= 0.5 * own_distance;
+}
+
+// Where marker i's own motion takes it this frame: its last position moved on by its last
+// frame's velocity when it was measured in the last two frames, else its last position (its
+// estimate, during a gap).
+Vec3 GapFiller::track_prediction(int i) const {
+  if (!before_previous_seen_[i] || !is_observed(previous_status_[i])) return previous_[i];
+  return 2.0 * previous_[i] - before_previous_[i];
+}
+
+// Whether marker i, measured in the last two frames, is now farther from where its own velocity
+// takes it than eps2 plus a frame's travel: a label that jumps off its track (a swap, a ghost),
+// where a fast limb at a low frame rate stays near it (a serve's hand: 240 mm a frame at 50 Hz).
+bool GapFiller::off_own_track(int i) const {
+  if (!before_previous_seen_[i] || !is_observed(previous_status_[i])) return false;
+  const double travel = (previous_[i] - before_previous_[i]).norm();
+  return (current_[i] - track_prediction(i)).norm() > eps2_[i] + travel;
+}
+
+// The distance from point p to the track prediction of the nearest other missing (or suspect)
+// marker that has no estimate this frame and a position last frame, within eps1 (infinity: none).
+double GapFiller::nearest_other_on_track(int i, const Vec3& p) {
+  double nearest = std::numeric_limits<double>::infinity();
+  Vec3 unused;
+  for (int j : missing_) {
+    if (observed_[j] || j == i || previous_status_[j] == MarkerStatus::Held) continue;
+    const double d = (p - track_prediction(j)).norm();
+    if (d <= eps1_[j] && d < nearest && !expected_position(j, unused)) nearest = d;
+  }
+  return nearest;
 }
 
 // The distance from point p to the nearest estimate of another missing marker that is within

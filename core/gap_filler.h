@@ -8,8 +8,9 @@
 //      against its last position). It is treated as unlabelled only on strong evidence, judged
 //      against this frame's estimates from the other markers: any missing marker explains it
 //      clearly better while its own confident estimate disagrees (a swap, or skin touching
-//      skin), or it was tracked and its neighbourhood's estimate disagrees too. Otherwise the
-//      measurement stands.
+//      skin; with no estimates, the markers' own tracks), or its neighbourhood's estimate
+//      disagrees and it left its own track (velocity prediction). Otherwise the measurement
+//      stands.
 //   2. Rigid estimates (eq. 2, Horn), greedy: the missing marker with the most available
 //      neighbours first, reusing earlier estimates.
 //   3. Relabelling: a tracked fragment stays with its marker while within eps2 (alpha2) of
@@ -125,7 +126,10 @@ class GapFiller {
   void find_suspect_labels();
   void judge_suspect_labels();
   bool explained_by_another(int i, double own_distance);
+  Vec3 track_prediction(int i) const;
+  bool off_own_track(int i) const;
   double nearest_other_expected(int i, const Vec3& p);
+  double nearest_other_on_track(int i, const Vec3& p);
   bool carried_position(int i, Vec3& out) const;
   void estimate_rigid();
   void fit_rigid_estimate(int i);
@@ -170,6 +174,8 @@ class GapFiller {
   long solve_stamp_ = 0;  // this frame's: a PCA solve made in it stands until its ring changes (refresh_estimates)
   std::vector<Vec3> previous_;
   std::vector<MarkerStatus> previous_status_;
+  std::vector<Vec3> before_previous_;       // two frames back, for a marker's own track
+  std::vector<char> before_previous_seen_;  // measured (or relabelled) two frames back
   std::vector<int> assigned_id_;      // free-point trajectory currently standing for marker i
   std::vector<long> probation_start_;  // frame its relabel was taken while still on probation, else -1
   std::vector<int> refused_id_;        // a fragment whose relabel was revoked, not taken again while it lasts

@@ -11,6 +11,7 @@ Wrongly labelled: a fragment (a run of samples on one delivered channel) with an
 a marker that is not its own. True measurements not kept: samples a labelled channel delivered of
 its own marker that the marker did not keep. Measured samples changed: labelled samples the filler
 replaced, right or wrong (on the synthetic takes some labels are wrong and should be).
+--json-out also keeps each take's list of wrongly labelled fragments (whose, taken by whom, how).
 """
 import argparse
 import json
@@ -39,7 +40,7 @@ def run_take(skinstream, motion, seed, lookahead, folder):
     return {"motion": motion, "seed": seed, "lookahead": lookahead,
             "fragments": stats["trajectories_before_merging"], "wrong": stats["wrongly_labelled_fragments"],
             "rate": stats["wrongly_labelled_rate"], "not_kept": stats.get("true_labels_not_kept", "-"),
-            "changed": stats["samples"]["changed_measured"]}
+            "changed": stats["samples"]["changed_measured"], "wrong_list": stats.get("wrongly_labelled_list", [])}
 
 
 def main():

@@ -19,6 +19,28 @@ std::string synthetic_region(const std::string& name) {
   return r;
 }
 
+// Each wrong fragment: its channel and frames, whose it was and who took it, and whether the two
+// are neighbours on the marker surface (a swap between neighbours, or skin touching skin).
+nlohmann::ordered_json wrong_fragment_list(const SubjectModel& model, const Capture& delivered,
+                                           const std::vector<WrongFragment>& wrong) {
+  nlohmann::ordered_json list = nlohmann::ordered_json::array();
+  for (const WrongFragment& w : wrong) {
+    bool neighbours = false;
+    if (w.true_marker >= 0)
+      for (int k = model.ring_offsets[w.taken_by]; k < model.ring_offsets[w.taken_by + 1]; ++k)
+        neighbours = neighbours || model.ring[k] == w.true_marker;
+    list.push_back({{"channel", delivered.labels[w.channel]},
+                    {"frames", {w.first_frame, w.last_frame}},
+                    {"first_wrong_frame", w.first_wrong_frame},
+                    {"wrong_samples", w.wrong_samples},
+                    {"true_marker", w.true_marker >= 0 ? model.marker_names[w.true_marker] : "ghost"},
+                    {"taken_by", model.marker_names[w.taken_by]},
+                    {"how", w.relabelled ? "relabelled" : "measured"},
+                    {"neighbours", neighbours}});
+  }
+  return list;
+}
+
 }  // namespace
 
 nlohmann::ordered_json evaluate_on_synthetic(const synth::SynthCapture& take, const synth::SynthCapture& training, int lookahead) {
@@ -96,6 +118,7 @@ nlohmann::ordered_json evaluate_on_synthetic(const synth::SynthCapture& take, co
   j["wrongly_labelled_rate"] = merge.wrong_rate();
   j["wrongly_labelled_by"] = {{"measured", merge.wrong_measured_fragments}, {"relabelled", merge.wrong_relabelled_fragments}};
   j["wrongly_labelled_samples"] = merge.wrong_samples;
+  j["wrongly_labelled_list"] = wrong_fragment_list(model, take.capture, merge.wrong_list);
   j["true_labels_not_kept"] = merge.true_labels_not_kept;
   j["samples"] = {{"measured", report.measured}, {"relabelled", report.relabelled}, {"filled", report.filled},
                   {"held", report.held}, {"rejected_labels", report.rejected_labels},

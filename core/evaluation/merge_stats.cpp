@@ -36,16 +36,28 @@ MergeStats merge_stats(const Capture& delivered, const std::vector<int>& true_ma
         continue;
       }
       bool used = false, wrong = false, wrong_measured = false, wrong_relabelled = false;
+      WrongFragment record;
+      record.channel = c;
+      record.first_frame = f;
       for (; f < frames && delivered.present(f, c); ++f) {
         const size_t at = static_cast<size_t>(f) * channels + c;
         if (taken_by[at] < 0) continue;
         used = true;
         if (taken_by[at] != true_marker[at]) {
+          if (!wrong) {
+            record.first_wrong_frame = f;
+            record.true_marker = true_marker[at];
+            record.taken_by = taken_by[at];
+            record.relabelled = relabelled[at];
+          }
           wrong = true;
           (relabelled[at] ? wrong_relabelled : wrong_measured) = true;
           ++s.wrong_samples;
+          ++record.wrong_samples;
         }
       }
+      record.last_frame = f - 1;
+      if (wrong) s.wrong_list.push_back(record);
       ++s.fragments;
       s.unmerged_fragments += !used;
       s.wrong_fragments += wrong;

@@ -10,6 +10,18 @@
 
 namespace skinstream {
 
+// One wrongly labelled fragment, for telling the kinds of error apart: which channel, when, whose
+// it really was and which marker took it first.
+struct WrongFragment {
+  int channel = -1;
+  int first_frame = 0, last_frame = 0;  // the fragment
+  int first_wrong_frame = 0;
+  int wrong_samples = 0;
+  int true_marker = -1;  // at the first wrong sample; negative: a ghost
+  int taken_by = -1;     // the marker that took that sample
+  bool relabelled = false;  // taken as a free point (else kept as a labelled channel's measurement)
+};
+
 struct MergeStats {
   int fragments = 0;           // partial trajectories delivered: runs of samples on one channel
   int unmerged_fragments = 0;  // fragments no marker took a sample of
@@ -23,6 +35,7 @@ struct MergeStats {
   // Samples a labelled channel delivered of its own marker (the label was right) that the marker
   // did not keep: a true measurement the label check rejected and nobody gave back.
   long true_labels_not_kept = 0;
+  std::vector<WrongFragment> wrong_list;  // every wrong fragment, by channel then frame
   double wrong_rate() const { return fragments ? static_cast<double>(wrong_fragments) / fragments : 0.0; }
 };
 

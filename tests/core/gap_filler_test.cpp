@@ -232,6 +232,92 @@ TEST(GapFiller, KeepsATrueMeasurementItsPoorEstimateDisagreesWith) {
   }
 }
 
+// From frame 20 on, kMiddle's labelled point speeds away from kOther, by 0.3 eps2 a frame more
+// each frame up to 1.5 eps2 a frame (with every other marker hidden when `alone`); every one of
+// those frames, the measurement must stand. Returns how far it went, in eps2, and in how many
+// frames it moved more than eps2.
+struct SpeedingMarker {
+  double travelled_eps2 = 0.0;
+  int fast_frames = 0;
+};
+
+SpeedingMarker expect_a_speeding_marker_stands(bool alone, int frames) {
+  Fixture fx;
+  GapFiller filler(fx.model);
+  Frame frame(fx.model.marker_count());
+  const double eps2 = fx.model.parameters.alpha2 * fx.model.neighbour_distance(kMiddle);
+  const Vec3 out = (fx.truth.at(0, kMiddle) - fx.truth.at(0, kOther)).normalized();
+  SpeedingMarker run;
+  for (int f = 0; f < frames; ++f) {
+    load(fx.truth, f, frame);
+    if (f >= 20) {
+      if (alone)
+        for (int j = 0; j < fx.model.marker_count(); ++j)
+          if (j != kMiddle) frame.labelled[j] = missing_point();
+      const double speed = std::min(f - 19, 5) * 0.3;
+      run.travelled_eps2 += speed;
+      run.fast_frames += speed > 1.0;
+      frame.labelled[kMiddle] += run.travelled_eps2 * eps2 * out;
+    }
+    const FillStats s = frame.run(filler);
+    if (f < 20) continue;
+    EXPECT_EQ(frame.status[kMiddle], MarkerStatus::Measured) << "frame " << f;
+    EXPECT_EQ(frame.positions[kMiddle], frame.labelled[kMiddle]) << "frame " << f;
+    EXPECT_EQ(s.changed_measured, 0) << "frame " << f;
+  }
+  return run;
+}
+
+// A marker that nothing else can estimate (its whole neighbourhood hidden, as the serving hand of
+// a 50 Hz tennis serve when its four markers all jumped more than eps2 at once) and that speeds up
+// to more than eps2 a frame is suspect, but nothing speaks against it: no estimate of its own
+// disagrees, no other marker reaches the point, and it keeps to its own track. Once, "explained by
+// another" compared no marker's distance (infinity) with no estimate's (infinity) and rejected it.
+TEST(GapFiller, KeepsAFastMarkerNothingElseCanEstimate) {
+  EXPECT_GE(expect_a_speeding_marker_stands(true, 40).fast_frames, 15)
+      << "the marker must move more than eps2 a frame for this test";
+}
+
+// A tracked marker that speeds away from its ring (a hand at a low frame rate moves more between
+// frames than its neighbourhood model allows) is suspect, and its own estimate, from a ring seen
+// whole, disagrees confidently. But it keeps to its own track, so nothing says it is another
+// marker: the measurement stands. Once, a tracked point was rejected on its estimate alone.
+TEST(GapFiller, KeepsATrackedMarkerOnItsOwnTrackItsEstimateDisagreesWith) {
+  EXPECT_GT(expect_a_speeding_marker_stands(false, 30).travelled_eps2, 3.0)
+      << "its estimate must disagree by more than eps2 for this test";
+}
+
+// Two neighbours return from a gap with their labels swapped, at a frame where the rest of the limb
+// is hidden: neither has an estimate, so only their tracks speak. Each point is next to where
+// the other marker was last estimated and a marker spacing from its own: both are rejected.
+// Once, a point with no estimate of its own stood unless another marker's estimate reached it.
+TEST(GapFiller, RejectsTwoLabelsSwappedWhereNeitherHasAnEstimate) {
+  Fixture fx;
+  GapFiller filler(fx.model);
+  Frame frame(fx.model.marker_count());
+  const int neighbour = fx.model.ring[fx.model.ring_offsets[kMiddle]];
+  const double eps2 = fx.model.parameters.alpha2 * std::max(fx.model.neighbour_distance(kMiddle), fx.model.neighbour_distance(neighbour));
+  for (int f = 0; f <= 30; ++f) {
+    load(fx.truth, f, frame);
+    if (f >= 20) frame.labelled[kMiddle] = frame.labelled[neighbour] = missing_point();
+    if (f == 30) {
+      for (int j = 0; j < fx.model.marker_count(); ++j) frame.labelled[j] = missing_point();
+      frame.labelled[kMiddle] = fx.truth.at(f, neighbour);
+      frame.labelled[neighbour] = fx.truth.at(f, kMiddle);
+      ASSERT_GT((fx.truth.at(f, kMiddle) - fx.truth.at(f, neighbour)).norm(), eps2) << "the swapped labels must be suspect";
+    }
+    const FillStats s = frame.run(filler);
+    if (f == 29) {
+      ASSERT_NE(frame.status[kMiddle], MarkerStatus::Held) << "estimated during the gap";
+      ASSERT_NE(frame.status[neighbour], MarkerStatus::Held);
+    }
+    if (f < 30) continue;
+    EXPECT_EQ(s.rejected_labels, 2);
+    EXPECT_NE(frame.positions[kMiddle], frame.labelled[kMiddle]);
+    EXPECT_NE(frame.positions[neighbour], frame.labelled[neighbour]);
+  }
+}
+
 // A marker comes back from a gap under the label of a neighbour that was itself missing: the
 // point is far from the neighbour's estimate and next to the estimate of the marker it really
 // is, which is missing. That explains it: it goes to that marker, and the neighbour is filled.

@@ -46,6 +46,12 @@ TEST(MergeStats, CountsMergedUnmergedAndWrongFragments) {
   EXPECT_EQ(s.wrong_relabelled_fragments, 1);
   EXPECT_EQ(s.wrong_measured_fragments, 0);
   EXPECT_EQ(s.unmerged_fragments, 0);
+  ASSERT_EQ(s.wrong_list.size(), 1u);
+  EXPECT_EQ(s.wrong_list[0].channel, 3);
+  EXPECT_EQ(s.wrong_list[0].first_wrong_frame, 4);
+  EXPECT_EQ(s.wrong_list[0].true_marker, -1);
+  EXPECT_EQ(s.wrong_list[0].taken_by, 0);
+  EXPECT_TRUE(s.wrong_list[0].relabelled);
 
   // And b's channel delivers a's point in frame 2 (a mislabel), kept as b's measurement.
   truth[2 * 4 + 1] = 0;
@@ -53,6 +59,16 @@ TEST(MergeStats, CountsMergedUnmergedAndWrongFragments) {
   EXPECT_EQ(s.wrong_fragments, 2);
   EXPECT_EQ(s.wrong_measured_fragments, 1);
   EXPECT_EQ(s.wrong_relabelled_fragments, 1);
+  ASSERT_EQ(s.wrong_list.size(), 2u);  // by channel: b's first
+  const WrongFragment& b = s.wrong_list[0];
+  EXPECT_EQ(b.channel, 1);
+  EXPECT_EQ(b.first_frame, 0);
+  EXPECT_EQ(b.last_frame, 4);
+  EXPECT_EQ(b.first_wrong_frame, 2);
+  EXPECT_EQ(b.wrong_samples, 1);
+  EXPECT_EQ(b.true_marker, 0);
+  EXPECT_EQ(b.taken_by, 1);
+  EXPECT_FALSE(b.relabelled);
 }
 
 // a's own channel delivers a's point in frames 0-2; the filler kept frame 0, rejected frame 1 and
