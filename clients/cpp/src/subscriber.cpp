@@ -17,6 +17,13 @@ namespace wire = skinstream::subscriber;
 
 namespace {
 
+// memcpy for spans that may be empty: an empty span's data() may be null, and memcpy's pointers
+// must be valid even for 0 bytes (a markers-only stream has no vertices, a mesh stream may have
+// no markers).
+void copy_bytes(void* to, const void* from, size_t bytes) {
+  if (bytes > 0) std::memcpy(to, from, bytes);
+}
+
 int64_t wall_clock_ns() {
   return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch()).count();
 }
@@ -353,16 +360,16 @@ bool Subscriber::State::on_frame(std::span<const unsigned char> payload, Frame& 
         normals[i] = value / 32767.0f;
       }
     } else {
-      std::memcpy(positions.data(), view.positions.data(), 4 * v3);
-      if (!view.normals.empty()) std::memcpy(normals.data(), view.normals.data(), 4 * v3);
+      copy_bytes(positions.data(), view.positions.data(), 4 * v3);
+      if (!view.normals.empty()) copy_bytes(normals.data(), view.normals.data(), 4 * v3);
     }
     have_positions = true;
     have_normals = !view.normals.empty();
   }
   const size_t m = view.marker_status.size();
   if (m > marker_status.size()) throw Error("a Frame with more markers than MeshInfo names");
-  std::memcpy(markers.data(), view.markers.data(), 12 * m);
-  std::memcpy(marker_status.data(), view.marker_status.data(), m);
+  copy_bytes(markers.data(), view.markers.data(), 12 * m);
+  copy_bytes(marker_status.data(), view.marker_status.data(), m);
 
   frame.frame_number = info.frame_number;
   frame.source_time_ns = info.source_time_ns;
