@@ -288,11 +288,17 @@ bool GapFiller::explained_by_another(int i, double own_distance) {
   return std::isfinite(nearest) && nearest <= 0.5 * own_distance;
 }
 
+// Whether marker i was measured (or relabelled) in each of the last two frames: then it has a
+// velocity of its own.
+bool GapFiller::measured_last_two_frames(int i) const {
+  return before_previous_seen_[i] && is_observed(previous_status_[i]);
+}
+
 // Where marker i's own motion takes it this frame: its last position moved on by its last
 // frame's velocity when it was measured in the last two frames, else its last position (its
 // estimate, during a gap).
 Vec3 GapFiller::track_prediction(int i) const {
-  if (!before_previous_seen_[i] || !is_observed(previous_status_[i])) return previous_[i];
+  if (!measured_last_two_frames(i)) return previous_[i];
   return 2.0 * previous_[i] - before_previous_[i];
 }
 
@@ -300,7 +306,7 @@ Vec3 GapFiller::track_prediction(int i) const {
 // takes it than eps2 plus a frame's travel: a label that jumps off its track (a swap, a ghost),
 // where a fast limb at a low frame rate stays near it (a serve's hand: 240 mm a frame at 50 Hz).
 bool GapFiller::off_own_track(int i) const {
-  if (!before_previous_seen_[i] || !is_observed(previous_status_[i])) return false;
+  if (!measured_last_two_frames(i)) return false;
   const double travel = (previous_[i] - before_previous_[i]).norm();
   return (current_[i] - track_prediction(i)).norm() > eps2_[i] + travel;
 }

@@ -126,6 +126,7 @@ class GapFiller {
   void find_suspect_labels();
   void judge_suspect_labels();
   bool explained_by_another(int i, double own_distance);
+  bool measured_last_two_frames(int i) const;
   Vec3 track_prediction(int i) const;
   bool off_own_track(int i) const;
   double nearest_other_expected(int i, const Vec3& p);
