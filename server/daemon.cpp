@@ -322,6 +322,14 @@ void Daemon::on_frame(const SourceFrame& frame) {
     std::lock_guard lock(state_mutex_);
     source_rate_hz_ = frame.rate_hz;
   }
+  const FrameNumbering::Step step = numbering_.next(frame.frame_number, frame.rate_hz);
+  if (step.skipped > 0) {
+    source_metrics_.source_frames_skipped.fetch_add(step.skipped, std::memory_order_relaxed);
+    bad_input_log_.warn("frames_skipped", "the source skipped " + std::to_string(step.skipped) + " frame numbers before frame " +
+                                              std::to_string(frame.frame_number) + " (never delivered)");
+  } else if (step.renumbered) {
+    source_metrics_.source_renumberings.fetch_add(1, std::memory_order_relaxed);
+  }
   for (size_t k = 0; k < subjects_.size(); ++k) routed_[k] = &subjects_[k]->writable();
   const SubjectRouter::Stats routed = router_.route(frame, routed_);
   if (routed.rejected_points > 0) {
@@ -342,8 +350,10 @@ void Daemon::on_source_state(SourceState state, std::string_view detail) {
     state_detail_ = std::string(detail);
   }
   // Every start of streaming (first connect, reconnect, replay loop) is a new take for the fillers.
-  if (state == SourceState::Streaming)
+  if (state == SourceState::Streaming) {
+    numbering_.restart();
     for (auto& s : subjects_) s->new_take();
+  }
   // A change of state is news; streaming again (a replay's loop) is not: the status line says
   // that the frames keep coming.
   if (state != previous) spdlog::info("source: {} ({})", to_string(state), detail);
@@ -422,7 +432,9 @@ std::string Daemon::health_json() const {
   {
     std::lock_guard lock(state_mutex_);
     source = {{"state", to_string(state_)}, {"detail", state_detail_}, {"rate_hz", source_rate_hz_},
-              {"frames", source_metrics_.frames_received.load()}};
+              {"frames", source_metrics_.frames_received.load()},
+              {"frames_skipped", source_metrics_.source_frames_skipped.load()},
+              {"renumberings", source_metrics_.source_renumberings.load()}};
   }
   nlohmann::json subjects = nlohmann::json::array();
   size_t subscribers = 0;

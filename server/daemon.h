@@ -19,6 +19,7 @@
 #include "server/asio.h"
 #include "server/config.h"
 #include "server/descriptor_reserve.h"
+#include "server/ingest/frame_numbering.h"
 #include "server/ingest/frame_source.h"
 #include "server/ingest/subject_router.h"
 #include "server/logging.h"
@@ -85,6 +86,7 @@ class Daemon : private SourceSink, private SubjectRouter::Observer {
   std::vector<std::unique_ptr<SubjectStream>> subjects_;
   SubjectRouter router_;
   std::vector<MarkerFrame*> routed_;  // per subject, its mailbox slot being filled (one frame)
+  FrameNumbering numbering_;  // the source's frame numbers (io thread only)
   std::shared_ptr<SubscriberAdmission> admission_;  // who may subscribe, and how many: every subject's subscribers together
   asio::io_context io_;
   // The TCP subscribers' threads: destroyed before io_ and after the listeners (declared

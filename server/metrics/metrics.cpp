@@ -123,6 +123,13 @@ std::string render_prometheus(const Metrics& source, const std::vector<SubjectMe
   };
   header(out, "source_frames_total", "Frames received from the source (every subject's together).", "counter");
   out += "skinstream_source_frames_total " + std::to_string(source.frames_received.load()) + "\n";
+  header(out, "source_frames_skipped_total",
+         "Frame numbers the source skipped: frames it numbered and never delivered (lost on the way, or skipped for a slow reader).",
+         "counter");
+  out += "skinstream_source_frames_skipped_total " + std::to_string(source.source_frames_skipped.load()) + "\n";
+  header(out, "source_renumberings_total", "Frames whose number continued nothing before it (the source restarted, a replay looped).",
+         "counter");
+  out += "skinstream_source_renumberings_total " + std::to_string(source.source_renumberings.load()) + "\n";
   header(out, "accepts_failed_no_descriptor_total",
          "Accepts (HTTP and subscriber ports) that failed for lack of file descriptors; each pauses that port's accepts, 10 ms doubling to 1 s.",
          "counter");

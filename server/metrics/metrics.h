@@ -60,6 +60,8 @@ struct SubscriberMetrics {
 class Metrics {
  public:
   std::atomic<uint64_t> frames_received{0};
+  // The source's: numbers it skipped (frames never delivered), and new numberings (restart, loop).
+  std::atomic<uint64_t> source_frames_skipped{0}, source_renumberings{0};
   std::atomic<uint64_t> frames_processed{0};
   std::atomic<uint64_t> frames_published{0};
   std::atomic<uint64_t> frames_dropped{0};  // gave way in the mailbox: waited too long, or a burst overfilled it

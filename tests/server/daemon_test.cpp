@@ -16,6 +16,8 @@
 #include "core/offline/subject_builder.h"
 #include "protocol/capture_file.h"
 #include "protocol/subject_file.h"
+#include "protocol/vicon_capture_encoder.h"
+#include "protocol/vicon_packet_writer.h"
 #include "server/beast.h"
 #include "server/client/subscriber_client.h"
 #include "server/publish/subscriber_hub.h"
@@ -460,6 +462,44 @@ TEST(Daemon, ServesHealthMetricsWebSocketAndSubscribersWithoutHello) {
   EXPECT_EQ(status, 404);
   http_get(daemon.http_port(), "/", &status);
   EXPECT_EQ(status, 404);  // no web root configured
+  daemon.stop();
+}
+
+// Frames a source numbered but never delivered are counted, so an operator sees that the preview
+// is not every frame: a Vicon source (written here) offers its types, ignores what the daemon
+// asks, and pushes the take's frames numbered 1-20, then 24-40 (3 never sent), then 200000 on (a
+// new numbering, as after the source restarted: no loss).
+TEST(Daemon, CountsTheFrameNumbersTheSourceSkipped) {
+  std::vector<uint32_t> numbers;
+  for (uint32_t n = 1; n <= 20; ++n) numbers.push_back(n);
+  for (uint32_t n = 24; n <= 40; ++n) numbers.push_back(n);
+  for (uint32_t n = 200000; n < 200010; ++n) numbers.push_back(n);
+  asio::io_context io;
+  tcp::acceptor acceptor(io, tcp::endpoint(asio::ip::make_address("127.0.0.1"), 0));
+  DaemonConfig config = test::loopback_config();
+  config.subjects = {{"", fixture().subject_path}};
+  config.vicon = "127.0.0.1:" + std::to_string(acceptor.local_endpoint().port());
+  Daemon daemon(config);
+  daemon.start();
+  tcp::socket source = acceptor.accept();
+  asio::write(source, asio::buffer(vicon::encode_packet(vicon::CaptureFrameEncoder::offered_types())));
+  vicon::CaptureFrameEncoder encoder(fixture().take, "subject");
+  vicon::PacketWriter writer;
+  for (size_t k = 0; k < numbers.size(); ++k) {
+    encoder.encode_frame(k, numbers[k], k == 0, writer);
+    const std::span<const unsigned char> packet = writer.finish();
+    asio::write(source, asio::buffer(packet.data(), packet.size()));
+  }
+  nlohmann::json health;
+  wait_until([&] {
+    health = nlohmann::json::parse(http_get(daemon.http_port(), "/health"));
+    return health["source"]["frames"].get<size_t>() == numbers.size();
+  });
+  EXPECT_EQ(health["source"]["frames_skipped"].get<uint64_t>(), 3u);
+  EXPECT_EQ(health["source"]["renumberings"].get<uint64_t>(), 1u);
+  const std::string metrics = http_get(daemon.http_port(), "/metrics");
+  EXPECT_NE(metrics.find("\nskinstream_source_frames_skipped_total 3\n"), std::string::npos);
+  EXPECT_NE(metrics.find("\nskinstream_source_renumberings_total 1\n"), std::string::npos);
   daemon.stop();
 }
 
