@@ -559,8 +559,20 @@ inline __attribute__((always_inline)) void MeshEvaluator::State::deform_cluster(
 
 // Compiled three times (AVX-512, AVX2 + FMA, baseline); the loader picks what the CPU runs.
 // The clones are named by ISA level: "arch=haswell" dispatches on the CPU model, so AMD
-// processors with AVX2 ran the baseline (measured 1.9x slower on this EPYC).
-__attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
+// processors with AVX2 ran the baseline (measured 1.9x slower on this EPYC). Not under
+// ThreadSanitizer: the clones' resolver is instrumented and runs while the loader relocates,
+// before the sanitizer's runtime exists, and the program crashed before main.
+#if defined(__SANITIZE_THREAD__)
+#define SKINSTREAM_ISA_CLONES
+#elif defined(__has_feature)
+#if __has_feature(thread_sanitizer)
+#define SKINSTREAM_ISA_CLONES
+#endif
+#endif
+#ifndef SKINSTREAM_ISA_CLONES
+#define SKINSTREAM_ISA_CLONES __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
+#endif
+SKINSTREAM_ISA_CLONES
 void MeshEvaluator::deform_clusters(int begin, int end) {
   State& s = *state_;
   end = std::min(end, cluster_count());
@@ -602,7 +614,7 @@ void MeshEvaluator::blend_vertices(int begin, int end, std::span<float> position
 // 1070 us on one thread (deform_benchmark's frame_work_p50_us).
 // Every vertex goes through the same lane code whatever the range, so a normal does not
 // depend on how the vertices were cut into ranges; a range only limits what is written.
-__attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
+SKINSTREAM_ISA_CLONES
 void MeshEvaluator::vertex_normals(int begin, int end, std::span<const float> positions, std::span<float> normals) const {
   const State& s = *state_;
   end = std::min(end, s.vertex_count);
