@@ -7,6 +7,8 @@
 #include <cstdio>
 #include <stdexcept>
 
+#include "server/client/stale_namespaces.h"
+
 namespace skinstream::bench {
 namespace {
 
@@ -70,6 +72,9 @@ ShapedLink::ShapedLink(const ShapedLinkOptions& options) {
   if (run({"ip", "-V"}).exit_code != 0 || run({"tc", "-V"}).exit_code != 0)
     throw std::runtime_error("--link-mbit needs iproute2's ip and tc (Debian: apt-get install iproute2)");
   if (options.rate_mbit < 1) throw std::runtime_error("--link-mbit must be at least 1");
+  // What a bench killed before its destructor left (named after its process, now gone): the
+  // namespace takes its veth pair with it.
+  for (const std::string& left_over : server::namespaces_of_dead_processes("skbench")) run({"ip", "netns", "del", left_over});
   // Names and a /30 of 10.213.0.0/16 from the process id: two benches at once do not collide.
   const unsigned id = static_cast<unsigned>(getpid()) & 0x3fff;
   namespace_ = "skbench" + std::to_string(getpid());

@@ -8,6 +8,7 @@
 #include <cstring>
 #include <stdexcept>
 
+#include "server/client/stale_namespaces.h"
 #include "support/program_run.h"
 
 namespace skinstream::test {
@@ -33,6 +34,8 @@ std::string BridgedNamespaces::unavailable_reason() {
 }
 
 BridgedNamespaces::BridgedNamespaces(int hosts) {
+  // What a run killed before its destructor left (named after its process, now gone).
+  for (const std::string& left_over : server::namespaces_of_dead_processes("skmc")) run_program("ip netns del " + left_over);
   const std::string stem = "skmc" + std::to_string(getpid());
   try {
     bridge_ = stem + "-lan";
