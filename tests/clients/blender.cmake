@@ -17,4 +17,7 @@ elseif(TARGET skinstreamd)
   if(TARGET skinstream_client)  # the fast path for the parameters the carried package finds
     set_property(TEST blender.addon APPEND PROPERTY ENVIRONMENT SKINSTREAM_CLIENT_LIBRARY=$<TARGET_FILE:skinstream_client>)
   endif()
+  if(uninstrumented_host_environment)
+    set_property(TEST blender.addon APPEND PROPERTY ENVIRONMENT ${uninstrumented_host_environment})
+  endif()
 endif()

@@ -8,4 +8,7 @@ if(TARGET skinstream_client AND TARGET skinstreamd AND SKINSTREAM_PYTHON)
       $<TARGET_FILE:skinstreamd> ${CMAKE_BINARY_DIR}/demo ${CMAKE_BINARY_DIR}/test_tmp/client_package)
   set_tests_properties(client_package.install_build_and_run_example PROPERTIES
     FIXTURES_REQUIRED demo_subject LABELS clients TIMEOUT ${time_limit_600})
+  if(uninstrumented_host_environment)
+    set_property(TEST client_package.install_build_and_run_example APPEND PROPERTY ENVIRONMENT ${uninstrumented_host_environment})
+  endif()
 endif()

@@ -19,6 +19,9 @@ if(TARGET skinstreamd AND TARGET skinstream-sub AND TARGET skinstream-replay)
     SKINSTREAM_SHARED_DIR="${SKINSTREAM_SHARED_DIR}"
     SKINSTREAM_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
     SKINSTREAM_TEST_TMP_DIR="${CMAKE_BINARY_DIR}/test_tmp/daemon")
+  if(SKINSTREAM_SANITIZE MATCHES undefined)
+    target_compile_definitions(daemon_tests PRIVATE SKINSTREAM_UBSAN_VPTR)  # its vptr check, on with undefined
+  endif()
   add_dependencies(daemon_tests skinstreamd skinstream-sub skinstream-replay skinstream)
   gtest_discover_tests(daemon_tests TEST_FILTER "-DaemonDemo*" DISCOVERY_TIMEOUT 60 PROPERTIES LABELS clients TIMEOUT ${time_limit_120})
   # The demo subject's tests need the demo_subject fixture (tests/clients/CMakeLists.txt).

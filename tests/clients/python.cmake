@@ -11,7 +11,8 @@ elseif(TARGET skinstreamd)
     SKINSTREAMD=$<TARGET_FILE:skinstreamd>
     SKINSTREAM_CLI=$<TARGET_FILE:skinstream>
     SKINSTREAM_DEMO_DIR=${CMAKE_BINARY_DIR}/demo
-    SKINSTREAM_TEST_TMP_DIR=${CMAKE_BINARY_DIR}/test_tmp/python)
+    SKINSTREAM_TEST_TMP_DIR=${CMAKE_BINARY_DIR}/test_tmp/python
+    ${uninstrumented_host_environment})
   set(python_tests vertex_codec meshoptimizer_library protocol evaluation normals decoder_choice install subscriber receiver)
   if(TARGET skinstream_client)  # the package's fast path for the parameters, through its C ABI
     list(APPEND python_test_environment SKINSTREAM_CLIENT_LIBRARY=$<TARGET_FILE:skinstream_client>)
