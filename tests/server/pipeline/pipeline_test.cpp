@@ -114,12 +114,19 @@ TEST(Pipeline, AllocatesNothingPerFrameFromMailboxToSubscriber) {
       ADD_FAILURE() << "subscriber: " << e.what();
     }
   });
-  // However the test ends: subscribers closed on the io thread (as the daemon does), then the
-  // threads joined. The pipeline, declared below, is stopped before this runs.
+  constexpr int kFrames = 200, kFirst = 40, kLast = 180;
+  FrameMailbox mailbox(subject.marker_count());  // what the pipeline uses lives longer than it
+  CountingConsumer consumer(hub, kFirst, kLast);
+  // However the test ends, in the daemon's order: the pipeline stopped, the subscribers closed on
+  // the io thread and the threads joined (every handler that held a frame has run), and only then
+  // the pipeline and its frame pool destroyed (declared before the teardown, so destroyed after
+  // it: a subscriber still writing a pooled frame when the pool went was a use after free).
+  std::optional<Pipeline> pipeline;
   struct Teardown {
     std::function<void()> run;
     ~Teardown() { run(); }
   } teardown{[&] {
+    if (pipeline) pipeline->stop();
     asio::post(io, [&] {
       hub.close_all();
       acceptor.close();  // a still pending accept (the subscriber never came) ends too
@@ -133,17 +140,14 @@ TEST(Pipeline, AllocatesNothingPerFrameFromMailboxToSubscriber) {
     std::this_thread::sleep_for(std::chrono::milliseconds(2));
   ASSERT_FALSE(hub.wanted_encodings().empty()) << "the subscriber never said Hello";
 
-  constexpr int kFrames = 200, kFirst = 40, kLast = 180;
-  FrameMailbox mailbox(subject.marker_count());
-  CountingConsumer consumer(hub, kFirst, kLast);
   PipelineOptions options;
   options.deform_threads = 2;
-  Pipeline pipeline(subject, &deformation, options, mailbox, consumer, metrics);
+  pipeline.emplace(subject, &deformation, options, mailbox, consumer, metrics);
   // As the daemon's hub does when a subscriber says Hello (here it said it before the pipeline
   // existed): the pool's buffers for what it wants are made off the pipeline thread, and so are
   // those of every frame the pool adds later, whenever the machine's load makes it add one.
-  hub.wanted_encodings().for_each([&](StreamKey key) { pipeline.prepare_encoding(key); });
-  pipeline.start();
+  hub.wanted_encodings().for_each([&](StreamKey key) { pipeline->prepare_encoding(key); });
+  pipeline->start();
   for (int f = 0; f < kFrames; ++f) {
     MarkerFrame& frame = mailbox.writable();
     frame.clear();
@@ -159,13 +163,12 @@ TEST(Pipeline, AllocatesNothingPerFrameFromMailboxToSubscriber) {
     // the pipeline runs, a subscriber on a busy machine falls behind its queue of 2).
     while (frames_received.load() < f + 1 && std::chrono::steady_clock::now() < give_up) std::this_thread::yield();
   }
-  ASSERT_TRUE(consumer.measured()) << "published " << pipeline.frames_published();
+  ASSERT_TRUE(consumer.measured()) << "published " << pipeline->frames_published();
   EXPECT_EQ(consumer.allocations(), 0u) << "heap allocations on the pipeline thread over " << kLast - kFirst << " frames";
   EXPECT_EQ(mailbox.dropped(), 0u);
 
   EXPECT_EQ(frames_received.load(), kFrames);
   EXPECT_GT(metrics.markers_filled.load(), 0u);  // the gaps went through the filler
-  pipeline.stop();  // before the teardown closes the subscriber
 }
 
 }  // namespace
