@@ -5,6 +5,8 @@
 #include <cmath>
 #include <limits>
 
+#include "core/rigid_fit_leverage.h"
+
 namespace skinstream {
 namespace {
 
@@ -76,6 +78,19 @@ GapFiller::GapFiller(const SubjectModel& model, const GapFillerOptions& options)
   pca_slot_variance_.assign(model.ring.size(), 1.0);
   rigid_support_.assign(n_, 0);
   rigid_novelty_.assign(n_, 1.0);
+  rigid_variance_.assign(n_, 0.0);
+  leverage_.assign(SubjectModel::kMaxRing, 0.0);
+  // Each marker's training error of eq. 2 with its whole ring seen, read as the ring members'
+  // departure from rigid seen through their leverage on the fit.
+  for (int i = 0; i < n_; ++i) {
+    const int first = model.ring_offsets[i], ring = model.ring_size(i);
+    double leverage = 0.0;
+    if (ring > 0) {
+      rigid_fit_leverage({&model.ring_local_reference[first], static_cast<size_t>(ring)}, {leverage_.data(), static_cast<size_t>(ring)});
+      for (int k = 0; k < ring; ++k) leverage += leverage_[k];
+    }
+    rigid_member_variance_.push_back(leverage > 0.0 ? model.pca[i].rigid_variance / leverage : model.pca[i].rigid_variance);
+  }
   precompute_single_gaps();
   static_assert(SubjectModel::kMaxRing < 32, "observed slots are a 32-bit mask");
   for (int j = 0; j < n_; ++j) {
@@ -389,17 +404,32 @@ void GapFiller::fit_rigid_estimate(int i) {
     if (!estimated_[j]) continue;
     scratch_source_[count] = model_.ring_local_reference[k];
     scratch_target_[count] = estimate_[j];
+    scratch_index_[count] = j;
     ++count;
   }
   rigid_support_[i] = observed_support;
   RigidTransform t;
   fit_rigid({scratch_source_.data(), static_cast<size_t>(count)}, {scratch_target_.data(), static_cast<size_t>(count)}, t);
+  // Its variance: every member's departure from rigid, and for a member that was itself only
+  // estimated that estimate's variance too, each seen through its leverage on this fit (few
+  // members, or far or nearly collinear ones, make a poor fit; an error in a member the chain
+  // estimated is carried on).
+  rigid_fit_leverage({scratch_source_.data(), static_cast<size_t>(count)}, {leverage_.data(), static_cast<size_t>(count)});
+  double variance = 0.0, member_variances = 0.0, miss = 0.0;
+  for (int k = 0; k < count; ++k) {
+    const int j = scratch_index_[k];
+    const double member = rigid_member_variance_[i] + (observed_[j] ? 0.0 : rigid_estimate_variance(j, true));
+    variance += leverage_[k] * member;
+    member_variances += member;
+    miss += (t.apply(scratch_source_[k]) - scratch_target_[k]).squaredNorm();
+  }
+  rigid_variance_[i] = std::max(variance, model_.pca[i].rigid_variance);
   // A ring that no longer moves rigidly (a joint bent beyond training) makes the estimate worth
-  // less: its members' miss against the fit, over what the estimate's own training error (per
-  // coordinate) leads one to expect of each.
-  double miss = 0.0;
-  for (int k = 0; k < count; ++k) miss += (t.apply(scratch_source_[k]) - scratch_target_[k]).squaredNorm();
-  rigid_novelty_[i] = novelty_factor(miss, count, model_.pca[i].rigid_variance);
+  // less: its members' miss against the fit, over what those variances lead one to expect of
+  // it. The fit takes six of the 3n coordinates: three members leave only their three
+  // distances to test.
+  const double expected = (3.0 * count - 6.0) / count * member_variances;
+  rigid_novelty_[i] = expected > 0.0 && miss > expected ? miss / expected : 1.0;
   estimate_[i] = t.translation;  // the local frame's origin is the marker
   rotation_[i] = t.rotation;
   has_rotation_[i] = 1;
@@ -661,7 +691,7 @@ bool GapFiller::expected_position(int i, Vec3& out, double* out_variance) {
 }
 
 double GapFiller::rigid_estimate_variance(int i, bool misfit) const {
-  return model_.pca[i].rigid_variance * model_.ring_size(i) / std::max(1, rigid_support_[i]) * (misfit ? rigid_novelty_[i] : 1.0);
+  return rigid_variance_[i] * (misfit ? rigid_novelty_[i] : 1.0);
 }
 
 // At the first frame of a gap: where the marker and its anchors were last frame.

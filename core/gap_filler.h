@@ -23,7 +23,9 @@
 //   4. PCA fill: every observed neighbour's PCA model reconstructs the missing marker from that
 //      neighbour's observed one-ring (regularised least squares on the coefficients); the
 //      estimates are averaged, each weighted by the inverse of its predictive variance
-//      (calibrated on the training take), together with the rigid estimate weighed likewise.
+//      (calibrated on the training take), together with the rigid estimate weighed likewise
+//      (its members' departure from rigid, and the variance of any member the chain only
+//      estimated, through each member's leverage on the fit: rigid_fit_leverage.h).
 //      Each variance is grown by its model's misfit to what it was fitted to this frame
 //      (novelty_factor, pca_fit.h): a pose training never showed makes its claim worth less.
 //      Without one, the rigid estimate; without that, held relative to the marker's anchors.
@@ -236,6 +238,9 @@ class GapFiller {
   std::vector<double> pca_novelty_;        // per model: novelty_factor of this frame's solve
   std::vector<int> rigid_support_;         // observed ring members behind each rigid estimate
   std::vector<double> rigid_novelty_;      // novelty_factor of each rigid estimate's fit
+  std::vector<double> rigid_variance_;     // each rigid estimate's predictive variance (mm^2, per coordinate)
+  std::vector<double> rigid_member_variance_;  // per marker: its ring members' departure from rigid (mm^2)
+  std::vector<double> leverage_;           // rigid_fit_leverage of the fit being made
   // One ring member missing, per ring entry: the coefficients' linear map (components x 3(d-1),
   // row-major, at single_gap_offset_) and the reconstruction's calibrated variance.
   std::vector<double> single_gap_map_;
