@@ -195,9 +195,14 @@ CompressedVertexDecoder::Result CompressedVertexDecoder::decode(std::span<const 
   const uint32_t coded = get<uint32_t>(at);
   if (kPositionHeaderBytes + coded + padding_to_4(coded) != positions_block.size())
     throw DecodeError("compressed positions: " + std::to_string(coded) + " coded bytes in a block of " + std::to_string(positions_block.size()));
-  for (int a = 0; a < 3; ++a)
+  for (int a = 0; a < 3; ++a) {
     if (!std::isfinite(origin[a]) || !std::isfinite(step[a]) || step[a] <= 0.0f)
       throw DecodeError("compressed positions: the grid's origin or step is not a finite positive number");
+    // Every position is origin + q * step with q < 65536: finite at both ends, finite between.
+    const float span = 65535.0f * step[a];
+    if (!std::isfinite(span) || !std::isfinite(origin[a] + span))
+      throw DecodeError("compressed positions: the grid reaches beyond the range of a float");
+  }
   if (!key && (!has_key_ || key_frame_number != key_frame_number_)) return Result::NeedsKey;
   if (meshopt_decodeVertexBuffer(vertices_.data(), v, kPositionVertexBytes, at, coded) != 0)
     throw DecodeError("compressed positions: the vertex codec refused the data");

@@ -155,6 +155,15 @@ TEST(CompressedVertices, BadBlocksAreRejected) {
   const float zero = 0.0f;
   std::memcpy(bad.data() + 16, &zero, 4);  // a grid step of 0
   EXPECT_THROW(decoder.decode(bad, {}, true, positions, {}), DecodeError);
+  // A grid whose far corner (origin + 65535 steps) is beyond float range: the positions would
+  // decode to infinity (found by fuzzing: a step of 1e35 passed as a finite positive number).
+  for (const auto& [origin, step] : {std::pair{0.0f, 1e35f}, std::pair{3e38f, 1e34f}, std::pair{-3e38f, 1e34f}}) {
+    SCOPED_TRACE(step);
+    bad.assign(b.positions().begin(), b.positions().end());
+    std::memcpy(bad.data() + 4, &origin, 4);
+    std::memcpy(bad.data() + 16, &step, 4);
+    EXPECT_THROW(decoder.decode(bad, {}, true, positions, {}), DecodeError);
+  }
   bad.assign(b.positions().begin(), b.positions().end());
   bad[32] ^= 0xFF;  // the codec's header byte
   EXPECT_THROW(decoder.decode(bad, {}, true, positions, {}), DecodeError);
