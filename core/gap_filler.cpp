@@ -428,8 +428,7 @@ void GapFiller::fit_rigid_estimate(int i) {
   // less: its members' miss against the fit, over what those variances lead one to expect of
   // it. The fit takes six of the 3n coordinates: three members leave only their three
   // distances to test.
-  const double expected = (3.0 * count - 6.0) / count * member_variances;
-  rigid_novelty_[i] = expected > 0.0 && miss > expected ? miss / expected : 1.0;
+  rigid_novelty_[i] = misfit_ratio(miss, (3.0 * count - 6.0) / count * member_variances);
   estimate_[i] = t.translation;  // the local frame's origin is the marker
   rotation_[i] = t.rotation;
   has_rotation_[i] = 1;

@@ -18,12 +18,17 @@ constexpr int kMaxRingDims = 3 * SubjectModel::kMaxRing;
 using PcaMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxRingDims, kMaxRingDims>;
 using PcaVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxRingDims, 1>;
 
+// A squared miss over the squared miss expected of it, at least 1: how much a claim's variance
+// grows when what it was fitted to fits worse than it should.
+inline double misfit_ratio(double squared_miss, double expected) {
+  return expected > 0.0 && squared_miss > expected ? squared_miss / expected : 1.0;
+}
+
 // How much less a model's claim is worth on a pose unlike those it was trained on: the observed
 // members' squared miss against the model's own estimate of them, over what its residual leads
 // one to expect (three coordinates a member); at least 1.
 inline double novelty_factor(double squared_miss, int observed, double residual_variance) {
-  const double expected = 3.0 * observed * residual_variance;
-  return expected > 0.0 && squared_miss > expected ? squared_miss / expected : 1.0;
+  return misfit_ratio(squared_miss, 3.0 * observed * residual_variance);
 }
 
 class PcaFit {
