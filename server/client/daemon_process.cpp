@@ -31,6 +31,9 @@ DaemonProcess::DaemonProcess(DaemonLaunch launch) : launch_(std::move(launch)) {
   if (pid_ == 0) {
     // The daemon goes when the process that started it does, even when that one is killed.
     prctl(PR_SET_PDEATHSIG, SIGTERM);
+    // Nothing of the starter's (its listening sockets, its subscribers') stays open in the
+    // daemon: Asio opens sockets without close-on-exec.
+    close_range(3, ~0U, 0);
     execl("/bin/sh", "sh", "-c", command.c_str(), static_cast<char*>(nullptr));
     _exit(127);
   }

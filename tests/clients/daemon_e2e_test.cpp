@@ -4,6 +4,8 @@
 // away and come back; the demo subject's vertex buffers equal `skinstream fill` + `deform`.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <filesystem>
 #include <functional>
 #include <csignal>
 #include <cstdio>
@@ -204,6 +206,34 @@ TEST_F(DaemonProgram, SigtermStopsCleanlyWithMarkersOnly) {
   EXPECT_NE(sub.output.find("\"frames\": 20"), std::string::npos) << sub.output;
   EXPECT_EQ(daemon.stop(), 0) << daemon.log();
   EXPECT_NE(daemon.log().find("no deformation model"), std::string::npos) << daemon.log();
+}
+
+// The daemon holds no descriptor of the process that starts it (skinstream-bench, a test): a
+// listening socket of the starter's, left open in the daemon, stayed listening after the starter
+// closed it, and the daemon's stdout and stderr are its log file, not the starter's JSON output.
+TEST_F(DaemonProgram, InheritsNoDescriptorOfTheProcessThatStartsIt) {
+  const int listening = ::socket(AF_INET, SOCK_STREAM, 0);  // no SOCK_CLOEXEC, as Asio opens them
+  ASSERT_GE(listening, 0);
+  sockaddr_in address{};
+  address.sin_family = AF_INET;
+  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  ASSERT_EQ(::bind(listening, reinterpret_cast<sockaddr*>(&address), sizeof address), 0);
+  ASSERT_EQ(::listen(listening, 4), 0);
+  char own_link[64] = {};
+  const std::string own_fd = "/proc/self/fd/" + std::to_string(listening);
+  ASSERT_GT(::readlink(own_fd.c_str(), own_link, sizeof own_link - 1), 0);  // "socket:[inode]"
+  DaemonProcess daemon("--subject " + subject_);
+  ASSERT_GT(daemon.pid(), 0);
+  std::vector<std::string> held;
+  for (const auto& entry : std::filesystem::directory_iterator("/proc/" + std::to_string(daemon.pid()) + "/fd")) {
+    std::error_code error;
+    const auto target = std::filesystem::read_symlink(entry.path(), error);
+    if (!error) held.push_back(target.string());
+  }
+  EXPECT_FALSE(held.empty());
+  EXPECT_EQ(std::count(held.begin(), held.end(), std::string(own_link)), 0) << "the daemon holds the starter's " << own_link;
+  ::close(listening);
+  EXPECT_EQ(daemon.stop(), 0) << daemon.log();
 }
 
 long count_lines_with(const std::string& text, const std::string& needle) {
