@@ -1,6 +1,9 @@
 // skinstream-bench: end-to-end latency and cost of the real skinstreamd, fed over the network as
 // in production: a Vicon DataStream replay server and N subscribers in this process, the daemon
 // a child process (on loopback, or behind a shaped link with --link-mbit). Arguments, run, report.
+#include <spdlog/sinks/stdout_color_sinks.h>
+#include <spdlog/spdlog.h>
+
 #include <atomic>
 #include <csignal>
 #include <cstdio>
@@ -19,6 +22,9 @@ void request_stop(int) { stop_requested = true; }
 int main(int argc, char** argv) {
   skinstream::bench::BenchOptions options;
   if (const auto exit_code = skinstream::bench::parse_bench_options(argc, argv, options)) return *exit_code;
+  // The replay server and subscribers in this process log to stderr: stdout is the report,
+  // JSON with --json, which a peer of the replay server once broke with a warning.
+  spdlog::set_default_logger(spdlog::stderr_color_mt("bench"));
   std::signal(SIGINT, request_stop);
   std::signal(SIGTERM, request_stop);
   try {
