@@ -3,6 +3,8 @@
 // Errors at startup print one line and exit 1; SIGINT/SIGTERM stop cleanly with exit code 0.
 #include <spdlog/spdlog.h>
 
+#include <malloc.h>
+
 #include <csignal>
 #include <cstdio>
 #include <nlohmann/json.hpp>
@@ -13,6 +15,12 @@
 
 int main(int argc, char** argv) {
   using namespace skinstream::server;
+  // Large buffers (pooled frames of 640 kB, MeshInfo of 1.35 MB, per-connection buffers of a
+  // flood) each in a mapping of their own, returned to the system the moment they are freed.
+  // By default malloc raises this threshold to the size of each mapped block it frees, after
+  // which such buffers land in its arenas, and what a wave of stalled subscribers took comes
+  // back only as far as the arenas' fragmentation lets it.
+  mallopt(M_MMAP_THRESHOLD, 128 * 1024);
   try {
     int exit_code = 0;
     const std::optional<CommandLine> command_line = parse_command_line(argc, argv, exit_code);

@@ -335,7 +335,8 @@ TEST(DaemonDemoSubscribers, ThePoolShrinksBackToItsHighWaterMarkAfterStalledSubs
   EXPECT_EQ(after["frame_buffers_allocated_by_pipeline"], 0) << after.dump();
   const long rss_after = resident_kb(daemon.pid());
   std::printf("pool after they left %s; RSS %ld kB\n", after["frame_pool"].dump().c_str(), rss_after);
-  EXPECT_LT(rss_after, rss_before + 64 * 1024) << "the stalled subscribers' memory did not come back";
+  // Within 10% (the soak's bound): 60 held frames are 38 MB, about 70% of the daemon's RSS.
+  EXPECT_LT(rss_after, rss_before + rss_before / 10) << "the stalled subscribers' memory did not come back";
   EXPECT_EQ(daemon.stop(), 0) << daemon.log();
 }
 
