@@ -15,8 +15,8 @@
 
 int main(int argc, char** argv) {
   using namespace skinstream::server;
-  // Large buffers (pooled frames of 640 kB, MeshInfo of 1.35 MB, per-connection buffers of a
-  // flood) each in a mapping of their own, returned to the system the moment they are freed.
+  // Large buffers (pooled frames of 320 kB-1.3 MB, the MeshInfo of 1.35 MB: few, long-lived)
+  // each in a mapping of their own, returned to the system the moment they are freed.
   // By default malloc raises this threshold to the size of each mapped block it frees, after
   // which such buffers land in its arenas, and what a wave of stalled subscribers took comes
   // back only as far as the arenas' fragmentation lets it.

@@ -210,7 +210,7 @@ TEST_F(DaemonProgram, SigtermStopsCleanlyWithMarkersOnly) {
 
 // The daemon holds no descriptor of the process that starts it (skinstream-bench, a test): a
 // listening socket of the starter's, left open in the daemon, stayed listening after the starter
-// closed it, and the daemon's stdout and stderr are its log file, not the starter's JSON output.
+// closed it (skinstream-bench's replay server's was found among the daemon's).
 TEST_F(DaemonProgram, InheritsNoDescriptorOfTheProcessThatStartsIt) {
   const int listening = ::socket(AF_INET, SOCK_STREAM, 0);  // no SOCK_CLOEXEC, as Asio opens them
   ASSERT_GE(listening, 0);
