@@ -84,7 +84,11 @@ SubjectStream::SubjectStream(SubjectConfig config, const SubjectStreamOptions& o
   } catch (const std::invalid_argument& e) {
     throw FileError(config_.file, std::string("deformation model unusable: ") + e.what());
   }
-  hub_->set_encoding_preparer([pipeline = pipeline_.get()](StreamKey key) { pipeline->prepare_encoding(key); });
+  Pipeline* pipeline = pipeline_.get();
+  hub_->set_encoding_preparer({.ready = [pipeline](StreamKey key) { return pipeline->encoding_ready(key); },
+                               .request = [pipeline](StreamKey key) { pipeline->request_encoding(key); },
+                               .activated = [pipeline](StreamKey key) { pipeline->encoding_activated(key); }});
+  pipeline_->set_encoding_ready_callback([hub = hub_.get()](StreamKey key) { hub->encoding_prepared(key); });
   hub_->set_compressed_order(pipeline_->compressed_order());
   if (const EvaluationModel* evaluation = pipeline_->evaluation_model()) {
     hub_->set_model_message(std::make_shared<const std::vector<unsigned char>>(subscriber::encode_model(*evaluation)));

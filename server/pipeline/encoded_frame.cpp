@@ -84,6 +84,12 @@ size_t FramePool::prepare(StreamKey key, size_t bytes) {
   return missing;
 }
 
+bool FramePool::prepared(StreamKey key, size_t bytes) const {
+  if (key >= EncodedFrame::kEncodings || bytes == 0) return false;
+  std::lock_guard lock(mutex_);
+  return prepared_bytes_[key] == bytes && sized_[key] + ready_[key].size() >= all_.size();
+}
+
 bool FramePool::size_message(EncodedFrame& frame, StreamKey key, size_t bytes) {
   std::vector<unsigned char>& message = frame.messages[key];
   if (message.size() == bytes) return false;

@@ -86,6 +86,9 @@ class FramePool {
   // take) for stream key `key` ready for every pooled frame that has none yet. Returns the
   // number of buffers it made.
   size_t prepare(StreamKey key, size_t bytes);
+  // Any thread: whether every pooled frame holds or has ready a buffer of `bytes` for `key`
+  // (prepare() would make none).
+  bool prepared(StreamKey key, size_t bytes) const;
   // Pipeline thread: gives frame.messages[key] `bytes` bytes, within its capacity, or from a
   // prepared buffer when one is ready. Returns true when it had to allocate here instead.
   bool size_message(EncodedFrame& frame, StreamKey key, size_t bytes);

@@ -65,8 +65,7 @@ Pipeline::Pipeline(const SubjectModel& model, const DeformationModel* deformatio
       mailbox_(mailbox),
       consumer_(consumer),
       metrics_(metrics),
-      pool_keeper_("frame-pool",
-                   [this] { metrics_.frame_buffers_allocated.fetch_add(pool_.keep_free(kFreeFrames), std::memory_order_relaxed); }),
+      pool_keeper_("frame-pool", [this] { keep_pool(); }),
       blender_(model, options.lookahead) {
   const int n = model.marker_count();
   filled_.resize(n);
@@ -195,13 +194,59 @@ size_t Pipeline::message_bytes(StreamKey key) const {
 void Pipeline::prepare_encoding(StreamKey key) {
   const size_t made = pool_.prepare(key, message_bytes(key));
   metrics_.frame_buffers_allocated.fetch_add(made, std::memory_order_relaxed);
+  encoding_activated(key);
+}
+
+bool Pipeline::encoding_ready(StreamKey key) const { return pool_.prepared(key, message_bytes(key)); }
+
+void Pipeline::request_encoding(StreamKey key) {
+  {
+    std::lock_guard lock(keeper_mutex_);
+    requested_encodings_.add(key);
+  }
+  pool_keeper_.wake();
+}
+
+void Pipeline::encoding_activated(StreamKey key) {
   if ((stream_flags(key) & subscriber::kFrameCompressed) && compressed_) compressed_->request_key();
 }
 
 void Pipeline::trim_pool() {
-  const size_t released = pool_.release_unwanted(consumer_.wanted_encodings(), std::chrono::steady_clock::now(), kUnwantedHoldOff);
-  metrics_.frame_buffers_released.fetch_add(released, std::memory_order_relaxed);
-  pool_.trim(kFreeFrames);
+  {
+    std::lock_guard lock(keeper_mutex_);
+    trim_asked_ = true;
+  }
+  pool_keeper_.wake();
+}
+
+// Everything that makes or frees pooled memory while frames flow happens here, on a thread that
+// serves no one: the frames kept free ahead of the pipeline, the encodings subscribers wait for,
+// then the trim.
+void Pipeline::keep_pool() {
+  for (;;) {
+    // The frames ahead of the pipeline first: without them it would make its own.
+    metrics_.frame_buffers_allocated.fetch_add(pool_.keep_free(kFreeFrames), std::memory_order_relaxed);
+    StreamKey key = 0;
+    {
+      std::lock_guard lock(keeper_mutex_);
+      if (requested_encodings_.empty()) break;
+      requested_encodings_.for_each([&](StreamKey k) { key = k; });
+      requested_encodings_.remove(key);
+    }
+    metrics_.frame_buffers_allocated.fetch_add(pool_.prepare(key, message_bytes(key)), std::memory_order_relaxed);
+    if (encoding_ready_callback_) encoding_ready_callback_(key);
+  }
+  bool trim = false;
+  {
+    std::lock_guard lock(keeper_mutex_);
+    std::swap(trim, trim_asked_);
+  }
+  if (trim) {
+    const size_t released = pool_.release_unwanted(consumer_.wanted_encodings(), std::chrono::steady_clock::now(), kUnwantedHoldOff);
+    metrics_.frame_buffers_released.fetch_add(released, std::memory_order_relaxed);
+    pool_.trim(kFreeFrames);
+  }
+  metrics_.frame_buffers_allocated.fetch_add(pool_.keep_free(kFreeFrames), std::memory_order_relaxed);
 }
 
 void Pipeline::publish(const Released& meta, std::span<const Vec3> positions, std::span<const MarkerStatus> status) {

@@ -9,7 +9,9 @@
 
 #include <atomic>
 #include <chrono>
+#include <functional>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <thread>
@@ -73,14 +75,28 @@ class Pipeline {
   const std::vector<uint32_t>& compressed_order() const { return compressed_order_; }
   // Any thread, before the pipeline is told anyone wants stream `key`: makes its buffers for
   // every pooled frame, so the first frames encoded that way do not allocate (and fault in
-  // 640 kB each) on the pipeline thread. For the compressed encoding, the next frame becomes a
-  // key frame, so the new subscriber need not wait for one.
+  // 640 kB each) on the pipeline thread. Waits for them, so it is for start-up; a subscriber's
+  // Hello goes through request_encoding().
   void prepare_encoding(StreamKey key);
-  // Any thread but the pipeline's (the daemon's 1 Hz tick): frees the pooled frames beyond the
-  // most in use at once since the last call plus the kFreeFrames kept ahead, so the frames that
-  // stalled subscribers held are freed once they leave; and frees the buffers of every encoding
-  // no subscriber has wanted for kUnwantedHoldOff, so a burst of Hellos asking for every
-  // combination of flags does not keep its memory for good.
+  // Any thread: whether stream key `key`'s buffers are made for every pooled frame, so a
+  // subscriber of it can start at once.
+  bool encoding_ready(StreamKey key) const;
+  // Any thread, never waits: the pool keeper's thread makes `key`'s buffers (as
+  // prepare_encoding() does), then calls the encoding-ready callback with `key` there. Making
+  // them on the subscriber's io thread held every other subscriber of that thread for as long
+  // as it took: 20-50 ms at a wave of Hellos in the soak (docs/measurements-log.md).
+  void request_encoding(StreamKey key);
+  // Before any request_encoding(): called on the pool keeper's thread as each requested key's
+  // buffers are ready.
+  void set_encoding_ready_callback(std::function<void(StreamKey)> ready) { encoding_ready_callback_ = std::move(ready); }
+  // Any thread, once a subscriber of `key` receives frames: a compressed stream's next frame
+  // becomes a key frame, so the new subscriber need not wait for one.
+  void encoding_activated(StreamKey key);
+  // Any thread, never waits (the daemon's 1 Hz tick): the pool keeper's thread frees the pooled
+  // frames beyond the most in use at once since the last trim plus the kFreeFrames kept ahead,
+  // so the frames that stalled subscribers held are freed once they leave; and frees the
+  // buffers of every encoding no subscriber has wanted for kUnwantedHoldOff, so a burst of
+  // Hellos asking for every combination of flags does not keep its memory for good.
   void trim_pool();
   size_t pool_frames() const { return pool_.allocated(); }
   size_t pool_frames_in_use() const { return pool_.in_use(); }
@@ -101,6 +117,7 @@ class Pipeline {
     bool has_timecode = false;
   };
   void run();
+  void keep_pool();  // the pool keeper's job
   GapFillerOptions filler_options(double rate_hz) const;
   void process(const MarkerFrame& frame, uint64_t generation);
   void publish(const Released& meta, std::span<const Vec3> positions, std::span<const MarkerStatus> status);
@@ -126,7 +143,14 @@ class Pipeline {
   // made; short enough that memory comes back well within a minute of a flood ending.
   static constexpr std::chrono::seconds kUnwantedHoldOff{10};
   FramePool pool_{static_cast<int>(kFreeFrames)};
-  OnDemandThread pool_keeper_;
+  // The pool keeper's work, asked for from any thread (guarded by keeper_mutex_): keys whose
+  // buffers a subscriber waits for, and whether a trim is due. Declared before the keeper, whose
+  // thread uses them until it is joined.
+  std::mutex keeper_mutex_;
+  StreamKeySet requested_encodings_;
+  bool trim_asked_ = false;
+  std::function<void(StreamKey)> encoding_ready_callback_;
+  OnDemandThread pool_keeper_;  // last of these: its thread starts as it is made
 
   std::optional<GapFiller> filler_;
   double filler_rate_hz_ = 0.0;

@@ -29,6 +29,9 @@ struct StreamKeySet {
   void add(StreamKey key) {
     if (key < kStreamKeys) bits[key >> 6] |= uint64_t{1} << (key & 63);
   }
+  void remove(StreamKey key) {
+    if (key < kStreamKeys) bits[key >> 6] &= ~(uint64_t{1} << (key & 63));
+  }
   bool empty() const { return bits[0] == 0 && bits[1] == 0; }
   // Calls f(key) for every key in the set, in increasing order.
   template <typename F>

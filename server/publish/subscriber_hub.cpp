@@ -41,16 +41,43 @@ void SubscriberHub::add(const std::shared_ptr<SubscriberSession>& session, bool 
 }
 
 void SubscriberHub::activate(SubscriberSession& session, StreamKey key) {
-  if (prepare_encoding_) prepare_encoding_(key);  // makes nothing once the key's buffers are made
-  std::lock_guard lock(mutex_);
-  if (std::find(active_.begin(), active_.end(), &session) == active_.end()) active_.push_back(&session);
-  update_wanted_locked();
+  bool ready = true;
+  {
+    std::lock_guard lock(mutex_);
+    std::erase_if(waiting_, [&](const Waiting& w) { return w.session == &session; });
+    const auto active = std::find(active_.begin(), active_.end(), &session);
+    ready = !preparer_.ready || preparer_.ready(key);
+    if (ready && active == active_.end()) active_.push_back(&session);
+    if (!ready) {
+      if (active != active_.end()) active_.erase(active);  // a new Hello asked for another key
+      waiting_.push_back({&session, key});
+    }
+    update_wanted_locked();
+  }
+  if (!ready) preparer_.request(key);
+  else if (preparer_.activated) preparer_.activated(key);
+}
+
+void SubscriberHub::encoding_prepared(StreamKey key) {
+  bool started = false;
+  {
+    std::lock_guard lock(mutex_);
+    std::erase_if(waiting_, [&](const Waiting& w) {
+      if (w.key != key) return false;
+      active_.push_back(w.session);
+      started = true;
+      return true;
+    });
+    if (started) update_wanted_locked();
+  }
+  if (started && preparer_.activated) preparer_.activated(key);
 }
 
 void SubscriberHub::remove(SubscriberSession& session) {
   std::shared_ptr<SubscriberSession> keep;  // destroyed after the lock is released
   std::lock_guard lock(mutex_);
   active_.erase(std::remove(active_.begin(), active_.end(), &session), active_.end());
+  std::erase_if(waiting_, [&](const Waiting& w) { return w.session == &session; });
   const auto it = std::find_if(sessions_.begin(), sessions_.end(), [&](const auto& s) { return s.get() == &session; });
   if (it != sessions_.end()) {
     keep = *it;
@@ -162,6 +189,11 @@ std::vector<SubscriberMetrics> SubscriberHub::subscriber_metrics() const {
 size_t SubscriberHub::active_count() const {
   std::lock_guard lock(mutex_);
   return active_.size();
+}
+
+size_t SubscriberHub::waiting_count() const {
+  std::lock_guard lock(mutex_);
+  return waiting_.size();
 }
 
 size_t SubscriberHub::subscriber_count() const {

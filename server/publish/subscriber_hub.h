@@ -46,12 +46,23 @@ class SubscriberHub : public FrameConsumer {
 
   // `accepted`: a new connection (counted); false for one moving in from another subject's hub.
   void add(const std::shared_ptr<SubscriberSession>& session, bool accepted = true);
-  // Called by activate() on the subscriber's thread before its stream key becomes wanted, so
-  // the pipeline can make that key's buffers there (Pipeline::prepare_encoding). Set before any
-  // subscriber connects.
-  void set_encoding_preparer(std::function<void(StreamKey key)> prepare) { prepare_encoding_ = std::move(prepare); }
-  // After Hello (or its timeout): the session starts receiving frames of this stream key.
+  // How a subscriber's stream key gets its pooled buffers (Pipeline): whether they are made,
+  // a request to make them off the subscriber's thread (encoding_prepared() follows), and word
+  // that a subscriber of the key now receives frames. Set before any subscriber connects; unset,
+  // every key counts as made.
+  struct EncodingPreparer {
+    std::function<bool(StreamKey)> ready;
+    std::function<void(StreamKey)> request;
+    std::function<void(StreamKey)> activated;
+  };
+  void set_encoding_preparer(EncodingPreparer preparer) { preparer_ = std::move(preparer); }
+  // After Hello (or its timeout): the session receives frames of this stream key from now on
+  // when the key's buffers are made, else once they are (encoding_prepared()); meanwhile it
+  // receives none. Never waits for them.
   void activate(SubscriberSession& session, StreamKey key);
+  // Any thread (the pipeline's pool keeper): `key`'s buffers are made; the sessions waiting for
+  // them start receiving frames.
+  void encoding_prepared(StreamKey key);
   void remove(SubscriberSession& session);
   void close_all();
   // Any thread (the daemon's 1 Hz timer): closes and counts each subscriber whose write has made
@@ -85,6 +96,7 @@ class SubscriberHub : public FrameConsumer {
   std::vector<SubscriberMetrics> subscriber_metrics() const;
   size_t subscriber_count() const;
   size_t active_count() const;  // subscribers receiving frames
+  size_t waiting_count() const;  // subscribers waiting for their key's buffers
 
  private:
   void update_wanted_locked();
@@ -102,11 +114,16 @@ class SubscriberHub : public FrameConsumer {
   mutable std::mutex mutex_;  // the sessions and the status
   std::vector<std::shared_ptr<SubscriberSession>> sessions_;
   std::vector<SubscriberSession*> active_;
+  struct Waiting {
+    SubscriberSession* session;
+    StreamKey key;
+  };
+  std::vector<Waiting> waiting_;  // activated, their key's buffers not made yet
   subscriber::Status status_;
   // The status encoded: version 1, then version 2 per encoding served.
   std::array<ControlMessage, 1 + subscriber::kEncodingCount> status_messages_;
   std::array<std::atomic<uint64_t>, 2> wanted_{};  // StreamKeySet::bits
-  std::function<void(StreamKey)> prepare_encoding_;
+  EncodingPreparer preparer_;
   const SubjectDirectory* directory_ = nullptr;
 };
 

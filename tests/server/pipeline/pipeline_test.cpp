@@ -7,6 +7,8 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <condition_variable>
+#include <mutex>
 #include <functional>
 #include <optional>
 #include <thread>
@@ -169,6 +171,43 @@ TEST(Pipeline, AllocatesNothingPerFrameFromMailboxToSubscriber) {
 
   EXPECT_EQ(frames_received.load(), kFrames);
   EXPECT_GT(metrics.markers_filled.load(), 0u);  // the gaps went through the filler
+}
+
+// Nobody's consumer: wants nothing.
+class NoConsumer : public FrameConsumer {
+ public:
+  StreamKeySet wanted_encodings() const override { return {}; }
+  void publish(const FrameRef&) override {}
+};
+
+// A subscriber's Hello asks for its key's buffers; they are made on the pool keeper's thread,
+// which then says so, and not on the thread that asked (a publish thread serving others).
+TEST(Pipeline, MakesTheBuffersARequestAsksForOnItsOwnThread) {
+  const SubjectModel subject = build_subject(read_capture(test::source_path("replay_data/cmu/85_02.c3d")), {});
+  const DeformationModel deformation = one_part_over(subject);
+  Metrics metrics;
+  FrameMailbox mailbox(subject.marker_count());
+  NoConsumer consumer;
+  Pipeline pipeline(subject, &deformation, PipelineOptions{}, mailbox, consumer, metrics);
+  const StreamKey key = stream_key(subscriber::kFrameNormals, subscriber::kVersion2);
+  std::mutex mutex;
+  std::condition_variable told;
+  std::optional<std::thread::id> made_on;
+  pipeline.set_encoding_ready_callback([&](StreamKey ready) {
+    EXPECT_EQ(ready, key);
+    std::lock_guard lock(mutex);
+    made_on = std::this_thread::get_id();
+    told.notify_one();
+  });
+  EXPECT_FALSE(pipeline.encoding_ready(key));
+
+  pipeline.request_encoding(key);
+  std::unique_lock lock(mutex);
+  ASSERT_TRUE(told.wait_for(lock, std::chrono::seconds(30), [&] { return made_on.has_value(); })) << "never made";
+  EXPECT_NE(*made_on, std::this_thread::get_id());
+  EXPECT_TRUE(pipeline.encoding_ready(key));
+  EXPECT_EQ(metrics.frame_buffers_allocated.load(), pipeline.pool_frames()) << "one buffer per pooled frame";
+  EXPECT_FALSE(pipeline.encoding_ready(stream_key(0, subscriber::kVersion2))) << "another key is not made with it";
 }
 
 }  // namespace
