@@ -91,6 +91,9 @@ class SubscriberHubTest : public ::testing::Test {
   }
 
   Metrics metrics;
+  // Before the hub, so it outlives the sessions and the frames queued in them (TearDown joins
+  // the io thread; the hub's sessions go with the hub).
+  FramePool pool;
   SubscriberHub hub{metrics, HubOptions{}, one_triangle(), true};
   std::atomic<int> requests{0}, activations{0};
   std::atomic<StreamKey> requested{0};
@@ -126,7 +129,6 @@ TEST_F(SubscriberHubTest, ASubscriberWaitsForItsKeysBuffersOffItsThreadAndStarts
   EXPECT_EQ(activations.load(), 0);
   EXPECT_TRUE(io_thread_answers()) << "the io thread waits for the buffers";
 
-  FramePool pool;
   const StreamKey key = requested.load();
   hub.publish(frame_for(pool, key, 6));  // nobody receives it yet
 
