@@ -8,8 +8,8 @@
 
 #include <atomic>
 #include <condition_variable>
-#include <mutex>
 #include <functional>
+#include <mutex>
 #include <optional>
 #include <thread>
 
@@ -188,11 +188,12 @@ TEST(Pipeline, MakesTheBuffersARequestAsksForOnItsOwnThread) {
   Metrics metrics;
   FrameMailbox mailbox(subject.marker_count());
   NoConsumer consumer;
-  Pipeline pipeline(subject, &deformation, PipelineOptions{}, mailbox, consumer, metrics);
+  // Before the pipeline, so that they outlive its keeper's thread, which calls back into them.
   const StreamKey key = stream_key(subscriber::kFrameNormals, subscriber::kVersion2);
   std::mutex mutex;
   std::condition_variable told;
   std::optional<std::thread::id> made_on;
+  Pipeline pipeline(subject, &deformation, PipelineOptions{}, mailbox, consumer, metrics);
   pipeline.set_encoding_ready_callback([&](StreamKey ready) {
     EXPECT_EQ(ready, key);
     std::lock_guard lock(mutex);
