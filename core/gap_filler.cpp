@@ -44,6 +44,7 @@ GapFiller::GapFiller(const SubjectModel& model, const GapFillerOptions& options)
   gap_offset_.assign(n_, Vec3::Zero());
   gap_age_.assign(n_, 0);
   gap_start_known_.assign(n_, 0);
+  gap_start_frame_.assign(n_, 0);
   gap_start_position_.assign(n_, Vec3::Zero());
   gap_start_anchor_.assign(model.anchors.size(), Vec3::Zero());
   gap_start_anchor_seen_.assign(model.anchors.size(), 0);
@@ -696,6 +697,7 @@ double GapFiller::rigid_estimate_variance(int i, bool misfit) const {
 // At the first frame of a gap: where the marker and its anchors were last frame.
 void GapFiller::remember_gap_start(int i) {
   gap_start_known_[i] = 1;
+  gap_start_frame_[i] = frame_;
   gap_start_position_[i] = previous_[i];
   for (int k = model_.anchor_offsets[i]; k < model_.anchor_offsets[i + 1]; ++k) {
     const int a = model_.anchors[k];
@@ -743,7 +745,7 @@ bool GapFiller::carried_from_gap_start(int i, Vec3& out, double& out_variance) {
   if (!carry_rigidly(i, gap_start_position_[i], {&gap_start_anchor_[first], static_cast<size_t>(count)},
                      {&gap_start_anchor_seen_[first], static_cast<size_t>(count)}, out, residual))
     return false;
-  const double age = gap_age_[i] + 1.0;
+  const double age = static_cast<double>(frame_ - gap_start_frame_[i]) + 1.0;
   out_variance = std::max(residual + carry_drift_[i] * age * age / 3.0, model_.pca[i].residual_variance);
   return true;
 }

@@ -189,6 +189,7 @@ class GapFiller {
   // model.anchors; usable where the anchor was measured or relabelled then).
   static constexpr int kCarryAnchors = 3;
   std::vector<char> gap_start_known_;
+  std::vector<long> gap_start_frame_;  // the gap's first frame (frame_ then)
   std::vector<Vec3> gap_start_position_;
   std::vector<Vec3> gap_start_anchor_;
   std::vector<char> gap_start_anchor_seen_;

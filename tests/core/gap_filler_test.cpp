@@ -110,6 +110,41 @@ TEST(GapFiller, PcaBeatsTheRigidEstimateOnADeformingLimb) {
   EXPECT_LT(pca_error / spacing, 0.02);  // the paper reports about 0.02 on real data
 }
 
+// A carry from the gap's start weighs less as the gap ages, by the gap's own age: once the
+// gap-start continuity has faded, the fill is the same with it or without it. (The age was once
+// counted by the continuity code alone: without it a carry kept its first frame's weight for the
+// whole gap, and a second gap started at the first one's age.)
+TEST(GapFiller, ACarryAgesWithItsGapWhetherContinuityIsOnOrOff) {
+  test::LimbOptions o;
+  o.frames = 1800;
+  Fixture fx(o);
+  GapFillerOptions with_continuity, without;
+  without.continuity_seconds = 0.0;
+  GapFiller a(fx.model, with_continuity), b(fx.model, without);
+  Frame fa(fx.model.marker_count()), fb(fx.model.marker_count());
+  const int faded = static_cast<int>(5 * with_continuity.continuity_seconds * with_continuity.rate_hz);
+  double largest = 0.0, spread = 0.0;  // the fills' largest difference; the fill's largest error
+  for (int f = 0; f < fx.truth.frame_count; ++f) {
+    load(fx.truth, f, fa);
+    load(fx.truth, f, fb);
+    const bool first_gap = f >= 300 && f < 400, second_gap = f >= 520;
+    if (first_gap || second_gap) {  // the marker and all but three of its ring: the carry weighs in
+      fa.labelled[kMiddle] = fb.labelled[kMiddle] = missing_point();
+      for (int k = fx.model.ring_offsets[kMiddle]; k < fx.model.ring_offsets[kMiddle + 1] - 3; ++k)
+        fa.labelled[fx.model.ring[k]] = fb.labelled[fx.model.ring[k]] = missing_point();
+    }
+    fa.run(a);
+    fb.run(b);
+    if (second_gap && f >= 520 + faded) {
+      largest = std::max(largest, (fa.positions[kMiddle] - fb.positions[kMiddle]).norm());
+      spread = std::max(spread, (fa.positions[kMiddle] - fx.truth.at(f, kMiddle)).norm());
+    }
+  }
+  // What is left is the faded offset (e^-5 of it): well under the fill's own error. (With the age
+  // counted by the continuity code, the two fills differed by more than that error.)
+  EXPECT_LT(largest, 0.01 * spread);
+}
+
 TEST(GapFiller, PcaFitsWithMissingEntriesInTheRing) {
   Fixture fx;
   GapFillerOptions o;
