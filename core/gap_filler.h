@@ -28,6 +28,11 @@
 //      estimated, through each member's leverage on the fit: rigid_fit_leverage.h).
 //      Each variance is grown by its model's misfit to what it was fitted to this frame
 //      (novelty_factor, pca_fit.h): a pose training never showed makes its claim worth less.
+//      And each is scaled by how much it lately missed: a few models a frame, where the marker
+//      and its whole ring are measured, estimate every member (and eq. 2 the marker) from the
+//      rest, and the miss over the variance claimed (recent frames counting most), never below
+//      one, scales the claim (check_rings): a ring that spans the two feet, steady while the
+//      subject stood in training, is no judge of either foot in a walk.
 //      Without one, the rigid estimate; without that, held relative to the marker's anchors.
 //      The marker's regional PCA (region_pca_fit.h), aligned on whichever members of its region
 //      are seen, joins as one more opinion weighed by its calibrated variance: it holds where the
@@ -74,6 +79,10 @@ struct GapFillerOptions {
   // With regions: each region also learns from the frames in which it is measured whole, and its
   // opinion blends that with the offline model (region_online_statistics.h).
   bool learn_regions = true;
+  // Each one-ring model's estimate of each member, and eq. 2's of the marker, is tried where the
+  // whole ring is measured (a few models a frame), and the variance each claims is scaled by how
+  // much more it lately missed (never below its offline calibration): check_rings.
+  bool calibrate_rings = true;
   // A new relabel stays on probation for this many frames: while it is, the fragment must pass
   // the taking test (eq. 3, unambiguous) every frame, else the relabel is revoked for all the
   // frames since it was taken (FrameOutput::revoked; GapEndBlender, holding those frames, gives
@@ -122,6 +131,9 @@ class GapFiller {
 
   FillStats run(const FrameInput& in, const FrameOutput& out);
   void reset();  // forget the past (new take, source reconnected)
+  // How much a one-ring opinion's claimed variance is scaled up by what it lately missed
+  // (calibrate_rings; 1: as calibrated offline), per entry of model.ring.
+  double ring_calibration(int ring_entry) const { return ring_calibration_[ring_entry]; }
 
 
  private:
@@ -139,6 +151,8 @@ class GapFiller {
   void relabel();
   void precompute_single_gaps();
   bool solve_pca(int j);
+  double reconstruct_single_gap(int j, int missing_slot, int count, Vec3& out_local);
+  void check_rings();
   int pca_estimate(int i, Vec3& out, double* out_variance = nullptr, bool misfit = false);
   void remember_gap_start(int i);
   bool carried_from_gap_start(int i, Vec3& out, double& out_variance);
@@ -250,6 +264,15 @@ class GapFiller {
   std::vector<double> single_gap_variance_;
   // Several ring members missing: per model, the observed slots (a bit each) its factor below
   // was made for, and that factor (PcaFit::factor_slots, components^2 at pattern_offset_).
+  // The one-ring opinions' online calibration (check_rings), parallel to model.ring: forgetting
+  // sums of the squared miss and of the variance claimed, and their ratio (>= 1).
+  static constexpr int kRingChecksPerFrame = 2;
+  static constexpr double kRingMemorySeconds = 10.0;
+  int ring_cursor_ = 0;
+  long ring_nominal_frames_ = 1;  // between a model's checks when every ring is seen
+  std::vector<double> ring_miss_, ring_claimed_, ring_calibration_;
+  std::vector<long> ring_checked_frame_;  // per model: the frame it was last checked
+  std::vector<double> rigid_miss_, rigid_claimed_, rigid_calibration_;  // per marker: eq. 2 on its whole ring, likewise
   std::vector<uint32_t> pattern_mask_;
   std::vector<int> pattern_offset_;
   std::vector<double> pattern_factor_;

@@ -69,7 +69,7 @@ int run_eval_fill(const EvalFillOptions& o, std::FILE* out) {
   for (int m = 0; m < model.marker_count(); ++m) normaliser[m] = model.neighbour_distance(m);
 
   auto skinstream_fill = [&](CaptureFillOptions fill) { return [&model, fill](const Capture& c) { return fill_capture(model, c, fill); }; };
-  CaptureFillOptions online, ahead, no_pca, no_continuity, plain_average, no_rigid_fusion, no_carry, no_learning;
+  CaptureFillOptions online, ahead, no_pca, no_continuity, plain_average, no_rigid_fusion, no_carry, no_learning, no_ring_calibration;
   ahead.lookahead = o.lookahead;
   no_pca.filler.use_pca = false;
   no_continuity.filler.continuity_seconds = 0.0;
@@ -77,6 +77,7 @@ int run_eval_fill(const EvalFillOptions& o, std::FILE* out) {
   no_rigid_fusion.filler.fuse_rigid = false;
   no_carry.filler.carry_from_gap_start = false;
   no_learning.filler.learn_regions = false;
+  no_ring_calibration.filler.calibrate_rings = false;
   std::vector<Method> methods = {
       {"linear", "linear interpolation (offline)", fill_linear},
       {"spline", "cubic spline (offline)", [](const Capture& c) { return fill_cubic_spline(c); }},
@@ -91,6 +92,7 @@ int run_eval_fill(const EvalFillOptions& o, std::FILE* out) {
     methods.push_back({"skinstream_pca_only", "skinstream online, PCA estimates weighted, rigid estimate not fused", skinstream_fill(no_rigid_fusion)});
     methods.push_back({"skinstream_no_carry", "skinstream online, no carry from the gap start by the steadiest anchors", skinstream_fill(no_carry)});
     methods.push_back({"skinstream_no_region_learning", "skinstream online, regions as trained offline (nothing learned online)", skinstream_fill(no_learning)});
+    methods.push_back({"skinstream_no_ring_calibration", "skinstream online, one-ring and eq. 2 opinions as calibrated offline (not checked online)", skinstream_fill(no_ring_calibration)});
   }
 
   long gap_samples = 0;
@@ -138,10 +140,10 @@ int run_eval_fill(const EvalFillOptions& o, std::FILE* out) {
   }
   std::fprintf(out, "%s: %d markers, %d test frames, %zu gaps (%ld samples, longest %d frames)\n", o.capture_path.c_str(),
                model.marker_count(), truth.frame_count, gaps.size(), gap_samples, longest);
-  std::fprintf(out, "%-26s %9s %9s %9s %9s %10s %10s %8s\n", "method", "mean mm", "median", "p95", "max", "mean norm", "max norm",
+  std::fprintf(out, "%-31s %9s %9s %9s %9s %10s %10s %8s\n", "method", "mean mm", "median", "p95", "max", "mean norm", "max norm",
                "changed");
   for (const auto& m : report["methods"])
-    std::fprintf(out, "%-26s %9.2f %9.2f %9.2f %9.2f %10.4f %10.4f %8ld\n", m["name"].get<std::string>().c_str(),
+    std::fprintf(out, "%-31s %9.2f %9.2f %9.2f %9.2f %10.4f %10.4f %8ld\n", m["name"].get<std::string>().c_str(),
                  m["mm"]["mean"].get<double>(), m["mm"]["median"].get<double>(), m["mm"]["p95"].get<double>(),
                  m["mm"]["max"].get<double>(), m["normalised"]["mean"].get<double>(), m["normalised"]["max"].get<double>(),
                  m["changed_measured_samples"].get<long>());

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 
 #include "support/allocation_counter.h"
 #include "core/offline/subject_builder.h"
@@ -143,6 +144,43 @@ TEST(GapFiller, ACarryAgesWithItsGapWhetherContinuityIsOnOrOff) {
   // What is left is the faded offset (e^-5 of it): well under the fill's own error. (With the age
   // counted by the continuity code, the two fills differed by more than that error.)
   EXPECT_LT(largest, 0.01 * spread);
+}
+
+// A marker that slides on the skin after training (a loose one) makes every one-ring opinion that
+// reads it a poor judge, and every opinion of where it is a poor one too. Checked while the ring
+// is seen, each such opinion comes to claim less (its variance scaled up); the others do not.
+TEST(GapFiller, AnOpinionThatLatelyMissedClaimsLess) {
+  Fixture fx;
+  const int loose = fx.model.ring[fx.model.ring_offsets[kMiddle]];
+  Capture live = fx.truth;
+  for (int f = 0; f < live.frame_count; ++f)  // 25 mm back and forth, at 0.9 Hz
+    live.positions[f * live.point_count() + loose] += Vec3(0, 0, 25.0 * std::sin(2.0 * M_PI * 0.9 * f / fx.options.rate));
+  auto calibrations = [&](const Capture& capture, bool calibrate) {
+    GapFillerOptions options;
+    options.calibrate_rings = calibrate;
+    GapFiller filler(fx.model, options);
+    Frame frame(fx.model.marker_count());
+    for (int f = 0; f < capture.frame_count; ++f) {
+      load(capture, f, frame);
+      frame.run(filler);
+    }
+    double about_loose = 1e300, others = 0.0;  // least among the opinions of or by it, most among rings without it
+    for (int j = 0; j < fx.model.marker_count(); ++j) {
+      const int first = fx.model.ring_offsets[j], last = fx.model.ring_offsets[j + 1];
+      const bool ring_has_loose = j == loose || std::count(fx.model.ring.begin() + first, fx.model.ring.begin() + last, loose) > 0;
+      for (int k = first; k < last; ++k) {
+        if (j == loose || fx.model.ring[k] == loose) about_loose = std::min(about_loose, filler.ring_calibration(k));
+        else if (!ring_has_loose) others = std::max(others, filler.ring_calibration(k));
+      }
+    }
+    return std::pair{about_loose, others};
+  };
+  const auto [loose_claims, other_claims] = calibrations(live, true);
+  EXPECT_GT(loose_claims, 4.0);  // where it is, and what its own ring says, each at least 4x the variance
+  EXPECT_LT(other_claims, 1.5);  // rings without it: as calibrated offline
+  const auto [clean_claims, unused] = calibrations(fx.truth, true);
+  EXPECT_LT(clean_claims, 1.5);  // the same opinions on the capture it was trained on
+  EXPECT_EQ(calibrations(live, false).first, 1.0);  // off: the offline calibration alone
 }
 
 TEST(GapFiller, PcaFitsWithMissingEntriesInTheRing) {

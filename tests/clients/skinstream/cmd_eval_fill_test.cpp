@@ -69,13 +69,13 @@ TEST(EvalFillCommand, TheSeedPlansTheGapsAndAblationsAddRows) {
   const nlohmann::json a = run_json(o);
   o.gaps.seed = 4;
   const nlohmann::json b = run_json(o);
-  EXPECT_EQ(a["methods"].size(), 11u);
+  EXPECT_EQ(a["methods"].size(), 12u);
   EXPECT_EQ(method(a, "skinstream_lookahead")["description"], "skinstream, lookahead 12 frames");
   EXPECT_NE(a["gaps"]["samples"], b["gaps"]["samples"]);
   std::set<std::string> names;
   for (const auto& m : a["methods"]) names.insert(m["name"].get<std::string>());
   EXPECT_TRUE(names.count("skinstream_rigid_only") && names.count("skinstream_no_carry") &&
-              names.count("skinstream_no_region_learning"));
+              names.count("skinstream_no_region_learning") && names.count("skinstream_no_ring_calibration"));
 }
 
 TEST(EvalFillCommand, TheTableHasARowPerMethod) {
