@@ -262,8 +262,6 @@ class GapFiller {
   PcaVector single_gap_deviation_, single_gap_coefficients_;
   std::vector<int> single_gap_offset_;
   std::vector<double> single_gap_variance_;
-  // Several ring members missing: per model, the observed slots (a bit each) its factor below
-  // was made for, and that factor (PcaFit::factor_slots, components^2 at pattern_offset_).
   // The one-ring opinions' online calibration (check_rings), parallel to model.ring: forgetting
   // sums of the squared miss and of the variance claimed, and their ratio (>= 1).
   static constexpr int kRingChecksPerFrame = 2;
@@ -273,6 +271,8 @@ class GapFiller {
   std::vector<double> ring_miss_, ring_claimed_, ring_calibration_;
   std::vector<long> ring_checked_frame_;  // per model: the frame it was last checked
   std::vector<double> rigid_miss_, rigid_claimed_, rigid_calibration_;  // per marker: eq. 2 on its whole ring, likewise
+  // Several ring members missing: per model, the observed slots (a bit each) its factor below
+  // was made for, and that factor (PcaFit::factor_slots, components^2 at pattern_offset_).
   std::vector<uint32_t> pattern_mask_;
   std::vector<int> pattern_offset_;
   std::vector<double> pattern_factor_;
