@@ -93,12 +93,10 @@ GapFiller::GapFiller(const SubjectModel& model, const GapFillerOptions& options)
     rigid_member_variance_.push_back(leverage > 0.0 ? model.pca[i].rigid_variance / leverage : model.pca[i].rigid_variance);
   }
   precompute_single_gaps();
-  ring_miss_.assign(model.ring.size(), 0.0);
-  ring_claimed_.assign(model.ring.size(), 0.0);
+  ring_recent_.assign(model.ring.size(), RecentMiss{});
   ring_calibration_.assign(model.ring.size(), 1.0);
   ring_checked_frame_.assign(n_, -1);
-  rigid_miss_.assign(n_, 0.0);
-  rigid_claimed_.assign(n_, 0.0);
+  rigid_recent_.assign(n_, RecentMiss{});
   rigid_calibration_.assign(n_, 1.0);
   ring_nominal_frames_ = std::max<long>(1, (n_ + kRingChecksPerFrame - 1) / kRingChecksPerFrame);
   static_assert(SubjectModel::kMaxRing < 32, "observed slots are a 32-bit mask");
@@ -158,12 +156,10 @@ void GapFiller::reset() {
   std::fill(carry_drift_.begin(), carry_drift_.end(), 0.0);
   std::fill(carry_checks_.begin(), carry_checks_.end(), 0);
   region_statistics_.reset();
-  std::fill(ring_miss_.begin(), ring_miss_.end(), 0.0);
-  std::fill(ring_claimed_.begin(), ring_claimed_.end(), 0.0);
+  std::fill(ring_recent_.begin(), ring_recent_.end(), RecentMiss{});
   std::fill(ring_calibration_.begin(), ring_calibration_.end(), 1.0);
   std::fill(ring_checked_frame_.begin(), ring_checked_frame_.end(), -1);
-  std::fill(rigid_miss_.begin(), rigid_miss_.end(), 0.0);
-  std::fill(rigid_claimed_.begin(), rigid_claimed_.end(), 0.0);
+  std::fill(rigid_recent_.begin(), rigid_recent_.end(), RecentMiss{});
   std::fill(rigid_calibration_.begin(), rigid_calibration_.end(), 1.0);
   ring_cursor_ = 0;
   for (RegionSolve& solve : region_solves_) solve.observed_mask = 0;
@@ -671,9 +667,8 @@ void GapFiller::check_rings() {
     }
     RigidTransform t;
     fit_rigid({scratch_source_.data(), static_cast<size_t>(ring)}, {scratch_target_.data(), static_cast<size_t>(ring)}, t);
-    rigid_miss_[j] = forget * rigid_miss_[j] + seconds * (t.translation - current_[j]).squaredNorm() / 3.0;
-    rigid_claimed_[j] = forget * rigid_claimed_[j] + seconds * model_.pca[j].rigid_variance;
-    rigid_calibration_[j] = std::max(1.0, rigid_miss_[j] / rigid_claimed_[j]);
+    rigid_recent_[j].add(forget, seconds, (t.translation - current_[j]).squaredNorm() / 3.0, model_.pca[j].rigid_variance);
+    rigid_calibration_[j] = std::max(1.0, rigid_recent_[j].ratio());
     for (int s = 0; s < ring; ++s) {
       int count = 0;
       for (int k = 0; k < ring; ++k) {
@@ -690,9 +685,8 @@ void GapFiller::check_rings() {
       reconstruct_single_gap(j, s, count, estimate);
       const int at = first + s;
       const double miss = (estimate - r * (current_[model_.ring[at]] - current_[j])).squaredNorm() / 3.0;
-      ring_miss_[at] = forget * ring_miss_[at] + seconds * miss;
-      ring_claimed_[at] = forget * ring_claimed_[at] + seconds * single_gap_variance_[at];
-      ring_calibration_[at] = std::max(1.0, ring_miss_[at] / ring_claimed_[at]);
+      ring_recent_[at].add(forget, seconds, miss, single_gap_variance_[at]);
+      ring_calibration_[at] = std::max(1.0, ring_recent_[at].ratio());
     }
   }
 }

@@ -54,6 +54,7 @@
 #include "core/absolute_orientation.h"
 #include "core/marker_status.h"
 #include "core/pca_fit.h"
+#include "core/recent_miss.h"
 #include "core/region_online_statistics.h"
 #include "core/region_pca_fit.h"
 #include "core/subject_model.h"
@@ -262,15 +263,17 @@ class GapFiller {
   PcaVector single_gap_deviation_, single_gap_coefficients_;
   std::vector<int> single_gap_offset_;
   std::vector<double> single_gap_variance_;
-  // The one-ring opinions' online calibration (check_rings), parallel to model.ring: forgetting
-  // sums of the squared miss and of the variance claimed, and their ratio (>= 1).
+  // The one-ring opinions' online calibration (check_rings), parallel to model.ring: how each
+  // lately did against its claim, and the ratio (>= 1) that scales the claim.
   static constexpr int kRingChecksPerFrame = 2;
   static constexpr double kRingMemorySeconds = 10.0;
   int ring_cursor_ = 0;
   long ring_nominal_frames_ = 1;  // between a model's checks when every ring is seen
-  std::vector<double> ring_miss_, ring_claimed_, ring_calibration_;
+  std::vector<RecentMiss> ring_recent_;
+  std::vector<double> ring_calibration_;
   std::vector<long> ring_checked_frame_;  // per model: the frame it was last checked
-  std::vector<double> rigid_miss_, rigid_claimed_, rigid_calibration_;  // per marker: eq. 2 on its whole ring, likewise
+  std::vector<RecentMiss> rigid_recent_;  // per marker: eq. 2 on its whole ring, likewise
+  std::vector<double> rigid_calibration_;
   // Several ring members missing: per model, the observed slots (a bit each) its factor below
   // was made for, and that factor (PcaFit::factor_slots, components^2 at pattern_offset_).
   std::vector<uint32_t> pattern_mask_;

@@ -90,8 +90,7 @@ void RegionOnlineStatistics::learn_region(int i, std::span<const Vec3> positions
   r.evidence = decay * r.evidence + seconds;
   if (tried) {
     const double forget = std::exp(-static_cast<double>(elapsed) / options_.rate_hz / options_.calibration_memory_seconds);
-    r.squared_miss = forget * r.squared_miss + seconds * squared_miss;
-    r.claimed = forget * r.claimed + seconds * claimed;
+    r.recent.add(forget, seconds, squared_miss, claimed);
   }
   // Weighted Welford: mean += (s / W) delta; scatter = decay scatter + s (1 - s / W) delta delta^T.
   Eigen::Map<Eigen::VectorXd> mean(&online_mean_[r.mean_at], dims);
@@ -108,8 +107,8 @@ void RegionOnlineStatistics::learn_region(int i, std::span<const Vec3> positions
 double RegionOnlineStatistics::calibration(int i) const {
   const Region& r = regions_[i];
   const double offline = model_.region_pca[i].slot_calibration(0);
-  if (r.claimed <= 0.0) return std::max(1.0, offline);
-  const double online = r.squared_miss / r.claimed, w = weight(r);
+  if (!r.recent.any()) return std::max(1.0, offline);
+  const double online = r.recent.ratio(), w = weight(r);
   return std::max({1.0, (1.0 - w) * offline + w * online, online});
 }
 

@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "core/marker_status.h"
+#include "core/recent_miss.h"
 #include "core/region_pca_fit.h"
 #include "core/region_shape_gaussian.h"
 #include "core/subject_model.h"
@@ -64,7 +65,7 @@ class RegionOnlineStatistics {
     double evidence = 0.0;  // seconds
     long learned_frame = -1;  // the frame it last learned from
     long updates = 0;
-    double squared_miss = 0.0, claimed = 0.0;  // the prequential calibration's sums, forgetting too
+    RecentMiss recent{};  // the prequential calibration's sums, forgetting too
   };
   double weight(const Region& r) const { return r.evidence / (r.evidence + options_.prior_seconds); }
   void learn_region(int i, std::span<const Vec3> positions);
