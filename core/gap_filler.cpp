@@ -516,13 +516,14 @@ void GapFiller::relabel() {
 }
 
 // Eq. 3's test for free point p at `distance` from where marker i is expected: within eps1, and
-// no other missing marker expected nearly as close (within twice the distance). Where two
-// estimates both reach a point (skin touching skin, neighbours close together) it is taken for
-// neither until the motion tells them apart.
+// no other missing marker expected nearly as close (within twice the distance), by its estimate
+// or, where it has none (its whole neighbourhood gone), by its own track. Where two markers both
+// reach a point (skin touching skin, neighbours close together) it is taken for neither until
+// the motion tells them apart.
 bool GapFiller::ambiguity_free_match(int i, int p, double distance) {
   if (distance > eps1_[i]) return false;
   if (free_ids_[p] == -(i + 1)) return true;  // its own labelled point, held back by the label check
-  return nearest_other_expected(i, free_points_[p]) >= 2.0 * distance;
+  return std::min(nearest_other_expected(i, free_points_[p]), nearest_other_on_track(i, free_points_[p])) >= 2.0 * distance;
 }
 
 int GapFiller::find_free_point(int id) const {

@@ -16,10 +16,10 @@
 //   3. Relabelling: a tracked fragment stays with its marker while within eps2 (alpha2) of
 //      where the marker is expected (its best estimate from the neighbours, step 4's fusion);
 //      a new one is taken when within eps1 (alpha1) of it (eq. 3) and no other missing marker is
-//      expected within twice that distance of it (ambiguous points wait), closest pairs first,
-//      in up to three rounds, estimates redone after each with the points taken. With
-//      `confirm_frames` a new relabel must pass that test again each frame of its probation,
-//      else it is revoked (FrameOutput::revoked).
+//      expected within twice that distance of it (by its estimate, else by its own track:
+//      ambiguous points wait), closest pairs first, in up to three rounds, estimates redone
+//      after each with the points taken. With `confirm_frames` a new relabel must pass that
+//      test again each frame of its probation, else it is revoked (FrameOutput::revoked).
 //   4. PCA fill: every observed neighbour's PCA model reconstructs the missing marker from that
 //      neighbour's observed one-ring (regularised least squares on the coefficients); the
 //      estimates are averaged, each weighted by the inverse of its predictive variance
