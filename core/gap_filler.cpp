@@ -80,15 +80,17 @@ GapFiller::GapFiller(const SubjectModel& model, const GapFillerOptions& options)
   rigid_support_.assign(n_, 0);
   rigid_novelty_.assign(n_, 1.0);
   rigid_variance_.assign(n_, 0.0);
-  leverage_.assign(SubjectModel::kMaxRing, 0.0);
+  leverage_.assign(model.ring.size(), 0.0);
+  leverage_mask_.assign(n_, 0);
   // Each marker's training error of eq. 2 with its whole ring seen, read as the ring members'
   // departure from rigid seen through their leverage on the fit.
   for (int i = 0; i < n_; ++i) {
     const int first = model.ring_offsets[i], ring = model.ring_size(i);
     double leverage = 0.0;
     if (ring > 0) {
-      rigid_fit_leverage({&model.ring_local_reference[first], static_cast<size_t>(ring)}, {leverage_.data(), static_cast<size_t>(ring)});
-      for (int k = 0; k < ring; ++k) leverage += leverage_[k];
+      rigid_fit_leverage({&model.ring_local_reference[first], static_cast<size_t>(ring)}, {&leverage_[first], static_cast<size_t>(ring)});
+      leverage_mask_[i] = (1u << ring) - 1u;
+      for (int k = 0; k < ring; ++k) leverage += leverage_[first + k];
     }
     rigid_member_variance_.push_back(leverage > 0.0 ? model.pca[i].rigid_variance / leverage : model.pca[i].rigid_variance);
   }
@@ -411,14 +413,17 @@ void GapFiller::estimate_rigid() {
 // Eq. 2 for marker i from the ring members known (observed or estimated) now, at least three
 // (estimate_rigid picks only such a marker).
 void GapFiller::fit_rigid_estimate(int i) {
+  const int first = model_.ring_offsets[i];
   int count = 0, observed_support = 0;
-  for (int k = model_.ring_offsets[i]; k < model_.ring_offsets[i + 1]; ++k) {
+  uint32_t mask = 0;
+  for (int k = first; k < model_.ring_offsets[i + 1]; ++k) {
     const int j = model_.ring[k];
     observed_support += observed_[j];
     if (!estimated_[j]) continue;
     scratch_source_[count] = model_.ring_local_reference[k];
     scratch_target_[count] = estimate_[j];
     scratch_index_[count] = j;
+    mask |= 1u << (k - first);
     ++count;
   }
   rigid_support_[i] = observed_support;
@@ -428,12 +433,16 @@ void GapFiller::fit_rigid_estimate(int i) {
   // estimated that estimate's variance too, each seen through its leverage on this fit (few
   // members, or far or nearly collinear ones, make a poor fit; an error in a member the chain
   // estimated is carried on).
-  rigid_fit_leverage({scratch_source_.data(), static_cast<size_t>(count)}, {leverage_.data(), static_cast<size_t>(count)});
+  const std::span<double> leverage(&leverage_[first], static_cast<size_t>(count));
+  if (leverage_mask_[i] != mask) {
+    rigid_fit_leverage({scratch_source_.data(), static_cast<size_t>(count)}, leverage);
+    leverage_mask_[i] = mask;
+  }
   double variance = 0.0, member_variances = 0.0, miss = 0.0;
   for (int k = 0; k < count; ++k) {
     const int j = scratch_index_[k];
     const double member = rigid_member_variance_[i] * rigid_calibration_[i] + (observed_[j] ? 0.0 : rigid_estimate_variance(j, true));
-    variance += leverage_[k] * member;
+    variance += leverage[k] * member;
     member_variances += member;
     miss += (t.apply(scratch_source_[k]) - scratch_target_[k]).squaredNorm();
   }

@@ -256,7 +256,11 @@ class GapFiller {
   std::vector<double> rigid_novelty_;      // novelty_factor of each rigid estimate's fit
   std::vector<double> rigid_variance_;     // each rigid estimate's predictive variance (mm^2, per coordinate)
   std::vector<double> rigid_member_variance_;  // per marker: its ring members' departure from rigid (mm^2)
-  std::vector<double> leverage_;           // rigid_fit_leverage of the fit being made
+  // Each marker's eq. 2 leverages (rigid_fit_leverage), at its ring's offset in model.ring, one
+  // per member known, for the members (a bit each) they were made for: the fit's source is the
+  // marker's reference ring, so they change only with which members are known.
+  std::vector<double> leverage_;
+  std::vector<uint32_t> leverage_mask_;
   // One ring member missing, per ring entry: the coefficients' linear map (components x 3(d-1),
   // row-major, at single_gap_offset_) and the reconstruction's calibrated variance.
   std::vector<double> single_gap_map_;
