@@ -42,7 +42,6 @@ GapFiller::GapFiller(const SubjectModel& model, const GapFillerOptions& options)
   refused_id_.assign(n_, kNoFragment);
   revoked_.assign(n_, 0);
   gap_offset_.assign(n_, Vec3::Zero());
-  gap_age_.assign(n_, 0);
   gap_start_known_.assign(n_, 0);
   gap_start_frame_.assign(n_, 0);
   gap_start_position_.assign(n_, Vec3::Zero());
@@ -151,7 +150,6 @@ void GapFiller::reset() {
   std::fill(assigned_id_.begin(), assigned_id_.end(), kNoFragment);
   std::fill(probation_start_.begin(), probation_start_.end(), -1);
   std::fill(refused_id_.begin(), refused_id_.end(), kNoFragment);
-  std::fill(gap_age_.begin(), gap_age_.end(), 0);
   std::fill(gap_offset_.begin(), gap_offset_.end(), Vec3::Zero());
   std::fill(gap_start_known_.begin(), gap_start_known_.end(), 0);
   std::fill(snapshot_frame_.begin(), snapshot_frame_.end(), -1);
@@ -893,7 +891,10 @@ void GapFiller::fill_missing() {
   auto combined_variance = [](double variance_a, double variance_b) { return variance_a * variance_b / (variance_a + variance_b); };
   for (int i : missing_) {
     if (observed_[i]) continue;  // relabelled
-    if (has_previous_ && is_observed(previous_status_[i])) remember_gap_start(i);
+    if (has_previous_ && is_observed(previous_status_[i])) {
+      remember_gap_start(i);
+      gap_offset_[i].setZero();  // set below when this frame has a neighbourhood rotation
+    }
     Vec3 carried;
     double carried_variance = 0.0;
     const bool carry = carry_on && carried_from_gap_start(i, carried, carried_variance);
@@ -936,17 +937,15 @@ void GapFiller::fill_missing() {
     }
 
     // Continuity: the gap starts where the last measurement, moved with the neighbours, would be.
+    // The offset is made at the gap's first frame (none if that frame has no neighbourhood
+    // rotation to keep it in) and decays with the gap's age.
     if (decay_frames <= 0.0 || !has_rotation_[i] || !has_previous_) continue;
-    if (is_observed(previous_status_[i])) {
-      Vec3 expected;
-      gap_age_[i] = 0;
-      gap_offset_[i].setZero();
-      if (transfer_motion(model_.ring_offsets[i], model_.ring_offsets[i + 1], model_.ring, previous_[i], expected))
-        gap_offset_[i] = rotation_[i].transpose() * (expected - current_[i]);
-    } else {
-      ++gap_age_[i];
-    }
-    current_[i] += rotation_[i] * gap_offset_[i] * std::exp(-gap_age_[i] / decay_frames);
+    Vec3 expected;
+    if (is_observed(previous_status_[i]) &&
+        transfer_motion(model_.ring_offsets[i], model_.ring_offsets[i + 1], model_.ring, previous_[i], expected))
+      gap_offset_[i] = rotation_[i].transpose() * (expected - current_[i]);
+    const double age = static_cast<double>(frame_ - gap_start_frame_[i]);
+    current_[i] += rotation_[i] * gap_offset_[i] * std::exp(-age / decay_frames);
   }
 }
 

@@ -198,8 +198,7 @@ class GapFiller {
   std::vector<long> probation_start_;  // frame its relabel was taken while still on probation, else -1
   std::vector<int> refused_id_;        // a fragment whose relabel was revoked, not taken again while it lasts
   std::vector<int> revoked_;           // this frame's FrameOutput::revoked
-  std::vector<Vec3> gap_offset_;      // continuity offset in the local frame
-  std::vector<int> gap_age_;
+  std::vector<Vec3> gap_offset_;      // continuity offset in the local frame, made at the gap's first frame
   // At the start of each marker's gap: its last position and its anchors' (parallel to
   // model.anchors; usable where the anchor was measured or relabelled then).
   static constexpr int kCarryAnchors = 3;

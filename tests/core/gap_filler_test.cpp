@@ -146,6 +146,40 @@ TEST(GapFiller, ACarryAgesWithItsGapWhetherContinuityIsOnOrOff) {
   EXPECT_LT(largest, 0.01 * spread);
 }
 
+// A gap whose first frame has no neighbourhood rotation to keep an offset in (the whole limb
+// hidden then) starts with no continuity offset, not with what was left of the marker's last one.
+TEST(GapFiller, AGapStartsWithNoOffsetLeftFromTheMarkersLastGap) {
+  Fixture fx;
+  GapFillerOptions options;  // nothing else kept from frame to frame that the first gap would change
+  options.carry_from_gap_start = options.use_regions = options.calibrate_rings = false;
+  GapFillerOptions no_continuity = options;
+  no_continuity.continuity_seconds = 0.0;
+  GapFiller a(fx.model, options), b(fx.model, options), plain(fx.model, no_continuity);
+  const int n = fx.model.marker_count();
+  Frame fa(n), fb(n), fp(n);
+  double first_offset = 0.0, left = 0.0;
+  for (int f = 0; f < 240; ++f) {
+    for (Frame* frame : {&fa, &fb, &fp}) {
+      load(fx.truth, f, *frame);
+      if (f == 200)
+        for (Vec3& p : frame->labelled) p = missing_point();
+      if (f >= 200 && f < 230) frame->labelled[kMiddle] = missing_point();
+    }
+    if (f >= 100 && f < 105) {  // a's first gap: the marker and all but three of its ring, a poorer estimate
+      fa.labelled[kMiddle] = fp.labelled[kMiddle] = missing_point();
+      for (int k = fx.model.ring_offsets[kMiddle]; k < fx.model.ring_offsets[kMiddle + 1] - 3; ++k)
+        fa.labelled[fx.model.ring[k]] = fp.labelled[fx.model.ring[k]] = missing_point();
+    }
+    fa.run(a);
+    fb.run(b);
+    fp.run(plain);
+    if (f == 100) first_offset = (fa.positions[kMiddle] - fp.positions[kMiddle]).norm();
+    if (f > 200 && f < 230) left = std::max(left, (fa.positions[kMiddle] - fb.positions[kMiddle]).norm());
+  }
+  ASSERT_GT(first_offset, 1.0) << "the first gap starts with an offset";
+  EXPECT_LT(left, 1e-9);
+}
+
 // A marker that slides on the skin after training (a loose one) makes every one-ring opinion that
 // reads it a poor judge, and every opinion of where it is a poor one too. Checked while the ring
 // is seen, each such opinion comes to claim less (its variance scaled up); the others do not.
