@@ -530,7 +530,8 @@ void GapFiller::relabel() {
 bool GapFiller::ambiguity_free_match(int i, int p, double distance) {
   if (distance > eps1_[i]) return false;
   if (free_ids_[p] == -(i + 1)) return true;  // its own labelled point, held back by the label check
-  return std::min(nearest_other_expected(i, free_points_[p]), nearest_other_on_track(i, free_points_[p])) >= 2.0 * distance;
+  return nearest_other_expected(i, free_points_[p]) >= 2.0 * distance &&
+         nearest_other_on_track(i, free_points_[p]) >= 2.0 * distance;
 }
 
 int GapFiller::find_free_point(int id) const {
