@@ -129,7 +129,7 @@ void BM_Fill350MarkersDense(benchmark::State& state) {
 
 const Scenario& synthetic_punch() {
   static const Scenario s = [] {
-    const synth::Body body = load_makehuman(std::string(SKINSTREAM_SHARED_DIR) + "/data/meshes/makehuman");
+    const Body body = load_makehuman(std::string(SKINSTREAM_SHARED_DIR) + "/data/meshes/makehuman");
     synth::SynthOptions take;
     take.motion = "punch";
     synth::SynthOptions rom;

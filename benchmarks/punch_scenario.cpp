@@ -9,7 +9,7 @@ namespace skinstream {
 
 const Scenario& scenario() {
   static const Scenario s = [] {
-    const synth::Body body = load_makehuman(std::string(SKINSTREAM_SHARED_DIR) + "/data/meshes/makehuman");
+    const Body body = load_makehuman(std::string(SKINSTREAM_SHARED_DIR) + "/data/meshes/makehuman");
     synth::SynthOptions rom;
     rom.motion = "rom";
     rom.seconds = 10.0;

@@ -16,10 +16,6 @@ namespace skinstream {
 
 namespace {
 
-using synth::Body;
-using synth::Bone;
-using synth::Skeleton;
-using synth::SkinWeights;
 
 std::string read_text(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
@@ -149,9 +145,9 @@ std::vector<int> match_vertices(const std::vector<Vec3>& part, const std::vector
   return out;
 }
 
-synth::Body load_makehuman(const std::string& dir) { return load_makehuman(MakeHumanFiles::in(dir)); }
+Body load_makehuman(const std::string& dir) { return load_makehuman(MakeHumanFiles::in(dir)); }
 
-synth::Body load_makehuman(const MakeHumanFiles& files) {
+Body load_makehuman(const MakeHumanFiles& files) {
   const ObjMesh body_mesh = read_obj(files.body_obj);
   const ObjMesh base_mesh = read_obj(files.base_obj);
   const std::vector<int> to_base = match_vertices(body_mesh.vertices, base_mesh.vertices);
@@ -271,7 +267,7 @@ synth::Body load_makehuman(const MakeHumanFiles& files) {
   try {
     body.skeleton = Skeleton(bones);
     body.weights = SkinWeights::from_lists(rows, body.skeleton.size());
-    synth::validate(body);
+    validate(body);
   } catch (const std::invalid_argument& e) {
     throw FileError(files.weights, e.what());
   }

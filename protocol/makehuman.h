@@ -19,7 +19,7 @@
 #include <vector>
 
 #include "core/capture.h"
-#include "core/synth/body.h"
+#include "core/body/body.h"
 
 namespace skinstream {
 
@@ -32,8 +32,8 @@ struct MakeHumanFiles {
 // Throws FileError (one line naming the file) for a missing or malformed file, a body vertex
 // with no match in base.obj, a bone that names an unknown joint or parent, or weights on an
 // unknown bone.
-synth::Body load_makehuman(const MakeHumanFiles& files);
-synth::Body load_makehuman(const std::string& dir);
+Body load_makehuman(const MakeHumanFiles& files);
+Body load_makehuman(const std::string& dir);
 
 // The raw OBJ: vertices (file units, file order) and polygons (0-based; quads and triangles
 // kept, larger polygons fanned). Throws FileError.

@@ -35,7 +35,7 @@ void print_table(const nlohmann::ordered_json& result, std::FILE* out) {
 }  // namespace
 
 int run_eval_deform(const EvalDeformOptions& o, std::FILE* out) {
-  const synth::Body body = load_makehuman(o.body_dir.empty() ? default_body_dir() : o.body_dir);
+  const Body body = load_makehuman(o.body_dir.empty() ? default_body_dir() : o.body_dir);
   synth::SynthOptions rom;
   rom.motion = "rom";
   rom.seconds = o.train_seconds;

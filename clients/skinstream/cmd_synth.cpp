@@ -15,7 +15,7 @@ namespace skinstream::cli {
 int run_synth(const SynthOptions& o, std::FILE* out) {
   const synth::SynthOptions& take = o.take;
   const auto start = std::chrono::steady_clock::now();
-  const synth::Body body = load_makehuman(o.body_dir.empty() ? default_body_dir() : o.body_dir);
+  const Body body = load_makehuman(o.body_dir.empty() ? default_body_dir() : o.body_dir);
   const synth::SynthCapture result = synth::generate(body, take);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 

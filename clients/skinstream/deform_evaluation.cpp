@@ -163,7 +163,7 @@ nlohmann::ordered_json worst_vertices(const std::vector<double>& peak_error, con
 
 }  // namespace
 
-DeformationSetup prepare_deformation(const synth::Body& body, const SynthCapture& training,
+DeformationSetup prepare_deformation(const Body& body, const SynthCapture& training,
                                      const DeformEvaluationOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   DeformationSetup setup;
@@ -208,7 +208,7 @@ DeformationSetup prepare_deformation(const synth::Body& body, const SynthCapture
                                               options.deform_registered_mesh ? registered : truth_skin, faces, build,
                                               &setup.build);
 
-  const synth::Body skinned = training.mesh_vertex_count() == body.vertex_count() ? body : synth::subdivide(body);
+  const Body skinned = training.mesh_vertex_count() == body.vertex_count() ? body : synth::subdivide(body);
   setup.conventional = synth::choose_conventional_markers(body, training, skinned.weights);
   // Its markers in subject order.
   for (auto& segment : setup.conventional.skinning.segment_markers)

@@ -53,7 +53,7 @@ struct DeformationSetup {
 
 // `body` is the generator's body (subdivided to match `training` when it is); the artist's
 // model given to registration is the skin-only truth mesh of the subject's reference frame.
-DeformationSetup prepare_deformation(const synth::Body& body, const synth::SynthCapture& training,
+DeformationSetup prepare_deformation(const Body& body, const synth::SynthCapture& training,
                                      const DeformEvaluationOptions& options);
 
 nlohmann::ordered_json evaluate_deformation(const DeformationSetup& setup, const synth::SynthCapture& take,

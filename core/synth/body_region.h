@@ -7,7 +7,7 @@
 #include <limits>
 #include <vector>
 
-#include "core/synth/body.h"
+#include "core/body/body.h"
 
 namespace skinstream::synth {
 

@@ -5,7 +5,7 @@
 #include <stdexcept>
 
 #include "core/baselines/bone_heat_weights.h"
-#include "core/synth/anatomy.h"
+#include "core/body/anatomy.h"
 
 namespace skinstream::synth {
 

@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "core/baselines/segment_skinning.h"
-#include "core/synth/body.h"
+#include "core/body/body.h"
 #include "core/synth/synth_capture.h"
 
 namespace skinstream::synth {

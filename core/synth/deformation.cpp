@@ -2,7 +2,7 @@
 
 #include <stdexcept>
 
-#include "core/synth/skinning.h"
+#include "core/body/skinning.h"
 
 namespace skinstream::synth {
 

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "core/synth/anatomy.h"
+#include "core/body/anatomy.h"
 #include "core/synth/body_region.h"
 #include "core/synth/breathing.h"
 #include "core/synth/muscle_bulge.h"

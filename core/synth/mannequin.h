@@ -3,7 +3,7 @@
 // around a skeleton with MakeHuman's bone names and (rounded) joint positions, skin weights by
 // distance to the bones. About 1.7 m tall, A-pose, millimetres, Z up, facing +Y, soles at z = 0.
 // For tests and benchmarks of the generator without the MakeHuman files.
-#include "core/synth/body.h"
+#include "core/body/body.h"
 
 namespace skinstream::synth {
 

@@ -14,8 +14,8 @@
 #include <string>
 #include <vector>
 
-#include "core/synth/anatomy.h"
-#include "core/synth/body.h"
+#include "core/body/anatomy.h"
+#include "core/body/body.h"
 
 namespace skinstream::synth {
 

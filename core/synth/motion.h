@@ -17,7 +17,7 @@
 #include <string>
 #include <vector>
 
-#include "core/synth/anatomy.h"
+#include "core/body/anatomy.h"
 
 namespace skinstream::synth {
 

@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "core/synth/anatomy.h"
+#include "core/body/anatomy.h"
 #include "core/synth/body_region.h"
 
 namespace skinstream::synth {

@@ -7,7 +7,7 @@
 // skinned surface stays within a fraction of a millimetre of the refined coarse one elsewhere).
 #include <vector>
 
-#include "core/synth/body.h"
+#include "core/body/body.h"
 
 namespace skinstream::synth {
 

@@ -13,7 +13,7 @@
 #include <string>
 
 #include "core/geometry/triangle_bvh.h"
-#include "core/synth/anatomy.h"
+#include "core/body/anatomy.h"
 #include "core/synth/subdivision.h"
 #include "core/synth/synth_capture.h"
 #include "protocol/file_error.h"
@@ -22,7 +22,6 @@
 namespace skinstream {
 namespace {
 
-using synth::Body;
 
 std::string mh_dir() { return test::shared_path("data/meshes/makehuman"); }
 
@@ -110,7 +109,7 @@ TEST(MakeHumanLoad, BodySkeletonAndWeightsInMillimetresZUp) {
   EXPECT_NEAR(hi.z(), 1666.0, 5.0);        // 16.66 MakeHuman decimetres tall
   EXPECT_NEAR(lo.x() + hi.x(), 0.0, 1.0);  // symmetric about x = 0
   EXPECT_GT(signed_volume(b.rest, triangulate(b.faces)), 0.04e9);  // outward, ~60 litres
-  const synth::Skeleton& sk = b.skeleton;
+  const Skeleton& sk = b.skeleton;
   EXPECT_LT(sk.bone(sk.require("upperarm01.L")).head.x(), -100.0);  // left on -X
   EXPECT_GT(sk.bone(sk.require("upperarm01.R")).head.x(), 100.0);
   const Vec3 toe = sk.bone(sk.require("toe1-1.L")).head, ankle = sk.bone(sk.require("foot.L")).head;
@@ -185,11 +184,11 @@ TEST(MakeHumanSynth, ArmpitsAndCrouchedBellyGoMissingMoreThanTheChest) {
   o.motion = "rom";
   o.seconds = 10.0;
   const synth::SynthCapture c = synth::generate(body(), o);
-  const synth::Anatomy a = synth::Anatomy::from(body());
+  const Anatomy a = Anatomy::from(body());
   std::vector<int> armpit, chest;
   for (int i = 0; i < c.truth.point_count(); ++i) {
     const synth::MarkerSite& m = c.markers[static_cast<size_t>(i)];
-    for (synth::Side s : {synth::kLeft, synth::kRight})
+    for (Side s : {kLeft, kRight})
       if ((m.rest_position - (a.shoulder_joint[s] - Vec3(0, 0, 70))).norm() < 60.0) armpit.push_back(i);
     if (m.region == "chest" && m.rest_normal.y() > 0.7) chest.push_back(i);
   }

@@ -38,7 +38,7 @@ TEST(TriangleBvh, RejectsBadTriangles) {
 }
 
 TEST(TriangleBvh, SegmentAndClosestQueriesMatchBruteForceAfterRefit) {
-  const synth::Body m = synth::make_mannequin();
+  const Body m = synth::make_mannequin();
   const std::vector<Triangle> tris = triangulate(m.faces);
   TriangleBvh bvh(m.rest, tris);
   std::vector<Vec3> moved = m.rest;

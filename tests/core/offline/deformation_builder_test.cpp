@@ -39,7 +39,7 @@ TEST(DeformationBuilder, RejectsAnEmptyMesh) {
 // the fold smoothing), where the MakeHuman body's mean falls in 22 of 25 takes. Every vertex
 // weight sums to 1 and the reference pose reproduces the mesh.
 TEST(DeformationBuilder, DeformedFramesMatchTheSyntheticTruth) {
-  const synth::Body body = synth::make_mannequin();
+  const Body body = synth::make_mannequin();
   synth::SynthOptions rom;
   rom.motion = "rom";
   rom.seconds = 4.0;

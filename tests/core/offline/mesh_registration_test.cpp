@@ -207,7 +207,7 @@ TEST(MeshRegistration, GuessesLandmarksAfterASimilarityAlignment) {
 // marker-to-surface RMS 4.11 mm before, 3.70 mm after the global phase, 0.43 mm after (max
 // 2.7 mm), landmark RMS 15.8 -> 0.09 mm, 4 solves.
 TEST(MeshRegistration, RegistersTheSyntheticBodyToAnotherPose) {
-  const synth::Body body = synth::make_mannequin();
+  const Body body = synth::make_mannequin();
   synth::SynthOptions options;
   options.motion = "rom";
   options.seconds = 0.5;

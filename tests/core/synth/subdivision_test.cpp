@@ -5,7 +5,7 @@
 #include <set>
 
 #include "core/synth/mannequin.h"
-#include "core/synth/skinning.h"
+#include "core/body/skinning.h"
 
 namespace skinstream::synth {
 namespace {

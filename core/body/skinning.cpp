@@ -1,9 +1,9 @@
-#include "core/synth/skinning.h"
+#include "core/body/skinning.h"
 
 #include <stdexcept>
 #include <string>
 
-namespace skinstream::synth {
+namespace skinstream {
 
 Eigen::Matrix<double, 3, 4> blended_transform(const SkinWeights& weights, int v,
                                               const BoneTransforms& bones) {
@@ -39,4 +39,4 @@ std::vector<Vec3> skin(const std::vector<Vec3>& rest, const SkinWeights& weights
   return out;
 }
 
-}  // namespace skinstream::synth
+}  // namespace skinstream

@@ -6,9 +6,9 @@
 
 #include "core/capture.h"
 #include "core/geometry/triangle_mesh.h"
-#include "core/synth/skeleton.h"
+#include "core/body/skeleton.h"
 
-namespace skinstream::synth {
+namespace skinstream {
 
 // Per-vertex bone weights in compressed rows: vertex v has entries [offsets[v], offsets[v+1]).
 struct SkinWeights {
@@ -43,4 +43,4 @@ struct Body {
 // index outside the skeleton.
 void validate(const Body& body);
 
-}  // namespace skinstream::synth
+}  // namespace skinstream

@@ -9,10 +9,10 @@
 #include <string>
 #include <vector>
 
-#include "core/synth/body.h"
-#include "core/synth/skeleton.h"
+#include "core/body/body.h"
+#include "core/body/skeleton.h"
 
-namespace skinstream::synth {
+namespace skinstream {
 
 enum Side { kLeft = 0, kRight = 1 };
 inline const char* side_suffix(Side s) { return s == kLeft ? "L" : "R"; }
@@ -90,4 +90,4 @@ class PoseBuilder {
 // Vertical offset that puts the lowest sole point of the posed skeleton at `clearance` mm.
 double ground_offset(const Anatomy& anatomy, const BoneTransforms& bones, double clearance);
 
-}  // namespace skinstream::synth
+}  // namespace skinstream

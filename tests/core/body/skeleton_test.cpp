@@ -1,13 +1,13 @@
-#include "core/synth/skeleton.h"
+#include "core/body/skeleton.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 
-#include "core/synth/body.h"
-#include "core/synth/skinning.h"
+#include "core/body/body.h"
+#include "core/body/skinning.h"
 
-namespace skinstream::synth {
+namespace skinstream {
 namespace {
 
 std::vector<Bone> chain() {
@@ -76,4 +76,4 @@ TEST(SynthSkinning, RejectsBadWeightsAndBlendsTransforms) {
 }
 
 }  // namespace
-}  // namespace skinstream::synth
+}  // namespace skinstream

@@ -1,7 +1,7 @@
 #pragma once
 // A bone hierarchy in its rest pose and the forward kinematics that poses it.
 //
-// Conventions (all of core/synth): millimetres, Z up, the subject faces +Y, its left side is
+// Conventions (core/body and everything built on it): millimetres, Z up, the subject faces +Y, its left side is
 // on -X. A bone rotates about its head joint. Pose::local[b] is the rotation of bone b about
 // its head expressed in rest-pose axes, relative to its parent (applied after the parent's
 // motion), so at rest every local rotation is the identity and every bone transform is the
@@ -14,7 +14,7 @@
 
 #include "core/capture.h"
 
-namespace skinstream::synth {
+namespace skinstream {
 
 struct Bone {
   std::string name;
@@ -67,4 +67,4 @@ inline Eigen::Quaterniond rotation(const Vec3& axis, double angle) {
   return Eigen::Quaterniond(Eigen::AngleAxisd(angle, axis.normalized()));
 }
 
-}  // namespace skinstream::synth
+}  // namespace skinstream

@@ -1,11 +1,11 @@
-#include "core/synth/anatomy.h"
+#include "core/body/anatomy.h"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
 
-namespace skinstream::synth {
+namespace skinstream {
 
 namespace {
 
@@ -198,4 +198,4 @@ double ground_offset(const Anatomy& anatomy, const BoneTransforms& bones, double
   return std::isfinite(lowest) ? clearance - lowest : 0.0;
 }
 
-}  // namespace skinstream::synth
+}  // namespace skinstream

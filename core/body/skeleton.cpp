@@ -1,10 +1,10 @@
-#include "core/synth/skeleton.h"
+#include "core/body/skeleton.h"
 
 #include <cmath>
 #include <stdexcept>
 #include <unordered_set>
 
-namespace skinstream::synth {
+namespace skinstream {
 
 Skeleton::Skeleton(std::vector<Bone> bones) : bones_(std::move(bones)) {
   std::unordered_set<std::string> names;
@@ -74,4 +74,4 @@ double twist_angle(const Eigen::Quaterniond& q, const Vec3& axis) {
   return 2.0 * std::atan2(p, w);
 }
 
-}  // namespace skinstream::synth
+}  // namespace skinstream

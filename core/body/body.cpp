@@ -1,11 +1,11 @@
-#include "core/synth/body.h"
+#include "core/body/body.h"
 
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
 
-namespace skinstream::synth {
+namespace skinstream {
 
 double SkinWeights::weight(int v, int bone) const {
   for (int k = begin(v); k < end(v); ++k)
@@ -89,4 +89,4 @@ void validate(const Body& body) {
                                   std::to_string(body.skeleton.size()));
 }
 
-}  // namespace skinstream::synth
+}  // namespace skinstream

@@ -2,10 +2,10 @@
 // Linear blend skinning: a vertex follows the weighted average of its bones' transforms.
 #include <vector>
 
-#include "core/synth/body.h"
-#include "core/synth/skeleton.h"
+#include "core/body/body.h"
+#include "core/body/skeleton.h"
 
-namespace skinstream::synth {
+namespace skinstream {
 
 // The blended (generally not rigid) transform of vertex v.
 Eigen::Matrix<double, 3, 4> blended_transform(const SkinWeights& weights, int v, const BoneTransforms& bones);
@@ -19,4 +19,4 @@ Vec3 skin_vertex(const SkinWeights& weights, int v, const Vec3& rest, const Bone
 std::vector<Vec3> skin(const std::vector<Vec3>& rest, const SkinWeights& weights,
                        const BoneTransforms& bones);
 
-}  // namespace skinstream::synth
+}  // namespace skinstream
