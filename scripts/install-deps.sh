@@ -4,7 +4,7 @@
 set -euo pipefail
 
 packages=(
-  build-essential cmake ninja-build pkg-config
+  build-essential cmake ninja-build pkg-config ccache
   libeigen3-dev libboost-dev libboost-system-dev nlohmann-json3-dev libspdlog-dev libfmt-dev
   libopenmesh-dev libmeshoptimizer-dev libgtest-dev libgmock-dev libbenchmark-dev libcli11-dev zlib1g-dev libexpat1-dev
   chromium
