@@ -13,8 +13,10 @@ namespace {
 
 constexpr int kLeafSize = 4;
 
-// Moller-Trumbore: distance along the unit direction to the triangle, or +inf.
-double ray_triangle(const Vec3& o, const Vec3& d, const Vec3& a, const Vec3& b, const Vec3& c) {
+// Moller-Trumbore: distance along the unit direction to the triangle, or +inf; the crossing's
+// barycentric weights of b and c when asked.
+double ray_triangle(const Vec3& o, const Vec3& d, const Vec3& a, const Vec3& b, const Vec3& c,
+                    double* out_u = nullptr, double* out_v = nullptr) {
   const Vec3 e1 = b - a, e2 = c - a;
   const Vec3 p = d.cross(e2);
   const double det = e1.dot(p);
@@ -26,6 +28,8 @@ double ray_triangle(const Vec3& o, const Vec3& d, const Vec3& a, const Vec3& b, 
   const Vec3 q = s.cross(e1);
   const double v = d.dot(q) * inv;
   if (v < 0.0 || u + v > 1.0) return std::numeric_limits<double>::infinity();
+  if (out_u) *out_u = u;
+  if (out_v) *out_v = v;
   return e2.dot(q) * inv;
 }
 
@@ -165,6 +169,45 @@ bool TriangleBvh::segment_blocked(const Vec3& from, const Vec3& to, double skip_
     }
   }
   return false;
+}
+
+std::vector<RayHit> TriangleBvh::ray_hits(const Vec3& origin, const Vec3& direction,
+                                          double max_distance) const {
+  const double length = direction.norm();
+  if (!is_present(origin) || !std::isfinite(length) || length == 0.0)
+    throw std::invalid_argument(
+        "TriangleBvh::ray_hits: the ray needs a finite origin and a non-zero direction");
+  std::vector<RayHit> hits;
+  if (nodes_.empty() || !(max_distance >= 0.0)) return hits;
+  const Vec3 d = direction / length;
+  const Vec3 inv_d(1.0 / d.x(), 1.0 / d.y(), 1.0 / d.z());
+  int stack[128];
+  int top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const int index = stack[--top];
+    const Node& n = nodes_[static_cast<size_t>(index)];
+    if (!ray_box(origin, inv_d, n.lo, n.hi, 0.0, max_distance)) continue;
+    if (n.count > 0) {
+      for (int i = n.first; i < n.first + n.count; ++i) {
+        const int ti = order_[static_cast<size_t>(i)];
+        const Triangle& t = triangles_[static_cast<size_t>(ti)];
+        double u = 0.0, v = 0.0;
+        const double hit =
+            ray_triangle(origin, d, points_[static_cast<size_t>(t[0])], points_[static_cast<size_t>(t[1])],
+                         points_[static_cast<size_t>(t[2])], &u, &v);
+        if (hit >= 0.0 && hit <= max_distance && std::isfinite(hit))
+          hits.push_back({hit, ti, Vec3(1.0 - u - v, u, v)});
+      }
+    } else if (top + 2 <= 128) {
+      stack[top++] = n.first;
+      stack[top++] = index + 1;
+    }
+  }
+  std::sort(hits.begin(), hits.end(), [](const RayHit& a, const RayHit& b) {
+    return a.distance < b.distance || (a.distance == b.distance && a.triangle < b.triangle);
+  });
+  return hits;
 }
 
 double TriangleBvh::closest(const Vec3& p, int* triangle, Vec3* point) const {

@@ -2,7 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <limits>
+#include <utility>
 
 #include "core/synth/mannequin.h"
 #include "core/synth/random.h"
@@ -35,6 +38,63 @@ TEST(TriangleBvh, RejectsBadTriangles) {
   TriangleBvh empty({}, {});
   EXPECT_FALSE(empty.segment_blocked(Vec3::Zero(), Vec3::UnitX()));
   EXPECT_EQ(empty.closest(Vec3::Zero()), std::numeric_limits<double>::infinity());
+}
+
+TEST(TriangleBvh, RayHitsRejectABadRay) {
+  const Body m = synth::make_mannequin();
+  TriangleBvh bvh(m.rest, triangulate(m.faces));
+  EXPECT_THROW(bvh.ray_hits(Vec3::Zero(), Vec3::Zero()), std::invalid_argument);
+  EXPECT_THROW(bvh.ray_hits(Vec3(0, 0, std::nan("")), Vec3::UnitX()), std::invalid_argument);
+  EXPECT_THROW(bvh.ray_hits(Vec3::Zero(), Vec3(1, std::numeric_limits<double>::infinity(), 0)),
+               std::invalid_argument);
+  EXPECT_TRUE(TriangleBvh({}, {}).ray_hits(Vec3::Zero(), Vec3::UnitX()).empty());
+}
+
+// Every crossing of a ray with a closed surface, brute force: the same triangles at the same
+// distances, nearest first, with barycentric weights that rebuild the crossing point.
+TEST(TriangleBvh, RayHitsMatchBruteForceNearestFirst) {
+  const Body m = synth::make_mannequin();
+  const std::vector<Triangle> tris = triangulate(m.faces);
+  TriangleBvh bvh(m.rest, tris);
+  synth::Random r(11);
+  int crossings = 0;
+  for (int i = 0; i < 200; ++i) {
+    const Vec3 a(r.uniform(-300, 300), r.uniform(-150, 150), r.uniform(50, 1600));
+    const Vec3 dir(r.uniform(-1, 1), r.uniform(-1, 1), r.uniform(-1, 1));
+    const double max_distance = i % 2 ? std::numeric_limits<double>::infinity() : 400.0;
+    const std::vector<RayHit> hits = bvh.ray_hits(a, 3.0 * dir, max_distance);  // scaled: distances in mm
+    const Vec3 d = dir.normalized();
+    std::vector<std::pair<double, int>> expected;
+    for (size_t t = 0; t < tris.size(); ++t) {
+      const Vec3 &v0 = m.rest[static_cast<size_t>(tris[t][0])], &v1 = m.rest[static_cast<size_t>(tris[t][1])],
+                 &v2 = m.rest[static_cast<size_t>(tris[t][2])];
+      const Vec3 n = (v1 - v0).cross(v2 - v0);
+      const double den = n.dot(d);
+      if (std::abs(den) < 1e-12) continue;
+      const double s = n.dot(v0 - a) / den;
+      if (s < 0.0 || s > max_distance) continue;
+      const Vec3 q = a + s * d;
+      if ((closest_point_on_triangle(q, v0, v1, v2) - q).norm() < 1e-7)
+        expected.emplace_back(s, static_cast<int>(t));
+    }
+    ASSERT_EQ(hits.size(), expected.size()) << i;
+    std::sort(expected.begin(), expected.end());
+    for (size_t k = 0; k < hits.size(); ++k) {
+      ASSERT_NEAR(hits[k].distance, expected[k].first, 1e-6) << i;
+      if (k > 0) {
+        ASSERT_LE(hits[k - 1].distance, hits[k].distance);
+      }
+      const Triangle& t = tris[static_cast<size_t>(hits[k].triangle)];
+      const Vec3 p = hits[k].barycentric[0] * m.rest[static_cast<size_t>(t[0])] +
+                     hits[k].barycentric[1] * m.rest[static_cast<size_t>(t[1])] +
+                     hits[k].barycentric[2] * m.rest[static_cast<size_t>(t[2])];
+      ASSERT_LT((p - (a + hits[k].distance * d)).norm(), 1e-6) << i;
+      ASSERT_NEAR(hits[k].barycentric.sum(), 1.0, 1e-12);
+      ASSERT_GE(hits[k].barycentric.minCoeff(), -1e-12);
+    }
+    crossings += static_cast<int>(hits.size());
+  }
+  EXPECT_GT(crossings, 100);  // the rays start in and around the body
 }
 
 TEST(TriangleBvh, SegmentAndClosestQueriesMatchBruteForceAfterRefit) {
