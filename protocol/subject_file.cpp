@@ -163,6 +163,55 @@ std::optional<DeformationModel> decode_deformation(ByteReader& r, uint32_t versi
   return d;
 }
 
+// Version 6: the fitted body's skeleton, per-part quadratic flags and rest vertices.
+void encode_fitted_body(const DeformationModel* d, ByteWriter& w) {
+  const bool fitted = d && (!d->skeleton.empty() || !d->part_quadratic.empty() || !d->rest_vertices.empty());
+  w.put<uint8_t>(fitted ? 1 : 0);
+  if (!fitted) return;
+  const SegmentSkeleton& s = d->skeleton;
+  w.put<uint32_t>(static_cast<uint32_t>(s.segments.size()));
+  for (const SkeletonSegment& segment : s.segments) {
+    w.put_string(segment.name);
+    w.put<int32_t>(segment.parent);
+    put_vec3(w, segment.pivot);
+  }
+  put_ints(w, s.marker_weight_offsets);
+  w.put<uint32_t>(static_cast<uint32_t>(s.marker_weights.size()));
+  for (const SegmentWeight& weight : s.marker_weights) {
+    w.put<int32_t>(weight.segment);
+    w.put<double>(weight.weight);
+  }
+  put_ints(w, s.part_segment);
+  w.put<uint32_t>(static_cast<uint32_t>(d->part_quadratic.size()));
+  for (uint8_t q : d->part_quadratic) w.put<uint8_t>(q);
+  w.put<uint32_t>(static_cast<uint32_t>(d->rest_vertices.size()));
+  for (const Vec3& v : d->rest_vertices) put_vec3(w, v);
+}
+
+void decode_fitted_body(ByteReader& r, std::optional<DeformationModel>& d) {
+  if (r.get<uint8_t>() == 0) return;
+  if (!d) throw std::out_of_range("a fitted body without a deformation model");
+  SegmentSkeleton& s = d->skeleton;
+  s.segments.resize(r.get_count(4 + 4 + 24));
+  for (SkeletonSegment& segment : s.segments) {
+    segment.name = r.get_string(256);
+    segment.parent = r.get<int32_t>();
+    segment.pivot = get_vec3(r);
+  }
+  s.marker_weight_offsets = get_ints(r);
+  s.marker_weights.resize(r.get_count(12));
+  for (SegmentWeight& weight : s.marker_weights) {
+    weight.segment = r.get<int32_t>();
+    weight.weight = r.get<double>();
+  }
+  s.part_segment = get_ints(r);
+  if (s.segments.empty()) s.marker_weight_offsets = {0};  // no skeleton: written as empty
+  d->part_quadratic.resize(r.get_count(1));
+  for (uint8_t& q : d->part_quadratic) q = r.get<uint8_t>();
+  d->rest_vertices.resize(r.get_count(24));
+  for (Vec3& v : d->rest_vertices) v = get_vec3(r);
+}
+
 SubjectModel decode(ByteReader& r) {
   SubjectModel m;
   const uint32_t n = r.get_count(4 + 24);
@@ -205,6 +254,7 @@ void write_subject(const SubjectModel& model, const DeformationModel* deformatio
   encode(model, payload_writer);
   encode(deformation, payload_writer);
   encode_regions(model, payload_writer);
+  encode_fitted_body(deformation, payload_writer);
   const std::vector<unsigned char>& payload = payload_writer.bytes();
   ByteWriter w;
   w.put_bytes(kMagic, sizeof kMagic);
@@ -247,6 +297,7 @@ SubjectFile read_subject_bytes(std::span<const unsigned char> bytes, const std::
     file.model = decode(r);
     if (version >= 2) file.deformation = decode_deformation(r, version);
     if (version >= 5) decode_regions(r, file.model);
+    if (version >= 6) decode_fitted_body(r, file.deformation);
     if (r.remaining() != 0) throw std::out_of_range(std::to_string(r.remaining()) + " unexpected bytes after the model");
   } catch (const std::out_of_range& e) {
     throw FileError(path, std::string("corrupt subject payload: ") + e.what());

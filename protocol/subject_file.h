@@ -11,7 +11,11 @@
 //               appends to it each part's ridge of eq. 7 (a count, then doubles), version 4
 //               each part's quadratic ridge; version 5 appends, after the deformation model, the
 //               regions and their PCA models (a count of markers, 0 for none; then the region
-//               offsets and members, and one PCA model per marker as the one-ring models are)
+//               offsets and members, and one PCA model per marker as the one-ring models are);
+//               version 6 appends the fitted body of a sparse marker set: a flag byte, then the
+//               skeleton (segments: name, parent, pivot; each marker's segment weights; each
+//               part's segment), each part's quadratic flag and the rest vertices (counts first,
+//               0 for none)
 //   last 4      u32 CRC-32 of the payload
 //
 // Another version, a bad magic, a size or CRC mismatch or an inconsistent model is rejected
@@ -26,8 +30,9 @@
 
 namespace skinstream {
 
-// Reads 1 (no deformation model), 2 (no ridges), 3 (no quadratic ridges), 4 (no regions) and 5.
-inline constexpr uint32_t kSubjectFileVersion = 5;
+// Reads 1 (no deformation model), 2 (no ridges), 3 (no quadratic ridges), 4 (no regions), 5 (no
+// fitted body) and 6.
+inline constexpr uint32_t kSubjectFileVersion = 6;
 
 struct SubjectFile {
   SubjectModel model;

@@ -91,6 +91,19 @@ std::string DeformationModel::validate(int marker_count) const {
   };
   if (!check_ridges(part_rbf_ridge, "ridge", 1e3) || !check_ridges(part_quadratic_ridge, "quadratic ridge", 1e4))
     return out.str();
+  if (!skeleton.empty()) {
+    if (const std::string e = skeleton.validate(marker_count, part_count()); !e.empty()) return "deformation model: " + e;
+  }
+  if (!part_quadratic.empty() && part_quadratic.size() != part_names.size()) {
+    out << "deformation model: " << part_quadratic.size() << " quadratic flags for " << part_count() << " parts";
+    return out.str();
+  }
+  if (!rest_vertices.empty() && rest_vertices.size() != reference_vertices.size()) {
+    out << "deformation model: " << rest_vertices.size() << " rest vertices for " << n << " vertices";
+    return out.str();
+  }
+  for (const Vec3& v : rest_vertices)
+    if (!finite(v)) return "deformation model: a rest vertex is not finite";
   if (auto e = check_csr(vertex_influence_offsets, reference_vertices.size(), vertex_influences.size(), "vertex influences"); !e.empty()) return "deformation model: " + e;
   for (int v = 0; v < n; ++v) {
     double sum = 0.0;

@@ -5,10 +5,12 @@
 // per-vertex part weights beta (5.2, barycentric from the nearest marker-surface triangle).
 
 #include <array>
+#include <cstdint>
 #include <string>
 #include <vector>
 
 #include "core/capture.h"
+#include "core/deform/segment_skeleton.h"
 #include "core/deform/vertex_blend.h"
 
 namespace skinstream {
@@ -37,6 +39,17 @@ struct DeformationModel {
   std::vector<PartInfluence> vertex_influences;  // beta_{j,p}, each vertex sums to 1
 
   double registration_rms_mm = 0.0;  // marker-to-surface distance after registration
+
+  // A body fitted to a sparse marker set (core/fitting): each part's rigid transform is its
+  // segment's motion in this skeleton's pose, fitted to all markers each frame, instead of the
+  // Horn fit of its own members. Empty: the paper's parts (a subject file before version 6, or
+  // a dense set).
+  SegmentSkeleton skeleton;
+  // Per part, whether eq. 6 is fitted (PartModel::quadratic); empty: every part.
+  std::vector<uint8_t> part_quadratic;
+  // The fitted template in its rest pose before registration, same topology: what the checks
+  // compare the registered mesh's edges with. Empty when the mesh was not fitted.
+  std::vector<Vec3> rest_vertices;
 
   int vertex_count() const { return static_cast<int>(reference_vertices.size()); }
   int face_count() const { return static_cast<int>(faces.size()); }

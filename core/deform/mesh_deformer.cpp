@@ -3,6 +3,7 @@
 #include <stdexcept>
 
 #include "core/deform/part_model.h"
+#include "core/deform/skeleton_solver.h"
 
 namespace skinstream {
 
@@ -13,6 +14,9 @@ struct MeshDeformer::State {
   std::vector<int> member_offsets;  // CSR over parts into member_markers
   std::vector<int> member_markers;
   std::vector<Vec3> member_scratch;
+  // A model fitted by its skeleton: the pose each frame, and each part's segment.
+  std::unique_ptr<SkeletonSolver> skeleton;
+  std::vector<int> part_segment;
   EvaluationModel evaluation_model;
   std::unique_ptr<MeshEvaluator> evaluator;
   FrameParameters parameters;
@@ -30,6 +34,7 @@ std::vector<PartModel> part_models(const DeformationModel& model, const SubjectM
       reference.push_back(subject.reference_positions[model.part_members[k].marker]);
     PartModel part = build_part_model(reference, model.part_quadratic_ridge.empty() ? 0.0 : model.part_quadratic_ridge[p]);
     if (!model.part_rbf_ridge.empty()) part.rbf_ridge = model.part_rbf_ridge[p];
+    if (!model.part_quadratic.empty()) part.quadratic = model.part_quadratic[p] != 0;
     parts.push_back(std::move(part));
   }
   return parts;
@@ -83,6 +88,10 @@ MeshDeformer::MeshDeformer(const DeformationModel& model, const SubjectModel& su
   s.member_scratch.resize(s.member_markers.size());
   s.parts.reserve(parts.size());
   for (PartModel& part : parts) s.parts.emplace_back(std::move(part), mode);
+  if (!model.skeleton.empty()) {
+    s.skeleton = std::make_unique<SkeletonSolver>(model.skeleton, subject.reference_positions);
+    s.part_segment = model.skeleton.part_segment;
+  }
 }
 
 MeshDeformer::~MeshDeformer() = default;
@@ -120,11 +129,23 @@ void MeshDeformer::solve_part(int p, std::span<const Vec3> markers) {
   const int begin = s.member_offsets[p], count = s.member_offsets[p + 1] - begin;
   Vec3* members = s.member_scratch.data() + begin;  // each part its own slice: parts may run in parallel
   for (int i = 0; i < count; ++i) members[i] = markers[s.member_markers[begin + i]];
-  if (s.parts[p].solve(std::span<const Vec3>(members, count))) s.store_parameters(p);
+  const std::span<const Vec3> member_span(members, count);
+  const bool solved = s.skeleton ? s.parts[p].solve(member_span, s.skeleton->segment_motion(s.part_segment[p]))
+                                 : s.parts[p].solve(member_span);
+  if (solved) s.store_parameters(p);
 }
+
+void MeshDeformer::solve_skeleton(std::span<const Vec3> markers) {
+  if (state_->skeleton) state_->skeleton->solve(markers);
+}
+
+bool MeshDeformer::has_skeleton() const { return state_->skeleton != nullptr; }
+
+const SkeletonSolver* MeshDeformer::skeleton() const { return state_->skeleton.get(); }
 
 bool MeshDeformer::solve_parts(std::span<const Vec3> markers) {
   if (!accepts(markers)) return false;
+  solve_skeleton(markers);
   for (int p = 0; p < part_count(); ++p) solve_part(p, markers);
   return true;
 }

@@ -27,6 +27,7 @@
 namespace skinstream {
 
 struct PartModel;
+class SkeletonSolver;
 
 // From the subject's deformation model and its parts' offline data (in part order), rounded to
 // float once here: what MeshDeformer evaluates with, and what the daemon sends parameter
@@ -54,6 +55,11 @@ class MeshDeformer {
   // markers can be used, then each part's fit (different parts may be solved concurrently;
   // the clusters of a part need that part's fit).
   bool accepts(std::span<const Vec3> markers) const;
+  // A model with a skeleton (a sparse marker set's fitted body) poses it first, once per frame,
+  // before any part is solved: every part takes its rigid transform from it. No-op otherwise.
+  void solve_skeleton(std::span<const Vec3> markers);
+  bool has_skeleton() const;
+  const SkeletonSolver* skeleton() const;  // null without one
   void solve_part(int part, std::span<const Vec3> markers);
   int part_count() const;
   int part_member_count(int part) const;

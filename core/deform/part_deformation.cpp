@@ -21,7 +21,7 @@ PartDeformer::PartDeformer(PartModel model, DeformationMode mode)
       kernel_lu_(model_.member_count()) {}
 
 bool PartDeformer::uses_quadratic() const {
-  return mode_ == DeformationMode::Quadratic || mode_ == DeformationMode::QuadraticRbf;
+  return model_.quadratic && (mode_ == DeformationMode::Quadratic || mode_ == DeformationMode::QuadraticRbf);
 }
 
 bool PartDeformer::uses_rbf() const {
@@ -29,14 +29,33 @@ bool PartDeformer::uses_rbf() const {
          model_.rbf_dilation > 0.0;
 }
 
-bool PartDeformer::solve(std::span<const Vec3> member_positions_now) {
-  const int count = model_.member_count();
-  if (static_cast<int>(member_positions_now.size()) != count) return false;
+bool PartDeformer::check_members(std::span<const Vec3> member_positions_now) const {
+  if (static_cast<int>(member_positions_now.size()) != model_.member_count()) return false;
   for (const Vec3& p : member_positions_now)
     if (!is_present(p)) return false;
+  return true;
+}
 
+bool PartDeformer::solve(std::span<const Vec3> member_positions_now) {
+  if (!check_members(member_positions_now)) return false;
   // R_t, d_t: current members as close as possible to their local part reference positions.
   fit_rigid(member_positions_now, model_.local_reference_points, to_local_);
+  fit_local_deformation(member_positions_now);
+  return true;
+}
+
+bool PartDeformer::solve(std::span<const Vec3> member_positions_now, const RigidTransform& segment_motion) {
+  if (!check_members(member_positions_now)) return false;
+  // World now -> world reference (the segment's motion undone) -> local part reference frame.
+  const Eigen::Matrix3d back = segment_motion.rotation.transpose();
+  to_local_.rotation = model_.reference_frame.rotation * back;
+  to_local_.translation = model_.reference_frame.translation - to_local_.rotation * segment_motion.translation;
+  fit_local_deformation(member_positions_now);
+  return true;
+}
+
+void PartDeformer::fit_local_deformation(std::span<const Vec3> member_positions_now) {
+  const int count = model_.member_count();
   for (int i = 0; i < count; ++i) local_now_.col(i) = to_local_.apply(member_positions_now[i]);
 
   if (uses_quadratic()) {
@@ -52,7 +71,6 @@ bool PartDeformer::solve(std::span<const Vec3> member_positions_now) {
   rbf_applied_ = false;
   weights_.setZero();
   if (uses_rbf()) solve_residual();
-  return true;
 }
 
 // Eq. 7's kernel with `ridge` on its diagonal, factored, and weights = kernel^-1 residuals.

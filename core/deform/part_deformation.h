@@ -26,6 +26,10 @@ class PartDeformer {
   // Returns false, leaving the previous state, when the count differs or a position is missing.
   // Before the first successful solve the part is in its reference pose.
   bool solve(std::span<const Vec3> member_positions_now);
+  // The same with the rigid transform given instead of Horn's: the motion of the part's
+  // skeleton segment from the reference pose to now (world). The members (there may be none)
+  // then only feed eqs. 6-7.
+  bool solve(std::span<const Vec3> member_positions_now, const RigidTransform& segment_motion);
 
   // Eq. 8: local part reference position -> deformed world position at the solved frame. Outside
   // the members' bounding box the field is that of the nearest box point plus the rigid offset
@@ -50,6 +54,8 @@ class PartDeformer {
  private:
   bool uses_quadratic() const;
   bool uses_rbf() const;
+  bool check_members(std::span<const Vec3> member_positions_now) const;
+  void fit_local_deformation(std::span<const Vec3> member_positions_now);
   void solve_residual();
   void factor_and_solve(double ridge);
 

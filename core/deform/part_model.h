@@ -37,6 +37,10 @@ struct PartModel {
   // out synthetic subject); the subject builder chooses it per part by leave-one-out error over
   // the training take (core/offline/quadratic_ridge_selection.h).
   double quadratic_ridge = 0.0;
+  // Whether eq. 6 is fitted at all. A part driven by a skeleton with only a few members (a
+  // sparse marker set) keeps its segment's rigid motion and interpolates what is left by eq. 7
+  // alone: a quadratic through three or four markers bends the whole part to follow one of them.
+  bool quadratic = true;
 
   // sigma of eq. 7: twice the largest nearest-member distance. 0 when the residual cannot be
   // interpolated (fewer than 2 distinct members); the RBF term is then skipped.

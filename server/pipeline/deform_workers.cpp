@@ -105,6 +105,7 @@ void DeformWorkers::reset(Stage& stage, uint32_t generation, bool skip) {
 bool DeformWorkers::run(std::span<const Vec3> markers, std::span<float> positions, std::span<float> normals) {
   if (!deformer_.accepts(markers)) return false;
   const auto start = std::chrono::steady_clock::now();
+  deformer_.solve_skeleton(markers);  // before the parts are shared out: each reads its segment's motion
   expect_next_run(start);
   const uint32_t generation = generation_.load(std::memory_order_relaxed) + 1;
   markers_ = markers;

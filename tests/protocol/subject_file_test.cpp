@@ -187,6 +187,51 @@ TEST_F(SubjectFile, DeformationModelRoundTripsExactly) {
   EXPECT_EQ(read_subject(path).marker_names, model_.marker_names);
 }
 
+// A sparse set's fitted body: the skeleton, each part's quadratic flag and the rest vertices.
+TEST_F(SubjectFile, FittedBodyRoundTripsExactly) {
+  DeformationModel d = limb_deformation(model_);
+  d.skeleton.segments = {{"pelvis", -1, Vec3(0, 0, 900)}, {"thigh", 0, Vec3(100, 0, 850)}};
+  for (int i = 0; i < model_.marker_count(); ++i) {
+    if (i % 2) d.skeleton.marker_weights.push_back({1, 1.0});
+    else d.skeleton.marker_weights.insert(d.skeleton.marker_weights.end(), {{0, 0.25}, {1, 0.75}});
+    d.skeleton.marker_weight_offsets.push_back(static_cast<int>(d.skeleton.marker_weights.size()));
+  }
+  d.skeleton.part_segment = {1};
+  d.part_quadratic = {0};
+  d.rest_vertices = d.reference_vertices;
+  for (Vec3& v : d.rest_vertices) v += Vec3(1.5, -2.0, 0.25);
+  const std::string path = test::scratch_path("limb_fitted.subject");
+  write_subject(model_, &d, path);
+  const auto back = read_subject_file(path);
+  ASSERT_TRUE(back.deformation.has_value());
+  const SegmentSkeleton& s = back.deformation->skeleton;
+  ASSERT_EQ(s.segment_count(), 2);
+  EXPECT_EQ(s.segments[1].name, "thigh");
+  EXPECT_EQ(s.segments[1].parent, 0);
+  EXPECT_EQ(s.segments[1].pivot, Vec3(100, 0, 850));
+  EXPECT_EQ(s.marker_weight_offsets, d.skeleton.marker_weight_offsets);
+  ASSERT_EQ(s.marker_weights.size(), d.skeleton.marker_weights.size());
+  for (size_t k = 0; k < s.marker_weights.size(); ++k) {
+    EXPECT_EQ(s.marker_weights[k].segment, d.skeleton.marker_weights[k].segment);
+    EXPECT_EQ(s.marker_weights[k].weight, d.skeleton.marker_weights[k].weight);
+  }
+  EXPECT_EQ(s.part_segment, d.skeleton.part_segment);
+  EXPECT_EQ(back.deformation->part_quadratic, d.part_quadratic);
+  EXPECT_EQ(back.deformation->rest_vertices, d.rest_vertices);
+}
+
+// A fitted body whose skeleton does not add up is refused when written and when read.
+TEST_F(SubjectFile, RefusesAFittedBodyWithBrokenWeights) {
+  DeformationModel d = limb_deformation(model_);
+  d.skeleton.segments = {{"pelvis", -1, Vec3(0, 0, 900)}};
+  for (int i = 0; i < model_.marker_count(); ++i) {
+    d.skeleton.marker_weights.push_back({0, i == 0 ? 0.5 : 1.0});  // marker 0 sums to 0.5
+    d.skeleton.marker_weight_offsets.push_back(i + 1);
+  }
+  d.skeleton.part_segment = {0};
+  EXPECT_THROW(write_subject(model_, &d, test::scratch_path("limb_bad_skeleton.subject")), FileError);
+}
+
 // Rewrites a file written now as an older version: drops the last `dropped` bytes before the
 // CRC (the fields that version lacks, all at the end of the deformation section), then mends
 // the version, the size and the CRC.
@@ -223,7 +268,7 @@ TEST_F(SubjectFile, RegionsRoundTrip) {
 TEST_F(SubjectFile, VersionFourFileReadsWithoutRegions) {
   const std::string path = test::scratch_path("limb_v4.subject");
   write_subject(without_regions(model_), path);
-  make_older(path, 4, 4);  // the region count (0)
+  make_older(path, 4, 4 + 1);  // the region count (0), the fitted body's flag (0)
   const SubjectModel back = read_subject(path);
   EXPECT_FALSE(back.has_regions());
   EXPECT_EQ(back.validate(), "");
@@ -238,7 +283,7 @@ TEST_F(SubjectFile, VersionTwoFileReadsWithoutRidges) {
   d.part_quadratic_ridge.clear();
   const std::string path = test::scratch_path("limb_v2.subject");
   write_subject(without_regions(model_), &d, path);
-  make_older(path, 2, 8 + 4);  // the two ridge counts (0 each), the region count (0)
+  make_older(path, 2, 8 + 4 + 1);  // the two ridge counts (0 each), the region count (0), the fitted body's flag (0)
   const auto back = read_subject_file(path);
   ASSERT_TRUE(back.deformation.has_value());
   EXPECT_TRUE(back.deformation->part_rbf_ridge.empty());
@@ -254,7 +299,7 @@ TEST_F(SubjectFile, VersionThreeFileReadsWithoutQuadraticRidges) {
   d.part_quadratic_ridge.clear();
   const std::string path = test::scratch_path("limb_v3.subject");
   write_subject(without_regions(model_), &d, path);
-  make_older(path, 3, 4 + 4);  // the quadratic ridge count (0), the region count (0)
+  make_older(path, 3, 4 + 4 + 1);  // the quadratic ridge count (0), the region count (0), the fitted body's flag (0)
   const auto back = read_subject_file(path);
   ASSERT_TRUE(back.deformation.has_value());
   EXPECT_EQ(back.deformation->part_rbf_ridge, d.part_rbf_ridge);

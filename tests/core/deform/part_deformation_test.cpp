@@ -76,6 +76,42 @@ TEST(PartDeformer, RigidMotionReproducedForAnyVertexInAllModes) {
   }
 }
 
+// A skeleton-driven part takes its rigid transform from its segment: with the members moved by
+// that same motion nothing is left for eqs. 6-7, and every point follows the motion.
+TEST(PartDeformer, AGivenSegmentMotionMovesThePartExactly) {
+  std::mt19937_64 rng(21);
+  const std::vector<Vec3> members = random_points(rng, 5, Vec3(120, 60, 40));
+  const std::vector<Vec3> vertices = random_points(rng, 100, Vec3(200, 120, 80));
+  const RigidTransform motion = random_motion(rng);
+  for (DeformationMode mode : kAllModes) {
+    PartModel model = build_part_model(members);
+    model.quadratic = false;  // as a part with a few members of a sparse set
+    PartDeformer part(model, mode);
+    ASSERT_TRUE(part.solve(move_rigidly(members, motion), motion));
+    double worst = 0.0;
+    for (const Vec3& v : vertices)
+      worst = std::max(worst, (part.deform(part.model().local_from_world(v)) - motion.apply(v)).norm());
+    EXPECT_LT(worst, 1e-6) << static_cast<int>(mode);
+  }
+}
+
+// What the segment's motion leaves at the members is interpolated by eq. 7 alone when the part
+// has no quadratic: the members are reached, and the quadratic transform stays the identity.
+TEST(PartDeformer, AGivenMotionLeavesTheMembersToTheResidual) {
+  std::mt19937_64 rng(22);
+  const std::vector<Vec3> members = random_points(rng, 5, Vec3(120, 60, 40));
+  const RigidTransform motion = random_motion(rng);
+  std::vector<Vec3> now = move_rigidly(members, motion);
+  now[2] += Vec3(4.0, -3.0, 2.0);  // the skin moved a little off the segment
+  PartModel model = build_part_model(members);
+  model.quadratic = false;
+  PartDeformer part(model, DeformationMode::QuadraticRbf);
+  ASSERT_TRUE(part.solve(now, motion));
+  EXPECT_TRUE(part.quadratic_transform().isApprox(identity_quadratic_transform()));
+  EXPECT_TRUE(part.rbf_applied());
+  EXPECT_LT(max_member_error(part, now), 1e-6);
+}
+
 TEST(PartDeformer, QuadraticFieldRecoveredExactly) {
   const std::vector<Vec3> members = octant_symmetric_members();
   const PartModel model = build_part_model(members);
