@@ -145,7 +145,13 @@ std::pair<double, double> landmark_residual(const std::vector<Vec3>& points, con
   const std::vector<Vec3> normals = vertex_normals(points, triangles);
   double sum2 = 0.0, max = 0.0;
   for (const RegistrationLandmark& l : landmarks) {
-    const double e = (points[l.vertex] - (markers[l.marker] - offset * normals[l.vertex])).norm() * to_mm;
+    Vec3 point = points[l.vertex], normal = normals[l.vertex];
+    if (l.triangle >= 0) {
+      const Triangle& t = triangles[static_cast<size_t>(l.triangle)];
+      point = l.barycentric[0] * points[t[0]] + l.barycentric[1] * points[t[1]] + l.barycentric[2] * points[t[2]];
+      normal = triangle_normal(points[t[0]], points[t[1]], points[t[2]]);
+    }
+    const double e = (point - (markers[l.marker] - offset * normal)).norm() * to_mm;
     sum2 += e * e;
     max = std::max(max, e);
   }
@@ -173,8 +179,15 @@ std::vector<Vec3> register_mesh(std::span<const Vec3> vertices, Triangles triang
   for (size_t i = 0; i < landmarks.size(); ++i) {
     require(landmarks[i].marker >= 0 && landmarks[i].marker < m,
             "landmark " + std::to_string(i) + " names marker " + std::to_string(landmarks[i].marker) + " of " + std::to_string(m));
-    require(landmarks[i].vertex >= 0 && landmarks[i].vertex < n,
-            "landmark " + std::to_string(i) + " names vertex " + std::to_string(landmarks[i].vertex) + " of " + std::to_string(n));
+    if (landmarks[i].triangle >= 0) {
+      require(landmarks[i].triangle < static_cast<int>(triangles.size()),
+              "landmark " + std::to_string(i) + " names triangle " + std::to_string(landmarks[i].triangle) + " of " +
+                  std::to_string(triangles.size()));
+      require(landmarks[i].barycentric.allFinite(), "landmark " + std::to_string(i) + " has non-finite barycentric coordinates");
+    } else {
+      require(landmarks[i].vertex >= 0 && landmarks[i].vertex < n,
+              "landmark " + std::to_string(i) + " names vertex " + std::to_string(landmarks[i].vertex) + " of " + std::to_string(n));
+    }
   }
   for (double w : {options.data_weight, options.smoothness_weight, options.landmark_weight, options.damping_weight,
                    options.marker_offset_mm, options.tolerance_mm})
@@ -211,9 +224,16 @@ std::vector<Vec3> register_mesh(std::span<const Vec3> vertices, Triangles triang
     const double data = data_weight / m;
     for (const auto& [i, j] : edges) eq.add_smoothness(smoothness, i, j);
     eq.add_damping(damping, x);
-    for (const RegistrationLandmark& l : landmarks)
-      eq.add_point_row<1>(landmark, {l.vertex}, {1.0}, unit_vertices,
-                          unit_markers[l.marker] - offset * normals[l.vertex]);
+    for (const RegistrationLandmark& l : landmarks) {
+      if (l.triangle >= 0) {
+        const Triangle& t = tris[static_cast<size_t>(l.triangle)];
+        const Vec3 normal = triangle_normal(current[t[0]], current[t[1]], current[t[2]]);
+        eq.add_point_row<3>(landmark, t, {l.barycentric[0], l.barycentric[1], l.barycentric[2]}, unit_vertices,
+                            unit_markers[l.marker] - offset * normal);
+      } else {
+        eq.add_point_row<1>(landmark, {l.vertex}, {1.0}, unit_vertices, unit_markers[l.marker] - offset * normals[l.vertex]);
+      }
+    }
     if (data_weight > 0.0) {
       const TriangleBvh bvh(current, tris);
       for (const Vec3& marker : unit_markers) {

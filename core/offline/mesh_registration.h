@@ -26,10 +26,14 @@
 namespace skinstream {
 
 // A marker <-> vertex correspondence that is known (elbow, knee...): the registered vertex
-// should reach the marker (minus the skin offset along the vertex normal).
+// should reach the marker (minus the skin offset along the vertex normal). With a triangle, the
+// correspondence is a point of that triangle instead (barycentric; `vertex` is then unused), as
+// a fitted template knows where each marker sits between vertices.
 struct RegistrationLandmark {
   int marker = 0;  // index into the markers
   int vertex = 0;  // index into the mesh vertices
+  int triangle = -1;                    // >= 0: the landmark is this triangle's point ...
+  Vec3 barycentric = Vec3::Zero();      // ... at these barycentric coordinates
   bool operator==(const RegistrationLandmark&) const = default;
 };
 

@@ -137,6 +137,33 @@ TEST(MeshRegistration, PullsAScaledAndBentCopyBackOntoTheMarkers) {
   EXPECT_LT(std::sqrt(vertex_error / out.size()), 6.0);  // measured 4.6 mm: markers do not pin sliding
 }
 
+// A landmark between vertices (a fitted marker's place: a triangle and barycentric weights)
+// pulls that point of the surface, not its nearest vertex: the patch, shifted off the markers,
+// comes back so that each landmark point lands on its marker.
+TEST(MeshRegistration, ALandmarkInsideATriangleReachesItsMarker) {
+  const Grid truth = flat_patch(11, 11, 20.0);
+  std::vector<Vec3> markers;
+  std::vector<RegistrationLandmark> landmarks;
+  for (int t = 10; t < static_cast<int>(truth.triangles.size()); t += 37) {
+    const Vec3 bary(0.2, 0.3, 0.5);
+    const auto& tri = truth.triangles[t];
+    landmarks.push_back({static_cast<int>(markers.size()), tri[0], t, bary});
+    markers.push_back(bary[0] * truth.vertices[tri[0]] + bary[1] * truth.vertices[tri[1]] + bary[2] * truth.vertices[tri[2]]);
+  }
+  std::vector<Vec3> mesh;
+  for (const Vec3& p : truth.vertices) mesh.push_back(p + Vec3(7.0, -4.0, 3.0));
+  RegistrationOptions options;
+  options.data_weight = 0.0;  // the landmarks alone
+  RegistrationReport report;
+  const std::vector<Vec3> out = register_mesh(mesh, truth.triangles, markers, landmarks, options, &report);
+  EXPECT_GT(report.landmark_rms_before_mm, 8.0);
+  EXPECT_LT(report.landmark_rms_after_mm, 0.1);
+  for (size_t j = 0; j < out.size(); ++j) EXPECT_LT((out[j] - truth.vertices[j]).norm(), 0.5) << "vertex " << j;
+  // A landmark's triangle must exist.
+  landmarks[0].triangle = static_cast<int>(truth.triangles.size());
+  EXPECT_THROW(register_mesh(mesh, truth.triangles, markers, landmarks, options), std::invalid_argument);
+}
+
 // Markers 5 mm above the middle of a flat patch; the mesh is the patch lifted 20 mm, shifted
 // and rotated in its plane. With a 5 mm offset the registered patch lies in z = 0 everywhere,
 // also where no marker constrains it: smoothness keeps it flat.
