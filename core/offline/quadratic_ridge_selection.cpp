@@ -19,8 +19,10 @@ std::vector<double> quadratic_ridge_candidates() {
 
 QuadraticRidgeChoice choose_quadratic_ridge(const std::vector<Vec3>& reference, std::span<const int> member_markers,
                                             std::span<const Vec3> training, int frame_count, int marker_count,
-                                            int sample_frames) {
+                                            int sample_frames, std::span<const RigidTransform> segment_motions) {
   check_training_take("choose_quadratic_ridge", training, frame_count, marker_count);
+  if (!segment_motions.empty() && static_cast<int>(segment_motions.size()) != frame_count)
+    throw std::invalid_argument("choose_quadratic_ridge: one segment motion per training frame is needed");
   if (member_markers.size() != reference.size())
     throw std::invalid_argument("choose_quadratic_ridge: member list does not match the part");
   QuadraticRidgeChoice choice;
@@ -34,8 +36,9 @@ QuadraticRidgeChoice choose_quadratic_ridge(const std::vector<Vec3>& reference, 
   std::vector<Eigen::Matrix3Xd> deviations;
   const int frames = for_each_training_frame(
       member_markers, training, frame_count, marker_count, sample_frames,
-      [&](const std::vector<Vec3>& members) {
-        if (!rigid.solve(members)) throw std::invalid_argument("choose_quadratic_ridge: a training frame misses a member");
+      [&](int frame, const std::vector<Vec3>& members) {
+        const bool solved = segment_motions.empty() ? rigid.solve(members) : rigid.solve(members, segment_motions[frame]);
+        if (!solved) throw std::invalid_argument("choose_quadratic_ridge: a training frame misses a member");
         deviations.push_back(rigid.local_positions() - exact.local_reference);
       });
   choice.frames = frames;

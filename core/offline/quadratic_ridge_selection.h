@@ -13,6 +13,7 @@
 #include <span>
 #include <vector>
 
+#include "core/absolute_orientation.h"
 #include "core/capture.h"
 
 namespace skinstream {
@@ -33,9 +34,11 @@ struct QuadraticRidgeChoice {
 // One part (members' reference positions, their marker indices): the rigid fit (Horn) at up to
 // `sample_frames` frames spread over the take (training: frame_count x marker_count,
 // frame-major, all present), then each candidate's summed leave-one-out miss; the smallest
-// wins. Parts with fewer than 9 members fit the linear modes only and get 0.
+// wins. Parts with fewer than 9 members fit the linear modes only and get 0. With
+// `segment_motions` (one per training frame: a skeleton-driven part's segment motion), that
+// motion stands for the rigid fit.
 QuadraticRidgeChoice choose_quadratic_ridge(const std::vector<Vec3>& reference, std::span<const int> member_markers,
                                             std::span<const Vec3> training, int frame_count, int marker_count,
-                                            int sample_frames = 48);
+                                            int sample_frames = 48, std::span<const RigidTransform> segment_motions = {});
 
 }  // namespace skinstream

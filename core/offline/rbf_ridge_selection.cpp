@@ -48,8 +48,11 @@ std::vector<double> leave_one_out_squared_errors(const Eigen::Matrix3Xd& centres
 }
 
 RidgeChoice choose_rbf_ridge(const PartModel& part, std::span<const int> member_markers, std::span<const Vec3> training,
-                             int frame_count, int marker_count, int sample_frames) {
+                             int frame_count, int marker_count, int sample_frames,
+                             std::span<const RigidTransform> segment_motions) {
   check_training_take("choose_rbf_ridge", training, frame_count, marker_count);
+  if (!segment_motions.empty() && static_cast<int>(segment_motions.size()) != frame_count)
+    throw std::invalid_argument("choose_rbf_ridge: one segment motion per training frame is needed");
   if (static_cast<int>(member_markers.size()) != part.member_count())
     throw std::invalid_argument("choose_rbf_ridge: member list does not match the part");
   RidgeChoice choice;
@@ -60,8 +63,9 @@ RidgeChoice choose_rbf_ridge(const PartModel& part, std::span<const int> member_
   PartDeformer fit(part, DeformationMode::Quadratic);  // eq. 6: the centres and residuals of eq. 7
   choice.frames = for_each_training_frame(
       member_markers, training, frame_count, marker_count, sample_frames,
-      [&](const std::vector<Vec3>& members) {
-        if (!fit.solve(members)) throw std::invalid_argument("choose_rbf_ridge: a training frame misses a member");
+      [&](int frame, const std::vector<Vec3>& members) {
+        const bool solved = segment_motions.empty() ? fit.solve(members) : fit.solve(members, segment_motions[frame]);
+        if (!solved) throw std::invalid_argument("choose_rbf_ridge: a training frame misses a member");
         const Eigen::MatrixX3d residuals = (fit.local_positions() - fit.rbf_centres()).transpose();
         const std::vector<double> scores =
             leave_one_out_squared_errors(fit.rbf_centres(), residuals, part.rbf_dilation, ridges);

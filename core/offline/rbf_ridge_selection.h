@@ -41,8 +41,10 @@ struct RidgeChoice {
 // One part: fits rigid + quadratic (eq. 6) to its members at up to `sample_frames` frames spread
 // over the take (training: frame_count x marker_count, frame-major, all present) and picks the
 // candidate with the smallest summed leave-one-out error. A part without an RBF term (dilation
-// 0) gets ridge 0.
+// 0) gets ridge 0. With `segment_motions` (one per training frame: a skeleton-driven part's
+// segment motion), that motion stands for the rigid fit.
 RidgeChoice choose_rbf_ridge(const PartModel& part, std::span<const int> member_markers, std::span<const Vec3> training,
-                             int frame_count, int marker_count, int sample_frames = 48);
+                             int frame_count, int marker_count, int sample_frames = 48,
+                             std::span<const RigidTransform> segment_motions = {});
 
 }  // namespace skinstream

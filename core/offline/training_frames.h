@@ -20,9 +20,9 @@ inline void check_training_take(const std::string& who, std::span<const Vec3> tr
     throw std::invalid_argument(who + ": training is not frame_count x marker_count");
 }
 
-// Calls visit(members) for each sampled frame of `training` (checked by check_training_take),
-// with `members` the positions of `member_markers` in that frame, and returns how many frames it
-// visited.
+// Calls visit(frame, members) for each sampled frame of `training` (checked by
+// check_training_take), with `members` the positions of `member_markers` in that frame, and
+// returns how many frames it visited.
 template <typename Visit>
 int for_each_training_frame(std::span<const int> member_markers, std::span<const Vec3> training, int frame_count,
                             int marker_count, int sample_frames, Visit&& visit) {
@@ -32,7 +32,7 @@ int for_each_training_frame(std::span<const int> member_markers, std::span<const
     const int frame = static_cast<int>((static_cast<long long>(s) * frame_count) / frames);
     for (size_t i = 0; i < members.size(); ++i)
       members[i] = training[static_cast<size_t>(frame) * marker_count + member_markers[i]];
-    visit(static_cast<const std::vector<Vec3>&>(members));
+    visit(frame, static_cast<const std::vector<Vec3>&>(members));
   }
   return frames;
 }
