@@ -257,4 +257,72 @@ double TriangleBvh::closest(const Vec3& p, int* triangle, Vec3* point) const {
   return std::sqrt(best2);
 }
 
+bool TriangleBvh::boxes_overlap(int a, int b) const {
+  const Node& x = nodes_[static_cast<size_t>(a)];
+  const Node& y = nodes_[static_cast<size_t>(b)];
+  return (x.lo.array() <= y.hi.array()).all() && (y.lo.array() <= x.hi.array()).all();
+}
+
+// The crossing pairs between the triangles of two leaves (or within one leaf when a == b).
+void TriangleBvh::cross_leaves(int a, int b, std::vector<std::array<int, 2>>& out) const {
+  const Node& x = nodes_[static_cast<size_t>(a)];
+  const Node& y = nodes_[static_cast<size_t>(b)];
+  for (int i = x.first; i < x.first + x.count; ++i) {
+    const int ti = order_[static_cast<size_t>(i)];
+    const Triangle& t = triangles_[static_cast<size_t>(ti)];
+    for (int j = (a == b ? i + 1 : y.first); j < y.first + y.count; ++j) {
+      const int tj = order_[static_cast<size_t>(j)];
+      const Triangle& u = triangles_[static_cast<size_t>(tj)];
+      bool shared = false;
+      for (int p : t)
+        for (int q : u) shared = shared || p == q;
+      if (shared) continue;  // neighbours meet at their shared vertex or edge by construction
+      const Vec3 &t0 = points_[static_cast<size_t>(t[0])], &t1 = points_[static_cast<size_t>(t[1])],
+                 &t2 = points_[static_cast<size_t>(t[2])];
+      const Vec3 &u0 = points_[static_cast<size_t>(u[0])], &u1 = points_[static_cast<size_t>(u[1])],
+                 &u2 = points_[static_cast<size_t>(u[2])];
+      // Box of each triangle first: most pairs of two overlapping leaves are apart.
+      const Eigen::Vector3d tlo = t0.cwiseMin(t1).cwiseMin(t2), thi = t0.cwiseMax(t1).cwiseMax(t2);
+      const Eigen::Vector3d ulo = u0.cwiseMin(u1).cwiseMin(u2), uhi = u0.cwiseMax(u1).cwiseMax(u2);
+      if ((tlo.array() > uhi.array()).any() || (ulo.array() > thi.array()).any()) continue;
+      if (triangles_cross(t0, t1, t2, u0, u1, u2)) out.push_back({std::min(ti, tj), std::max(ti, tj)});
+    }
+  }
+}
+
+std::vector<std::array<int, 2>> TriangleBvh::self_intersections() const {
+  std::vector<std::array<int, 2>> out;
+  if (nodes_.empty()) return out;
+  // Pairs of nodes whose triangles may cross, a node paired with itself for the pairs inside it.
+  std::vector<std::array<int, 2>> stack{{0, 0}};
+  while (!stack.empty()) {
+    const auto [a, b] = stack.back();
+    stack.pop_back();
+    const Node& x = nodes_[static_cast<size_t>(a)];
+    const Node& y = nodes_[static_cast<size_t>(b)];
+    if (a == b) {
+      if (x.count > 0) {
+        cross_leaves(a, a, out);
+      } else {
+        stack.push_back({a + 1, a + 1});
+        stack.push_back({x.first, x.first});
+        stack.push_back({a + 1, x.first});
+      }
+      continue;
+    }
+    if (!boxes_overlap(a, b)) continue;
+    if (x.count > 0 && y.count > 0) {
+      cross_leaves(a, b, out);
+    } else if (y.count > 0 || (x.count == 0 && (x.hi - x.lo).squaredNorm() >= (y.hi - y.lo).squaredNorm())) {
+      stack.push_back({a + 1, b});  // split the larger inner node
+      stack.push_back({x.first, b});
+    } else {
+      stack.push_back({a, b + 1});
+      stack.push_back({a, y.first});
+    }
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
 }  // namespace skinstream

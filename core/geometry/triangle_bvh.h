@@ -1,9 +1,11 @@
 #pragma once
 // A bounding volume hierarchy over a triangle mesh for the camera ray tests (is the segment from
 // a marker to a camera blocked by the body?), ray casts (where does a ray from a bone leave the
-// body?) and closest-point queries. Built once per topology; refit() updates the boxes when the
-// mesh deforms (cheap, and exact: only traversal gets slower as the pose drifts from the one it
-// was built in, so callers rebuild now and then).
+// body?), closest-point queries and the surface's crossings of itself (the checks of a fitted
+// body). Built once per topology; refit() updates the boxes when the mesh deforms (cheap, and
+// exact: only traversal gets slower as the pose drifts from the one it was built in, so callers
+// rebuild now and then).
+#include <array>
 #include <limits>
 #include <vector>
 
@@ -41,6 +43,10 @@ class TriangleBvh {
   // Distance from p to the surface; the closest triangle and point when asked.
   double closest(const Vec3& p, int* triangle = nullptr, Vec3* point = nullptr) const;
 
+  // Pairs {i, j}, i < j, of triangles that share no vertex and cross each other
+  // (triangles_cross): where the surface passes through itself. Sorted.
+  std::vector<std::array<int, 2>> self_intersections() const;
+
   int triangle_count() const { return static_cast<int>(triangles_.size()); }
 
  private:
@@ -51,6 +57,8 @@ class TriangleBvh {
   };
   int build(int begin, int end, std::vector<Vec3>& centroids);
   void refit_node(int node);
+  bool boxes_overlap(int a, int b) const;
+  void cross_leaves(int a, int b, std::vector<std::array<int, 2>>& out) const;
 
   std::vector<Vec3> points_;
   std::vector<Triangle> triangles_;

@@ -76,6 +76,48 @@ Vec3 closest_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, cons
   return done(1 - v - w, v, w);
 }
 
+namespace {
+
+// Six times the signed volume of the tetrahedron (a, b, c, d): positive when d is on the side
+// of (a, b, c) its counter-clockwise normal points to.
+double orient(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
+  return (b - a).cross(c - a).dot(d - a);
+}
+
+// Segment p-q passes through the interior of triangle (a, b, c), by more than `tol` (a volume)
+// on every side.
+bool segment_crosses(const Vec3& p, const Vec3& q, const Vec3& a, const Vec3& b, const Vec3& c, double tol) {
+  const double sp = orient(a, b, c, p), sq = orient(a, b, c, q);
+  if (!(sp > tol && sq < -tol) && !(sp < -tol && sq > tol)) return false;
+  // The line through p and q meets the plane inside the triangle when it turns the same way
+  // around all three edges.
+  const double u = orient(p, q, a, b), v = orient(p, q, b, c), w = orient(p, q, c, a);
+  return (u > tol && v > tol && w > tol) || (u < -tol && v < -tol && w < -tol);
+}
+
+}  // namespace
+
+bool triangles_cross(const Vec3& a0, const Vec3& a1, const Vec3& a2, const Vec3& b0, const Vec3& b1,
+                     const Vec3& b2) {
+  // Relative to a0, so that rounding scales with the triangles and not with their distance from
+  // the origin; volumes within 1e-10 of the cube of their extent count as zero (touching or
+  // coplanar: rounding would otherwise give either sign).
+  const Vec3 p[6] = {Vec3::Zero(), a1 - a0, a2 - a0, b0 - a0, b1 - a0, b2 - a0};
+  Eigen::Vector3d lo = p[0], hi = p[0];
+  for (const Vec3& x : p) {
+    lo = lo.cwiseMin(x);
+    hi = hi.cwiseMax(x);
+  }
+  const double extent = (hi - lo).norm(), tol = 1e-10 * extent * extent * extent;
+  // Two triangles in different planes meet along a segment whose ends lie on their edges, so
+  // they cross exactly when one triangle's edge passes through the other.
+  for (int k = 0; k < 3; ++k)
+    if (segment_crosses(p[k], p[(k + 1) % 3], p[3], p[4], p[5], tol) ||
+        segment_crosses(p[3 + k], p[3 + (k + 1) % 3], p[0], p[1], p[2], tol))
+      return true;
+  return false;
+}
+
 double signed_volume(const std::vector<Vec3>& points, const std::vector<Triangle>& triangles) {
   double v = 0.0;
   for (const Triangle& t : triangles)

@@ -28,6 +28,13 @@ Vec3 triangle_normal(const Vec3& a, const Vec3& b, const Vec3& c);
 Vec3 closest_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c,
                                Vec3* barycentric = nullptr);
 
+// Whether triangles (a0, a1, a2) and (b0, b1, b2) cross each other: an edge of one passes
+// through the interior of the other. Touching (a vertex or an edge on the other triangle, to
+// within 1e-10 of their extent) and coplanar overlaps do not count: a surface passing through
+// itself crosses.
+bool triangles_cross(const Vec3& a0, const Vec3& a1, const Vec3& a2, const Vec3& b0, const Vec3& b1,
+                     const Vec3& b2);
+
 // Signed volume enclosed by a closed triangle surface (positive when faces point outward).
 double signed_volume(const std::vector<Vec3>& points, const std::vector<Triangle>& triangles);
 

@@ -133,5 +133,46 @@ TEST(TriangleBvh, SegmentAndClosestQueriesMatchBruteForceAfterRefit) {
   }
 }
 
+TEST(TriangleBvh, SelfIntersectionsMatchBruteForce) {
+  // The mannequin, then the same with its left arm swung through the chest: the BVH query
+  // finds exactly the crossing pairs that testing every pair finds.
+  const Body m = synth::make_mannequin();
+  const std::vector<Triangle> tris = triangulate(m.faces);
+  auto brute = [&](const std::vector<Vec3>& p) {
+    std::vector<std::array<int, 2>> pairs;
+    for (size_t i = 0; i < tris.size(); ++i)
+      for (size_t j = i + 1; j < tris.size(); ++j) {
+        const Triangle &t = tris[i], &u = tris[j];
+        bool shared = false;
+        for (int a : t)
+          for (int b : u) shared = shared || a == b;
+        if (!shared && triangles_cross(p[static_cast<size_t>(t[0])], p[static_cast<size_t>(t[1])],
+                                       p[static_cast<size_t>(t[2])], p[static_cast<size_t>(u[0])],
+                                       p[static_cast<size_t>(u[1])], p[static_cast<size_t>(u[2])]))
+          pairs.push_back({static_cast<int>(i), static_cast<int>(j)});
+      }
+    return pairs;
+  };
+  TriangleBvh bvh(m.rest, tris);
+  EXPECT_EQ(bvh.self_intersections(), brute(m.rest));
+  // Every vertex left of the body's middle and above the hips moves 40% of the body's width
+  // to the right: the left side passes through the right.
+  double lo = 1e30, hi = -1e30, top = -1e30;
+  for (const Vec3& p : m.rest) {
+    lo = std::min(lo, p.x());
+    hi = std::max(hi, p.x());
+    top = std::max(top, p.z());
+  }
+  std::vector<Vec3> moved = m.rest;
+  for (Vec3& p : moved)
+    if (p.x() < 0.5 * (lo + hi) && p.z() > 0.5 * top) p.x() += 0.4 * (hi - lo);
+  bvh.refit(moved);
+  const auto pairs = bvh.self_intersections();
+  EXPECT_GT(pairs.size(), 10u);
+  EXPECT_EQ(pairs, brute(moved));
+  TriangleBvh empty({}, {});
+  EXPECT_TRUE(empty.self_intersections().empty());
+}
+
 }  // namespace
 }  // namespace skinstream
