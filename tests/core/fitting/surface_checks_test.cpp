@@ -145,6 +145,7 @@ TEST(SurfaceCheck, ShardsFail) {
   print("five shards", c);
   EXPECT_LT(c.strained_fraction, 0.01);
   EXPECT_GT(c.max_stretch, 100.0);
+  EXPECT_GT(c.longest_stretched_edge, 25.0);
   EXPECT_FALSE(c.ok());
   EXPECT_NE(c.problem.find("an edge stretched"), std::string::npos) << c.problem;
 }
