@@ -12,11 +12,15 @@ namespace skinstream {
 namespace {
 
 constexpr int kLeafSize = 4;
+// Barycentric slack of ray casts: a ray along the body's symmetry plane runs through the edges
+// of the seam there; rounding must not let it pass between the triangles.
+constexpr double kEdgeSlack = 1e-9;
 
 // Moller-Trumbore: distance along the unit direction to the triangle, or +inf; the crossing's
-// barycentric weights of b and c when asked.
+// barycentric weights of b and c when asked. `slack` widens the triangle by that much in
+// barycentric terms, so that a ray through a shared edge cannot slip between its two triangles.
 double ray_triangle(const Vec3& o, const Vec3& d, const Vec3& a, const Vec3& b, const Vec3& c,
-                    double* out_u = nullptr, double* out_v = nullptr) {
+                    double* out_u = nullptr, double* out_v = nullptr, double slack = 0.0) {
   const Vec3 e1 = b - a, e2 = c - a;
   const Vec3 p = d.cross(e2);
   const double det = e1.dot(p);
@@ -24,10 +28,10 @@ double ray_triangle(const Vec3& o, const Vec3& d, const Vec3& a, const Vec3& b, 
   const double inv = 1.0 / det;
   const Vec3 s = o - a;
   const double u = s.dot(p) * inv;
-  if (u < 0.0 || u > 1.0) return std::numeric_limits<double>::infinity();
+  if (u < -slack || u > 1.0 + slack) return std::numeric_limits<double>::infinity();
   const Vec3 q = s.cross(e1);
   const double v = d.dot(q) * inv;
-  if (v < 0.0 || u + v > 1.0) return std::numeric_limits<double>::infinity();
+  if (v < -slack || u + v > 1.0 + slack) return std::numeric_limits<double>::infinity();
   if (out_u) *out_u = u;
   if (out_v) *out_v = v;
   return e2.dot(q) * inv;
@@ -195,9 +199,12 @@ std::vector<RayHit> TriangleBvh::ray_hits(const Vec3& origin, const Vec3& direct
         double u = 0.0, v = 0.0;
         const double hit =
             ray_triangle(origin, d, points_[static_cast<size_t>(t[0])], points_[static_cast<size_t>(t[1])],
-                         points_[static_cast<size_t>(t[2])], &u, &v);
-        if (hit >= 0.0 && hit <= max_distance && std::isfinite(hit))
-          hits.push_back({hit, ti, Vec3(1.0 - u - v, u, v)});
+                         points_[static_cast<size_t>(t[2])], &u, &v, kEdgeSlack);
+        if (!(hit >= 0.0 && hit <= max_distance && std::isfinite(hit))) continue;
+        // Back onto the triangle when the slack let the crossing fall just outside it.
+        Vec3 w(1.0 - u - v, u, v);
+        w = w.cwiseMax(0.0);
+        hits.push_back({hit, ti, w / w.sum()});
       }
     } else if (top + 2 <= 128) {
       stack[top++] = n.first;
