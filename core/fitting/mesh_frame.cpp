@@ -24,6 +24,7 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr int kSymmetrySamples = 1500;         // surface points mirrored per plane tried
 constexpr double kTrimmed = 0.6;               // the closest 60% of mirrored points fit the plane
 constexpr double kMaxSymmetryResidual = 0.01;  // median mirror distance: 17 mm on 1.7 m
+constexpr double kSymmetryTie = 0.001;         // planes this close in residual mirror equally well
 constexpr double kMinHeightToDepth = 2.0;      // a standing body is 4-6 times taller than deep
 constexpr double kSnapDeg = 10.0;              // long axis this close to a file axis: that axis
 constexpr double kLegGap = 0.005;              // no surface this close to the mirror plane: apart
@@ -345,10 +346,9 @@ Axes detect_axes(const Surface& s, const std::optional<Vec3>& given_up,
     const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(flat * s.covariance * flat);
     return eigen.eigenvectors().col(2);
   };
-  // A few rounds from each start. A shape with several mirror planes (a box, a cylinder) or a
-  // body nearly symmetric front to back as well: of the planes that mirror the surface onto
-  // itself, the body's is the one across which it is slenderest (height over depth, where the
-  // front-back plane sees height over span).
+  // A few rounds from each start; the plane that mirrors the surface best. Planes that mirror it
+  // equally well (a box, a cylinder: shapes with several mirror planes) are told apart by the
+  // long axis: a body's mirror plane is the one across which it is slenderest.
   std::vector<MirrorFit> fits;
   std::vector<double> slender;
   for (const Vec3& n : starts) {
@@ -359,10 +359,7 @@ Axes detect_axes(const Surface& s, const std::optional<Vec3>& given_up,
     fits.back().residual /= height;  // now a fraction of the height
   }
   const auto better = [&](size_t i, size_t j) {  // is fit i a better choice than fit j?
-    const bool mirrors_i = fits[i].residual <= kMaxSymmetryResidual,
-               mirrors_j = fits[j].residual <= kMaxSymmetryResidual;
-    if (mirrors_i && mirrors_j) return slender[i] > slender[j];
-    if (mirrors_i != mirrors_j) return mirrors_i;
+    if (std::abs(fits[i].residual - fits[j].residual) <= kSymmetryTie) return slender[i] > slender[j];
     return fits[i].residual < fits[j].residual;
   };
   size_t chosen = 0;

@@ -10,7 +10,8 @@
 //               (a mirror-symmetric shape has its mirror normal among them) and the file axes,
 //               the plane whose mirror image of the surface lies closest to the surface, refined
 //               by Gauss-Newton on the point-to-plane distances of the mirrored samples (the
-//               worst 40% left out, so that an asymmetric pose still finds the body's plane);
+//               worst 40% left out, so that an asymmetric pose still finds the body's plane;
+//               of planes that mirror it equally well, the one across which it is slenderest);
 //   vertical    the long axis within the mirror plane (a body is several times taller than
 //               deep), snapped to a file axis when within 10 degrees of one (files are made
 //               upright; a principal axis tilts by a degree or two with the feet forward);
@@ -49,7 +50,7 @@ struct MeshFrame {
                                     // mirror plane at x = 0, the surface's centroid at y = 0
   double height_mm = 0.0;
   // Arms from hanging straight down (degrees): about 45 in an A pose, 90 in a T pose; NaN when
-  // an arm is too close to the body to be told apart (arms at the sides).
+  // an arm is too close to the body to be told apart (at the sides, or straight ahead).
   double arm_elevation_deg = 0.0;                  // mean of both sides
   std::array<double, 2> side_arm_elevation_deg{};  // left, right
 

@@ -253,6 +253,21 @@ TEST(MeshFrame, AsymmetricPose) {
       f.side_arm_elevation_deg[1]);
 }
 
+TEST(MeshFrame, ArmsReachingForward) {
+  // Arms straight ahead: the body is then slenderer seen from the side than from the front, but
+  // only the left-right plane mirrors it. The arms are not told apart from the body sideways.
+  const auto& t = template_body();
+  const std::vector<Vec3> posed = test::posed_template([](PoseBuilder& p) {
+    for (Side s : {kLeft, kRight}) {
+      p.shoulder(s, 90.0, 90.0);
+      p.elbow(s, 0.0);
+    }
+  });
+  const MeshFrame f = detect_mesh_frame(posed, t.triangles);
+  EXPECT_LT(angle_deg(f.rotation, Eigen::Matrix3d::Identity()), 1e-6);
+  EXPECT_TRUE(std::isnan(f.arm_elevation_deg));
+}
+
 TEST(MeshFrame, UnitFlagIsCheckedAndNoUnitIsRefused) {
   const auto& t = template_body();
   MeshFrameOptions metres;
