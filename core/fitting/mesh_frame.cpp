@@ -399,7 +399,7 @@ Axes detect_axes(const Surface& s, const std::optional<Vec3>& given_up,
         100.0 * fig.symmetry_residual)));
   if (fig.height_to_depth < kMinHeightToDepth)
     throw std::invalid_argument(
-        not_a_body(text("it is not taller than deep (%.3g times; a standing body is over %.3g)",
+        not_a_body(text("its height is only %.2f times its depth (a standing body's is over %.3g)",
                         fig.height_to_depth, kMinHeightToDepth)));
   double bottom_split = split_fraction(s, up, height, best.plane),
          top_split = split_fraction(s, -up, height, best.plane);
