@@ -11,7 +11,7 @@
 #include <utility>
 #include <vector>
 
-#include "core/offline/mesh_edges.h"
+#include "core/deform/mesh_edges.h"
 #include "core/precondition.h"
 
 namespace skinstream {

@@ -12,7 +12,7 @@
 #include "core/absolute_orientation.h"
 #include "core/geometry/triangle_bvh.h"
 #include "core/geometry/triangle_mesh.h"
-#include "core/offline/mesh_edges.h"
+#include "core/deform/mesh_edges.h"
 #include "core/precondition.h"
 
 namespace skinstream {

@@ -1,4 +1,4 @@
-#include "core/offline/mesh_edges.h"
+#include "core/deform/mesh_edges.h"
 
 #include <gtest/gtest.h>
 

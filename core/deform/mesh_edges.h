@@ -1,7 +1,7 @@
 #pragma once
 // The edges of a triangle mesh, each once: (a, b) with a < b, sorted. Degenerate edges (a face
 // naming one vertex twice) are left out. Registration's smoothness term and the fold smoothing's
-// graph over the detailed mesh both run on these.
+// graph over the detailed mesh both run on these, and the strain of a body (surface_strain.h).
 #include <array>
 #include <span>
 #include <utility>
