@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
+#include "core/deform/body_plausibility.h"
 #include "protocol/file_error.h"
 #include "protocol/subscriber_model.h"
 
@@ -65,6 +66,9 @@ SubjectStream::SubjectStream(SubjectConfig config, const SubjectStreamOptions& o
       mailbox_(subject_.model.marker_count(), options.max_frame_wait),
       deform_cpus_(options.pipeline.deform_cpus),
       deform_threads_(options.pipeline.deform_threads) {
+  if (subject_.deformation)
+    if (const std::string problem = implausible_body(subject_.model, *subject_.deformation); !problem.empty())
+      throw FileError(config_.file, "refused: " + problem);
   if (!subject_.deformation)
     spdlog::warn("subject {}: {}: no deformation model (built without --mesh): publishing markers only (MeshInfo with V = 0)",
                  name_, config_.file);

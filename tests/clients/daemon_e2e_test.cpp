@@ -28,6 +28,7 @@
 #include "server/client/process_usage.h"
 #include "protocol/capture_file.h"
 #include "protocol/point_cache.h"
+#include "protocol/subject_file.h"
 #include "server/client/subscriber_client.h"
 #include "support/loopback_peer.h"
 #include "support/program_processes.h"
@@ -90,6 +91,37 @@ TEST_F(DaemonProgram, CorruptSubjectFailsNamingIt) {
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.output.find("corrupt.sks"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("CRC"), std::string::npos) << r.output;
+}
+
+// A real actor's body from the template: the daemon poses it by its fitted skeleton each frame
+// and parameter subscribers evaluate it; the same body with a few vertices torn away is refused
+// when the daemon loads it, in one line naming the file, before any renderer sees it.
+TEST_F(DaemonProgram, AFittedActorStreamsAndATornBodyIsRefused) {
+  const std::string own = std::to_string(getpid());
+  const std::string actor = test::scratch_path("actor_" + own + ".sks"), torn = test::scratch_path("torn_" + own + ".sks");
+  const ProgramRun built = run(std::string(SKINSTREAM_CLI) + " build-subject --capture " + test::source_path("replay_data/cmu/85_02.c3d") +
+                               " --mesh " + test::source_path("replay_data/makehuman/makehuman_hm08_body_only.obj") + " --out " + actor);
+  ASSERT_EQ(built.exit_code, 0) << built.output;
+  SubjectFile file = read_subject_file(actor);
+  ASSERT_TRUE(file.deformation.has_value());
+  ASSERT_FALSE(file.deformation->skeleton.empty());
+  for (int v : {100, 3000, 7000, 9000, 12000}) file.deformation->reference_vertices[v] += Vec3(0, 400, 300);
+  write_subject(file.model, &*file.deformation, torn);
+  const ProgramRun refused = run(std::string(SKINSTREAMD) + " --subject " + torn + " --replay " + take_ + " --http-port 0 --sub-port 0");
+  EXPECT_EQ(refused.exit_code, 1);
+  EXPECT_NE(refused.output.find(torn), std::string::npos) << refused.output;
+  EXPECT_NE(refused.output.find("the body is torn"), std::string::npos) << refused.output;
+
+  DaemonProcess daemon("--subject " + actor + " --replay " + take_ + " --loop");
+  const ProgramRun sub = run(std::string(SKINSTREAM_SUB) + " 127.0.0.1:" + std::to_string(daemon.sub_port) +
+                             " --encoding parameters --evaluate --json --frames 120");
+  EXPECT_EQ(daemon.stop(), 0) << daemon.log();
+  ASSERT_EQ(sub.exit_code, 0) << sub.output;
+  nlohmann::json summary;
+  std::istringstream lines(sub.output);
+  for (std::string line; std::getline(lines, line);)
+    if (line.find("\"summary\"") != std::string::npos) summary = nlohmann::json::parse(line)["summary"];
+  EXPECT_EQ(summary["frames"], 120) << sub.output.substr(sub.output.size() > 2000 ? sub.output.size() - 2000 : 0);
 }
 
 TEST_F(DaemonProgram, BadConfigJsonFailsNamingIt) {
