@@ -1,19 +1,121 @@
 #include "clients/skinstream/cmd_build_subject.h"
 
+#include <filesystem>
 #include <optional>
 #include <stdexcept>
 #include <nlohmann/json.hpp>
 
+#include "clients/skinstream/default_paths.h"
 #include "clients/skinstream/json_output.h"
 #include "clients/skinstream/part_file.h"
 #include "core/capture_filler.h"
+#include "core/fitting/marker_priors.h"
 #include "protocol/capture_file.h"
 #include "protocol/file_error.h"
+#include "protocol/makehuman.h"
+#include "protocol/marker_set_file.h"
 #include "protocol/marker_surface_obj.h"
 #include "protocol/mesh_file.h"
 #include "protocol/subject_file.h"
 
 namespace skinstream::cli {
+
+namespace {
+
+// The body template: a MakeHuman body OBJ with its skeleton, weights and base mesh beside it.
+bool is_body_template(const std::string& mesh_path) {
+  const std::filesystem::path dir = std::filesystem::path(mesh_path).parent_path();
+  const MakeHumanFiles files = MakeHumanFiles::in(dir.empty() ? "." : dir.string());
+  std::error_code ec;
+  return std::filesystem::equivalent(mesh_path, files.body_obj, ec) && std::filesystem::exists(files.skeleton, ec) &&
+         std::filesystem::exists(files.weights, ec) && std::filesystem::exists(files.base_obj, ec);
+}
+
+nlohmann::ordered_json vec_json(const Vec3& v) { return {v.x(), v.y(), v.z()}; }
+
+nlohmann::ordered_json surface_json(const SurfaceCheck& c) {
+  return {{"strained_fraction", c.strained_fraction}, {"max_strain", c.max_strain},
+          {"flipped_triangles", c.flipped_triangles}, {"self_intersecting_triangles", c.self_intersecting_triangles},
+          {"problem", c.problem}};
+}
+
+nlohmann::ordered_json actor_json(const ActorSubject& s, const MarkerPriors& priors, const TemplateSegments& segments) {
+  const ActorFit& fit = s.fit;
+  nlohmann::ordered_json markers = nlohmann::ordered_json::object();
+  for (int i = 0; i < s.model.marker_count(); ++i)
+    markers[s.model.marker_names[i]] = {{"named", priors.priors[i].place.triangle >= 0 || !priors.priors[i].allowed_triangles.empty()},
+                                        {"fit_rms_mm", fit.marker_rms_mm[i]},
+                                        {"height_mm", fit.attachments[i].offset_mm}};
+  nlohmann::ordered_json proportions = {{"overall", fit.proportions.overall}};
+  for (size_t g = 0; g < fit.proportions.length.size(); ++g)
+    proportions[segments.shape_groups[g]] = {{"length", fit.proportions.length[g]}, {"girth", fit.proportions.girth[g]}};
+  nlohmann::ordered_json lengths = nlohmann::ordered_json::object();
+  for (const SegmentLength& l : s.check.lengths) lengths[l.name] = {{"mm", l.mm}, {"human_range_mm", {l.low_mm, l.high_mm}}};
+  nlohmann::ordered_json parts = nlohmann::ordered_json::array();
+  for (const PartChoice& p : s.skeletal_report.parts)
+    parts.push_back({{"part", p.name}, {"members", p.members}, {"terms", p.why}, {"quadratic_ridge", p.quadratic_ridge},
+                     {"rbf_ridge", p.rbf_ridge}});
+  return {{"marker_set", priors.set_name},
+          {"marker_set_match", priors.description},
+          {"blind_start", fit.blind},
+          {"fit_frames", fit.frames.size()},
+          {"tracked_frames", fit.tracked_frames},
+          {"fit_rms_mm", fit.rms_mm},
+          {"height_mm", s.check.height_mm},
+          {"proportions", proportions},
+          {"segment_lengths", lengths},
+          {"parts_by", s.skeleton_parts ? "skeleton segments (sparse marker set)" : "mean shift on the marker surface (dense set)"},
+          {"parts", parts},
+          {"skeleton_rms_mm", s.skeletal_report.skeleton_rms_mm},
+          {"checks",
+           {{"plausible", s.check.ok()},
+            {"problem", s.check.problem},
+            {"registration", surface_json(s.check.registration)},
+            {"reference_pose", surface_json(s.check.pose)},
+            {"take_frames_checked", s.check.take_frames_checked},
+            {"worst_take_frame", s.check.worst_take_frame_index},
+            {"worst_take_frame_surface", surface_json(s.check.worst_take_frame)},
+            {"unplaced_markers", s.check.unplaced_markers}}},
+          {"markers", markers},
+          {"seconds", {{"fit", s.fit_seconds}, {"build", s.build_seconds}, {"checks", s.check_seconds}}}};
+}
+
+// The template path: the actor's body from the template, fitted to the markers, checked.
+int build_from_template(const BuildSubjectOptions& o, const Capture& training, std::FILE* out) {
+  // The template as a mesh first: it must be a body in the unit and axes the flags say.
+  const TriangleMesh raw = read_mesh(o.mesh_path);
+  detect_mesh_frame(raw.vertices, raw.faces, o.mesh_frame);
+  const Body body = load_makehuman(std::filesystem::path(o.mesh_path).parent_path().string());
+  const std::vector<MarkerSet> sets = read_marker_sets(o.marker_sets_dir.empty() ? default_marker_sets_dir() : o.marker_sets_dir);
+  std::vector<std::string> labels;
+  for (int c : training.labelled_points()) labels.push_back(training.labels[c]);
+  const std::vector<Triangle> triangles = triangulate(body.faces);
+  const MarkerPriors priors = marker_priors(labels, body, triangles, sets);
+  ActorSubjectOptions options = o.actor;
+  options.subject = o.subject;
+  const ActorSubject s = build_actor_subject(training, body, priors.priors, options);
+  if (!s.check.ok()) throw std::invalid_argument("refused, nothing written: " + s.check.problem);
+  write_subject(s.model, &s.deformation, o.out_path);
+  if (!o.surface_out.empty()) write_marker_surface_obj(o.surface_out, s.model.marker_names, s.model.reference_positions, s.model.triangles);
+  nlohmann::ordered_json report = {{"subject", o.out_path},
+                                   {"markers", s.subject_report.markers},
+                                   {"reference_frame", s.subject_report.reference_frame},
+                                   {"triangles", s.subject_report.triangles},
+                                   {"mean_pca_components", s.subject_report.mean_pca_components},
+                                   {"markers_never_complete", s.subject_report.markers_never_complete}};
+  report["mesh"] = {{"template", o.mesh_path},
+                    {"vertices", s.deformation.vertex_count()},
+                    {"faces", s.deformation.face_count()},
+                    {"registered", s.skeletal_report.registered},
+                    {"registration_skipped", s.registration_skipped},
+                    {"marker_skin_rms_after_mm", s.skeletal_report.registration.after.rms},
+                    {"landmark_rms_after_mm", s.skeletal_report.registration.landmark_rms_after_mm}};
+  report["actor"] = actor_json(s, priors, segment_template(body.skeleton));
+  std::fprintf(out, "%s\n", report.dump(2).c_str());
+  return 0;
+}
+
+}  // namespace
 
 int run_build_subject(const BuildSubjectOptions& o, std::FILE* out) {
   DeformationBuildOptions deformation = o.deformation;
@@ -21,6 +123,11 @@ int run_build_subject(const BuildSubjectOptions& o, std::FILE* out) {
   if (!o.parts_out.empty() && o.mesh_path.empty()) throw std::invalid_argument("--part-file-out needs --mesh (parts are made with the mesh)");
   if (!o.parts_path.empty() && o.mesh_path.empty()) throw std::invalid_argument("--part-file needs --mesh (parts are made with the mesh)");
   const Capture training = read_capture(o.capture_path);
+  if (!o.mesh_path.empty() && is_body_template(o.mesh_path)) {
+    if (!o.landmarks_path.empty() || !o.parts_path.empty() || !o.surface_in.empty() || !deformation.register_mesh)
+      throw std::invalid_argument("--landmarks, --part-file, --surface and --no-register are for a mesh in the capture's pose, not the body template");
+    return build_from_template(o, training, out);
+  }
   std::vector<std::array<int, 3>> triangles;
   if (!o.surface_in.empty()) triangles = read_marker_surface_obj(o.surface_in, static_cast<int>(training.labelled_points().size()));
   SubjectBuildReport report;
@@ -29,6 +136,16 @@ int run_build_subject(const BuildSubjectOptions& o, std::FILE* out) {
   DeformationBuildReport deformation_report;
   if (!o.mesh_path.empty()) {
     const TriangleMesh mesh = read_mesh(o.mesh_path);
+    // A mesh in the capture's own pose and axes is registered as it is; it must still be a body.
+    const MeshFrame frame = detect_mesh_frame(mesh.vertices, mesh.faces, o.mesh_frame);
+    const bool z_up = (frame.rotation.transpose() * Vec3::UnitZ() - Vec3::UnitZ()).norm() < 1e-6;
+    const SurfaceDistance near = marker_surface_distance(mesh.vertices, mesh.faces, model.reference_positions);
+    if (frame.unit_mm != 1.0 || !z_up || near.mean > 40.0)
+      throw std::invalid_argument("the mesh is not where the markers are in the reference frame (markers " +
+                                  std::to_string(static_cast<int>(near.mean)) + " mm from its surface on average, " +
+                                  std::to_string(frame.unit_mm) + " mm per unit" + (z_up ? "" : ", not Z up") +
+                                  "): give the body template (replay_data/makehuman/makehuman_hm08_body_only.obj), which is "
+                                  "fitted to the actor, or a mesh made in the capture's reference pose");
     // Segmentation and weights need every marker every frame: the take filled by this model.
     const Capture filled = fill_capture(model, training, CaptureFillOptions{});
     const int n = model.marker_count();
@@ -53,6 +170,11 @@ int run_build_subject(const BuildSubjectOptions& o, std::FILE* out) {
     deformation_model = build_deformation_model(model, positions, filled.frame_count, mesh.vertices, mesh.faces,
                                                 deformation, &deformation_report);
     warn_unused_parts(o.parts_path, deformation_report.unused_parts);
+    // The registration may move the skin onto the markers; it may not crumple it.
+    const SurfaceCheck check = check_surface(mesh.vertices, deformation_model->reference_vertices, mesh.faces,
+                                             SurfaceCheckLimits::at_rest());
+    if (!check.ok()) throw std::invalid_argument("refused, nothing written: the registration damaged the mesh: " + check.problem);
+    deformation_model->rest_vertices = mesh.vertices;
   }
   write_subject(model, deformation_model ? &*deformation_model : nullptr, o.out_path);
   if (!o.parts_out.empty()) write_part_file(o.parts_out, model, deformation_report.marker_part);

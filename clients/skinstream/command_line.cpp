@@ -27,6 +27,28 @@ void add_weight_rule_flags(CLI::App& command, WeightRuleFlags& flags) {
       ->check(CLI::NonNegativeNumber);
 }
 
+// A mesh's unit and axes when they should not be detected.
+void add_mesh_frame_flags(CLI::App& command, MeshFrameOptions& frame) {
+  auto axis = [](const std::string& name) {
+    const double sign = name[0] == '-' ? -1.0 : 1.0;
+    const char a = name.back();
+    return Vec3(a == 'x' ? sign : 0.0, a == 'y' ? sign : 0.0, a == 'z' ? sign : 0.0);
+  };
+  const std::vector<std::string> axes{"x", "y", "z", "-x", "-y", "-z"};
+  command
+      .add_option_function<std::string>(
+          "--mesh-unit",
+          [&frame](const std::string& unit) { frame.unit_mm = unit == "mm" ? 1.0 : unit == "cm" ? 10.0 : unit == "dm" ? 100.0 : 1000.0; },
+          "the mesh file's unit (default: detected from its height)")
+      ->check(CLI::IsMember({"mm", "cm", "dm", "m"}));
+  command.add_option_function<std::string>("--mesh-up", [&frame, axis](const std::string& a) { frame.up = axis(a); },
+                                           "the mesh file's up axis (default: detected)")
+      ->check(CLI::IsMember(axes));
+  command.add_option_function<std::string>("--mesh-forward", [&frame, axis](const std::string& a) { frame.forward = axis(a); },
+                                            "the axis the mesh's body faces (default: detected)")
+      ->check(CLI::IsMember(axes));
+}
+
 void add_info(CLI::App& app, InfoOptions& o) {
   auto* cmd = app.add_subcommand("info", "Print markers, frames, rate, missing fraction and gaps of a C3D/TRC file");
   cmd->add_option("FILE", o.path, "capture (.c3d or .trc)")->required();
@@ -49,7 +71,20 @@ void add_build_subject(CLI::App& app, BuildSubjectOptions& o) {
   cmd->add_option("--variance", o.subject.pca.variance_kept, "PCA variance kept")->check(CLI::Range(0.5, 1.0))->capture_default_str();
   cmd->add_option("--alpha1", o.subject.parameters.alpha1, "relabel start tolerance (eq. 3)")->capture_default_str();
   cmd->add_option("--alpha2", o.subject.parameters.alpha2, "relabel keep tolerance")->capture_default_str();
-  cmd->add_option("--mesh", o.mesh_path, "detailed mesh (.obj/.ply, mm) in the reference pose: adds the deformation model");
+  cmd->add_option("--mesh", o.mesh_path,
+                  "the body: the template (a MakeHuman body OBJ with its skeleton and weights beside it, fitted to the actor), "
+                  "or a mesh (.obj/.ply) already in the capture's reference pose and axes; adds the deformation model");
+  cmd->add_option("--marker-sets", o.marker_sets_dir, "folder of marker-set definitions (default: the bundled config/marker_sets)");
+  cmd->add_option("--marker-height", o.actor.fit.marker_offset_mm, "height of a marker's centre above the skin (mm)")
+      ->capture_default_str()->check(CLI::Range(0.0, 100.0));
+  cmd->add_option_function<std::string>(
+         "--parts-by",
+         [&o](const std::string& rule) {
+           o.actor.parts = rule == "skeleton" ? PartChoiceRule::Skeleton : rule == "markers" ? PartChoiceRule::Markers : PartChoiceRule::Automatic;
+         },
+         "the template's parts: skeleton (its segments, for 37-120 markers), markers (mean shift, a dense set), auto")
+      ->check(CLI::IsMember({"auto", "skeleton", "markers"}))->default_str("auto");
+  add_mesh_frame_flags(*cmd, o.mesh_frame);
   cmd->add_option("--landmarks", o.landmarks_path, "JSON {\"marker\": vertex index} for registration (default: guessed)");
   cmd->add_flag_callback("--no-register", [&o] { o.deformation.register_mesh = false; },
                          "the mesh is already registered to the marker surface");
@@ -198,6 +233,24 @@ void add_deform(CLI::App& app, DeformOptions& o) {
   cmd->add_flag("--no-pc2", o.no_pc2, "do not write the point cache");
 }
 
+void add_eval_actor(CLI::App& app, EvalActorOptions& o) {
+  auto* cmd = app.add_subcommand(
+      "eval-actor", "Measure a real actor's subject on markers it was not given: held-out markers, folds, methods side by side");
+  cmd->add_option("--capture", o.capture_path, "a real take with named markers (.c3d/.trc)")->required();
+  cmd->add_option("--mesh", o.mesh_path, "the template's body OBJ, its skeleton and weights beside it (default: the bundled body)");
+  cmd->add_option("--marker-sets", o.marker_sets_dir, "folder of marker-set definitions (default: the bundled ones)");
+  cmd->add_option("--withhold", o.withhold, "markers withheld per fold")->capture_default_str()->check(CLI::PositiveNumber);
+  cmd->add_option("--split", o.split, "train on this fraction of the take, test on the rest")
+      ->check(CLI::Range(0.1, 0.9))->capture_default_str();
+  cmd->add_option("--stride", o.stride, "test every Nth frame")->capture_default_str()->check(CLI::PositiveNumber);
+  cmd->add_option("--folds", o.max_folds, "at most this many folds (0: every marker withheld once)")->capture_default_str();
+  cmd->add_option("--marker-height", o.build.fit.marker_offset_mm, "height of a marker's centre above the skin (mm)")
+      ->capture_default_str()->check(CLI::Range(0.0, 100.0));
+  cmd->add_option("--seed", o.seed, "seed of the folds' marker order")->capture_default_str();
+  cmd->add_option("--render", o.render_dir, "write PNGs of the first fold (reference pose, a few test frames) to this folder");
+  cmd->add_flag("--json", o.json, "JSON only");
+}
+
 }  // namespace
 
 std::optional<int> parse_command_line(int argc, const char* const* argv, CommandLine& out) {
@@ -211,6 +264,7 @@ std::optional<int> parse_command_line(int argc, const char* const* argv, Command
   add_synth(app, out.synth);
   add_eval_deform(app, out.eval_deform);
   add_deform(app, out.deform);
+  add_eval_actor(app, out.eval_actor);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

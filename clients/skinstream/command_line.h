@@ -7,6 +7,7 @@
 #include "clients/skinstream/cmd_build_subject.h"
 #include "clients/skinstream/cmd_convert.h"
 #include "clients/skinstream/cmd_deform.h"
+#include "clients/skinstream/cmd_eval_actor.h"
 #include "clients/skinstream/cmd_eval_deform.h"
 #include "clients/skinstream/cmd_eval_fill.h"
 #include "clients/skinstream/cmd_fill.h"
@@ -26,6 +27,7 @@ struct CommandLine {
   SynthOptions synth;
   EvalDeformOptions eval_deform;
   DeformOptions deform;
+  EvalActorOptions eval_actor;
 };
 
 // Parses argv into `out`. Returns the exit code to leave with instead (after --help, or a usage

@@ -26,3 +26,18 @@ std::string default_body_dir() {
 }
 
 }  // namespace skinstream::cli
+
+namespace skinstream::cli {
+
+std::string default_marker_sets_dir() {
+  namespace fs = std::filesystem;
+  if (const char* d = std::getenv("SKINSTREAM_MARKER_SETS_DIR")) return d;
+  std::error_code ec;
+  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+  if (!ec)
+    for (fs::path p = exe.parent_path(); !p.empty() && p != p.root_path(); p = p.parent_path())
+      if (fs::is_directory(p / "config" / "marker_sets", ec)) return (p / "config" / "marker_sets").string();
+  return (fs::current_path(ec) / "config" / "marker_sets").string();
+}
+
+}  // namespace skinstream::cli

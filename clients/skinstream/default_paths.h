@@ -9,4 +9,9 @@ namespace skinstream::cli {
 // ancestor of the executable, else either from the working directory.
 std::string default_body_dir();
 
+// The shipped marker-set definitions: $SKINSTREAM_MARKER_SETS_DIR, else config/marker_sets
+// beside an ancestor of the executable (the source tree of a build), else from the working
+// directory.
+std::string default_marker_sets_dir();
+
 }  // namespace skinstream::cli

@@ -19,6 +19,7 @@ int run_command(const skinstream::cli::CommandLine& c, std::FILE* out) {
   if (c.command == "synth") return run_synth(c.synth, out);
   if (c.command == "eval-deform") return run_eval_deform(c.eval_deform, out);
   if (c.command == "deform") return run_deform(c.deform, out);
+  if (c.command == "eval-actor") return run_eval_actor(c.eval_actor, out);
   throw std::logic_error("no command " + c.command);
 }
 
