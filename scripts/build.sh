@@ -6,11 +6,12 @@ cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
 # A compiler cache (installed by install-deps.sh): rebuilds, other checkouts of the same tree and
 # the fuzz and sanitizer builds reuse what was compiled. Paths below the checkout are hashed
-# relative to it, so two clones share entries.
+# relative to it and the build folder left out of the hash (-g would put it in), so two clones
+# share entries.
 launcher=()
 if command -v ccache >/dev/null 2>&1; then
   launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
-  export CCACHE_BASEDIR="$PWD"
+  export CCACHE_BASEDIR="$PWD" CCACHE_NOHASHDIR=1
 fi
 cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo "${launcher[@]}" "$@"
 cmake --build build -j "$(nproc)"
