@@ -8,7 +8,7 @@
 #include <cstdio>
 #include <random>
 
-#include "core/offline/mesh_edges.h"
+#include "core/deform/mesh_edges.h"
 #include "tests/core/fitting/fitting_test_support.h"
 
 namespace skinstream {
