@@ -18,7 +18,7 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
 
 }  // namespace
 
-ActorSubject build_actor_subject(const Capture& training, const Body& body, std::span<const MarkerPrior> priors,
+ActorSubject build_actor_subject(const Capture& training, const FitBody& body, std::span<const MarkerPrior> priors,
                                  const ActorSubjectOptions& options) {
   const std::vector<int> channels = training.labelled_points();
   const int markers = static_cast<int>(channels.size());
@@ -38,10 +38,8 @@ ActorSubject build_actor_subject(const Capture& training, const Body& body, std:
   std::vector<Vec3> frames(static_cast<size_t>(training.frame_count) * markers);
   for (int f = 0; f < training.frame_count; ++f)
     for (int i = 0; i < markers; ++i) frames[static_cast<size_t>(f) * markers + i] = training.at(f, channels[i]);
-  const TemplateSegments segments = segment_template(body.skeleton);
-  const std::vector<Triangle> triangles = triangulate(body.faces);
-  out.fit = fit_actor(body, segments, triangles, frames, training.frame_count, markers, subject_options.reference_frame,
-                      priors, options.fit);
+  const std::vector<Triangle>& triangles = body.triangles;
+  out.fit = fit_actor(body, frames, training.frame_count, markers, subject_options.reference_frame, priors, options.fit);
   out.fit_seconds = seconds_since(start);
 
   const auto build_start = std::chrono::steady_clock::now();
@@ -95,7 +93,7 @@ ActorSubject build_actor_subject(const Capture& training, const Body& body, std:
     deformed.push_back(std::move(mesh));
     deformed_frames.push_back(f);
   }
-  out.check = check_subject(out.fit, segments, out.deformation, out.model.marker_names, deformed, deformed_frames, options.limits);
+  out.check = check_subject(out.fit, body, out.deformation, out.model.marker_names, deformed, deformed_frames, options.limits);
   out.check_seconds = seconds_since(check_start);
   return out;
 }

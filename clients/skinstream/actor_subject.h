@@ -45,12 +45,12 @@ struct ActorSubject {
   double fit_seconds = 0.0, build_seconds = 0.0, check_seconds = 0.0;
 };
 
-// training: the take (labelled channels are the markers); body: the template (mm, Z up, facing
-// +Y, with skeleton and weights); priors: one per labelled marker (core/fitting/marker_priors.h).
+// training: the take (labelled channels are the markers); body: the body to fit (the template
+// with its bones, fit_body_of(), or a scan made a skinned body, scan_body.h); priors: one per labelled marker (core/fitting/marker_priors.h).
 // Throws std::invalid_argument with one line when the take cannot make a subject (no complete
 // frame, too few markers); a subject whose checks fail is returned with check.problem set (the
 // caller refuses it).
-ActorSubject build_actor_subject(const Capture& training, const Body& body, std::span<const MarkerPrior> priors,
+ActorSubject build_actor_subject(const Capture& training, const FitBody& body, std::span<const MarkerPrior> priors,
                                  const ActorSubjectOptions& options = {});
 
 }  // namespace skinstream::cli

@@ -20,40 +20,39 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 // Everything the fit changes, and what follows from it.
 class Fit {
  public:
-  Fit(const Body& body, const TemplateSegments& segments, std::span<const Triangle> triangles,
-      std::span<const Vec3> frames, int frame_count, int marker_count, std::span<const MarkerPrior> priors,
-      const ActorFitOptions& options)
+  Fit(const FitBody& body, std::span<const Vec3> frames, int frame_count, int marker_count,
+      std::span<const MarkerPrior> priors, const ActorFitOptions& options)
       : body_(body),
-        segments_(segments),
-        triangles_(triangles),
+        triangles_(body.triangles),
         frames_(frames),
         frame_count_(frame_count),
         marker_count_(marker_count),
         priors_(priors),
         options_(options),
-        vertex_weights_(segment_weights(body.weights, segments)),
-        proportions_(BodyProportions::neutral(segments)),
+        vertex_weights_(body.weights),
         attachments_(static_cast<size_t>(marker_count), MarkerAttachment{-1}) {
     solver_options_.robust_mm = options.robust_mm;
     solver_options_.prior = options.pose_prior;
     solver_options_.twist_prior = options.twist_prior;
-    for (const TemplateSegment& s : segments.segments) {
-      const Bone& bone = body.skeleton.bone(s.first_bone);
-      // Limbs twist about their bone; the trunk's segments have no twist of their own to hold.
-      const bool limb = s.name.find('.') != std::string::npos && s.name.rfind("clavicle", 0) != 0;
-      solver_options_.twist_axes.push_back(limb && bone.length() > 0.0 ? bone.axis() : Vec3::Zero());
-    }
+    solver_options_.twist_axes = body.twist_axes;
+    if (proportionable()) proportions_ = BodyProportions::neutral(*body.segments);
     set_proportions(proportions_);
   }
 
-  int segment_count() const { return segments_.segment_count(); }
+  bool proportionable() const { return body_.bones != nullptr && body_.segments != nullptr; }
+  int segment_count() const { return body_.segment_count(); }
   const Vec3* frame(int f) const { return frames_.data() + static_cast<size_t>(f) * marker_count_; }
 
   void set_proportions(const BodyProportions& p) {
     proportions_ = p;
-    maps_ = proportion_bones(body_.skeleton, segments_, p);
-    rest_ = proportioned_vertices(body_.rest, body_.weights, maps_);
-    pivots_ = proportioned_pivots(body_.skeleton, segments_, maps_);
+    if (proportionable()) {
+      maps_ = proportion_bones(body_.bones->skeleton, *body_.segments, p);
+      rest_ = proportioned_vertices(body_.bones->rest, body_.bones->weights, maps_);
+      pivots_ = proportioned_pivots(body_.bones->skeleton, *body_.segments, maps_);
+    } else {
+      rest_ = body_.rest;
+      pivots_ = body_.rest_pivots;
+    }
     rest_bvh_valid_ = false;
   }
 
@@ -64,8 +63,7 @@ class Fit {
     const std::vector<Vec3>& vertices = rest ? *rest : rest_;
     const std::vector<Vec3>& joints = pivots ? *pivots : pivots_;
     SegmentSkeleton s;
-    for (int k = 0; k < segment_count(); ++k)
-      s.segments.push_back({segments_.segments[k].name, segments_.segments[k].parent, joints[k]});
+    for (int k = 0; k < segment_count(); ++k) s.segments.push_back({body_.segment_names[k], body_.segment_parents[k], joints[k]});
     rest_markers.resize(static_cast<size_t>(marker_count_));
     for (int i = 0; i < marker_count_; ++i) {
       const MarkerAttachment& a = attachments_[i];
@@ -132,13 +130,14 @@ class Fit {
       std::vector<SegmentWeight> w;
       attachment_segment_weights(place, triangles_, vertex_weights_, w);
       const auto dominant = std::max_element(w.begin(), w.end(), [](auto& a, auto& b) { return a.weight < b.weight; });
-      const std::string& name = segments_.segments[dominant->segment].name;
+      const std::string& name = body_.segment_names[dominant->segment];
       if (name == "pelvis" || name == "abdomen" || name == "chest" || name == "head") {
         trunk[i] = points[i];
         ++trunk_named;
       }
     }
     *blind = named < 3;
+    if (options_.start) return {*options_.start};
     const std::vector<Vec3> seen(measured, measured + marker_count_);
     if (!*blind) return {align_named(trunk_named >= 4 ? trunk : points, seen)};
     std::vector<Similarity> out;
@@ -151,8 +150,8 @@ class Fit {
 
   // Sets the overall scale from a guess and returns the pelvis pose that places the template.
   SegmentPose pose_from(const Similarity& similarity) {
-    BodyProportions p = BodyProportions::neutral(segments_);
-    p.overall = std::clamp(similarity.scale, 0.5, 2.0);
+    BodyProportions p = proportionable() ? BodyProportions::neutral(*body_.segments) : BodyProportions{};
+    p.overall = proportionable() ? std::clamp(similarity.scale, 0.5, 2.0) : 1.0;  // a scan keeps its size
     set_proportions(p);
     SegmentPose pose{std::vector<Eigen::Matrix3d>(static_cast<size_t>(segment_count()), Eigen::Matrix3d::Identity()), Vec3::Zero()};
     const Eigen::Matrix3d rotation = similarity.rigid.rotation;
@@ -275,7 +274,8 @@ class Fit {
 
   // The proportions: damped Gauss-Newton in log scales over the fit frames, poses held.
   void update_proportions(const std::vector<int>& fit_frames, const std::vector<SegmentPose>& poses) {
-    const int groups = static_cast<int>(segments_.shape_groups.size());
+    if (!proportionable()) return;
+    const int groups = static_cast<int>(body_.segments->shape_groups.size());
     const int unknowns = 1 + 2 * groups;
     auto to_vector = [&](const BodyProportions& p) {
       Eigen::VectorXd x(unknowns);
@@ -287,7 +287,7 @@ class Fit {
       return x;
     };
     auto from_vector = [&](const Eigen::VectorXd& x) {
-      BodyProportions p = BodyProportions::neutral(segments_);
+      BodyProportions p = BodyProportions::neutral(*body_.segments);
       p.overall = std::exp(x[0]);
       for (int g = 0; g < groups; ++g) {
         p.length[g] = std::exp(x[1 + g]);
@@ -345,7 +345,7 @@ class Fit {
   // each group's length within 0.75-1.35 of the template's, its girth within 0.8-1.25 of its
   // length (the template is an average adult; the overall scale is free within 0.5-2).
   Eigen::VectorXd within_human_range(Eigen::VectorXd x) const {
-    const int groups = static_cast<int>(segments_.shape_groups.size());
+    const int groups = static_cast<int>(body_.segments->shape_groups.size());
     x[0] = std::clamp(x[0], std::log(0.5), std::log(2.0));
     for (int g = 0; g < groups; ++g) {
       x[1 + g] = std::clamp(x[1 + g], std::log(0.75), std::log(1.35));
@@ -358,13 +358,14 @@ class Fit {
   Eigen::VectorXd residuals(const Eigen::VectorXd& x, const FromVector& from_vector, const std::vector<int>& fit_frames,
                             const std::vector<SegmentPose>& poses, const std::vector<double>* robust) const {
     const BodyProportions p = from_vector(x);
-    const std::vector<BoneMap> maps = proportion_bones(body_.skeleton, segments_, p);
-    const std::vector<Vec3> pivots = proportioned_pivots(body_.skeleton, segments_, maps);
+    const std::vector<BoneMap> maps = proportion_bones(body_.bones->skeleton, *body_.segments, p);
+    const std::vector<Vec3> pivots = proportioned_pivots(body_.bones->skeleton, *body_.segments, maps);
     // Only the vertices under the markers need proportioning.
     std::vector<Vec3> rest = rest_;
     for (const MarkerAttachment& a : attachments_)
       if (a.triangle >= 0)
-        for (int v : triangles_[static_cast<size_t>(a.triangle)]) rest[v] = proportioned_vertex(body_.rest[v], body_.weights, v, maps);
+        for (int v : triangles_[static_cast<size_t>(a.triangle)])
+          rest[v] = proportioned_vertex(body_.bones->rest[v], body_.bones->weights, v, maps);
     std::vector<Vec3> rest_markers;
     const SegmentSkeleton s = skeleton(rest_markers, &rest, &pivots);
     SkeletonSolver solver(s, rest_markers);
@@ -380,14 +381,13 @@ class Fit {
         out.insert(out.end(), {d.x(), d.y(), d.z()});
       }
     }
-    const int groups = static_cast<int>(segments_.shape_groups.size());
+    const int groups = static_cast<int>(body_.segments->shape_groups.size());
     for (int g = 0; g < groups; ++g) out.push_back(std::sqrt(options_.length_prior) * x[1 + g]);
     for (int g = 0; g < groups; ++g) out.push_back(std::sqrt(options_.girth_prior) * (x[1 + groups + g] - x[1 + g]));
     return Eigen::Map<const Eigen::VectorXd>(out.data(), static_cast<long>(out.size()));
   }
 
-  const Body& body_;
-  const TemplateSegments& segments_;
+  const FitBody& body_;
   std::span<const Triangle> triangles_;
   std::span<const Vec3> frames_;
   int frame_count_;
@@ -433,17 +433,44 @@ std::vector<Vec3> pose_vertices(const std::vector<Vec3>& rest_vertices, const Ve
   return out;
 }
 
-ActorFit fit_actor(const Body& body, const TemplateSegments& segments, std::span<const Triangle> triangles,
-                   std::span<const Vec3> frames, int frame_count, int marker_count, int reference_frame,
-                   std::span<const MarkerPrior> priors, const ActorFitOptions& options) {
+int FitBody::find(const std::string& name) const {
+  for (int s = 0; s < segment_count(); ++s)
+    if (segment_names[s] == name) return s;
+  return -1;
+}
+
+FitBody fit_body_of(const Body& body, const TemplateSegments& segments) {
+  FitBody out;
+  out.rest = body.rest;
+  out.triangles = triangulate(body.faces);
+  out.weights = segment_weights(body.weights, segments);
+  for (const TemplateSegment& s : segments.segments) {
+    out.segment_names.push_back(s.name);
+    out.segment_parents.push_back(s.parent);
+    const Bone& bone = body.skeleton.bone(s.first_bone);
+    out.rest_pivots.push_back(bone.head);
+    // Limbs twist about their bone; the trunk's segments have no twist of their own to hold.
+    const bool limb = s.name.find('.') != std::string::npos && s.name.rfind("clavicle", 0) != 0;
+    out.twist_axes.push_back(limb && bone.length() > 0.0 ? bone.axis() : Vec3::Zero());
+  }
+  out.bones = &body;
+  out.segments = &segments;
+  return out;
+}
+
+ActorFit fit_actor(const FitBody& body, std::span<const Vec3> frames, int frame_count, int marker_count,
+                   int reference_frame, std::span<const MarkerPrior> priors, const ActorFitOptions& options) {
   if (frame_count <= 0 || marker_count <= 0 || frames.size() != static_cast<size_t>(frame_count) * marker_count)
     throw std::invalid_argument("fit_actor: " + std::to_string(frames.size()) + " positions for " +
                                 std::to_string(frame_count) + " frames of " + std::to_string(marker_count) + " markers");
   if (reference_frame < 0 || reference_frame >= frame_count) throw std::invalid_argument("fit_actor: no such reference frame");
   if (static_cast<int>(priors.size()) != marker_count) throw std::invalid_argument("fit_actor: one marker prior per marker is needed");
-  if (body.weights.vertex_count() != body.vertex_count()) throw std::invalid_argument("fit_actor: the template has no skin weights");
+  if (body.weights.vertex_count() != static_cast<int>(body.rest.size()) || body.segment_count() == 0 ||
+      body.rest_pivots.size() != body.segment_names.size() || body.segment_parents.size() != body.segment_names.size() ||
+      body.twist_axes.size() != body.segment_names.size())
+    throw std::invalid_argument("fit_actor: the body has no skin weights or an inconsistent skeleton");
 
-  Fit fit(body, segments, triangles, frames, frame_count, marker_count, priors, options);
+  Fit fit(body, frames, frame_count, marker_count, priors, options);
   ActorFit out;
 
   // 1. The reference frame: first guesses, each posed with the markers placed where the posed
@@ -526,7 +553,7 @@ ActorFit fit_actor(const Body& body, const TemplateSegments& segments, std::span
   out.reference_vertices = pose_vertices(out.rest_vertices, out.vertex_weights, at_reference);
   std::vector<Vec3> rest_markers;
   out.reference_skeleton = fit.skeleton(rest_markers);
-  for (int s = 0; s < segments.segment_count(); ++s)
+  for (int s = 0; s < body.segment_count(); ++s)
     out.reference_skeleton.segments[s].pivot = at_reference[s].apply(out.rest_pivots[s]);
   std::vector<double> sum(static_cast<size_t>(marker_count), 0.0);
   std::vector<int> count(static_cast<size_t>(marker_count), 0);

@@ -20,6 +20,7 @@
 // mislabelled samples cannot bend the body; a marker the fit cannot place is reported.
 
 #include <Eigen/Core>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -28,10 +29,34 @@
 #include "core/body/body.h"
 #include "core/deform/segment_skeleton.h"
 #include "core/fitting/body_proportions.h"
+#include "core/fitting/initial_alignment.h"
 #include "core/fitting/marker_attachment.h"
 #include "core/fitting/template_segments.h"
 
 namespace skinstream {
+
+// The body the fit poses: a mesh skinned by segments, and, for the template, the bones that
+// proportion it. A scan made a skinned body through the template (scan_body.h) is the actor's
+// own shape: it is posed and its markers placed, not proportioned.
+struct FitBody {
+  std::vector<Vec3> rest;  // mm, Z up, facing +Y
+  std::vector<Triangle> triangles;
+  VertexSegmentWeights weights;  // per vertex, over the segments
+  std::vector<std::string> segment_names;
+  std::vector<int> segment_parents;  // parents before children, the pelvis first
+  std::vector<Vec3> rest_pivots;
+  std::vector<Vec3> twist_axes;  // per segment: a limb's bone axis at rest, zero for the trunk's
+  // The template's bones and segments, when the fit may proportion it (null: it may not). They
+  // must outlive the FitBody.
+  const Body* bones = nullptr;
+  const TemplateSegments* segments = nullptr;
+
+  int segment_count() const { return static_cast<int>(segment_names.size()); }
+  int find(const std::string& name) const;  // -1 when absent
+};
+
+// The template as a fit body (proportions fitted): keeps pointers to both arguments.
+FitBody fit_body_of(const Body& body, const TemplateSegments& segments);
 
 // What the marker set says of one marker.
 struct MarkerPrior {
@@ -64,6 +89,9 @@ struct ActorFitOptions {
   double length_prior = 2e4;
   double girth_prior = 5e4;
   int track_stride = 1;  // track every n-th frame of the take (poses between are not needed)
+  // Where the body stands in the reference frame, when known (a scan already brought upright and
+  // facing +Y: its centre and height); otherwise from the named markers or the blind search.
+  std::optional<Similarity> start;
 };
 
 // A pose of the template's segments (local rotations relative to the parent, rest-pose axes,
@@ -74,7 +102,7 @@ struct SegmentPose {
 };
 
 struct ActorFit {
-  BodyProportions proportions;
+  BodyProportions proportions;                // empty lengths and girths when not proportioned
   std::vector<MarkerAttachment> attachments;  // one per marker
   std::vector<Vec3> rest_vertices;            // the template proportioned, in its rest pose
   std::vector<Vec3> rest_pivots;              // per segment
@@ -91,13 +119,11 @@ struct ActorFit {
   bool blind = false;                 // no marker had a defined place: the blind alignment was used
 };
 
-// body: the template (mm, Z up, facing +Y, rest pose); triangles: its surface (the triangulated
-// faces); frames: frame_count x marker_count positions (mm, frame-major, non-finite = missing);
-// priors: one per marker. Throws std::invalid_argument (one line) when the reference frame has
-// too few markers to place the body.
-ActorFit fit_actor(const Body& body, const TemplateSegments& segments, std::span<const Triangle> triangles,
-                   std::span<const Vec3> frames, int frame_count, int marker_count, int reference_frame,
-                   std::span<const MarkerPrior> priors, const ActorFitOptions& options = {});
+// body: the body to pose (fit_body_of() for the template); frames: frame_count x marker_count
+// positions (mm, frame-major, non-finite = missing); priors: one per marker. Throws
+// std::invalid_argument (one line) when the reference frame has too few markers to place the body.
+ActorFit fit_actor(const FitBody& body, std::span<const Vec3> frames, int frame_count, int marker_count,
+                   int reference_frame, std::span<const MarkerPrior> priors, const ActorFitOptions& options = {});
 
 // The template's vertices (rest_vertices, segment weights) posed by a pose of the segments.
 std::vector<Vec3> pose_vertices(const std::vector<Vec3>& rest_vertices, const VertexSegmentWeights& weights,

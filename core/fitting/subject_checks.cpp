@@ -34,7 +34,7 @@ std::string fixed(double v, int digits = 1) {
 
 }  // namespace
 
-SubjectCheck check_subject(const ActorFit& fit, const TemplateSegments& segments, const DeformationModel& model,
+SubjectCheck check_subject(const ActorFit& fit, const FitBody& body, const DeformationModel& model,
                            std::span<const std::string> marker_names,
                            std::span<const std::vector<Vec3>> deformed_take, std::span<const int> take_frames,
                            const SubjectCheckLimits& limits) {
@@ -75,7 +75,7 @@ SubjectCheck check_subject(const ActorFit& fit, const TemplateSegments& segments
   }
   out.height_mm = high - low;
   for (const HumanFraction& f : kFractions) {
-    const int a = segments.find(f.from), b = segments.find(f.to);
+    const int a = body.find(f.from), b = body.find(f.to);
     if (a < 0 || b < 0) continue;
     const double expected = f.fraction * out.height_mm;
     out.lengths.push_back({f.name, (fit.rest_pivots[a] - fit.rest_pivots[b]).norm(), expected * (1.0 - limits.length_tolerance),

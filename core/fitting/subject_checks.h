@@ -19,7 +19,6 @@
 #include "core/deform/deformation_model.h"
 #include "core/fitting/actor_fit.h"
 #include "core/fitting/surface_checks.h"
-#include "core/fitting/template_segments.h"
 
 namespace skinstream {
 
@@ -49,7 +48,9 @@ struct SubjectCheckLimits {
   static SurfaceCheckLimits posed_limits() {
     SurfaceCheckLimits limits;
     limits.max_flipped_fraction = 0.003;
-    limits.max_edge_stretch = 10.0;  // the take's limit (25) allows for an arm raised overhead
+    // A scan in a T pose brought down to an A-like reference pose stretches its armpits' edges
+    // to 13 typical edges; a shard pulled half a metre off the template, over 30.
+    limits.max_edge_stretch = 25.0;
     return limits;
   }
   static SurfaceCheckLimits take_limits() {
@@ -85,7 +86,7 @@ struct SubjectCheck {
 // rest vertices, faces); marker_names: the subject's, for the report; deformed_take: meshes of
 // the training take deformed by the model (any number, each model.vertex_count() positions), the
 // caller's choice of frames (take_frames: their indices, for the report).
-SubjectCheck check_subject(const ActorFit& fit, const TemplateSegments& segments, const DeformationModel& model,
+SubjectCheck check_subject(const ActorFit& fit, const FitBody& body, const DeformationModel& model,
                            std::span<const std::string> marker_names,
                            std::span<const std::vector<Vec3>> deformed_take, std::span<const int> take_frames,
                            const SubjectCheckLimits& limits = {});

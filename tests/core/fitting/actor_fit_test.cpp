@@ -18,12 +18,12 @@ TEST(ActorFit, RefusesInputOfTheWrongShape) {
   const Actor a = make_actor(1, 30);
   const int markers = static_cast<int>(a.attachments.size());
   std::vector<MarkerPrior> priors(markers);
-  EXPECT_THROW(fit_actor(a.body, a.segments, a.triangles, a.frames, a.frame_count + 1, markers, 0, priors),
+  EXPECT_THROW(fit_actor(test::fit_body(a), a.frames, a.frame_count + 1, markers, 0, priors),
                std::invalid_argument);
-  EXPECT_THROW(fit_actor(a.body, a.segments, a.triangles, a.frames, a.frame_count, markers, a.frame_count, priors),
+  EXPECT_THROW(fit_actor(test::fit_body(a), a.frames, a.frame_count, markers, a.frame_count, priors),
                std::invalid_argument);
   priors.pop_back();
-  EXPECT_THROW(fit_actor(a.body, a.segments, a.triangles, a.frames, a.frame_count, markers, 0, priors),
+  EXPECT_THROW(fit_actor(test::fit_body(a), a.frames, a.frame_count, markers, 0, priors),
                std::invalid_argument);
 }
 
@@ -32,7 +32,7 @@ TEST(ActorFit, RecoversProportionsAndPlacesFromNamedMarkers) {
   std::mt19937 random(2);
   const std::vector<MarkerPrior> priors = guessed_priors(a, random);
   const int markers = static_cast<int>(a.attachments.size());
-  const ActorFit fit = fit_actor(a.body, a.segments, a.triangles, a.frames, a.frame_count, markers, 0, priors);
+  const ActorFit fit = fit_actor(test::fit_body(a), a.frames, a.frame_count, markers, 0, priors);
   EXPECT_FALSE(fit.blind);
   EXPECT_LT(fit.rms_mm, 3.0);
   EXPECT_NEAR(fit.proportions.overall, a.proportions.overall, 0.05);
@@ -55,7 +55,7 @@ TEST(ActorFit, PlacesUnnamedMarkersFromABlindStart) {
   const Actor a = make_actor(3, 240);
   const int markers = static_cast<int>(a.attachments.size());
   const std::vector<MarkerPrior> priors(markers);
-  const ActorFit fit = fit_actor(a.body, a.segments, a.triangles, a.frames, a.frame_count, markers, 0, priors);
+  const ActorFit fit = fit_actor(test::fit_body(a), a.frames, a.frame_count, markers, 0, priors);
   EXPECT_TRUE(fit.blind);
   const std::vector<BoneMap> maps = proportion_bones(a.body.skeleton, a.segments, a.proportions);
   const std::vector<Vec3> true_rest = proportioned_vertices(a.body.rest, a.body.weights, maps);

@@ -29,7 +29,7 @@ Built build(uint32_t seed, int frames) {
   take.positions = b.actor.frames;
   std::mt19937 random(seed);
   const std::vector<MarkerPrior> priors = test::guessed_priors(b.actor, random);
-  b.fit = fit_actor(b.actor.body, b.actor.segments, b.actor.triangles, b.actor.frames, frames, markers, 0, priors);
+  b.fit = fit_actor(test::fit_body(b.actor), b.actor.frames, frames, markers, 0, priors);
   SubjectBuildOptions options;
   options.reference_frame = 0;
   b.subject = build_subject(take, options);

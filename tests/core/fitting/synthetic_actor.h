@@ -159,4 +159,7 @@ inline std::vector<MarkerPrior> guessed_priors(const Actor& a, std::mt19937& ran
   return priors;
 }
 
+// The actor's template as the fit sees it (its body and segments must outlive the result).
+inline FitBody fit_body(const Actor& a) { return fit_body_of(a.body, a.segments); }
+
 }  // namespace skinstream::test
