@@ -5,6 +5,7 @@
 #include <stdexcept>
 #include <nlohmann/json.hpp>
 
+#include "clients/skinstream/actor_body.h"
 #include "clients/skinstream/default_paths.h"
 #include "clients/skinstream/json_output.h"
 #include "clients/skinstream/part_file.h"
@@ -21,17 +22,6 @@
 namespace skinstream::cli {
 
 namespace {
-
-// The body template: a MakeHuman body OBJ with its skeleton, weights and base mesh beside it.
-bool is_body_template(const std::string& mesh_path) {
-  const std::filesystem::path dir = std::filesystem::path(mesh_path).parent_path();
-  const MakeHumanFiles files = MakeHumanFiles::in(dir.empty() ? "." : dir.string());
-  std::error_code ec;
-  return std::filesystem::equivalent(mesh_path, files.body_obj, ec) && std::filesystem::exists(files.skeleton, ec) &&
-         std::filesystem::exists(files.weights, ec) && std::filesystem::exists(files.base_obj, ec);
-}
-
-nlohmann::ordered_json vec_json(const Vec3& v) { return {v.x(), v.y(), v.z()}; }
 
 nlohmann::ordered_json surface_json(const SurfaceCheck& c) {
   return {{"strained_fraction", c.strained_fraction}, {"max_strain", c.max_strain},
@@ -80,20 +70,16 @@ nlohmann::ordered_json actor_json(const ActorSubject& s, const MarkerPriors& pri
           {"seconds", {{"fit", s.fit_seconds}, {"build", s.build_seconds}, {"checks", s.check_seconds}}}};
 }
 
-// The template path: the actor's body from the template, fitted to the markers, checked.
-int build_from_template(const BuildSubjectOptions& o, const Capture& training, std::FILE* out) {
-  // The template as a mesh first: it must be a body in the unit and axes the flags say.
-  const TriangleMesh raw = read_mesh(o.mesh_path);
-  detect_mesh_frame(raw.vertices, raw.faces, o.mesh_frame);
-  const Body body = load_makehuman(std::filesystem::path(o.mesh_path).parent_path().string());
+// The actor path: the template, or a scan through it, fitted to the markers, checked.
+int build_actor(const BuildSubjectOptions& o, const Capture& training, std::FILE* out) {
+  const ActorBody body(o.mesh_path, o.mesh_frame, default_body_dir());
   const std::vector<MarkerSet> sets = read_marker_sets(o.marker_sets_dir.empty() ? default_marker_sets_dir() : o.marker_sets_dir);
   std::vector<std::string> labels;
   for (int c : training.labelled_points()) labels.push_back(training.labels[c]);
-  const std::vector<Triangle> triangles = triangulate(body.faces);
-  const MarkerPriors priors = marker_priors(labels, body, triangles, sets);
+  const MarkerPriors priors = body.priors(labels, sets);
   ActorSubjectOptions options = o.actor;
   options.subject = o.subject;
-  const ActorSubject s = build_actor_subject(training, body, priors.priors, options);
+  const ActorSubject s = build_actor_subject(training, body.fit_body(), priors.priors, options);
   if (!s.check.ok()) throw std::invalid_argument("refused, nothing written: " + s.check.problem);
   write_subject(s.model, &s.deformation, o.out_path);
   if (!o.surface_out.empty()) write_marker_surface_obj(o.surface_out, s.model.marker_names, s.model.reference_positions, s.model.triangles);
@@ -103,16 +89,43 @@ int build_from_template(const BuildSubjectOptions& o, const Capture& training, s
                                    {"triangles", s.subject_report.triangles},
                                    {"mean_pca_components", s.subject_report.mean_pca_components},
                                    {"markers_never_complete", s.subject_report.markers_never_complete}};
-  report["mesh"] = {{"template", o.mesh_path},
+  nlohmann::ordered_json scan;
+  if (const ScanBody* sb = body.scan())
+    scan = {{"unit_mm", body.frame().unit_mm},
+            {"height_mm", body.frame().height_mm},
+            {"arm_elevation_deg", body.frame().arm_elevation_deg},
+            {"template_fit_rms_mm", sb->fit_rms_mm},
+            {"template_registered_rms_mm", sb->registered_rms_mm},
+            {"scan_to_template_median_mm", sb->inherited_median_mm},
+            {"scan_to_template_max_mm", sb->inherited_max_mm}};
+  report["mesh"] = {{body.is_scan() ? "scan" : "template", o.mesh_path},
+                    {"through_the_template", scan},
                     {"vertices", s.deformation.vertex_count()},
                     {"faces", s.deformation.face_count()},
                     {"registered", s.skeletal_report.registered},
                     {"registration_skipped", s.registration_skipped},
                     {"marker_skin_rms_after_mm", s.skeletal_report.registration.after.rms},
                     {"landmark_rms_after_mm", s.skeletal_report.registration.landmark_rms_after_mm}};
-  report["actor"] = actor_json(s, priors, segment_template(body.skeleton));
+  report["actor"] = actor_json(s, priors, body.segments());
   std::fprintf(out, "%s\n", report.dump(2).c_str());
   return 0;
+}
+
+// A mesh made in the capture's own reference pose and axes (the same subject, e.g. the synthetic
+// demo's): a body in millimetres, Z up, with the markers of the reference frame on its skin. Any
+// other mesh (the template, a scan in its own pose and axes) goes through the actor fit.
+bool in_capture_frame(const BuildSubjectOptions& o, const Capture& training) {
+  if (is_body_template(o.mesh_path)) return false;
+  const TriangleMesh mesh = read_mesh(o.mesh_path);
+  const MeshFrame frame = detect_mesh_frame(mesh.vertices, mesh.faces, o.mesh_frame);  // refuses what is not a body
+  const bool z_up = (frame.rotation.transpose() * Vec3::UnitZ() - Vec3::UnitZ()).norm() < 1e-6;
+  if (frame.unit_mm != 1.0 || !z_up) return false;
+  const std::vector<int> channels = training.labelled_points();
+  const int reference = o.subject.reference_frame >= 0 ? o.subject.reference_frame : choose_reference_frame(training, channels);
+  if (reference < 0 || reference >= training.frame_count) return false;
+  std::vector<Vec3> markers;
+  for (int c : channels) markers.push_back(training.at(reference, c));
+  return marker_surface_distance(mesh.vertices, mesh.faces, markers).mean <= 40.0;
 }
 
 }  // namespace
@@ -123,10 +136,11 @@ int run_build_subject(const BuildSubjectOptions& o, std::FILE* out) {
   if (!o.parts_out.empty() && o.mesh_path.empty()) throw std::invalid_argument("--part-file-out needs --mesh (parts are made with the mesh)");
   if (!o.parts_path.empty() && o.mesh_path.empty()) throw std::invalid_argument("--part-file needs --mesh (parts are made with the mesh)");
   const Capture training = read_capture(o.capture_path);
-  if (!o.mesh_path.empty() && is_body_template(o.mesh_path)) {
+  if (!o.mesh_path.empty() && !in_capture_frame(o, training)) {
     if (!o.landmarks_path.empty() || !o.parts_path.empty() || !o.surface_in.empty() || !deformation.register_mesh)
-      throw std::invalid_argument("--landmarks, --part-file, --surface and --no-register are for a mesh in the capture's pose, not the body template");
-    return build_from_template(o, training, out);
+      throw std::invalid_argument("--landmarks, --part-file, --surface and --no-register are for a mesh in the capture's pose, not "
+                                  "the body template or a scan");
+    return build_actor(o, training, out);
   }
   std::vector<std::array<int, 3>> triangles;
   if (!o.surface_in.empty()) triangles = read_marker_surface_obj(o.surface_in, static_cast<int>(training.labelled_points().size()));
@@ -135,17 +149,8 @@ int run_build_subject(const BuildSubjectOptions& o, std::FILE* out) {
   std::optional<DeformationModel> deformation_model;
   DeformationBuildReport deformation_report;
   if (!o.mesh_path.empty()) {
+    // A mesh made in the capture's own reference pose (in_capture_frame) is registered as it is.
     const TriangleMesh mesh = read_mesh(o.mesh_path);
-    // A mesh in the capture's own pose and axes is registered as it is; it must still be a body.
-    const MeshFrame frame = detect_mesh_frame(mesh.vertices, mesh.faces, o.mesh_frame);
-    const bool z_up = (frame.rotation.transpose() * Vec3::UnitZ() - Vec3::UnitZ()).norm() < 1e-6;
-    const SurfaceDistance near = marker_surface_distance(mesh.vertices, mesh.faces, model.reference_positions);
-    if (frame.unit_mm != 1.0 || !z_up || near.mean > 40.0)
-      throw std::invalid_argument("the mesh is not where the markers are in the reference frame (markers " +
-                                  std::to_string(static_cast<int>(near.mean)) + " mm from its surface on average, " +
-                                  std::to_string(frame.unit_mm) + " mm per unit" + (z_up ? "" : ", not Z up") +
-                                  "): give the body template (replay_data/makehuman/makehuman_hm08_body_only.obj), which is "
-                                  "fitted to the actor, or a mesh made in the capture's reference pose");
     // Segmentation and weights need every marker every frame: the take filled by this model.
     const Capture filled = fill_capture(model, training, CaptureFillOptions{});
     const int n = model.marker_count();

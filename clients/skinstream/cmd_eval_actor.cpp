@@ -9,6 +9,7 @@
 #include <random>
 #include <stdexcept>
 
+#include "clients/skinstream/actor_body.h"
 #include "clients/skinstream/actor_render.h"
 #include "clients/skinstream/default_paths.h"
 #include "clients/skinstream/json_output.h"
@@ -192,9 +193,8 @@ int run_eval_actor(const EvalActorOptions& o, std::FILE* out) {
   const int train_frames = static_cast<int>(o.split * capture.frame_count);
   if (train_frames < 2 || train_frames >= capture.frame_count - 1) throw std::invalid_argument("--split leaves no frames to train or test on");
   const std::string mesh = o.mesh_path.empty() ? default_body_dir() + "/makehuman_hm08_body_only.obj" : o.mesh_path;
-  const Body body = load_makehuman(std::filesystem::path(mesh).parent_path().string());
+  const ActorBody body(mesh, o.mesh_frame, default_body_dir());
   const std::vector<MarkerSet> sets = read_marker_sets(o.marker_sets_dir.empty() ? default_marker_sets_dir() : o.marker_sets_dir);
-  const std::vector<Triangle> body_triangles = triangulate(body.faces);
 
   int folds = (markers + o.withhold - 1) / o.withhold;
   const std::vector<int> order = spread_folds(capture, channels, folds, o.withhold, o.seed);
@@ -218,11 +218,11 @@ int run_eval_actor(const EvalActorOptions& o, std::FILE* out) {
     for (int k : kept) kept_channels.push_back(channels[k]);
     const Capture train = capture.select(kept_channels, 0, train_frames);
     const Capture test = capture.select(kept_channels, train_frames, capture.frame_count - train_frames);
-    const MarkerPriors priors = marker_priors(train.labels, body, body_triangles, sets);
+    const MarkerPriors priors = body.priors(train.labels, sets);
     set_name = priors.set_name;
     named = priors.named;
     std::fprintf(stderr, "eval-actor: fold %d of %d: building without %zu markers\n", fold + 1, folds, withheld.size());
-    const ActorSubject subject = build_actor_subject(train, body, priors.priors, o.build);
+    const ActorSubject subject = build_actor_subject(train, body.fit_body(), priors.priors, o.build);
     fold_seconds.push_back(subject.fit_seconds + subject.build_seconds);
     const DeformationModel& model = subject.deformation;
     const std::vector<Triangle>& triangles = model.faces;

@@ -15,12 +15,14 @@
 #include <string>
 
 #include "clients/skinstream/actor_subject.h"
+#include "core/fitting/mesh_frame.h"
 
 namespace skinstream::cli {
 
 struct EvalActorOptions {
   std::string capture_path;
-  std::string mesh_path;         // the template's body OBJ (its skeleton files beside it); empty: the bundled one
+  std::string mesh_path;         // the template's body OBJ, or a scan; empty: the bundled template
+  MeshFrameOptions mesh_frame;   // the mesh's unit and axes, when not detected
   std::string marker_sets_dir;   // empty: the bundled definitions
   int withhold = 5;              // markers withheld per fold
   double split = 0.5;            // train on this fraction, test on the rest

@@ -73,7 +73,8 @@ void add_build_subject(CLI::App& app, BuildSubjectOptions& o) {
   cmd->add_option("--alpha2", o.subject.parameters.alpha2, "relabel keep tolerance")->capture_default_str();
   cmd->add_option("--mesh", o.mesh_path,
                   "the body: the template (a MakeHuman body OBJ with its skeleton and weights beside it, fitted to the actor), "
-                  "or a mesh (.obj/.ply) already in the capture's reference pose and axes; adds the deformation model");
+                  "a scan of the actor (.obj/.ply, any pose, unit and axes: fitted through the template), or a mesh "
+                  "already in the capture's reference pose and axes; adds the deformation model");
   cmd->add_option("--marker-sets", o.marker_sets_dir, "folder of marker-set definitions (default: the bundled config/marker_sets)");
   cmd->add_option("--marker-height", o.actor.fit.marker_offset_mm, "height of a marker's centre above the skin (mm)")
       ->capture_default_str()->check(CLI::Range(0.0, 100.0));
@@ -237,7 +238,8 @@ void add_eval_actor(CLI::App& app, EvalActorOptions& o) {
   auto* cmd = app.add_subcommand(
       "eval-actor", "Measure a real actor's subject on markers it was not given: held-out markers, folds, methods side by side");
   cmd->add_option("--capture", o.capture_path, "a real take with named markers (.c3d/.trc)")->required();
-  cmd->add_option("--mesh", o.mesh_path, "the template's body OBJ, its skeleton and weights beside it (default: the bundled body)");
+  cmd->add_option("--mesh", o.mesh_path, "the body template's OBJ (its skeleton and weights beside it) or a scan (default: the bundled template)");
+  add_mesh_frame_flags(*cmd, o.mesh_frame);
   cmd->add_option("--marker-sets", o.marker_sets_dir, "folder of marker-set definitions (default: the bundled ones)");
   cmd->add_option("--withhold", o.withhold, "markers withheld per fold")->capture_default_str()->check(CLI::PositiveNumber);
   cmd->add_option("--split", o.split, "train on this fraction of the take, test on the rest")

@@ -9,7 +9,12 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "core/body/anatomy.h"
+#include "core/body/skinning.h"
+#include "core/fitting/body_proportions.h"
+#include "core/fitting/template_segments.h"
 #include "protocol/capture_file.h"
+#include "protocol/makehuman.h"
 #include "protocol/mesh_file.h"
 #include "protocol/subject_file.h"
 #include "support/program_run.h"
@@ -141,6 +146,48 @@ TEST(SkinstreamActor, ATakeWithNoCompleteFrameIsRefused) {
   const std::string out = test::scratch_path("never_complete.sksubj");
   expect_refused(run("build-subject --capture " + capture + " --mesh " + kTemplate + " --out " + out), out,
                  "all 41 labelled markers");
+}
+
+// A scan of someone else, as a scanner hands it over: the MakeHuman body with other proportions,
+// standing with its arms up in a T, in centimetres with Y up, its vertices shuffled, no skeleton.
+TEST(SkinstreamActor, AScanInItsOwnPoseUnitAndAxesGoesThroughTheTemplate) {
+  const Body body = load_makehuman(test::source_path("replay_data/makehuman"));
+  const TemplateSegments segments = segment_template(body.skeleton);
+  BodyProportions proportions = BodyProportions::neutral(segments);
+  proportions.overall = 1.05;
+  proportions.girth[1] = 1.1;  // the abdomen
+  const std::vector<Vec3> rest = proportioned_vertices(body.rest, body.weights, proportion_bones(body.skeleton, segments, proportions));
+  const Anatomy anatomy = Anatomy::from(body);
+  PoseBuilder pose(body.skeleton, anatomy);
+  pose.shoulder(kLeft, 0.0, 90.0);
+  pose.shoulder(kRight, 0.0, 90.0);
+  const std::vector<Vec3> posed = skin(rest, body.weights, pose_bones(body.skeleton, pose.pose()));
+  std::vector<int> order(posed.size()), where(posed.size());
+  for (size_t v = 0; v < order.size(); ++v) order[v] = static_cast<int>((v * 7919) % order.size());  // 7919 is prime: a permutation
+  for (size_t k = 0; k < order.size(); ++k) where[static_cast<size_t>(order[k])] = static_cast<int>(k);
+  TriangleMesh scan;
+  for (int v : order) {
+    const Vec3& p = posed[static_cast<size_t>(v)];
+    scan.vertices.push_back(Vec3(-p.x(), p.z(), p.y()) / 10.0);  // skinstream axes to centimetres, Y up, facing +Z
+  }
+  for (const Triangle& t : triangulate(body.faces)) scan.faces.push_back({where[t[0]], where[t[1]], where[t[2]]});
+  const std::string mesh = test::scratch_path("scan_cm_yup.ply");
+  write_ply(mesh, scan);
+
+  const std::string subject = test::scratch_path("scan_actor.sksubj");
+  const ProgramRun r = run("build-subject --capture " + kCmu02 + " --mesh " + mesh + " --out " + subject, false);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const nlohmann::json report = nlohmann::json::parse(r.output);
+  const nlohmann::json& through = report["mesh"]["through_the_template"];
+  EXPECT_EQ(through["unit_mm"], 10.0);
+  EXPECT_GT(through["arm_elevation_deg"].get<double>(), 75.0);  // a T pose
+  EXPECT_LT(through["scan_to_template_median_mm"].get<double>(), 3.0);
+  EXPECT_TRUE(report["actor"]["checks"]["plausible"].get<bool>());
+  // The subject's body is the scan: its vertices, in its order.
+  const SubjectFile file = read_subject_file(subject);
+  ASSERT_TRUE(file.deformation.has_value());
+  EXPECT_EQ(file.deformation->vertex_count(), static_cast<int>(scan.vertices.size()));
+  EXPECT_EQ(file.deformation->faces, scan.faces);
 }
 
 // The measure on a real take: withheld markers followed through the second half, three methods.
