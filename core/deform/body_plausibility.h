@@ -13,7 +13,7 @@ namespace skinstream {
 
 struct BodyPlausibilityLimits {
   double max_strain = 1.5;               // an edge strained beyond this either way ...
-  double max_strained_fraction = 0.01;   // ... on at most this fraction of the edges
+  double max_strained_fraction = 0.05;   // ... on at most this fraction of the edges (the builder's refusal)
   double max_flipped_fraction = 0.003;   // turned triangles (a real reference pose's creases turn ~0.1%)
   double max_edge_stretch = 25.0;        // in typical edges: a shard (a crease of linear blend skinning stays below)
   double max_median_marker_skin_mm = 30.0;  // the markers' median distance to the nearest vertex

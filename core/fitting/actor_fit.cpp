@@ -152,6 +152,7 @@ class Fit {
   SegmentPose pose_from(const Similarity& similarity) {
     BodyProportions p = proportionable() ? BodyProportions::neutral(*body_.segments) : BodyProportions{};
     p.overall = proportionable() ? std::clamp(similarity.scale, 0.5, 2.0) : 1.0;  // a scan keeps its size
+    first_overall_ = p.overall;
     set_proportions(p);
     SegmentPose pose{std::vector<Eigen::Matrix3d>(static_cast<size_t>(segment_count()), Eigen::Matrix3d::Identity()), Vec3::Zero()};
     const Eigen::Matrix3d rotation = similarity.rigid.rotation;
@@ -299,7 +300,7 @@ class Fit {
     std::vector<double> robust;
     {
       const Eigen::VectorXd r = residuals(to_vector(proportions_), from_vector, fit_frames, poses, nullptr);
-      for (int k = 0; k + 2 < r.size() - 2 * groups; k += 3) {
+      for (int k = 0; k + 2 < r.size() - 2 * groups - 1; k += 3) {
         const double miss = r.segment<3>(k).norm();
         robust.push_back(miss > options_.robust_mm ? std::sqrt(options_.robust_mm / miss) : 1.0);
       }
@@ -382,6 +383,10 @@ class Fit {
       }
     }
     const int groups = static_cast<int>(body_.segments->shape_groups.size());
+    // The overall scale is held to its first guess as the lengths are to the template's: without
+    // it, the body could shrink all over while the groups the markers see grow back, leaving the
+    // groups no marker sees (the arms of a lower-body set) too small.
+    out.push_back(std::sqrt(options_.length_prior) * (x[0] - std::log(first_overall_)));
     for (int g = 0; g < groups; ++g) out.push_back(std::sqrt(options_.length_prior) * x[1 + g]);
     for (int g = 0; g < groups; ++g) out.push_back(std::sqrt(options_.girth_prior) * (x[1 + groups + g] - x[1 + g]));
     return Eigen::Map<const Eigen::VectorXd>(out.data(), static_cast<long>(out.size()));
@@ -407,6 +412,7 @@ class Fit {
  private:
   TriangleBvh rest_bvh_;
   bool rest_bvh_valid_ = false;
+  double first_overall_ = 1.0;
 };
 
 double pose_distance(const SegmentPose& a, const SegmentPose& b) {

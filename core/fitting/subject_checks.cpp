@@ -11,7 +11,8 @@ namespace {
 
 // Segment lengths as fractions of the height (Drillis & Contini 1966, as Winter tabulates them):
 // joint centre to joint centre. Shoulder and hip widths are between the joint centres, narrower
-// than the bony widths those tables give (biacromial 0.259, bi-iliac 0.191).
+// than the bony widths those tables give (biacromial 0.259, bi-iliac 0.191; the hip joint
+// centres lie about a third of the pelvis's width inside its outline).
 struct HumanFraction {
   const char* name;
   const char* from;
@@ -23,7 +24,7 @@ constexpr HumanFraction kFractions[] = {
     {"forearm left", "forearm.L", "hand.L", 0.146},       {"forearm right", "forearm.R", "hand.R", 0.146},
     {"thigh left", "thigh.L", "shank.L", 0.245},          {"thigh right", "thigh.R", "shank.R", 0.245},
     {"shank left", "shank.L", "foot.L", 0.246},           {"shank right", "shank.R", "foot.R", 0.246},
-    {"shoulder width", "upperarm.L", "upperarm.R", 0.20}, {"hip width", "thigh.L", "thigh.R", 0.10},
+    {"shoulder width", "upperarm.L", "upperarm.R", 0.20}, {"hip width", "thigh.L", "thigh.R", 0.11},
 };
 
 std::string fixed(double v, int digits = 1) {
