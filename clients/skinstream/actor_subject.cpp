@@ -38,6 +38,8 @@ ActorSubject build_actor_subject(const Capture& training, const FitBody& body, s
   std::vector<Vec3> frames(static_cast<size_t>(training.frame_count) * markers);
   for (int f = 0; f < training.frame_count; ++f)
     for (int i = 0; i < markers; ++i) frames[static_cast<size_t>(f) * markers + i] = training.at(f, channels[i]);
+  out.motion = measure_take_motion(frames, training.frame_count, markers, options.motion);
+  if (!out.motion.ok()) throw std::invalid_argument("refused, nothing written: " + out.motion.problem);
   const std::vector<Triangle>& triangles = body.triangles;
   out.fit = fit_actor(body, frames, training.frame_count, markers, subject_options.reference_frame, priors, options.fit);
   out.fit_seconds = seconds_since(start);

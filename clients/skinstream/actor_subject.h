@@ -14,6 +14,7 @@
 #include "core/fitting/actor_fit.h"
 #include "core/fitting/skeletal_deformation_builder.h"
 #include "core/fitting/subject_checks.h"
+#include "core/fitting/take_motion.h"
 #include "core/offline/deformation_builder.h"
 #include "core/offline/subject_builder.h"
 
@@ -23,6 +24,7 @@ enum class PartChoiceRule { Automatic, Skeleton, Markers };
 
 struct ActorSubjectOptions {
   SubjectBuildOptions subject;
+  TakeMotionLimits motion;  // a take that does not move like a body is refused before the fit
   ActorFitOptions fit;
   SkeletalDeformationOptions skeletal;
   DeformationBuildOptions marker_parts;  // the dense path (its mesh is registered already)
@@ -35,6 +37,7 @@ struct ActorSubjectOptions {
 struct ActorSubject {
   SubjectModel model;
   DeformationModel deformation;
+  TakeMotion motion;
   ActorFit fit;
   SubjectBuildReport subject_report;
   bool skeleton_parts = false;
@@ -48,7 +51,7 @@ struct ActorSubject {
 // training: the take (labelled channels are the markers); body: the body to fit (the template
 // with its bones, fit_body_of(), or a scan made a skinned body, scan_body.h); priors: one per labelled marker (core/fitting/marker_priors.h).
 // Throws std::invalid_argument with one line when the take cannot make a subject (no complete
-// frame, too few markers); a subject whose checks fail is returned with check.problem set (the
+// frame, too few markers, a take that does not articulate); a subject whose checks fail is returned with check.problem set (the
 // caller refuses it).
 ActorSubject build_actor_subject(const Capture& training, const FitBody& body, std::span<const MarkerPrior> priors,
                                  const ActorSubjectOptions& options = {});

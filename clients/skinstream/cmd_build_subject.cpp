@@ -47,6 +47,7 @@ nlohmann::ordered_json actor_json(const ActorSubject& s, const MarkerPriors& pri
                      {"rbf_ridge", p.rbf_ridge}});
   return {{"marker_set", priors.set_name},
           {"marker_set_match", priors.description},
+          {"articulation_mm", s.motion.articulation_mm},
           {"blind_start", fit.blind},
           {"fit_frames", fit.frames.size()},
           {"tracked_frames", fit.tracked_frames},

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <random>
 
 #include "core/body/anatomy.h"
 #include "core/body/skinning.h"
@@ -135,7 +136,22 @@ TEST(SkinstreamActor, MarkersOnABoxAreRefused) {
   const std::string capture = test::scratch_path("box.c3d");
   write_capture(box, capture);
   const std::string out = test::scratch_path("box.sksubj");
-  expect_refused(run("build-subject --capture " + capture + " --mesh " + kTemplate + " --out " + out), out, "refused");
+  expect_refused(run("build-subject --capture " + capture + " --mesh " + kTemplate + " --out " + out), out, "rigid object");
+}
+
+// A calibration take of an actor standing still (one real frame held for two seconds, 1 mm of
+// marker noise): no joint moves, so none can be fitted; refused before the fit.
+TEST(SkinstreamActor, AnActorStandingStillIsRefused) {
+  const Capture take = read_capture(kCmu02);
+  Capture still(take.labels, 240, take.rate_hz);
+  std::mt19937 random(7);
+  std::normal_distribution<double> noise(0.0, 1.0);
+  for (int f = 0; f < still.frame_count; ++f)
+    for (int i = 0; i < take.point_count(); ++i) still.at(f, i) = take.at(100, i) + Vec3(noise(random), noise(random), noise(random));
+  const std::string capture = test::scratch_path("still.c3d");
+  write_capture(still, capture);
+  const std::string out = test::scratch_path("still.sksubj");
+  expect_refused(run("build-subject --capture " + capture + " --mesh " + kTemplate + " --out " + out), out, "standing still");
 }
 
 TEST(SkinstreamActor, ATakeWithNoCompleteFrameIsRefused) {
