@@ -35,26 +35,30 @@ export async function waitUntil(page, what, predicate, argument = null, timeout 
 export const sleep = (ms) => new Promise((resolve) => setTimeout(resolve, ms));
 
 // The page's drawn frame (window.skinstreamViewer.readDrawnFrame) as Float32Arrays, moved as
-// base64 (a JSON array of 320,000 numbers took seconds). With `keys`, only a frame whose key
-// (frame number @ daemon receive time) is among them is read; else null.
-export async function readDrawnFrame(page, keys = null) {
-  const frame = await page.evaluate((wanted) => {
-    const v = window.skinstreamViewer;
-    if (wanted && !wanted.includes(v.lastFrameKey)) return null;
-    const drawn = v.readDrawnFrame();
+// base64 (a JSON array of 320,000 numbers took seconds). Copied in the page first, its key
+// (frame number @ daemon receive time) known at once: `whenKeyKnown(key)` is awaited before the
+// seconds the copy takes to move, so that a reference can take its own copy of that frame
+// before newer frames push it out.
+export async function readDrawnFrame(page, whenKeyKnown = null) {
+  const key = await page.evaluate(() => {
+    const drawn = window.skinstreamViewer.readDrawnFrame();
+    window.skinstreamTestDrawnFrame = drawn;
+    return `${drawn.frameNumber}@${drawn.receiveTimeNs}`;
+  });
+  if (whenKeyKnown) await whenKeyKnown(key);
+  const frame = await page.evaluate(() => {
+    const drawn = window.skinstreamTestDrawnFrame;
     const base64 = (array) => {
       const bytes = new Uint8Array(array.buffer, array.byteOffset, array.byteLength);
       let text = '';
       for (let i = 0; i < bytes.length; i += 0x8000) text += String.fromCharCode.apply(null, bytes.subarray(i, i + 0x8000));
       return btoa(text);
     };
-    return { frameNumber: drawn.frameNumber, key: `${drawn.frameNumber}@${drawn.receiveTimeNs}`,
-      positions: base64(drawn.positions), normals: base64(drawn.normals) };
-  }, keys);
-  if (frame === null) return null;
+    return { frameNumber: drawn.frameNumber, positions: base64(drawn.positions), normals: base64(drawn.normals) };
+  });
   const floats = (text) => {
     const bytes = Buffer.from(text, 'base64');
     return new Float32Array(bytes.buffer.slice(bytes.byteOffset, bytes.byteOffset + bytes.length));
   };
-  return { ...frame, positions: floats(frame.positions), normals: floats(frame.normals) };
+  return { ...frame, key, positions: floats(frame.positions), normals: floats(frame.normals) };
 }

@@ -11,8 +11,9 @@ const requireWeb = createRequire(path.join(repoRoot, 'clients/web/package.json')
 const protocol = await import(path.join(repoRoot, 'clients/web/src/protocol.js'));
 
 export class ReferenceSubscriber {
-  // keep: how many recent frames to hold (a float frame with normals is 1.3 MB on the demo body).
-  constructor(url, { keep = 48, encoding = protocol.Encoding.FLOAT, wants = protocol.Wants.NORMALS } = {}) {
+  // keep: how many recent frames to hold (a float frame with normals is 1.3 MB on the demo body):
+  // a second, as a page on a loaded machine draws a frame 200-300 ms after the daemon got it.
+  constructor(url, { keep = 120, encoding = protocol.Encoding.FLOAT, wants = protocol.Wants.NORMALS } = {}) {
     const WebSocket = requireWeb('ws');
     this.keep = keep;
     this.frames = new Map(); // "frame number@receive time" -> ArrayBuffer
@@ -72,6 +73,21 @@ export class ReferenceSubscriber {
     const out = { positions: new Float32Array(3 * V), normals: new Float32Array(3 * V), markers: new Float32Array(0), markerStatus: new Uint8Array(0) };
     protocol.decodeFrameArrays(view, header, out);
     return out;
+  }
+
+  // The frame of `key` once it is held: the page may draw a frame before this subscriber has
+  // read it (node busy on a loaded machine), so it is waited for; null when it never comes, or
+  // came and gave way to newer frames.
+  async waitForFrame(key, timeoutMs = 2000) {
+    const deadline = Date.now() + timeoutMs;
+    const receiveTime = (k) => BigInt(k.split('@')[1]);
+    for (;;) {
+      const frame = this.frame(key);
+      if (frame !== null || Date.now() >= deadline) return frame;
+      const oldest = this.frames.keys().next().value;
+      if (oldest !== undefined && receiveTime(key) < receiveTime(oldest)) return null;  // gone already
+      await new Promise((resolve) => setTimeout(resolve, 20));
+    }
   }
 
   close() {
