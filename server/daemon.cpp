@@ -478,7 +478,10 @@ std::string Daemon::health_json() const {
       {"source_limits",
        {{"max_subjects", config_.source_max_subjects},
         {"max_markers_per_subject", config_.source_max_markers_per_subject},
-        {"max_name_bytes", config_.source_max_name_bytes}}},
+        {"max_name_bytes", config_.source_max_name_bytes},
+        {"max_coordinate_m", config_.source_max_coordinate_m},
+        {"handshake_timeout_ms", config_.source_handshake_timeout_ms},
+        {"stall_ms", config_.source_stall_ms}}},
       {"latency_ms", first["latency_ms"]}};
   return health.dump();
 }
