@@ -143,7 +143,7 @@ Daemon::Daemon(const DaemonConfig& config)
     : config_(config),
       deform_cpus_(deform_cpus_of(config)),
       subjects_(load_subjects(config, deform_cpus_)),
-      router_(targets_of(subjects_), static_cast<SubjectRouter::Observer&>(*this)),
+      router_(targets_of(subjects_), static_cast<SubjectRouter::Observer&>(*this), 1000.0 * config.source_max_coordinate_m),
       routed_(subjects_.size(), nullptr),
       publish_(config.publish_threads),
       status_timer_(io_),
@@ -336,6 +336,12 @@ void Daemon::on_frame(const SourceFrame& frame) {
     source_metrics_.count_bad_input("rejected_point");
     bad_input_log_.warn("rejected_point", "frame " + std::to_string(frame.frame_number) + ": " + std::to_string(routed.rejected_points) +
                                               " unlabelled points ignored (not finite)");
+  }
+  if (routed.implausible_points > 0) {
+    source_metrics_.count_bad_input("implausible_point");
+    bad_input_log_.warn("implausible_point", "frame " + std::to_string(frame.frame_number) + ": " +
+                                                 std::to_string(routed.implausible_points) + " unlabelled points ignored (beyond " +
+                                                 fmt::format("{:g}", config_.source_max_coordinate_m) + " m of the origin)");
   }
   for (size_t k = 0; k < subjects_.size(); ++k)
     if (router_.present(static_cast<int>(k))) subjects_[k]->post();

@@ -123,6 +123,12 @@ void SubjectStream::post() {
                                               std::to_string(frame.rejected_points) + " points ignored (not finite, or beyond " +
                                               std::to_string(MarkerFrame::kMaxUnlabelled) + " unlabelled)");
   }
+  if (frame.implausible_points > 0) {
+    metrics_.count_bad_input("implausible_point");
+    bad_input_log_.warn("implausible_point", "subject " + name_ + ", frame " + std::to_string(frame.frame_number) + ": " +
+                                                 std::to_string(frame.implausible_points) +
+                                                 " points taken as missing (outside the capture volume, source_max_coordinate_m)");
+  }
   if (frame.source_rate_hz > 0 && frame.source_rate_hz != source_rate_hz_) {
     source_rate_hz_ = frame.source_rate_hz;
     hub_->set_source_rate(static_cast<float>(frame.source_rate_hz));

@@ -3,8 +3,10 @@
 #include <spdlog/spdlog.h>
 
 #include <chrono>
+#include <cmath>
 #include <stdexcept>
 
+#include "protocol/finite_values.h"
 #include "protocol/frame_parameters.h"
 #include "protocol/subscriber_stream.h"
 #include "server/pipeline/deform_cpus.h"
@@ -37,6 +39,13 @@ struct FrameNeeds {
   bool compressed_normals = false;
 };
 
+bool all_finite(const FrameParameters& parameters) {
+  for (const PartParameters& part : parameters.parts)
+    if (!skinstream::all_finite(part.quadratic) || !skinstream::all_finite(part.rotation) || !skinstream::all_finite(part.translation))
+      return false;
+  return skinstream::all_finite(parameters.weights);
+}
+
 FrameNeeds needs_of(const StreamKeySet& wanted) {
   FrameNeeds needs;
   wanted.for_each([&](StreamKey key) {
@@ -54,6 +63,17 @@ FrameNeeds needs_of(const StreamKeySet& wanted) {
     }
   });
   return needs;
+}
+
+// What of a frame about to be encoded is not all finite ("markers", "vertices", ...), or null.
+const char* non_finite_output(const FrameNeeds& needs, std::span<const float> markers, const MeshDeformer* deformer,
+                              std::span<const float> positions, std::span<const float> normals) {
+  if (!skinstream::all_finite(markers)) return "markers";
+  if (!deformer) return nullptr;
+  if (needs.vertices && !skinstream::all_finite(positions)) return "vertices";
+  if (needs.vertices && needs.normals && !skinstream::all_finite(normals)) return "normals";
+  if (needs.parameters && !all_finite(deformer->parameters())) return "parameters";
+  return nullptr;
 }
 
 }  // namespace
@@ -272,6 +292,15 @@ void Pipeline::publish(const Released& meta, std::span<const Vec3> positions, st
   for (size_t m = 0; m < status.size(); ++m) {
     for (int a = 0; a < 3; ++a) marker_floats_[3 * m + a] = static_cast<float>(positions[m][a]);
     marker_status_bytes_[m] = static_cast<uint8_t>(status[m]);
+  }
+  // Nothing that is not finite is encoded: a frame whose markers, vertices or parameters are not
+  // all finite (a value the router should have refused, a deformation that overflowed) is
+  // counted and not sent; subscribers keep the last good one.
+  if (const char* what = non_finite_output(needs, marker_floats_, deformer_.get(), positions_, normals_)) {
+    metrics_.count_bad_input("non_finite_frame");
+    non_finite_log_.warn("non_finite_frame", "pipeline: frame " + std::to_string(meta.frame_number) + " not sent: its " + what +
+                                                 " are not all finite");
+    return;
   }
   subscriber::FrameInfo info;
   info.frame_number = meta.frame_number;

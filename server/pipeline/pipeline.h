@@ -23,6 +23,7 @@
 #include "core/gap_end_blender.h"
 #include "core/gap_filler.h"
 #include "core/subject_model.h"
+#include "server/logging.h"
 #include "server/metrics/metrics.h"
 #include "server/pipeline/deform_workers.h"
 #include "server/pipeline/encoded_frame.h"
@@ -173,6 +174,8 @@ class Pipeline {
   std::vector<uint32_t> compressed_order_;
   std::unique_ptr<subscriber::CompressedVertexEncoder> compressed_;
   std::vector<unsigned char> compressed_blocks_;
+
+  RateLimitedLog non_finite_log_;
 
   std::atomic<bool> running_{false};
   std::atomic<uint64_t> published_{0};

@@ -16,6 +16,7 @@
 #include <poll.h>
 #include <sys/socket.h>
 #include <netinet/in.h>
+#include <arpa/inet.h>
 #include <sys/wait.h>
 #include <thread>
 #include <unistd.h>
@@ -28,11 +29,17 @@
 #include "server/client/process_usage.h"
 #include "protocol/capture_file.h"
 #include "protocol/point_cache.h"
+#include "protocol/qtm_packet_writer.h"
 #include "server/client/subscriber_client.h"
 #include "support/loopback_peer.h"
 #include "support/program_processes.h"
 #include "support/program_run.h"
 #include "support/recording_match.h"
+#include "server/natnet/natnet_server.h"
+#include "server/qtm/qtm_server.h"
+#include "support/io_thread.h"
+#include "support/scripted_daemon.h"
+#include "support/silent_capture_servers.h"
 #include "support/test_data.h"
 
 namespace skinstream {
@@ -503,6 +510,74 @@ class DaemonDemo : public ::testing::Test {
   static inline PointCache offline_;
   static inline int first_frame_ = 0;
 };
+
+// A capture server sending absurd coordinates now and then (QTM RT: 3.4e38 mm, its float's
+// largest; NatNet: 1e36 m; both: 1e7 mm, 10 km) once made the daemon publish a parameter block
+// that was not finite: skinstream-sub exited 1 ("an RBF weight is not finite"), and 1e7 mm put
+// vertices 612 m away. They are missing now, counted as implausible points: every subscriber
+// goes on, and every filled marker it receives lies within the capture volume (50 m).
+enum class AbsurdSource { Qtm, NatNet };
+
+void expect_absurd_coordinates_are_missing(const std::string& subject, const std::string& live, AbsurdSource kind) {
+  Capture take = read_capture(live);
+  const double absurd = kind == AbsurdSource::Qtm ? 3.4e38 : 1e39;  // mm
+  for (int f = 5; f + 10 < take.frame_count; f += 30) {
+    take.at(f, 0) = Vec3(absurd, 0.0, 0.0);
+    take.at(f + 10, 1) = Vec3(0.0, 1e7, 0.0);
+  }
+  test::IoThread server_io;
+  std::unique_ptr<server::QtmServer> qtm;
+  std::unique_ptr<server::NatNetServer> natnet;
+  std::string source;
+  if (kind == AbsurdSource::Qtm) {
+    server::QtmServerOptions options;
+    options.bind_address = "127.0.0.1";
+    options.port = 0;
+    options.loop = true;
+    qtm = std::make_unique<server::QtmServer>(server_io.io, std::vector<ReplaySubject>{{"demo", &take}}, options);
+    source = "--qtm 127.0.0.1:" + std::to_string(server_io.call([&] {
+               qtm->start();
+               return qtm->port();
+             }));
+  } else {
+    server::NatNetServerOptions options;
+    options.bind_address = "127.0.0.1";
+    options.command_port = 0;
+    options.multicast = false;
+    options.loop = true;
+    natnet = std::make_unique<server::NatNetServer>(server_io.io, std::vector<ReplaySubject>{{"demo", &take}}, options);
+    source = "--natnet 127.0.0.1:" + std::to_string(server_io.call([&] {
+               natnet->start();
+               return natnet->command_port();
+             }));
+  }
+  DaemonProcess daemon("--subject " + subject + " " + source);
+  const ProgramRun sub = run(std::string(SKINSTREAM_SUB) + " 127.0.0.1:" + std::to_string(daemon.sub_port) +
+                             " --encoding parameters --evaluate --markers --json --frames 240");
+  const std::string metrics = http_get_within(daemon.http_port, "/metrics", std::chrono::seconds(10));
+  EXPECT_EQ(daemon.stop(), 0) << daemon.log();
+  server_io.call([&] {
+    if (qtm) qtm->stop();
+    if (natnet) natnet->stop();
+  });
+  ASSERT_EQ(sub.exit_code, 0) << sub.output.substr(sub.output.size() > 3000 ? sub.output.size() - 3000 : 0) << daemon.log();
+  const std::vector<nlohmann::json> frames = test::frames_of(sub.output);
+  ASSERT_EQ(frames.size(), 240u);
+  for (const nlohmann::json& frame : frames)
+    for (const float coordinate : frame["markers"].get<std::vector<float>>())
+      ASSERT_LE(std::abs(coordinate), 50'000.0f) << "frame " << frame["frame"];
+  EXPECT_NE(sub.output.find("\"frames_rejected\":0"), std::string::npos) << sub.output.substr(sub.output.rfind('\n', sub.output.size() - 2));
+  EXPECT_NE(metrics.find("category=\"implausible_point\"}"), std::string::npos) << metrics;
+  EXPECT_EQ(metrics.find("category=\"non_finite_frame\"}"), std::string::npos) << metrics;
+}
+
+TEST_F(DaemonDemo, AbsurdQtmCoordinatesAreMissingAndParameterSubscribersGoOn) {
+  expect_absurd_coordinates_are_missing(subject_, live_, AbsurdSource::Qtm);
+}
+
+TEST_F(DaemonDemo, AbsurdNatNetCoordinatesAreMissingAndParameterSubscribersGoOn) {
+  expect_absurd_coordinates_are_missing(subject_, live_, AbsurdSource::NatNet);
+}
 
 // One pass of the replay as a subscriber saw it: the frames from the first one of a pass (a new
 // take for the filler) on, `count` of them, with their positions.
