@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 #include <unistd.h>
 
+#include "protocol/datagram_authentication.h"
 #include "protocol/file_error.h"
 #include "protocol/printable_text.h"
 #include "server/http/http_server.h"
@@ -111,7 +112,15 @@ vicon::DescriptionLimits description_limits_of(const DaemonConfig& config) {
 
 MulticastSenderOptions multicast_options_of(const DaemonConfig& config, uint32_t stream_id) {
   const HostPort group = host_port_of("--multicast", config.multicast);
-  return {group.host, group.port, config.multicast_interface, config.multicast_ttl, stream_id};
+  MulticastSenderOptions options{group.host, group.port, config.multicast_interface, config.multicast_ttl, stream_id};
+  if (!config.multicast_key_file.empty()) {
+    try {
+      options.key = subscriber::read_datagram_key_file(config.multicast_key_file);
+    } catch (const std::runtime_error& e) {
+      throw ConfigError(std::string("multicast_key_file: ") + e.what());
+    }
+  }
+  return options;
 }
 
 AdmissionOptions admission_options_of(const DaemonConfig& config) {
