@@ -485,6 +485,77 @@ TEST_F(DaemonProgram, ViconSourceDisconnectsAndReturns) {
   EXPECT_EQ(daemon.stop(), 0) << daemon.log();
 }
 
+// skinstream-sub meeting a Frame that is not finite (a daemon that published one) says so on
+// stderr, counts it, and goes on with the next; it exited 1 at the first.
+TEST(SubscriberProgram, ABrokenFrameIsSkippedWithAWarningAndTheStreamGoesOn) {
+  test::ScriptedDaemon daemon(test::broken_frame_stream(10, 4));
+  const ProgramRun sub = run(std::string(SKINSTREAM_SUB) + " 127.0.0.1:" + std::to_string(daemon.port) +
+                             " --encoding parameters --evaluate --json --frames 9");
+  ASSERT_EQ(sub.exit_code, 0) << sub.output;
+  std::vector<int> numbers;
+  nlohmann::json summary;
+  std::istringstream lines(sub.output);
+  for (std::string line; std::getline(lines, line);) {
+    if (line.empty() || line[0] != '{') continue;
+    const nlohmann::json j = nlohmann::json::parse(line);
+    if (j.contains("frame")) numbers.push_back(j["frame"]);
+    else summary = j["summary"];
+  }
+  EXPECT_EQ(numbers, (std::vector<int>{1, 2, 3, 5, 6, 7, 8, 9, 10}));
+  EXPECT_EQ(summary["frames_rejected"], 1) << sub.output;
+  EXPECT_NE(sub.output.find("skinstream-sub: warning: frame skipped: parameters: an RBF weight is not finite (1 frames skipped so far)"),
+            std::string::npos)
+      << sub.output;
+}
+
+// skinstream-sub with the token in a file, or in the environment's SKINSTREAM_TOKEN: the Hello
+// carries it, and it is on no command line (--token put it in the process list for all to read).
+TEST(SubscriberProgram, TheTokenComesFromAFileOrTheEnvironment) {
+  const std::string token_file = test::scratch_path("sub_token_" + std::to_string(getpid()) + ".txt");
+  std::ofstream(token_file) << "stage-7/east\n";
+  subscriber::Status refused;
+  refused.state = subscriber::SourceStateCode::Refused;
+  refused.detail = "enough";
+  for (const std::string& how : {"--token-file " + token_file, std::string("env")}) {
+    test::ScriptedDaemon daemon(subscriber::encode_status(refused, subscriber::kVersion2));
+    const std::string command = (how == "env" ? "SKINSTREAM_TOKEN=stage-7/east " : "") + std::string(SKINSTREAM_SUB) + " 127.0.0.1:" +
+                                std::to_string(daemon.port) + (how == "env" ? "" : " " + how) + " --frames 1";
+    const ProgramRun sub = run(command);
+    EXPECT_EQ(sub.exit_code, 1) << sub.output;
+    const std::vector<unsigned char> hello = daemon.hello();
+    ASSERT_GE(hello.size(), subscriber::kHeaderBytes) << how;
+    const subscriber::MessageHeader header = subscriber::decode_header(hello);
+    const subscriber::Hello decoded =
+        subscriber::decode_hello(std::span(hello).subspan(subscriber::kHeaderBytes, header.payload_bytes), header.version);
+    EXPECT_EQ(decoded.token, "stage-7/east") << how;
+  }
+}
+
+// A daemon that sends MeshInfo, then half a message, then nothing with its connection open:
+// skinstream-sub waited without a word. After --timeout it says so and exits 1.
+TEST(SubscriberProgram, ADaemonThatFallsSilentEndsTheRunWithAnError) {
+  std::vector<unsigned char> reply = test::broken_frame_stream(0, 0);
+  reply.resize(reply.size() - 10);  // the Model cut short
+  test::ScriptedDaemon daemon(reply);
+  const ProgramRun sub = run(std::string(SKINSTREAM_SUB) + " 127.0.0.1:" + std::to_string(daemon.port) + " --encoding parameters --timeout 1");
+  EXPECT_EQ(sub.exit_code, 1) << sub.output;
+  EXPECT_NE(sub.output.find("skinstream-sub: error: nothing from the daemon for 1000 ms"), std::string::npos) << sub.output;
+}
+
+// The daemon's words reach the terminal made printable: a refusal whose detail holds a line
+// break, a terminal escape and a second "skinstream-sub:" line is one line.
+TEST(SubscriberProgram, TheDaemonsWordsArePrintedPrintable) {
+  subscriber::Status refused;
+  refused.state = subscriber::SourceStateCode::Refused;
+  refused.detail = "no\n\x1b[2Jskinstream-sub: all is well";
+  test::ScriptedDaemon daemon(subscriber::encode_status(refused, subscriber::kVersion2));
+  const ProgramRun sub = run(std::string(SKINSTREAM_SUB) + " 127.0.0.1:" + std::to_string(daemon.port));
+  EXPECT_EQ(sub.exit_code, 1) << sub.output;
+  EXPECT_EQ(count_lines_with(sub.output, "skinstream-sub:"), 1) << sub.output;
+  EXPECT_EQ(sub.output.find('\x1b'), std::string::npos) << sub.output;
+  EXPECT_NE(sub.output.find("refused this subscriber: no\\x0a\\x1b[2Jskinstream-sub: all is well"), std::string::npos) << sub.output;
+}
+
 // The demo subject (ctest fixture demo_subject): the vertex buffers skinstreamd publishes equal
 // the offline pipeline, `skinstream fill` (causal, lookahead 0) then `skinstream deform`.
 class DaemonDemo : public ::testing::Test {
