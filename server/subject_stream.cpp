@@ -208,6 +208,7 @@ nlohmann::json SubjectStream::health() const {
                    {"published", metrics_.frames_published.load()},
                    {"dropped", metrics_.frames_dropped.load()},
                    {"dropped_mailbox_full", metrics_.frames_dropped_mailbox_full.load()}};
+  out["source_rate_changes"] = metrics_.source_rate_changes.load();
   // Encoded frame buffers created so far: grows only while the pool meets a new high-water
   // mark of frames in use (bounded by the subscribers' queues) or an encoding is asked for
   // again after its buffers were released, so RSS steps with it.

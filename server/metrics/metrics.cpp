@@ -152,6 +152,8 @@ std::string render_prometheus(const Metrics& source, const std::vector<SubjectMe
   per_subject("markers_filled_total", "Marker samples filled (PCA, rigid or held).", &Metrics::markers_filled);
   per_subject("markers_relabelled_total", "Marker samples taken from unlabelled points.", &Metrics::markers_relabelled);
   per_subject("markers_held_total", "Marker samples held relative to their anchors.", &Metrics::markers_held);
+  per_subject("source_rate_changes_total", "Times the gap filler was rebuilt for a new source rate (the rate became known, or changed by more than 0.1%).",
+              &Metrics::source_rate_changes);
   per_subject("bad_subscriber_messages_total", "Subscriber messages that broke the protocol.", &Metrics::bad_subscriber_messages);
   per_subject("subscribers_accepted_total", "Subscriber connections accepted.", &Metrics::subscribers_connected);
   per_subject("subscribers_refused_total", "Subscribers refused after their Hello (unknown subject, ...).", &Metrics::subscribers_refused);

@@ -69,6 +69,9 @@ class Metrics {
   std::atomic<uint64_t> markers_filled{0};
   std::atomic<uint64_t> markers_relabelled{0};
   std::atomic<uint64_t> markers_held{0};
+  // Times the pipeline's filler was rebuilt for a new source rate (once when the rate becomes
+  // known, again only when it really changes: server/pipeline/pipeline.h).
+  std::atomic<uint64_t> source_rate_changes{0};
   std::atomic<uint64_t> bad_subscriber_messages{0};
   std::atomic<uint64_t> subscribers_connected{0};  // total accepted
   std::atomic<uint64_t> subscribers_refused{0};    // Hello refused (unknown subject, ...)

@@ -46,6 +46,12 @@ struct NatNetServerOptions {
   bool loop = false;
   bool start_on_first_request = true;
   std::chrono::milliseconds client_timeout{10'000};  // unicast clients without a keep-alive
+  size_t max_clients = 16;                           // unicast clients served, and senders remembered as connected
+  // The frames' timestamps as a real capture clock stamps them, for tests and benchmarks of the
+  // clients (0: exact): moved by up to +-timestamp_jitter_us, then quantised to the ticks of a
+  // timestamp_clock_hz clock (protocol/natnet_capture_encoder.h).
+  double timestamp_jitter_us = 0.0;
+  double timestamp_clock_hz = 0.0;
 };
 
 struct NatNetServerStats {

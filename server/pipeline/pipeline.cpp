@@ -166,11 +166,13 @@ void Pipeline::process(const MarkerFrame& frame, uint64_t generation) {
     generation_ = generation;
     has_generation_ = true;
   }
-  if (frame.source_rate_hz > 0 && std::abs(frame.source_rate_hz - filler_rate_hz_) > 1e-6) {
-    // Rare (the rate becomes known): rebuilding allocates, which is fine here.
+  if (rate_changed(frame.source_rate_hz)) {
+    // Rare (the rate becomes known, the operator changes it): rebuilding allocates, which is fine here.
     filler_rate_hz_ = frame.source_rate_hz;
+    last_rate_change_ = std::chrono::steady_clock::now();
     filler_.emplace(model_, filler_options(filler_rate_hz_));
     blender_.reset();
+    metrics_.source_rate_changes.fetch_add(1, std::memory_order_relaxed);
     spdlog::info("pipeline: source rate {} Hz", frame.source_rate_hz);
   }
 
@@ -198,6 +200,12 @@ void Pipeline::process(const MarkerFrame& frame, uint64_t generation) {
   long released = 0;
   if (blender_.push(filled_, filled_status_, sequence, {released_positions_, released_status_}, released, filled_revoked_))
     publish(held_[static_cast<size_t>(released) % held_.size()], released_positions_, released_status_);
+}
+
+bool Pipeline::rate_changed(double source_rate_hz) const {
+  if (!(source_rate_hz > 0.0) || std::abs(source_rate_hz - filler_rate_hz_) <= kRateTolerance * filler_rate_hz_) return false;
+  return last_rate_change_ == std::chrono::steady_clock::time_point{} ||
+         std::chrono::steady_clock::now() - last_rate_change_ >= kMinRateChangeInterval;
 }
 
 size_t Pipeline::message_bytes(StreamKey key) const {
