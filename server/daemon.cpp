@@ -143,6 +143,8 @@ ViconSourceOptions vicon_options_of(const DaemonConfig& config) {
   options.port = address.port;
   options.mode = config.vicon_pull ? ViconSourceOptions::Mode::ClientPull : ViconSourceOptions::Mode::ServerPush;
   options.limits = description_limits_of(config);
+  options.handshake_timeout = std::chrono::milliseconds(config.source_handshake_timeout_ms);
+  options.stall_timeout = std::chrono::milliseconds(config.source_stall_ms);
   return options;
 }
 
@@ -194,6 +196,8 @@ Daemon::Daemon(const DaemonConfig& config)
     QtmSourceOptions options;
     options.host = address.host;
     options.port = address.port;
+    options.handshake_timeout = std::chrono::milliseconds(config.source_handshake_timeout_ms);
+    options.stall_timeout = std::chrono::milliseconds(config.source_stall_ms);
     spdlog::info("source: QTM RT {}:{}", options.host, options.port);
     source_ = std::make_unique<QtmSource>(io_, std::move(options), static_cast<SourceSink&>(*this));
   } else if (!config.natnet.empty()) {
@@ -437,7 +441,9 @@ void Daemon::schedule_status_log() {
   status_log_timer_.expires_after(std::chrono::seconds(config_.status_log_seconds));
   status_log_timer_.async_wait([this](const boost::system::error_code& ec) {
     if (ec || stopping_.load()) return;
-    for (auto& s : subjects_) spdlog::info("{}", s->status_line(StatusLine::Clock::now()));
+    // The source's state at the end: a stalled or lost source shows in every line until it is back.
+    const char* state = to_string(source_state());
+    for (auto& s : subjects_) spdlog::info("{}; source {}", s->status_line(StatusLine::Clock::now()), state);
     schedule_status_log();
   });
 }

@@ -34,7 +34,18 @@ subscriber::MeshInfo mesh_info_of(const SubjectFile& subject) {
   return info;
 }
 
-subscriber::SourceStateCode code_of(SourceState s) { return static_cast<subscriber::SourceStateCode>(static_cast<uint32_t>(s)); }
+// Stalled goes out as Disconnected (the protocol's subscribers know no other state), with its
+// detail saying "stalled".
+subscriber::SourceStateCode code_of(SourceState s) {
+  switch (s) {
+    case SourceState::Connecting: return subscriber::SourceStateCode::Connecting;
+    case SourceState::Streaming: return subscriber::SourceStateCode::Streaming;
+    case SourceState::Finished: return subscriber::SourceStateCode::Finished;
+    case SourceState::Disconnected:
+    case SourceState::Stalled: break;
+  }
+  return subscriber::SourceStateCode::Disconnected;
+}
 
 // The /metrics histograms condensed for scripts, over the stream's life: per stage its count,
 // the quantiles as bucket upper bounds ("le") and the largest value seen.

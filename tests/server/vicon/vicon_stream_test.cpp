@@ -26,6 +26,8 @@
 #include "server/vicon/vicon_server.h"
 #include "support/allocation_counter.h"
 #include "support/io_thread.h"
+#include "support/silent_capture_servers.h"
+#include "support/source_sink_recorder.h"
 #include "support/socket_lookup.h"
 #include "support/test_data.h"
 
@@ -370,6 +372,33 @@ TEST(ViconStream, ServerGoneThenBackGivesDisconnectedThenStreaming) {
     EXPECT_EQ(sink.count_state(SourceState::Disconnected), 1u);  // reported once per outage
     EXPECT_NE(sink.states_[2].second.find("127.0.0.1"), std::string::npos) << sink.states_[2].second;
   });
+}
+
+// A server that accepts and never sends ObjectEnums kept the source "connecting" for ever: it is
+// left after the handshake timeout and tried again. One that stops sending frames with its
+// connection open was shown streaming: it is reported stalled and tried again.
+TEST(ViconStream, ASilentServerIsLeftAndOneThatGoesSilentIsStalled) {
+  test::SilentViconServer silent({.handshake = false});
+  test::SilentViconServer goes_silent({.frames = 5});
+  IoThread client_io;
+  test::SourceSinkRecorder a, b;
+  ViconSource to_silent(client_io.io, {.host = "127.0.0.1", .port = silent.port(), .handshake_timeout = 300ms}, a);
+  ViconSource to_goes_silent(client_io.io, {.host = "127.0.0.1", .port = goes_silent.port(), .stall_timeout = 300ms}, b);
+  to_silent.start();
+  to_goes_silent.start();
+  ASSERT_TRUE(a.wait_state(SourceState::Disconnected));
+  ASSERT_TRUE(b.wait_frames(5));
+  ASSERT_TRUE(b.wait_state(SourceState::Stalled));
+  ASSERT_TRUE(test::eventually([&] { return silent.connections() >= 2 && goes_silent.connections() >= 2; }));
+  to_silent.stop();
+  to_goes_silent.stop();
+  client_io.call([] {});
+  EXPECT_NE(a.last_detail(SourceState::Disconnected).find("no ObjectEnums from 127.0.0.1:"), std::string::npos)
+      << a.last_detail(SourceState::Disconnected);
+  EXPECT_TRUE(a.frames.empty());
+  EXPECT_NE(b.last_detail(SourceState::Stalled).find("stalled: no frame from 127.0.0.1:"), std::string::npos)
+      << b.last_detail(SourceState::Stalled);
+  EXPECT_EQ(b.count_state(SourceState::Disconnected), 0u);
 }
 
 TEST(ViconStream, GarbageFromTheServerIsCountedNotFatal) {
