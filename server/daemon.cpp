@@ -206,6 +206,9 @@ Daemon::Daemon(const DaemonConfig& config)
     options.host = address.host;
     options.command_port = address.port;
     options.interface_address = config.natnet_interface;
+    options.bind_address = config.bind_address;
+    options.reply_timeout = std::chrono::milliseconds(config.source_handshake_timeout_ms);
+    options.stall_timeout = std::chrono::milliseconds(config.source_stall_ms);
     spdlog::info("source: NatNet {}:{}", options.host, options.command_port);
     source_ = std::make_unique<NatNetSource>(io_, std::move(options), static_cast<SourceSink&>(*this));
   } else {

@@ -412,6 +412,70 @@ TEST_F(DaemonProgram, QtmReachesTheSubscriberInOrder) { expect_vicon_stream_in_o
 
 TEST_F(DaemonProgram, NatNetReachesTheSubscriberInOrder) { expect_vicon_stream_in_order(subject_, take_, ViconMode::NatNet); }
 
+// A NatNet server whose timestamps jitter by +-20 us, or tick on a 10 MHz clock (83,333 or 83,334
+// ticks a frame at 120 Hz), as real capture clocks do: the daemon's source rate is the nominal
+// 120 Hz and never changes, the gap filler is never rebuilt, and the log says the rate once at
+// most. (The rate read from each pair of frames rebuilt the filler on every frame: 952 "source
+// rate" lines in 12 s, processing p99 1.5 -> 50 ms.)
+void expect_natnet_clock_changes_nothing(const std::string& subject, const std::string& take, const std::string& clock) {
+  ReplayProcess replay(take, 0, "--protocol natnet --unicast " + clock);
+  DaemonProcess daemon("--subject " + subject + " --natnet 127.0.0.1:" + std::to_string(replay.port));
+  const ProgramRun sub = run(std::string(SKINSTREAM_SUB) + " 127.0.0.1:" + std::to_string(daemon.sub_port) + " --markers --no-mesh --frames 360");
+  const nlohmann::json health = server::fetch_health(daemon.http_port);
+  EXPECT_EQ(daemon.stop(), 0) << daemon.log();
+  ASSERT_EQ(sub.exit_code, 0) << sub.output << daemon.log();
+  EXPECT_EQ(health["source"]["rate_hz"], 120.0) << health.dump();
+  EXPECT_EQ(health["subjects"][0]["source_rate_changes"], 0) << health.dump();
+  EXPECT_LE(count_lines_with(daemon.log(), "source rate"), 1) << daemon.log().substr(0, 4000);
+}
+
+TEST_F(DaemonProgram, NatNetClockJitterChangesNoRate) {
+  expect_natnet_clock_changes_nothing(subject_, take_, "--natnet-timestamp-jitter-us 20");
+}
+
+TEST_F(DaemonProgram, NatNetTenMegahertzClockChangesNoRate) {
+  expect_natnet_clock_changes_nothing(subject_, take_, "--natnet-clock-hz 10000000");
+}
+
+// A capture server that answers the handshake, sends a few frames and then nothing with its
+// connection open (a QTM, Motive or Nexus whose stream stopped) was shown "streaming" at 120 Hz
+// while the frames stayed frozen: with the daemon's defaults it is "stalled" on /health, in the
+// status line and (as disconnected, saying "stalled") in Status, and the daemon connects again.
+template <typename Server>
+void expect_silence_is_a_stall(const std::string& subject, const std::string& source_flag) {
+  Server server({.frames = 5});
+  const std::string config = test::scratch_path("stall_" + std::to_string(getpid()) + ".json");
+  { std::ofstream(config) << R"({"status_log_seconds": 1})"; }
+  DaemonProcess daemon("--config " + config + " --subject " + subject + " " + source_flag + " 127.0.0.1:" + std::to_string(server.port()));
+  BackgroundSubscriber subscriber(daemon.sub_port, subscriber::kWantMarkers | subscriber::kWantNoMesh);
+  EXPECT_TRUE(eventually([&] { return server::fetch_health(daemon.http_port)["source"]["state"] == "stalled"; })) << daemon.log();
+  EXPECT_TRUE(eventually([&] { return server.connections() >= 2; })) << daemon.log();
+  EXPECT_TRUE(eventually([&] { return daemon.log().find("; source stalled") != std::string::npos; })) << daemon.log();
+  EXPECT_TRUE(eventually([&] { return subscriber.last_status_detail().find("stalled: no frame from") == 0; }))
+      << subscriber.last_status_detail();
+  EXPECT_FALSE(subscriber.closed()) << subscriber.error();
+  EXPECT_EQ(daemon.stop(), 0) << daemon.log();
+}
+
+TEST_F(DaemonProgram, QtmServerThatGoesSilentIsStalled) { expect_silence_is_a_stall<test::SilentQtmServer>(subject_, "--qtm"); }
+
+TEST_F(DaemonProgram, NatNetServerThatGoesSilentIsStalled) { expect_silence_is_a_stall<test::SilentNatNetServer>(subject_, "--natnet"); }
+
+TEST_F(DaemonProgram, ViconServerThatGoesSilentIsStalled) { expect_silence_is_a_stall<test::SilentViconServer>(subject_, "--vicon"); }
+
+// A QTM server that accepts and never answers kept the daemon "connecting" for ever: it is left
+// after the handshake timeout, reported, and tried again.
+TEST_F(DaemonProgram, QtmServerThatNeverAnswersIsLeftAndTriedAgain) {
+  test::SilentQtmServer server({.handshake = false});
+  DaemonProcess daemon("--subject " + subject_ + " --qtm 127.0.0.1:" + std::to_string(server.port()));
+  EXPECT_TRUE(eventually([&] {
+    const nlohmann::json source = server::fetch_health(daemon.http_port)["source"];
+    return source["state"] == "disconnected" && source["detail"].get<std::string>().find("no handshake with") == 0;
+  })) << daemon.log();
+  EXPECT_TRUE(eventually([&] { return server.connections() >= 2; })) << daemon.log();
+  EXPECT_EQ(daemon.stop(), 0) << daemon.log();
+}
+
 TEST_F(DaemonProgram, ViconUnreachableIsReportedAndServingGoesOn) {
   const int port = test::free_loopback_port(SOCK_STREAM);  // nobody listens on it
   ASSERT_GT(port, 0);
