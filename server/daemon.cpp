@@ -49,6 +49,7 @@ std::vector<std::unique_ptr<SubjectStream>> load_subjects(const DaemonConfig& co
   options.hub.queue_frames = config.subscriber_queue_frames;
   options.hub.frame_max_wait = std::chrono::milliseconds(config.max_frame_wait_ms);
   options.hub.hello_timeout = std::chrono::milliseconds(config.hello_timeout_ms);
+  options.hub.unauthenticated_hello_timeout = std::chrono::milliseconds(config.unauthenticated_hello_timeout_ms);
   PipelineOptions& pipeline = options.pipeline;
   pipeline.lookahead = config.lookahead;
   pipeline.deform_threads = config.deform_threads;
@@ -133,6 +134,8 @@ AdmissionOptions admission_options_of(const DaemonConfig& config) {
   options.max_total = config.max_subscribers;
   options.max_per_address = config.max_subscribers_per_address;
   options.token = config.subscriber_token;
+  options.max_unauthenticated = config.max_unauthenticated_subscribers;
+  options.max_unauthenticated_per_address = config.max_unauthenticated_per_address;
   return options;
 }
 
@@ -242,10 +245,14 @@ Daemon::Daemon(const DaemonConfig& config)
     }
     SubscriberHub& hub = subject(0).hub();  // until a version 2 Hello names another
     auto subscriber = std::make_shared<TcpSubscriber>(placed.io, hub, std::move(socket), remote, std::move(placed.token));
-    // Refused or not, the subscriber is answered after its Hello, in the version it speaks.
-    SubscriberAdmission::Decision admitted = admission_->admit(endpoint.address());
-    const bool ask_token = admitted.ticket && admission_->token_required();
-    subscriber->set_admission(std::move(admitted), ask_token ? admission_ : nullptr);
+    // Refused or not, the subscriber is answered after its Hello, in the version it speaks. With
+    // a token it is admitted once it gave it; until then it holds a place kept for connections
+    // without it.
+    const bool token = admission_->token_required();
+    SubscriberAdmission::Decision admitted =
+        token ? admission_->admit_unauthenticated(endpoint.address()) : admission_->admit(endpoint.address());
+    const bool ask_token = admitted.ticket && token;
+    subscriber->set_admission(std::move(admitted), ask_token ? admission_ : nullptr, endpoint.address());
     hub.add(subscriber);
     asio::post(placed.io, [subscriber] { subscriber->start(); });
   }, ListenerOptions{config.subscriber_tcp_congestion, &source_metrics_, &descriptor_reserve_, false, config.subscriber_unsent_kb * 1024});
@@ -486,6 +493,10 @@ std::string Daemon::health_json() const {
         {"allow_subscribers", allowed},
         {"token_required", admission_->token_required()},
         {"admitted", admission_->admitted()},
+        {"max_unauthenticated_subscribers", config_.max_unauthenticated_subscribers},
+        {"max_unauthenticated_per_address", config_.max_unauthenticated_per_address},
+        {"unauthenticated", admission_->unauthenticated()},
+        {"refused_unauthenticated", source_metrics_.subscribers_refused_unauthenticated.load()},
         {"refused_not_allowed", source_metrics_.subscribers_refused_not_allowed.load()},
         {"refused_limit", source_metrics_.subscribers_refused_limit.load()},
         {"refused_token", source_metrics_.subscribers_refused_token.load()},

@@ -144,6 +144,10 @@ std::string render_prometheus(const Metrics& source, const std::vector<SubjectMe
   daemon_counter("subscribers_refused_limit_total", "Subscribers refused as they connected: max_subscribers or max_subscribers_per_address reached.",
                  source.subscribers_refused_limit);
   daemon_counter("subscribers_refused_token_total", "Subscribers refused for a missing or wrong subscriber_token.", source.subscribers_refused_token);
+  daemon_counter("subscribers_refused_unauthenticated_total",
+                 "Connections refused as they connected: too many without the subscriber_token yet (max_unauthenticated_subscribers, "
+                 "max_unauthenticated_per_address).",
+                 source.subscribers_refused_unauthenticated);
   per_subject("frames_received_total", "Marker frames of the subject received from the source.", &Metrics::frames_received);
   per_subject("frames_processed_total", "Frames through the gap filler.", &Metrics::frames_processed);
   per_subject("frames_published_total", "Frames handed to the publishers.", &Metrics::frames_published);
