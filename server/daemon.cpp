@@ -384,8 +384,9 @@ void Daemon::on_source_state(SourceState state, std::string_view detail) {
     for (auto& s : subjects_) s->new_take();
   }
   // A change of state is news; streaming again (a replay's loop) is not: the status line says
-  // that the frames keep coming.
-  if (state != previous) spdlog::info("source: {} ({})", to_string(state), detail);
+  // that the frames keep coming. At most one line a second: a source that flaps (stalls and comes
+  // back, again and again) says so with a count of what was not logged.
+  if (state != previous) state_log_.info("source_state", fmt::format("source: {} ({})", to_string(state), detail));
   else spdlog::debug("source: {} ({})", to_string(state), detail);
   broadcast_status();
 }
