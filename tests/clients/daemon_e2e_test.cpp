@@ -353,6 +353,92 @@ TEST_F(DaemonProgram, ViconReplayServerOutOfDescriptorsPausesAccepts) {
   close(client);
 }
 
+// The QTM RT replay server out of file descriptors (limited to 32) with clients still waiting:
+// its accepts pause as the daemon's do (it retried at once on a full core, without a word), and
+// it accepts again once they leave.
+TEST_F(DaemonProgram, QtmReplayServerOutOfDescriptorsPausesAccepts) {
+  if (kVptrCheckNeedsADescriptor) GTEST_SKIP() << "UndefinedBehaviorSanitizer's vptr check needs a free descriptor";
+  ReplayProcess replay(take_, 0, "--protocol qtm", "ulimit -n 32; ");
+  ASSERT_GT(replay.pid(), 0);
+  std::vector<int> flood;
+  ASSERT_NO_FATAL_FAILURE(expect_accepts_paused_when_flooded(replay.port, 100, replay.pid(), [&] { return replay.log(); }, flood));
+  for (int fd : flood) close(fd);
+  EXPECT_TRUE(eventually([&] { return replay.log().find("accepting again after") != std::string::npos; })) << replay.log();
+}
+
+// Bytes of a QTM RT command packet.
+std::vector<unsigned char> qtm_command(const std::string& text) { return qtm::encode_text(qtm::PacketType::Command, text); }
+
+long resident_kb_of(pid_t pid) {
+  std::ifstream status("/proc/" + std::to_string(pid) + "/status");
+  for (std::string line; std::getline(status, line);)
+    if (line.rfind("VmRSS:", 0) == 0) return std::stol(line.substr(6));
+  return 0;
+}
+
+// A QTM RT client that sends 20,000 GetParameters and reads none of the replies: the replay
+// server queued every reply (RSS 21 -> 652 MB, kept). Now its commands wait, unread, once 64
+// replies do; another client is served meanwhile, and the server's memory stays where it was.
+TEST_F(DaemonProgram, QtmReplayServerQueuesFewRepliesForAClientThatDoesNotRead) {
+  ReplayProcess replay(take_, 0, "--protocol qtm");
+  const long before = resident_kb_of(replay.pid());
+  const int greedy = connect_loopback(replay.port, "", 4096);
+  ASSERT_GE(greedy, 0);
+  std::vector<unsigned char> commands;
+  for (int i = 0; i < 20000; ++i) {
+    const std::vector<unsigned char> one = qtm_command("GetParameters General 3D");
+    commands.insert(commands.end(), one.begin(), one.end());
+  }
+  // Sent from a thread: once the server stops reading, the send waits.
+  std::thread sender([&] { send(greedy, commands.data(), commands.size(), MSG_NOSIGNAL); });
+  std::this_thread::sleep_for(std::chrono::seconds(2));
+  const long after = resident_kb_of(replay.pid());
+  // Another client: welcomed at once.
+  const int polite = connect_loopback(replay.port);
+  pollfd readable{polite, POLLIN, 0};
+  EXPECT_EQ(poll(&readable, 1, 10'000), 1) << "no welcome to another client";
+  close(polite);
+  shutdown(greedy, SHUT_RDWR);
+  sender.join();
+  close(greedy);
+  std::printf("replay server RSS: %ld kB before, %ld kB after 20,000 unread GetParameters\n", before, after);
+  EXPECT_LT(after - before, 64 * 1024) << replay.log();
+}
+
+// StreamFrames asking for UDP to another address than the client's own: the replay server sent
+// its frames there (a relay toward anyone). Refused now, with an Error, and nothing is sent.
+TEST_F(DaemonProgram, QtmReplayServerStreamsUdpOnlyToTheClientsOwnAddress) {
+  ReplayProcess replay(take_, 0, "--protocol qtm");
+  const int victim = socket(AF_INET, SOCK_DGRAM, 0);
+  sockaddr_in address{};
+  address.sin_family = AF_INET;
+  inet_pton(AF_INET, "127.0.0.2", &address.sin_addr);
+  ASSERT_EQ(bind(victim, reinterpret_cast<sockaddr*>(&address), sizeof address), 0);
+  socklen_t length = sizeof address;
+  getsockname(victim, reinterpret_cast<sockaddr*>(&address), &length);
+  const int client = connect_loopback(replay.port, "127.0.0.1");
+  ASSERT_GE(client, 0);
+  const std::vector<unsigned char> command =
+      qtm_command("StreamFrames AllFrames UDP:127.0.0.2:" + std::to_string(ntohs(address.sin_port)) + " 3D");
+  ASSERT_EQ(send(client, command.data(), command.size(), MSG_NOSIGNAL), static_cast<ssize_t>(command.size()));
+  // The welcome, then the refusal.
+  std::string replies;
+  for (auto end = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+       replies.find("UDP only to") == std::string::npos && std::chrono::steady_clock::now() < end;) {
+    pollfd readable{client, POLLIN, 0};
+    if (poll(&readable, 1, 200) != 1) continue;
+    char buffer[4096];
+    const ssize_t n = recv(client, buffer, sizeof buffer, 0);
+    if (n <= 0) break;
+    replies.append(buffer, static_cast<size_t>(n));
+  }
+  EXPECT_NE(replies.find("StreamFrames: UDP only to this client's own address 127.0.0.1"), std::string::npos) << replies;
+  pollfd datagram{victim, POLLIN, 0};
+  EXPECT_EQ(poll(&datagram, 1, 1000), 0) << "the replay server sent frames to another address";
+  close(client);
+  close(victim);
+}
+
 // skinstream-replay -> skinstreamd --vicon -> skinstream-sub, in both Vicon modes (and the same
 // with --qtm and --natnet): frames arrive in order, and a measured marker is the recording's
 // sample of the same frame number (so the numbering and the marker mapping survive the round trip

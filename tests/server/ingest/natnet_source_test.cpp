@@ -409,5 +409,44 @@ TEST(NatNetServer, CountsMalformedDatagramsAndAnswersTheRest) {
   server_io.call([&] { server.stop(); });
 }
 
+// A model request costs 4 bytes and its answer ~1,000 times that: answered only to a sender that
+// CONNECTed (a forged source address would have the server flood a victim). And CONNECTs from
+// many ports (2,000 once starved the real client of frames for 10 s) beyond max_clients are
+// not answered: the clients already served keep their frames.
+TEST(NatNetServer, AnswersRequestsOnlyToConnectedClientsAndServesAFew) {
+  const Capture walker = test::replay_capture(10, 0.0);
+  IoThread server_io;
+  NatNetServerOptions options = unicast_server({4, 1});
+  options.max_clients = 4;
+  NatNetServer server(server_io.io, {{"walker", &walker}}, options);
+  server_io.call([&] { server.start(); });
+  const udp::endpoint to(asio::ip::make_address("127.0.0.1"), server_io.call([&] { return server.command_port(); }));
+  asio::io_context io;
+  auto answered = [&](udp::socket& s) {
+    s.non_blocking(true);
+    std::vector<unsigned char> buffer(natnet::kMaxMessageBytes);
+    udp::endpoint from;
+    boost::system::error_code ec;
+    for (auto end = std::chrono::steady_clock::now() + 500ms; std::chrono::steady_clock::now() < end;) {
+      if (s.receive_from(asio::buffer(buffer), from, 0, ec) > 0) return true;
+      std::this_thread::sleep_for(5ms);
+    }
+    return false;
+  };
+  udp::socket stranger(io, udp::endpoint(asio::ip::make_address("127.0.0.1"), 0));
+  stranger.send_to(asio::buffer(natnet::encode_empty(natnet::message::RequestModelDef)), to);
+  EXPECT_FALSE(answered(stranger)) << "a model request answered to a sender that never connected";
+  std::vector<std::unique_ptr<udp::socket>> clients;
+  for (int i = 0; i < 6; ++i) {
+    clients.push_back(std::make_unique<udp::socket>(io, udp::endpoint(asio::ip::make_address("127.0.0.1"), 0)));
+    clients.back()->send_to(asio::buffer(natnet::encode_connect("test", {4, 1})), to);
+    EXPECT_EQ(answered(*clients.back()), i < 4) << "client " << i;
+  }
+  EXPECT_EQ(server.stats().clients_refused.load(), 2u);
+  EXPECT_EQ(server.stats().requests_not_connected.load(), 1u);
+  EXPECT_EQ(server.stats().clients_connected.load(), 4u);
+  server_io.call([&] { server.stop(); });
+}
+
 }  // namespace
 }  // namespace skinstream::server
