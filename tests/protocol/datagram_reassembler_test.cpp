@@ -248,7 +248,7 @@ TEST(DatagramReassembler, WithAKeyOnlyItsTaggedDatagramsAreTaken) {
   const std::vector<ByteVector> plain = datagrams_of(1), foreign = signed_datagrams(1, &stranger);
   std::vector<ByteVector> altered = signed_datagrams(1, authenticator.get());
   altered[0][16] ^= 1;  // the sequence, after signing
-  for (const auto* forged : {&plain, &foreign, &altered})
+  for (const std::vector<ByteVector>* forged : {&plain, &foreign, static_cast<const std::vector<ByteVector>*>(&altered)})
     for (const ByteVector& d : *forged) EXPECT_THROW(r.add(d, t0), DecodeError);
   EXPECT_EQ(r.stats().datagrams_unauthenticated, plain.size() + foreign.size() + altered.size());
   std::vector<std::vector<ByteVector>> frames;
