@@ -248,9 +248,10 @@ TEST(DatagramReassembler, WithAKeyOnlyItsTaggedDatagramsAreTaken) {
   const std::vector<ByteVector> plain = datagrams_of(1), foreign = signed_datagrams(1, &stranger);
   std::vector<ByteVector> altered = signed_datagrams(1, authenticator.get());
   altered[0][16] ^= 1;  // the sequence, after signing
-  for (const std::vector<ByteVector>* forged : {&plain, &foreign, static_cast<const std::vector<ByteVector>*>(&altered)})
+  for (const std::vector<ByteVector>* forged : {&plain, &foreign})
     for (const ByteVector& d : *forged) EXPECT_THROW(r.add(d, t0), DecodeError);
-  EXPECT_EQ(r.stats().datagrams_unauthenticated, plain.size() + foreign.size() + altered.size());
+  EXPECT_THROW(r.add(altered[0], t0), DecodeError);
+  EXPECT_EQ(r.stats().datagrams_unauthenticated, plain.size() + foreign.size() + 1);
   std::vector<std::vector<ByteVector>> frames;
   for (uint32_t s = 1; s <= 10; ++s) frames.push_back(signed_datagrams(s, authenticator.get()));
   const test::CountAllocations allocations;

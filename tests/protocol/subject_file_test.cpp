@@ -343,8 +343,9 @@ TEST_F(SubjectFile, EveryValueReadIsChecked) {
   d.reference_vertices[0] = Vec3(1e300, 0, 0);
   EXPECT_NE(refusal(model_, &d).find("a mesh vertex is not finite or beyond 1 km"), std::string::npos) << refusal(model_, &d);
   d = limb_deformation(model_);
-  d.vertex_influences[0].weight = std::nan("");
-  EXPECT_NE(refusal(model_, &d).find("vertex weight outside [0, 1]"), std::string::npos) << refusal(model_, &d);
+  d.part_names[0] = "arm\x07";
+  EXPECT_NE(refusal(model_, &d).find("a part's name is empty, longer than 256 bytes or holds a control character"), std::string::npos)
+      << refusal(model_, &d);
   // The model as built reads back.
   write_subject(model_, path);
   EXPECT_NO_THROW(read_subject_file(path));
