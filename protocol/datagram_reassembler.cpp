@@ -1,5 +1,6 @@
 #include "protocol/datagram_reassembler.h"
 
+#include <algorithm>
 #include <cstring>
 #include <string>
 
@@ -74,24 +75,27 @@ std::optional<DatagramReassembler::Message> DatagramReassembler::add(std::span<c
   ++stats_.datagrams;
   expire(now);
   if (!in_window(h.sequence, now)) return std::nullopt;
+  // A fragment whose count, size or model differ from those of its sequence's other fragments
+  // belongs to another frame of that sequence, put together beside it: one of the two is not the
+  // sender's, and a copy of every real fragment with another model id once kept every real frame
+  // from completing.
   Slot* slot = nullptr;
   for (Slot& s : slots_)
-    if (s.used && s.header.sequence == h.sequence) slot = &s;
-  if (slot && (slot->header.count != h.count || slot->header.message_bytes != h.message_bytes || slot->header.model_id != h.model_id)) {
-    // One of the two is not the sender's: the newcomer begins the frame again, so a forged first
-    // fragment cannot keep the real frame out (a forged later one costs the frame, as a loss does).
-    ++stats_.frames_restarted;
-    start(*slot, h, now);
-  }
+    if (s.used && s.header.sequence == h.sequence && s.header.count == h.count && s.header.message_bytes == h.message_bytes &&
+        s.header.model_id == h.model_id)
+      slot = &s;
   if (!slot) {
-    // A free slot; else the frame furthest ahead gives way (the next one due is the one to keep),
-    // unless this datagram is further ahead still.
+    // A free slot; else the frame furthest ahead gives way (the next one due is the one to keep;
+    // of two of one sequence, the one with fewer fragments), unless this datagram is further
+    // ahead still.
     for (Slot& s : slots_)
       if (!s.used) slot = &s;
     if (!slot) {
       Slot* furthest = &slots_[0];
       for (Slot& s : slots_)
-        if (after(s.header.sequence, furthest->header.sequence)) furthest = &s;
+        if (after(s.header.sequence, furthest->header.sequence) ||
+            (s.header.sequence == furthest->header.sequence && s.fragments < furthest->fragments))
+          furthest = &s;
       if (after(h.sequence, furthest->header.sequence)) {
         ++stats_.datagrams_no_slot;
         return std::nullopt;
@@ -99,6 +103,8 @@ std::optional<DatagramReassembler::Message> DatagramReassembler::add(std::span<c
       give_up(*furthest);
       slot = furthest;
     }
+    if (std::any_of(slots_.begin(), slots_.end(), [&](const Slot& s) { return s.used && s.header.sequence == h.sequence; }))
+      ++stats_.frames_disputed;
     start(*slot, h, now);
   }
   const uint64_t bit = uint64_t{1} << h.index;
@@ -112,10 +118,11 @@ std::optional<DatagramReassembler::Message> DatagramReassembler::add(std::span<c
               fragment_size);
   if (slot->fragments < h.count) return std::nullopt;
 
-  // Complete: the frames before it are of no more use (the newest frame wins).
+  // Complete: the frames before it, and another of its sequence, are of no more use (the newest
+  // frame wins).
   slot->used = false;
   for (Slot& s : slots_)
-    if (s.used && after(h.sequence, s.header.sequence)) give_up(s);
+    if (s.used && !after(s.header.sequence, h.sequence)) give_up(s);
   if (has_completed_ && after(h.sequence, last_completed_)) stats_.frames_lost += h.sequence - last_completed_ - 1;
   has_completed_ = true;
   last_completed_ = h.sequence;

@@ -14,9 +14,10 @@
 //     10 s, + 60,000 for the rest of the run);
 //   - when no frame completed for resync_after, the next datagram starts the stream afresh,
 //     whatever its sequence (the sender started again, or the network was away for long);
-//   - with every slot in use, the frame furthest ahead gives way, not the next one due, and a
-//     fragment that disagrees with its frame's others starts that frame again (about 360 forged
-//     first fragments a second once kept every real frame out).
+//   - with every slot in use, the frame furthest ahead gives way, not the next one due (about 360
+//     forged first fragments a second once kept every real frame out), and a fragment whose
+//     count, size or model id differ from its sequence's other fragments is put together apart
+//     from them (a copy of every real fragment with another model id cannot spoil the real frame).
 
 #include <array>
 #include <chrono>
@@ -53,7 +54,7 @@ class DatagramReassembler {
     uint64_t datagrams_out_of_window = 0;  // more than max_ahead after the last completed frame
     uint64_t datagrams_no_slot = 0;        // further ahead than every frame in progress, with none free
     uint64_t datagrams_unauthenticated = 0;  // of the rejected: no tag, or a wrong one
-    uint64_t frames_restarted = 0;           // a fragment that disagreed with its frame's others began it again
+    uint64_t frames_disputed = 0;            // a second frame of one sequence begun (its count, size or model differ)
     uint64_t resyncs = 0;                    // the stream started afresh after resync_after without a frame
   };
   struct Message {

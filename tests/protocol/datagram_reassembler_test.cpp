@@ -56,21 +56,27 @@ TEST(DatagramReassembler, BadDatagramsAreCountedAndLeaveFramesInProgressAlone) {
   EXPECT_EQ(message->header.model_id, 9u);
 }
 
-// A fragment whose count, size or model disagrees with its frame's first one: one of them is
-// not the sender's. The newcomer begins the frame again, so a forged first fragment (it was
-// rejected, and the real frame after it too) cannot keep the real frame out.
-TEST(DatagramReassembler, AFragmentThatDisagreesBeginsTheFrameAgain) {
+// Fragments whose count, size or model disagree with those of their sequence's others: one of
+// them is not the sender's. They are put together apart, so neither a forged first fragment nor
+// a forged copy of every real fragment (another model id) keeps the real frame out; the real one,
+// complete, ends the other.
+TEST(DatagramReassembler, FragmentsThatDisagreeArePutTogetherApart) {
   DatagramReassembler r({});
   const Clock::time_point t0{};
   EXPECT_FALSE(r.add(datagrams_of(1, 7000)[1], t0));       // forged: another size
   EXPECT_FALSE(r.add(datagrams_of(1, 7788, 0, 10)[0], t0));  // forged: another model
+  const std::vector<ByteVector> real = datagrams_of(1), copies = datagrams_of(1, 7788, 0, 10);
   std::optional<DatagramReassembler::Message> message;
-  for (const ByteVector& d : datagrams_of(1)) message = r.add(d, t0);
+  for (size_t i = 0; i < real.size() && !message; ++i) {
+    message = r.add(real[i], t0);
+    if (!message && i > 0) EXPECT_FALSE(r.add(copies[i], t0));  // each real fragment copied at once
+  }
   ASSERT_TRUE(message);
   EXPECT_TRUE(holds_message(message->bytes, 7788));
   EXPECT_EQ(message->header.model_id, 9u);
-  EXPECT_EQ(r.stats().frames_restarted, 2u);
+  EXPECT_EQ(r.stats().frames_disputed, 2u);
   EXPECT_EQ(r.stats().datagrams_rejected, 0u);
+  EXPECT_FALSE(r.add(copies.back(), t0));  // the copy's last fragment: late
 }
 
 TEST(DatagramReassembler, FragmentsInAnyOrderMakeTheMessageWithoutAllocating) {
