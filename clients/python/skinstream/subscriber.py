@@ -147,7 +147,7 @@ class Subscriber:
                 if self.status.refused:
                     raise Refused(f'the daemon refused this subscriber: {wire.printable(self.status.detail)}')
             elif kind == wire.FRAME:
-                self._check_frame_order()
+                self._check_frame_order(payload)
                 # Its length framed it, so the stream is still in step: a bad frame costs itself only.
                 try:
                     frame = self._on_frame(payload)
@@ -178,10 +178,12 @@ class Subscriber:
         self._evaluator = parameter_evaluator(model, payload, self.mesh.faces, self.libraries)
         self.model = model
 
-    def _check_frame_order(self):
+    def _check_frame_order(self, payload):
+        """Frames out of order end the subscription (unlike a frame broken on its own)."""
         if self.mesh is None:
             raise ProtocolError('a Frame before MeshInfo')
-        if self.mesh.encoding == wire.PARAMETERS and self._evaluator is None:
+        flags = struct.unpack_from('<I', payload, 4)[0] if len(payload) >= 8 else 0
+        if flags & wire.FRAME_PARAMETERS and self._evaluator is None:
             raise ProtocolError('a parameter Frame before the Model')
 
     def _reject(self, error):
