@@ -1,5 +1,6 @@
 #include "protocol/multicast_datagram.h"
 
+#include <algorithm>
 #include <cstring>
 #include <string>
 
@@ -26,9 +27,10 @@ T get(const unsigned char*& p) {
 
 }  // namespace
 
-uint16_t fragment_count(size_t message_bytes) {
-  if (message_bytes == 0 || message_bytes > kMaxDatagramMessageBytes) return 0;
-  return static_cast<uint16_t>((message_bytes + kMaxFragmentBytes - 1) / kMaxFragmentBytes);
+uint16_t fragment_count(size_t message_bytes, bool authenticated) {
+  const size_t largest = authenticated ? kMaxAuthenticatedFragmentBytes : kMaxFragmentBytes;
+  if (message_bytes == 0 || message_bytes > kMaxFragments * largest) return 0;
+  return static_cast<uint16_t>((message_bytes + largest - 1) / largest);
 }
 
 size_t fragment_offset(size_t message_bytes, uint16_t count, uint16_t index) { return index * stride(message_bytes, count); }
@@ -42,7 +44,7 @@ void encode_datagram_header(const DatagramHeader& h, std::span<unsigned char, kD
   unsigned char* p = out.data();
   put<uint32_t>(p, kDatagramMagic);
   put<uint16_t>(p, kDatagramVersion);
-  put<uint16_t>(p, 0);  // reserved
+  put<uint16_t>(p, h.authenticated ? kDatagramAuthenticated : 0);  // flags; the other bits reserved
   put<uint32_t>(p, h.stream_id);
   put<uint32_t>(p, h.model_id);
   put<uint32_t>(p, h.sequence);
@@ -61,8 +63,12 @@ DatagramHeader decode_datagram_header(std::span<const unsigned char> datagram) {
   if (get<uint32_t>(p) != kDatagramMagic) throw DecodeError("bad magic (not a skinstream multicast datagram)");
   const uint16_t version = get<uint16_t>(p);
   if (version != kDatagramVersion) throw DecodeError("multicast datagram version " + std::to_string(version) + " (this side speaks 1)");
-  if (get<uint16_t>(p) != 0) throw DecodeError("reserved header bits set");
+  const uint16_t flags = get<uint16_t>(p);
+  if (flags & ~kDatagramAuthenticated) throw DecodeError("reserved header bits set");
   DatagramHeader h;
+  h.authenticated = (flags & kDatagramAuthenticated) != 0;
+  const size_t largest = h.authenticated ? kMaxAuthenticatedFragmentBytes : kMaxFragmentBytes;
+  const size_t trailer = h.authenticated ? kDatagramTrailerBytes : 0;
   h.stream_id = get<uint32_t>(p);
   h.model_id = get<uint32_t>(p);
   h.sequence = get<uint32_t>(p);
@@ -72,13 +78,14 @@ DatagramHeader decode_datagram_header(std::span<const unsigned char> datagram) {
   if (h.count == 0 || h.count > kMaxFragments)
     throw DecodeError("fragment count " + std::to_string(h.count) + " (1-" + std::to_string(kMaxFragments) + ")");
   if (h.index >= h.count) throw DecodeError("fragment " + std::to_string(h.index) + " of " + std::to_string(h.count));
-  if (h.message_bytes == 0 || stride(h.message_bytes, h.count) > kMaxFragmentBytes ||
+  if (h.message_bytes == 0 || stride(h.message_bytes, h.count) > largest ||
       fragment_bytes(h.message_bytes, h.count, static_cast<uint16_t>(h.count - 1)) == 0)
     throw DecodeError("a message of " + std::to_string(h.message_bytes) + " bytes cannot be cut into " + std::to_string(h.count) + " fragments");
   const size_t expected = fragment_bytes(h.message_bytes, h.count, h.index);
-  if (datagram.size() - kDatagramHeaderBytes != expected)
+  if (datagram.size() - kDatagramHeaderBytes != expected + trailer)
     throw DecodeError("fragment " + std::to_string(h.index) + " of " + std::to_string(h.count) + " holds " +
-                      std::to_string(datagram.size() - kDatagramHeaderBytes) + " bytes, not " + std::to_string(expected));
+                      std::to_string(datagram.size() - kDatagramHeaderBytes - std::min(trailer, datagram.size() - kDatagramHeaderBytes)) +
+                      " bytes, not " + std::to_string(expected));
   return h;
 }
 

@@ -1,5 +1,6 @@
 #include "protocol/natnet_capture_encoder.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -34,6 +35,11 @@ CaptureEncoder::CaptureEncoder(std::vector<ReplaySubject> subjects, double rate_
   frame_.marker_set_count = frame_.marker_sets.size();
   frame_.other_markers.reserve(unlabelled);
   frame_.labelled_markers.reserve(labelled + unlabelled);
+}
+
+void CaptureEncoder::set_clock(const Clock& clock) {
+  clock_ = clock;
+  random_.seed(clock.seed);
 }
 
 uint32_t CaptureEncoder::frame_number(uint64_t stream_index) const {
@@ -80,6 +86,10 @@ const FrameOfData& CaptureEncoder::frame(uint64_t stream_index) {
   frame_.timecode = join_timecode({tc.hours, tc.minutes, tc.seconds, tc.frames});
   frame_.timecode_subframe = tc.subframes;
   frame_.timestamp_s = rate_hz_ > 0.0 ? static_cast<double>(stream_index) / rate_hz_ : 0.0;
+  if (clock_.jitter_s > 0.0)
+    frame_.timestamp_s = std::max(0.0, frame_.timestamp_s + std::uniform_real_distribution<double>(-clock_.jitter_s, clock_.jitter_s)(random_));
+  if (clock_.ticks_per_second > 0.0)
+    frame_.timestamp_s = static_cast<double>(std::llround(frame_.timestamp_s * clock_.ticks_per_second)) / clock_.ticks_per_second;
   const auto ticks = static_cast<uint64_t>(std::llround(frame_.timestamp_s * 1e9));  // 1 GHz clock
   frame_.stamp_mid_exposure = frame_.stamp_data_received = frame_.stamp_transmit = ticks;
   frame_.precise_seconds = static_cast<uint32_t>(frame_.timestamp_s);

@@ -8,10 +8,13 @@
 //     s + 1, member id = its index + 1, params "has model"), then the unlabelled points (model
 //     id 0, their own id, params "unlabelled"; the second
 //     recording's ids offset by 10,000, all modulo 65,536: the member id has 16 bits),
-//   - SMPTE timecode from the frame number (as the Vicon replay derives it), timestamp k / rate.
+//   - SMPTE timecode from the frame number (as the Vicon replay derives it), timestamp k / rate,
+//     or, with set_clock(), k / rate as a real capture clock gives it: moved by a random offset
+//     of up to +-jitter and quantised to the ticks of a clock of a given frequency.
 // Stream index k is frame number first_frame + k of the first recording.
 
 #include <cstdint>
+#include <random>
 #include <vector>
 
 #include "protocol/natnet.h"
@@ -26,6 +29,14 @@ class CaptureEncoder {
   static constexpr float kMarkerSizeMetres = 0.014f;
 
   CaptureEncoder(std::vector<ReplaySubject> subjects, double rate_hz = 0.0);
+
+  // The timestamps as an imperfect capture clock stamps them (the default is exact).
+  struct Clock {
+    double jitter_s = 0.0;       // each timestamp moved by a uniform random offset in [-jitter, +jitter]
+    double ticks_per_second = 0.0;  // > 0: then rounded to the ticks of a clock of this frequency
+    uint32_t seed = 1;
+  };
+  void set_clock(const Clock& clock);
 
   const ModelDefinitions& model_definitions() const { return definitions_; }
   double rate_hz() const { return rate_hz_; }
@@ -44,6 +55,8 @@ class CaptureEncoder {
   int frame_count_;
   ModelDefinitions definitions_;
   FrameOfData frame_;
+  Clock clock_;
+  std::mt19937 random_{1};
 };
 
 }  // namespace skinstream::natnet

@@ -1,11 +1,14 @@
 #include "protocol/subject_file.h"
 
+#include <cmath>
 #include <cstring>
 #include <fstream>
 #include <iterator>
+#include <unordered_set>
 
 #include "protocol/byte_buffer.h"
 #include "protocol/file_error.h"
+#include "protocol/printable_text.h"
 
 namespace skinstream {
 namespace {
@@ -239,6 +242,86 @@ SubjectModel decode(ByteReader& r) {
   return m;
 }
 
+// ---- Every value read is checked: the model's own validate() checks its shape, not its numbers,
+// and a NaN or 1e300 in a reference position, a local frame, an alpha or the PCA once went into
+// the filler (non-finite markers were then published).
+
+// Reference positions and vertices lie within this of the origin (mm): 1 km.
+constexpr double kMaxCoordinateMm = 1e6;
+
+bool finite_within(double value, double bound) { return std::isfinite(value) && std::abs(value) <= bound; }
+
+bool position_ok(const Vec3& p) {
+  return finite_within(p.x(), kMaxCoordinateMm) && finite_within(p.y(), kMaxCoordinateMm) && finite_within(p.z(), kMaxCoordinateMm);
+}
+
+// A name fit for logs and for the subscribers: not empty, at most 256 bytes, printable ASCII or
+// UTF-8 (no control characters).
+bool name_ok(const std::string& name) {
+  if (name.empty() || name.size() > 256) return false;
+  for (const char c : name) {
+    const auto byte = static_cast<unsigned char>(c);
+    if (byte < 0x20 || byte == 0x7F) return false;
+  }
+  return true;
+}
+
+std::string pca_problem(const MarkerPcaModel& p) {
+  for (Eigen::Index k = 0; k < p.mean.size(); ++k)
+    if (!finite_within(p.mean(k), kMaxCoordinateMm)) return "a mean that is not a finite coordinate";
+  for (Eigen::Index k = 0; k < p.variance.size(); ++k)
+    if (!std::isfinite(p.variance(k)) || p.variance(k) < 0) return "a variance that is negative or not finite";
+  for (Eigen::Index k = 0; k < p.basis.size(); ++k)
+    if (!finite_within(p.basis.data()[k], 1.0 + 1e-6)) return "a basis value outside [-1, 1]";
+  for (Eigen::Index k = 0; k < p.slot_calibration.size(); ++k)
+    if (!std::isfinite(p.slot_calibration(k)) || p.slot_calibration(k) < 0) return "a calibration that is negative or not finite";
+  if (!std::isfinite(p.residual_variance) || p.residual_variance < 0) return "a residual variance that is negative or not finite";
+  if (!std::isfinite(p.rigid_variance) || p.rigid_variance < 0) return "a rigid variance that is negative or not finite";
+  if (p.training_frames < 0) return "a negative count of training frames";
+  return "";
+}
+
+std::string values_problem(const SubjectFile& file) {
+  const SubjectModel& m = file.model;
+  std::unordered_set<std::string> names;
+  for (size_t i = 0; i < m.marker_names.size(); ++i) {
+    const std::string which = "marker " + std::to_string(i);
+    if (!name_ok(m.marker_names[i])) return which + "'s name is empty, longer than 256 bytes or holds a control character";
+    if (!names.insert(m.marker_names[i]).second) return which + "'s name " + quoted_text(m.marker_names[i]) + " is another marker's too";
+    if (!position_ok(m.reference_positions[i])) return which + "'s reference position is not finite or beyond 1 km";
+    const Eigen::Matrix3d& frame = m.local_reference_frames[i];
+    if (!frame.allFinite() || (frame * frame.transpose() - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() > 1e-3)
+      return which + "'s local reference frame is not a rotation";
+    if (const std::string bad = pca_problem(m.pca[i]); !bad.empty()) return which + "'s PCA model has " + bad;
+  }
+  for (const Vec3& p : m.ring_local_reference)
+    if (!position_ok(p)) return "a one-ring member's local position is not finite or beyond 1 km";
+  for (size_t i = 0; i < m.region_pca.size(); ++i)
+    if (const std::string bad = pca_problem(m.region_pca[i]); !bad.empty())
+      return "marker " + std::to_string(i) + "'s region PCA model has " + bad;
+  const FillParameters& fill = m.parameters;
+  if (!(fill.alpha1 > 0 && fill.alpha1 <= 10) || !(fill.alpha2 > 0 && fill.alpha2 <= 10))
+    return "the fill parameters alpha1 and alpha2 must be in (0, 10]";
+  if (!file.deformation) return "";
+  const DeformationModel& d = *file.deformation;
+  for (const Vec3& v : d.reference_vertices)
+    if (!position_ok(v)) return "a mesh vertex is not finite or beyond 1 km";
+  std::unordered_set<std::string> parts;
+  for (const std::string& name : d.part_names) {
+    if (!name_ok(name)) return "a part's name is empty, longer than 256 bytes or holds a control character";
+    if (!parts.insert(name).second) return "part name " + quoted_text(name) + " is given twice";
+  }
+  for (const PartMember& member : d.part_members)
+    if (!finite_within(member.weight, 1e6)) return "a part's marker weight is not finite";
+  for (const PartInfluence& influence : d.vertex_influences)
+    if (!std::isfinite(influence.weight) || influence.weight < 0 || influence.weight > 1 + 1e-6) return "a vertex weight outside [0, 1]";
+  for (const std::vector<double>* ridges : {&d.part_rbf_ridge, &d.part_quadratic_ridge})
+    for (double ridge : *ridges)
+      if (!std::isfinite(ridge) || ridge < 0) return "a part's ridge is negative or not finite";
+  if (!std::isfinite(d.registration_rms_mm) || d.registration_rms_mm < 0) return "the registration error is negative or not finite";
+  return "";
+}
+
 }  // namespace
 
 void write_subject(const SubjectModel& model, const std::string& path) { write_subject(model, nullptr, path); }
@@ -308,6 +391,7 @@ SubjectFile read_subject_bytes(std::span<const unsigned char> bytes, const std::
     const std::string bad = file.deformation->validate(file.model.marker_count());
     if (!bad.empty()) throw FileError(path, "inconsistent " + bad);
   }
+  if (const std::string bad = values_problem(file); !bad.empty()) throw FileError(path, "bad value: " + bad);
   return file;
 }
 

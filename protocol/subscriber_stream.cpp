@@ -392,14 +392,20 @@ Ack decode_ack(std::span<const unsigned char> payload) {
   return decode_payload("Ack", payload, [](ByteReader& r) { return Ack{r.get<uint32_t>()}; });
 }
 
-MeshInfo decode_mesh_info(std::span<const unsigned char> payload, uint16_t version) {
-  return decode_payload("MeshInfo", payload, [version](ByteReader& r) {
+MeshInfo decode_mesh_info(std::span<const unsigned char> payload, uint16_t version, const MeshInfoLimits& limits) {
+  return decode_payload("MeshInfo", payload, [version, &limits](ByteReader& r) {
     MeshInfo info;
     info.vertex_count = r.get<uint32_t>();
     const uint32_t face_count = r.get<uint32_t>();
     info.marker_count = r.get<uint32_t>();
     info.part_count = r.get<uint32_t>();
     info.source_rate_hz = r.get<float>();
+    if (info.vertex_count > limits.max_vertices)
+      throw DecodeError("MeshInfo: " + std::to_string(info.vertex_count) + " vertices, more than this subscriber takes (" +
+                        std::to_string(limits.max_vertices) + ", its max_vertices)");
+    if (info.marker_count > limits.max_markers)
+      throw DecodeError("MeshInfo: " + std::to_string(info.marker_count) + " markers, more than this subscriber takes (" +
+                        std::to_string(limits.max_markers) + ", its max_markers)");
     if (face_count > r.remaining() / 12 || info.vertex_count > r.remaining())
       throw std::out_of_range("vertex or face count exceeds the data left");
     info.faces.resize(face_count);

@@ -226,7 +226,14 @@ void patch_publish_time(std::span<unsigned char> frame_message, int64_t publish_
 MessageHeader decode_header(std::span<const unsigned char> bytes, uint32_t max_payload = kMaxPayloadBytes);
 Hello decode_hello(std::span<const unsigned char> payload, uint16_t version = kVersion1);
 Ack decode_ack(std::span<const unsigned char> payload);
-MeshInfo decode_mesh_info(std::span<const unsigned char> payload, uint16_t version = kVersion1);
+// What a subscriber takes of a MeshInfo, checked before anything is made for it: a daemon (or
+// something posing as one) can announce 67 million vertices in a 64 MiB message, or 8 million
+// empty marker names, and a client that sized its buffers from them took 3-4 GB.
+struct MeshInfoLimits {
+  uint32_t max_vertices = 4'000'000;
+  uint32_t max_markers = 4096;
+};
+MeshInfo decode_mesh_info(std::span<const unsigned char> payload, uint16_t version = kVersion1, const MeshInfoLimits& limits = {});
 Frame decode_frame(std::span<const unsigned char> payload, uint16_t version = kVersion1);
 // The payload cut into its blocks, every size checked, nothing copied or allocated.
 FrameView view_frame(std::span<const unsigned char> payload, uint16_t version = kVersion1);

@@ -7,6 +7,7 @@ packages=(
   build-essential cmake ninja-build pkg-config ccache
   libeigen3-dev libboost-dev libboost-system-dev nlohmann-json3-dev libspdlog-dev libfmt-dev
   libopenmesh-dev libmeshoptimizer-dev libgtest-dev libgmock-dev libbenchmark-dev libcli11-dev zlib1g-dev libexpat1-dev
+  libssl-dev  # OpenSSL's libcrypto: SHA-256 for the multicast datagrams' HMAC (protocol/datagram_authentication.cpp)
   chromium
   clang libclang-rt-14-dev  # scripts/fuzz.sh: libFuzzer and clang's sanitizer runtimes
   # The Python package (clients/python): Debian's python3 and numpy; pip, venv, setuptools and

@@ -59,9 +59,12 @@ void apply_json(const nlohmann::json& json, DaemonConfig& c, const std::string& 
                                       "deform_cpus", "deform_spin_lead_us",
                                       "continuity_seconds", "use_pca", "ports_file", "log_level", "hello_timeout_ms",
                                       "subscriber_queue_frames", "subscriber_tcp_congestion", "publish_threads", "status_interval_ms", "status_log_seconds", "default_rate_hz",
-                                      "compressed_key_interval", "multicast", "multicast_interface", "multicast_ttl", "source_max_subjects", "source_max_markers_per_subject",
-                                      "source_max_name_bytes", "max_subscribers", "max_subscribers_per_address",
+                                      "compressed_key_interval", "multicast", "multicast_interface", "multicast_ttl", "multicast_key_file", "source_max_subjects", "source_max_markers_per_subject",
+                                      "source_max_name_bytes", "source_max_coordinate_m", "source_handshake_timeout_ms",
+                                      "source_stall_ms", "max_subscribers", "max_subscribers_per_address",
                                       "subscriber_write_stall_ms", "allow_subscribers", "subscriber_token",
+                                      "max_unauthenticated_subscribers", "max_unauthenticated_per_address",
+                                      "unauthenticated_hello_timeout_ms",
                                       "subscriber_unsent_kb"};
   for (const auto& [key, value] : json.items()) {
     bool known = false;
@@ -113,14 +116,21 @@ void apply_json(const nlohmann::json& json, DaemonConfig& c, const std::string& 
   take(json, "multicast", c.multicast, origin);
   take(json, "multicast_interface", c.multicast_interface, origin);
   take(json, "multicast_ttl", c.multicast_ttl, origin);
+  take(json, "multicast_key_file", c.multicast_key_file, origin);
   take(json, "source_max_subjects", c.source_max_subjects, origin);
   take(json, "source_max_markers_per_subject", c.source_max_markers_per_subject, origin);
   take(json, "source_max_name_bytes", c.source_max_name_bytes, origin);
+  take(json, "source_max_coordinate_m", c.source_max_coordinate_m, origin);
+  take(json, "source_handshake_timeout_ms", c.source_handshake_timeout_ms, origin);
+  take(json, "source_stall_ms", c.source_stall_ms, origin);
   take(json, "max_subscribers", c.max_subscribers, origin);
   take(json, "max_subscribers_per_address", c.max_subscribers_per_address, origin);
   take(json, "subscriber_write_stall_ms", c.subscriber_write_stall_ms, origin);
   take(json, "allow_subscribers", c.allow_subscribers, origin);
   take(json, "subscriber_token", c.subscriber_token, origin);
+  take(json, "max_unauthenticated_subscribers", c.max_unauthenticated_subscribers, origin);
+  take(json, "max_unauthenticated_per_address", c.max_unauthenticated_per_address, origin);
+  take(json, "unauthenticated_hello_timeout_ms", c.unauthenticated_hello_timeout_ms, origin);
   take(json, "subscriber_unsent_kb", c.subscriber_unsent_kb, origin);
 }
 
@@ -178,14 +188,21 @@ nlohmann::json to_json(const DaemonConfig& c) {
           {"multicast", c.multicast},
           {"multicast_interface", c.multicast_interface},
           {"multicast_ttl", c.multicast_ttl},
+          {"multicast_key_file", c.multicast_key_file},
           {"source_max_subjects", c.source_max_subjects},
           {"source_max_markers_per_subject", c.source_max_markers_per_subject},
           {"source_max_name_bytes", c.source_max_name_bytes},
+          {"source_max_coordinate_m", c.source_max_coordinate_m},
+          {"source_handshake_timeout_ms", c.source_handshake_timeout_ms},
+          {"source_stall_ms", c.source_stall_ms},
           {"max_subscribers", c.max_subscribers},
           {"max_subscribers_per_address", c.max_subscribers_per_address},
           {"subscriber_write_stall_ms", c.subscriber_write_stall_ms},
           {"allow_subscribers", c.allow_subscribers},
           {"subscriber_token", c.subscriber_token},
+          {"max_unauthenticated_subscribers", c.max_unauthenticated_subscribers},
+          {"max_unauthenticated_per_address", c.max_unauthenticated_per_address},
+          {"unauthenticated_hello_timeout_ms", c.unauthenticated_hello_timeout_ms},
           {"subscriber_unsent_kb", c.subscriber_unsent_kb}};
 }
 
@@ -232,9 +249,18 @@ void validate(const DaemonConfig& c) {
   if (c.source_max_markers_per_subject < 1 || c.source_max_markers_per_subject > 65536)
     fail("source_max_markers_per_subject must be 1-65536");
   if (c.source_max_name_bytes < 1 || c.source_max_name_bytes > 4096) fail("source_max_name_bytes must be 1-4096");
+  if (!(c.source_max_coordinate_m > 0 && c.source_max_coordinate_m <= 1e6)) fail("source_max_coordinate_m must be in (0, 1000000]");
+  if (c.source_handshake_timeout_ms < 100 || c.source_handshake_timeout_ms > 600'000)
+    fail("source_handshake_timeout_ms must be 100-600000");
+  if (c.source_stall_ms != 0 && (c.source_stall_ms < 50 || c.source_stall_ms > 600'000))
+    fail("source_stall_ms must be 0 (never) or 50-600000");
   if (c.max_subscribers < 0) fail("max_subscribers must be >= 0 (0 = no limit)");
   if (c.max_subscribers_per_address < 0) fail("max_subscribers_per_address must be >= 0 (0 = no limit)");
   if (c.subscriber_write_stall_ms < 0) fail("subscriber_write_stall_ms must be >= 0 (0 = never)");
+  if (c.max_unauthenticated_subscribers < 0) fail("max_unauthenticated_subscribers must be >= 0 (0 = no limit)");
+  if (c.max_unauthenticated_per_address < 0) fail("max_unauthenticated_per_address must be >= 0 (0 = no limit)");
+  if (c.unauthenticated_hello_timeout_ms < 10 || c.unauthenticated_hello_timeout_ms > 600'000)
+    fail("unauthenticated_hello_timeout_ms must be 10-600000");
   if (c.subscriber_unsent_kb < 0 || c.subscriber_unsent_kb > 1024 * 1024)
     fail("subscriber_unsent_kb must be 0-1048576 (0 = the system's)");
   for (const std::string& network : c.allow_subscribers)
@@ -313,6 +339,9 @@ std::optional<CommandLine> parse_command_line(int argc, const char* const* argv,
   auto* multicast_interface = app.add_option("--multicast-interface", flags.multicast_interface,
                                              "multicast: this host's IPv4 address to send from (default: the system's route)");
   auto* multicast_ttl = app.add_option("--multicast-ttl", flags.multicast_ttl, "multicast: hops the datagrams may cross (default 1: this link)");
+  auto* multicast_key_file = app.add_option("--multicast-key-file", flags.multicast_key_file,
+                                            "multicast: sign every datagram (HMAC-SHA-256) with the key on this file's first line "
+                                            "(at least 16 bytes; receivers need the same key)");
   auto* bind = app.add_option("--bind", flags.bind_address, "address to listen on");
   auto* http_port = app.add_option("--http-port", flags.http_port, "HTTP/WebSocket port (0 = ephemeral)");
   auto* sub_port = app.add_option("--sub-port", flags.sub_port, "TCP subscriber port (0 = ephemeral)");
@@ -358,6 +387,7 @@ std::optional<CommandLine> parse_command_line(int argc, const char* const* argv,
   if (given(multicast)) c.multicast = flags.multicast;
   if (given(multicast_interface)) c.multicast_interface = flags.multicast_interface;
   if (given(multicast_ttl)) c.multicast_ttl = flags.multicast_ttl;
+  if (given(multicast_key_file)) c.multicast_key_file = flags.multicast_key_file;
   if (given(loop)) c.loop = flags.loop;
   if (given(speed)) c.speed = flags.speed;
   if (given(vicon_pull)) c.vicon_pull = flags.vicon_pull;

@@ -61,17 +61,28 @@ struct DaemonConfig {
   std::string multicast;          // GROUP:PORT: also send every frame's parameters to this IPv4 multicast group; empty = off
   std::string multicast_interface = "0.0.0.0";  // multicast: this host's address to send from; 0.0.0.0 = the system's route
   int multicast_ttl = 1;          // multicast: hops the datagrams may cross (1: this link)
+  std::string multicast_key_file;  // multicast: a file whose first line is the key the datagrams are signed with; empty = unsigned
   double default_rate_hz = 120.0;  // until the source says its rate
   // What one source message may describe (vicon::DescriptionLimits); more is a malformed packet.
   int source_max_subjects = 128;
   int source_max_markers_per_subject = 1024;
   int source_max_name_bytes = 256;
+  // Positions farther than this from the capture system's origin along any axis are missing (counted).
+  double source_max_coordinate_m = 50.0;
+  // QTM RT, NatNet and Vicon: a server that does not finish its handshake within this is left and
+  // retried; one that sends no frame for source_stall_ms while streaming is "stalled" and retried (0: never).
+  int source_handshake_timeout_ms = 3000;
+  int source_stall_ms = 1000;
   // Who may subscribe, and how many (server/publish/subscriber_admission.h).
   int max_subscribers = 256;              // TCP and WebSocket together; 0 = no limit
   int max_subscribers_per_address = 64;   // from one remote address; 0 = no limit
   int subscriber_write_stall_ms = 10000;  // a write without progress this long closes the subscriber; 0 = never
   std::vector<std::string> allow_subscribers;  // CIDR networks subscribers may connect from; empty = any
   std::string subscriber_token;           // asked of every subscriber (Hello version 2, ?token=); empty = none
+  // With a token: connections that have not given it yet, in all and from one address (0 = no limit) ...
+  int max_unauthenticated_subscribers = 64;
+  int max_unauthenticated_per_address = 4;
+  int unauthenticated_hello_timeout_ms = 1000;  // ... and how long they have to say Hello
   // Bytes a subscriber's socket may hold not yet sent (TCP_NOTSENT_LOWAT); 0 = the system's (no limit).
   int subscriber_unsent_kb = 128;
 };

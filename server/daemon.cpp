@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 #include <unistd.h>
 
+#include "protocol/datagram_authentication.h"
 #include "protocol/file_error.h"
 #include "protocol/printable_text.h"
 #include "server/http/http_server.h"
@@ -48,6 +49,7 @@ std::vector<std::unique_ptr<SubjectStream>> load_subjects(const DaemonConfig& co
   options.hub.queue_frames = config.subscriber_queue_frames;
   options.hub.frame_max_wait = std::chrono::milliseconds(config.max_frame_wait_ms);
   options.hub.hello_timeout = std::chrono::milliseconds(config.hello_timeout_ms);
+  options.hub.unauthenticated_hello_timeout = std::chrono::milliseconds(config.unauthenticated_hello_timeout_ms);
   PipelineOptions& pipeline = options.pipeline;
   pipeline.lookahead = config.lookahead;
   pipeline.deform_threads = config.deform_threads;
@@ -111,7 +113,15 @@ vicon::DescriptionLimits description_limits_of(const DaemonConfig& config) {
 
 MulticastSenderOptions multicast_options_of(const DaemonConfig& config, uint32_t stream_id) {
   const HostPort group = host_port_of("--multicast", config.multicast);
-  return {group.host, group.port, config.multicast_interface, config.multicast_ttl, stream_id};
+  MulticastSenderOptions options{group.host, group.port, config.multicast_interface, config.multicast_ttl, stream_id};
+  if (!config.multicast_key_file.empty()) {
+    try {
+      options.key = subscriber::read_datagram_key_file(config.multicast_key_file);
+    } catch (const std::runtime_error& e) {
+      throw ConfigError(std::string("multicast_key_file: ") + e.what());
+    }
+  }
+  return options;
 }
 
 AdmissionOptions admission_options_of(const DaemonConfig& config) {
@@ -124,6 +134,8 @@ AdmissionOptions admission_options_of(const DaemonConfig& config) {
   options.max_total = config.max_subscribers;
   options.max_per_address = config.max_subscribers_per_address;
   options.token = config.subscriber_token;
+  options.max_unauthenticated = config.max_unauthenticated_subscribers;
+  options.max_unauthenticated_per_address = config.max_unauthenticated_per_address;
   return options;
 }
 
@@ -134,6 +146,8 @@ ViconSourceOptions vicon_options_of(const DaemonConfig& config) {
   options.port = address.port;
   options.mode = config.vicon_pull ? ViconSourceOptions::Mode::ClientPull : ViconSourceOptions::Mode::ServerPush;
   options.limits = description_limits_of(config);
+  options.handshake_timeout = std::chrono::milliseconds(config.source_handshake_timeout_ms);
+  options.stall_timeout = std::chrono::milliseconds(config.source_stall_ms);
   return options;
 }
 
@@ -143,7 +157,7 @@ Daemon::Daemon(const DaemonConfig& config)
     : config_(config),
       deform_cpus_(deform_cpus_of(config)),
       subjects_(load_subjects(config, deform_cpus_)),
-      router_(targets_of(subjects_), static_cast<SubjectRouter::Observer&>(*this)),
+      router_(targets_of(subjects_), static_cast<SubjectRouter::Observer&>(*this), 1000.0 * config.source_max_coordinate_m),
       routed_(subjects_.size(), nullptr),
       publish_(config.publish_threads),
       status_timer_(io_),
@@ -185,6 +199,8 @@ Daemon::Daemon(const DaemonConfig& config)
     QtmSourceOptions options;
     options.host = address.host;
     options.port = address.port;
+    options.handshake_timeout = std::chrono::milliseconds(config.source_handshake_timeout_ms);
+    options.stall_timeout = std::chrono::milliseconds(config.source_stall_ms);
     spdlog::info("source: QTM RT {}:{}", options.host, options.port);
     source_ = std::make_unique<QtmSource>(io_, std::move(options), static_cast<SourceSink&>(*this));
   } else if (!config.natnet.empty()) {
@@ -193,6 +209,9 @@ Daemon::Daemon(const DaemonConfig& config)
     options.host = address.host;
     options.command_port = address.port;
     options.interface_address = config.natnet_interface;
+    options.bind_address = config.bind_address;
+    options.reply_timeout = std::chrono::milliseconds(config.source_handshake_timeout_ms);
+    options.stall_timeout = std::chrono::milliseconds(config.source_stall_ms);
     spdlog::info("source: NatNet {}:{}", options.host, options.command_port);
     source_ = std::make_unique<NatNetSource>(io_, std::move(options), static_cast<SourceSink&>(*this));
   } else {
@@ -226,10 +245,14 @@ Daemon::Daemon(const DaemonConfig& config)
     }
     SubscriberHub& hub = subject(0).hub();  // until a version 2 Hello names another
     auto subscriber = std::make_shared<TcpSubscriber>(placed.io, hub, std::move(socket), remote, std::move(placed.token));
-    // Refused or not, the subscriber is answered after its Hello, in the version it speaks.
-    SubscriberAdmission::Decision admitted = admission_->admit(endpoint.address());
-    const bool ask_token = admitted.ticket && admission_->token_required();
-    subscriber->set_admission(std::move(admitted), ask_token ? admission_ : nullptr);
+    // Refused or not, the subscriber is answered after its Hello, in the version it speaks. With
+    // a token it is admitted once it gave it; until then it holds a place kept for connections
+    // without it.
+    const bool token = admission_->token_required();
+    SubscriberAdmission::Decision admitted =
+        token ? admission_->admit_unauthenticated(endpoint.address()) : admission_->admit(endpoint.address());
+    const bool ask_token = admitted.ticket && token;
+    subscriber->set_admission(std::move(admitted), ask_token ? admission_ : nullptr, endpoint.address());
     hub.add(subscriber);
     asio::post(placed.io, [subscriber] { subscriber->start(); });
   }, ListenerOptions{config.subscriber_tcp_congestion, &source_metrics_, &descriptor_reserve_, false, config.subscriber_unsent_kb * 1024});
@@ -337,6 +360,12 @@ void Daemon::on_frame(const SourceFrame& frame) {
     bad_input_log_.warn("rejected_point", "frame " + std::to_string(frame.frame_number) + ": " + std::to_string(routed.rejected_points) +
                                               " unlabelled points ignored (not finite)");
   }
+  if (routed.implausible_points > 0) {
+    source_metrics_.count_bad_input("implausible_point");
+    bad_input_log_.warn("implausible_point", "frame " + std::to_string(frame.frame_number) + ": " +
+                                                 std::to_string(routed.implausible_points) + " unlabelled points ignored (beyond " +
+                                                 fmt::format("{:g}", config_.source_max_coordinate_m) + " m of the origin)");
+  }
   for (size_t k = 0; k < subjects_.size(); ++k)
     if (router_.present(static_cast<int>(k))) subjects_[k]->post();
 }
@@ -355,8 +384,9 @@ void Daemon::on_source_state(SourceState state, std::string_view detail) {
     for (auto& s : subjects_) s->new_take();
   }
   // A change of state is news; streaming again (a replay's loop) is not: the status line says
-  // that the frames keep coming.
-  if (state != previous) spdlog::info("source: {} ({})", to_string(state), detail);
+  // that the frames keep coming. At most one line a second: a source that flaps (stalls and comes
+  // back, again and again) says so with a count of what was not logged.
+  if (state != previous) state_log_.info("source_state", fmt::format("source: {} ({})", to_string(state), detail));
   else spdlog::debug("source: {} ({})", to_string(state), detail);
   broadcast_status();
 }
@@ -422,7 +452,9 @@ void Daemon::schedule_status_log() {
   status_log_timer_.expires_after(std::chrono::seconds(config_.status_log_seconds));
   status_log_timer_.async_wait([this](const boost::system::error_code& ec) {
     if (ec || stopping_.load()) return;
-    for (auto& s : subjects_) spdlog::info("{}", s->status_line(StatusLine::Clock::now()));
+    // The source's state at the end: a stalled or lost source shows in every line until it is back.
+    const char* state = to_string(source_state());
+    for (auto& s : subjects_) spdlog::info("{}; source {}", s->status_line(StatusLine::Clock::now()), state);
     schedule_status_log();
   });
 }
@@ -462,6 +494,10 @@ std::string Daemon::health_json() const {
         {"allow_subscribers", allowed},
         {"token_required", admission_->token_required()},
         {"admitted", admission_->admitted()},
+        {"max_unauthenticated_subscribers", config_.max_unauthenticated_subscribers},
+        {"max_unauthenticated_per_address", config_.max_unauthenticated_per_address},
+        {"unauthenticated", admission_->unauthenticated()},
+        {"refused_unauthenticated", source_metrics_.subscribers_refused_unauthenticated.load()},
         {"refused_not_allowed", source_metrics_.subscribers_refused_not_allowed.load()},
         {"refused_limit", source_metrics_.subscribers_refused_limit.load()},
         {"refused_token", source_metrics_.subscribers_refused_token.load()},
@@ -478,7 +514,10 @@ std::string Daemon::health_json() const {
       {"source_limits",
        {{"max_subjects", config_.source_max_subjects},
         {"max_markers_per_subject", config_.source_max_markers_per_subject},
-        {"max_name_bytes", config_.source_max_name_bytes}}},
+        {"max_name_bytes", config_.source_max_name_bytes},
+        {"max_coordinate_m", config_.source_max_coordinate_m},
+        {"handshake_timeout_ms", config_.source_handshake_timeout_ms},
+        {"stall_ms", config_.source_stall_ms}}},
       {"latency_ms", first["latency_ms"]}};
   return health.dump();
 }

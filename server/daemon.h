@@ -80,6 +80,7 @@ class Daemon : private SourceSink, private SubjectRouter::Observer {
   std::vector<int> deform_cpus_;  // deform_threads per subject, subject after subject, or none (not pinned)
   Metrics source_metrics_;
   RateLimitedLog bad_input_log_;
+  RateLimitedLog state_log_;  // the source's changes of state
   SubjectDirectory directory_;  // the subjects' hubs by name; outlives them
   // Before io_: the io_context is destroyed first, and with it the handlers still holding
   // sessions whose queues hold frames of the subjects' pipelines' pools.

@@ -35,7 +35,18 @@ subscriber::MeshInfo mesh_info_of(const SubjectFile& subject) {
   return info;
 }
 
-subscriber::SourceStateCode code_of(SourceState s) { return static_cast<subscriber::SourceStateCode>(static_cast<uint32_t>(s)); }
+// Stalled goes out as Disconnected (the protocol's subscribers know no other state), with its
+// detail saying "stalled".
+subscriber::SourceStateCode code_of(SourceState s) {
+  switch (s) {
+    case SourceState::Connecting: return subscriber::SourceStateCode::Connecting;
+    case SourceState::Streaming: return subscriber::SourceStateCode::Streaming;
+    case SourceState::Finished: return subscriber::SourceStateCode::Finished;
+    case SourceState::Disconnected:
+    case SourceState::Stalled: break;
+  }
+  return subscriber::SourceStateCode::Disconnected;
+}
 
 // The /metrics histograms condensed for scripts, over the stream's life: per stage its count,
 // the quantiles as bucket upper bounds ("le") and the largest value seen.
@@ -127,6 +138,12 @@ void SubjectStream::post() {
                                               std::to_string(frame.rejected_points) + " points ignored (not finite, or beyond " +
                                               std::to_string(MarkerFrame::kMaxUnlabelled) + " unlabelled)");
   }
+  if (frame.implausible_points > 0) {
+    metrics_.count_bad_input("implausible_point");
+    bad_input_log_.warn("implausible_point", "subject " + name_ + ", frame " + std::to_string(frame.frame_number) + ": " +
+                                                 std::to_string(frame.implausible_points) +
+                                                 " points taken as missing (outside the capture volume, source_max_coordinate_m)");
+  }
   if (frame.source_rate_hz > 0 && frame.source_rate_hz != source_rate_hz_) {
     source_rate_hz_ = frame.source_rate_hz;
     hub_->set_source_rate(static_cast<float>(frame.source_rate_hz));
@@ -206,6 +223,7 @@ nlohmann::json SubjectStream::health() const {
                    {"published", metrics_.frames_published.load()},
                    {"dropped", metrics_.frames_dropped.load()},
                    {"dropped_mailbox_full", metrics_.frames_dropped_mailbox_full.load()}};
+  out["source_rate_changes"] = metrics_.source_rate_changes.load();
   // Encoded frame buffers created so far: grows only while the pool meets a new high-water
   // mark of frames in use (bounded by the subscribers' queues) or an encoding is asked for
   // again after its buffers were released, so RSS steps with it.

@@ -42,6 +42,13 @@ std::optional<int> parse_bench_options(int argc, char** argv, BenchOptions& o) {
   app.add_option("--protocol", protocol, "the capture system the replay plays to the daemon: vicon (DataStream, TCP), qtm (QTM RT, TCP) or natnet (NatNet, UDP unicast)")
       ->check(CLI::IsMember({"vicon", "qtm", "natnet"}))
       ->capture_default_str();
+  app.add_option("--natnet-timestamp-jitter-us", o.natnet_timestamp_jitter_us,
+                 "--protocol natnet: each frame's timestamp moved by a random offset of up to +-this many microseconds, as a "
+                 "capture clock jitters")
+      ->check(CLI::Range(0.0, 1e6));
+  app.add_option("--natnet-clock-hz", o.natnet_clock_hz,
+                 "--protocol natnet: each frame's timestamp rounded to the ticks of a clock of this frequency (e.g. 10000000)")
+      ->check(CLI::Range(1.0, 1e12));
   app.add_option("--vicon-subject-name", o.vicon_subject_name, "subject (marker set) name the replay announces (default: the recording's file name)");
   app.add_option("--subjects", o.subjects, "actors on the stage: the recording streamed this many times, moved apart, as Actor1..ActorN; subscriber s follows ActorN with N = s mod subjects + 1")
       ->check(CLI::Range(1, 16))

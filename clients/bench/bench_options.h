@@ -17,6 +17,9 @@ struct BenchOptions {
   std::string subject;             // the subject file (required)
   std::string vicon_subject_name;  // the replay's subject name (default: the recording's file name)
   CaptureProtocol protocol = CaptureProtocol::Vicon;  // what the replay speaks to the daemon
+  // NatNet: the replay's timestamps as a real capture clock stamps them (0: exact).
+  double natnet_timestamp_jitter_us = 0.0;
+  double natnet_clock_hz = 0.0;
   int subjects = 1;                  // actors: the recording streamed this many times, apart
   double subject_spacing_mm = 3000;  // how far apart along x
   // What the subscribers ask for and do with it.

@@ -164,6 +164,8 @@ nlohmann::json run_bench(const BenchOptions& o, const std::atomic<bool>& stop) {
   replay_options.protocol = o.protocol;
   replay_options.bind_address = replay_address;
   replay_options.tcp_congestion = o.replay_tcp_congestion;
+  replay_options.natnet_timestamp_jitter_us = o.natnet_timestamp_jitter_us;
+  replay_options.natnet_clock_hz = o.natnet_clock_hz;
   const ReplayStage stage = replay_stage(capture, o.subjects, o.subject_spacing_mm,
                                          o.vicon_subject_name.empty() ? fs::path(o.recording).stem().string() : o.vicon_subject_name);
   ReplayEngine replay(replay_io, stage.subjects, replay_options);
@@ -322,6 +324,7 @@ nlohmann::json run_bench(const BenchOptions& o, const std::atomic<bool>& stop) {
       {"subjects", o.subjects},
       {"encoding", client::to_string(o.encoding)},
       {"protocol", to_string(o.protocol)},
+      {"natnet_clock", {{"timestamp_jitter_us", o.natnet_timestamp_jitter_us}, {"clock_hz", o.natnet_clock_hz}}},
       {"link_mbit", o.link_mbit},
       {"subscribers_want", {{"normals", o.normals}, {"quantised", o.encoding == client::Encoding::Quantised}, {"decode", o.decode}, {"paced", o.paced}}},
       {"seconds_until_every_subscriber_had_a_frame", seconds_to_first_frames},
@@ -378,6 +381,8 @@ nlohmann::json run_bench(const BenchOptions& o, const std::atomic<bool>& stop) {
                   // Of those, made on the 120 Hz thread because no prepared one was ready: 0 when
                   // every subscriber's encoding was prepared on its Hello.
                   {"frame_buffers_made_by_pipeline", health.value("frame_buffers_allocated_by_pipeline", 0)},
+                  // Gap filler rebuilds for a new source rate over the daemon's life (1: the rate became known).
+                  {"source_rate_changes", health["subjects"][0].value("source_rate_changes", uint64_t{0})},
                   {"exit_status", exit_status},
                   {"warnings", daemon_warnings}}},
       // This process: the replay server and the subscribers, sharing the machine with the daemon.

@@ -47,6 +47,8 @@ ReplayEngine::ReplayEngine(server::asio::io_context& io, const std::vector<Repla
       o.command_port = 0;
       o.multicast = false;  // unicast to the daemon: multicast does not loop back on every machine
       o.loop = true;
+      o.timestamp_jitter_us = options.natnet_timestamp_jitter_us;
+      o.timestamp_clock_hz = options.natnet_clock_hz;
       servers_->natnet = std::make_unique<server::NatNetServer>(io, subjects, o);
       break;
     }

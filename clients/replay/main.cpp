@@ -7,6 +7,7 @@
 //   skinstream-replay [--protocol vicon|qtm|natnet] RECORDING... --port P [--rate HZ] [--speed X]
 //                     [--loop | --hold] [--subject NAME]... [--multicast GROUP[:PORT]] [--multicast-ttl N]
 //                     [--start-now] [--unicast] [--multicast-interface ADDR] [--natnet-version 3.1|4.0|4.1]
+//                     [--natnet-timestamp-jitter-us US] [--natnet-clock-hz HZ]
 //
 // Prints one JSON line {"port": N} on stdout once listening (port 0 picks a free one); logs go to
 // stderr. Errors are one line on stderr and a non-zero exit code.
@@ -52,6 +53,8 @@ struct Arguments {
   bool unicast = false;           // NatNet
   std::string multicast_interface;  // NatNet: the interface multicast leaves by; empty: the system's
   std::string natnet_version = "4.1";
+  double natnet_timestamp_jitter_us = 0.0;  // NatNet: a capture clock's jitter and resolution
+  double natnet_clock_hz = 0.0;
 };
 
 // "239.1.2.3:44801" or "239.1.2.3" -> address and port.
@@ -172,6 +175,8 @@ int run_qtm_or_natnet(const Arguments& args) {
     options.speed = args.speed;
     options.loop = args.loop;
     options.start_on_first_request = !args.start_now;
+    options.timestamp_jitter_us = args.natnet_timestamp_jitter_us;
+    options.timestamp_clock_hz = args.natnet_clock_hz;
     natnet = std::make_unique<server::NatNetServer>(io, recordings.subjects, options);
     natnet->start();
     port = natnet->command_port();
@@ -246,6 +251,13 @@ int main(int argc, char** argv) {
   app.add_option("--natnet-version", args.natnet_version, "natnet: the NatNet layout streamed")
       ->check(CLI::IsMember({"3.0", "3.1", "4.0", "4.1"}))
       ->capture_default_str();
+  app.add_option("--natnet-timestamp-jitter-us", args.natnet_timestamp_jitter_us,
+                 "natnet: move each frame's timestamp by a random offset of up to +-this many microseconds, as a real "
+                 "capture clock jitters")
+      ->check(CLI::Range(0.0, 1e6));
+  app.add_option("--natnet-clock-hz", args.natnet_clock_hz,
+                 "natnet: round each frame's timestamp to the ticks of a clock of this frequency (e.g. 10000000)")
+      ->check(CLI::Range(1.0, 1e12));
   app.add_option("--multicast-ttl", args.multicast_ttl, "multicast TTL (hops)")
       ->check(CLI::Range(0, 255))
       ->capture_default_str();

@@ -4,13 +4,17 @@
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cstdio>
+#include <cstdlib>
+#include <fstream>
 #include <filesystem>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
 
+#include "protocol/datagram_authentication.h"
 #include "protocol/mesh_ply.h"
 #include "protocol/point_cache.h"
+#include "protocol/printable_text.h"
 #include "skinstream/client.h"
 
 namespace {
@@ -66,13 +70,26 @@ int main(int argc, char** argv) {
   app.add_flag("--no-mesh", no_mesh, "markers only, no vertex positions");
   app.add_flag("--paced", paced, "acknowledge each frame: at most 2 in flight");
   app.add_option("--subject", subject, "the subject's name (protocol 2; default: the daemon's first)");
-  app.add_option("--token", token, "the daemon's shared token, when it has one");
+  std::string token_file;
+  double timeout_seconds = 10.0;
+  uint32_t max_vertices = client::Options{}.max_vertices, max_markers = client::Options{}.max_markers;
+  app.add_option("--token-file", token_file,
+                 "the daemon's shared token, when it has one: this file's first line (or the environment's SKINSTREAM_TOKEN)");
+  app.add_option("--token", token, "the token itself (seen by anyone who lists the processes: prefer --token-file)");
+  app.add_option("--timeout", timeout_seconds,
+                 "seconds without a word from the daemon (it speaks every second) before giving up with an error; 0: wait for ever")
+      ->check(CLI::Range(0.0, 86400.0));
+  app.add_option("--max-vertices", max_vertices, "the largest mesh taken (a MeshInfo announcing more is an error)");
+  app.add_option("--max-markers", max_markers, "the most markers taken");
   app.add_option("--protocol", protocol, "subscriber protocol version: 2 (default) or 1 (float and quantised only)")->check(CLI::Range(1, 2));
   app.add_option("--multicast", multicast,
                  "GROUP:PORT: the parameters of every frame from the daemon's multicast group (its --multicast; --evaluate "
                  "turns them into vertices); MeshInfo and the Model still come from ADDRESS over TCP");
   app.add_option("--multicast-interface", multicast_interface, "multicast: this host's IPv4 address to join the group on");
   app.add_option("--multicast-stream", multicast_stream, "multicast: the subject's stream id (0: the daemon's first)");
+  std::string multicast_key_file;
+  app.add_option("--multicast-key-file", multicast_key_file,
+                 "multicast: take only datagrams signed with the key on this file's first line (the daemon's multicast_key_file)");
   app.add_option("--frames", frames_wanted, "exit after this many frames (0 = run until the daemon closes)");
   std::vector<std::string> save_arguments;
   app.add_option("--save-every", save_arguments, "N DIR: save every Nth frame as DIR/frame_<frame number>.ply")->expected(2);
@@ -107,13 +124,27 @@ int main(int argc, char** argv) {
     options.paced = paced;
     options.evaluate = evaluate || save_every > 0 || !record_path.empty();
     options.subject = subject;
+    if (!token_file.empty()) {
+      std::ifstream in(token_file);
+      if (!in || !std::getline(in, token)) throw std::runtime_error(token_file + ": cannot read the token (its first line)");
+      if (!token.empty() && token.back() == '\r') token.pop_back();
+    } else if (token.empty()) {
+      if (const char* from_environment = std::getenv("SKINSTREAM_TOKEN")) token = from_environment;
+    }
     options.token = token;
+    options.silence_timeout = std::chrono::milliseconds(static_cast<long long>(timeout_seconds * 1000.0));
+    options.max_vertices = max_vertices;
+    options.max_markers = max_markers;
     options.protocol_version = protocol;
     if (!multicast.empty()) {
       if (!encoding_name.empty() && encoding_name != "parameters") throw std::invalid_argument("--multicast carries the parameters encoding only");
       std::tie(options.multicast.group, options.multicast.port) = split_host_port(multicast);
       options.multicast.interface_address = multicast_interface;
       options.multicast.stream_id = multicast_stream;
+      if (!multicast_key_file.empty()) {
+        const std::vector<unsigned char> key = subscriber::read_datagram_key_file(multicast_key_file);
+        options.multicast.key.assign(key.begin(), key.end());
+      }
       options.encoding = client::Encoding::Parameters;
     }
     if (save_every > 0) std::filesystem::create_directories(save_dir);
@@ -131,9 +162,23 @@ int main(int argc, char** argv) {
     long frames_at_report = 0;
     bool finished = false;
     client::Frame frame;
+    // A frame the daemon sent broken is skipped by the library: said here, at most once a second.
+    uint64_t rejections_reported = 0;
+    auto last_rejection_report = start - std::chrono::seconds(1);
+    auto report_rejections = [&] {
+      const uint64_t rejected = sub.frames_rejected();
+      const auto now = std::chrono::steady_clock::now();
+      if (rejected == rejections_reported || now - last_rejection_report < std::chrono::seconds(1)) return;
+      std::fprintf(stderr, "skinstream-sub: warning: %s (%llu frames skipped so far)\n", sub.last_rejection().c_str(),
+                   static_cast<unsigned long long>(rejected));
+      rejections_reported = rejected;
+      last_rejection_report = now;
+    };
     for (;;) {
       try {
-        if (!sub.next(frame, std::chrono::seconds(1))) continue;
+        const bool got = sub.next(frame, std::chrono::seconds(1));
+        report_rejections();
+        if (!got) continue;
       } catch (const client::Error& e) {
         const std::string what = e.what();
         if (what.find("closed the connection") == std::string::npos) throw;
@@ -145,7 +190,7 @@ int main(int argc, char** argv) {
         announced = true;
         if (!json)
           std::printf("mesh: %u vertices, %zu faces, %zu markers, %u parts, %.2f Hz, subject \"%s\", encoding %s%s\n", mesh.vertex_count,
-                      mesh.indices.size() / 3, mesh.marker_names.size(), mesh.part_count, mesh.source_rate_hz, mesh.subject.c_str(),
+                      mesh.indices.size() / 3, mesh.marker_names.size(), mesh.part_count, mesh.source_rate_hz, printable_text(mesh.subject).c_str(),
                       client::to_string(mesh.encoding),
                       sub.model_bytes() ? (", model " + std::to_string(sub.model_bytes()) + " bytes").c_str() : "");
         if (!record_path.empty()) {
@@ -225,6 +270,7 @@ int main(int argc, char** argv) {
                               {"bytes_per_frame", frames > 0 ? static_cast<double>(frame_bytes) / frames : 0.0},
                               {"model_bytes", sub.model_bytes()},
                               {"frames_skipped", sub.frames_skipped()},
+                              {"frames_rejected", sub.frames_rejected()},
                               {"pipeline_dropped", pipeline_dropped},
                               {"subscriber_dropped", subscriber_dropped},
                               {"saved", saved},
@@ -245,6 +291,11 @@ int main(int argc, char** argv) {
                               {"datagrams_duplicate", m.datagrams_duplicate},
                               {"frames_superseded", m.frames_superseded},
                               {"messages_rejected", m.messages_rejected},
+                              {"datagrams_out_of_window", m.datagrams_out_of_window},
+                              {"datagrams_unauthenticated", m.datagrams_unauthenticated},
+                              {"resyncs", m.resyncs},
+                              {"frames_other_model", m.frames_other_model},
+                              {"model_fetches", m.model_fetches},
                               {"last_error", m.last_error}};
     }
     if (json) std::printf("%s\n", nlohmann::json{{"summary", summary}}.dump().c_str());

@@ -60,29 +60,32 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
   // in the HTTP status and a one-line body, and the connection closed.
   void upgrade() {
     SubscriberAdmission::Decision decision;
-    std::shared_ptr<const SubscriberAdmission> token_check;
+    std::shared_ptr<SubscriberAdmission> authenticate;
+    tcp::endpoint peer;
     if (SubscriberAdmission* admission = routes_->stream_admission.get()) {
       boost::system::error_code ec;
-      const tcp::endpoint peer = stream_.socket().remote_endpoint(ec);
+      peer = stream_.socket().remote_endpoint(ec);
       if (ec) return shutdown();
-      decision = admission->admit(peer.address());
+      // With a token on the URL the subscriber is admitted now; without one it holds a place
+      // kept for connections without the token until its Hello (version 2) carries it.
+      std::optional<std::string> token;
+      if (admission->token_required()) {
+        token = query_parameter(std::string_view(request_.target().data(), request_.target().size()), "token");
+        if (token && !admission->token_matches(*token)) return refuse(http::status::forbidden, "wrong token");
+      }
+      const bool unauthenticated = admission->token_required() && !token;
+      decision = unauthenticated ? admission->admit_unauthenticated(peer.address()) : admission->admit(peer.address());
       if (decision.refusal != SubscriberAdmission::Refusal::None) {
         const bool not_allowed = decision.refusal == SubscriberAdmission::Refusal::NotAllowed;
         return refuse(not_allowed ? http::status::forbidden : http::status::service_unavailable, decision.reason);
       }
-      if (admission->token_required()) {
-        const std::optional<std::string> token = query_parameter(std::string_view(request_.target().data(), request_.target().size()), "token");
-        if (token && !admission->token_matches(*token)) {
-          return refuse(http::status::forbidden, "wrong token");
-        }
-        if (!token) token_check = routes_->stream_admission;  // then Hello version 2 must carry it
-      }
+      if (unauthenticated) authenticate = routes_->stream_admission;
     }
     stream_.expires_never();
     tcp::socket socket = stream_.release_socket();
     const std::string remote = remote_of(socket);
     auto subscriber = std::make_shared<WebSocketSubscriber>(io_, hub_, std::move(socket), remote);
-    subscriber->set_admission(std::move(decision), std::move(token_check));
+    subscriber->set_admission(std::move(decision), std::move(authenticate), peer.address());
     hub_.add(subscriber);
     subscriber->accept(std::move(request_));
   }

@@ -8,6 +8,7 @@ const char* to_string(SourceState state) {
     case SourceState::Streaming: return "streaming";
     case SourceState::Disconnected: return "disconnected";
     case SourceState::Finished: return "finished";
+    case SourceState::Stalled: return "stalled";
   }
   return "unknown";
 }

@@ -28,6 +28,7 @@ struct MarkerFrame {
 
   int unknown_labels = 0;            // labelled points whose name the subject does not have
   int rejected_points = 0;           // neither a position nor NaN, or beyond the unlabelled capacity
+  int implausible_points = 0;        // finite, but outside the capture volume (SubjectRouter)
 
   explicit MarkerFrame(int marker_count = 0) { resize(marker_count); }
   void resize(int marker_count) {
@@ -42,6 +43,7 @@ struct MarkerFrame {
     unlabelled_count = 0;
     unknown_labels = 0;
     rejected_points = 0;
+    implausible_points = 0;
     timecode = SourceTimecode{};
   }
 };

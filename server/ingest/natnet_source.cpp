@@ -8,6 +8,7 @@
 #include "protocol/natnet_reader.h"
 #include "protocol/natnet_writer.h"
 #include "server/ingest/source_lifecycle.h"
+#include "server/ingest/source_rate_estimate.h"
 #include "server/ingest/source_reconnection.h"
 
 namespace skinstream::server {
@@ -64,10 +65,8 @@ struct NatNetSource::State : std::enable_shared_from_this<NatNetSource::State> {
   SourceFrame frame;
   std::unordered_map<std::string, size_t> subject_of;  // marker set name -> subject index
   Phase phase = Phase::ServerInfo;
-  Clock::time_point phase_start, last_heard, last_model_request;
-  bool have_previous = false;
-  int32_t previous_frame_number = 0;
-  double previous_timestamp = 0.0;
+  Clock::time_point phase_start, last_frame, last_model_request;
+  SourceRateEstimate rate;  // NatNet sends no rate: from the frames' numbers and timestamps
   uint64_t generation = 0;
   std::atomic<bool> stopped{false};
 
@@ -78,7 +77,7 @@ struct NatNetSource::State : std::enable_shared_from_this<NatNetSource::State> {
     const uint64_t gen = ++generation;
     phase = Phase::ServerInfo;
     phase_start = Clock::now();
-    have_previous = false;
+    rate.reset();
     resolver.async_resolve(udp::v4(), options.host, std::to_string(options.command_port),
                            [self = shared_from_this(), gen](const boost::system::error_code& ec,
                                                             const udp::resolver::results_type& results) {
@@ -90,11 +89,26 @@ struct NatNetSource::State : std::enable_shared_from_this<NatNetSource::State> {
                            });
   }
 
+  // The address to bind the command socket to: the one configured (an IPv4 address), or this
+  // host's address on the route to the server (what a connected socket is given).
+  asio::ip::address_v4 local_address(boost::system::error_code& ec) {
+    const auto configured = asio::ip::make_address_v4(options.bind_address, ec);
+    if (!ec && !configured.is_unspecified()) return configured;
+    ec.clear();
+    udp::socket probe(io);
+    probe.open(udp::v4(), ec);
+    if (!ec) probe.connect(server, ec);  // no datagram is sent: the kernel only picks the route
+    const udp::endpoint local = ec ? udp::endpoint() : probe.local_endpoint(ec);
+    return ec ? asio::ip::address_v4() : local.address().to_v4();
+  }
+
   void open_command_socket(uint64_t gen) {
     boost::system::error_code ec;
+    const auto local = local_address(ec);
+    if (ec) return fail(gen, "no local address toward " + where() + " (bind " + options.bind_address + "): " + ec.message());
     command_socket.open(udp::v4(), ec);
-    if (!ec) command_socket.bind(udp::endpoint(udp::v4(), 0), ec);
-    if (ec) return fail(gen, "cannot open a UDP socket: " + ec.message());
+    if (!ec) command_socket.bind(udp::endpoint(local, 0), ec);
+    if (ec) return fail(gen, "cannot open a UDP socket on " + local.to_string() + ": " + ec.message());
     receive(gen, command_socket, command_buffer, command_sender);
     send(natnet::encode_connect("skinstream", kWanted));
     watch(gen);
@@ -120,7 +134,12 @@ struct NatNetSource::State : std::enable_shared_from_this<NatNetSource::State> {
                               [self = shared_from_this(), gen, &socket, &buffer, &sender](
                                   const boost::system::error_code& ec, size_t n) {
                                 if (self->stopped || gen != self->generation) return;
-                                if (!ec) self->on_datagram(gen, natnet::Bytes(buffer.data(), n));
+                                if (!ec && &socket == &self->command_socket && sender.address() != self->server.address())
+                                  self->sink.on_bad_input("foreign_datagram", "NatNet: dropped a datagram from " +
+                                                                                  sender.address().to_string() + ", not the server " +
+                                                                                  self->server.address().to_string());
+                                else if (!ec)
+                                  self->on_datagram(gen, natnet::Bytes(buffer.data(), n));
                                 if (self->stopped || gen != self->generation) return;
                                 if (ec && ec != asio::error::message_size && ec != asio::error::connection_refused)
                                   return self->fail(gen, "cannot receive from " + self->where() + ": " + ec.message());
@@ -146,7 +165,6 @@ struct NatNetSource::State : std::enable_shared_from_this<NatNetSource::State> {
       sink.on_bad_input("malformed_packet", "NatNet: " + error);
       return;
     }
-    last_heard = Clock::now();
     switch (id) {
       case natnet::message::ServerInfo:
         if (phase != Phase::ServerInfo) return;
@@ -174,7 +192,7 @@ struct NatNetSource::State : std::enable_shared_from_this<NatNetSource::State> {
         set_subjects();
         if (phase == Phase::ModelDef) {
           phase = Phase::Streaming;
-          phase_start = Clock::now();
+          phase_start = last_frame = Clock::now();
         }
         return;
       case natnet::message::FrameOfData:
@@ -183,6 +201,7 @@ struct NatNetSource::State : std::enable_shared_from_this<NatNetSource::State> {
           sink.on_bad_input("malformed_packet", "NatNet frame: " + error);
           return;
         }
+        last_frame = Clock::now();
         on_frame();
         return;
       default:
@@ -251,11 +270,7 @@ struct NatNetSource::State : std::enable_shared_from_this<NatNetSource::State> {
         frame.unlabelled.push_back(p);
         frame.unlabelled_ids.push_back(-1);
       }
-    if (have_previous && data.frame_number > previous_frame_number && data.timestamp_s > previous_timestamp)
-      frame.rate_hz = (data.frame_number - previous_frame_number) / (data.timestamp_s - previous_timestamp);
-    have_previous = true;
-    previous_frame_number = data.frame_number;
-    previous_timestamp = data.timestamp_s;
+    frame.rate_hz = rate.add(data.frame_number, data.timestamp_s);
 
     frame.frame_number = static_cast<uint32_t>(data.frame_number);
     frame.source_time_ns = static_cast<int64_t>(std::llround(data.timestamp_s * 1e9));
@@ -271,7 +286,7 @@ struct NatNetSource::State : std::enable_shared_from_this<NatNetSource::State> {
     sink.on_frame(frame);
   }
 
-  // Silence is the only sign a UDP server has gone: no answer in the handshake, no datagram while
+  // Silence is the only sign a UDP server has gone: no answer in the handshake, no frame while
   // streaming.
   void watch(uint64_t gen) {
     watchdog.expires_after(kWatchdogPeriod);
@@ -284,9 +299,12 @@ struct NatNetSource::State : std::enable_shared_from_this<NatNetSource::State> {
         return self->fail(gen, std::string("no ") + (self->phase == Phase::ServerInfo ? "server info" : "model definitions") +
                                    " from " + self->where() + " within " +
                                    std::to_string(self->options.reply_timeout.count()) + " ms");
-      if (self->phase == Phase::Streaming && now - self->last_heard > self->options.stall_timeout)
-        return self->fail(gen, "nothing from " + self->where() + " for " +
-                                   std::to_string(duration_cast<milliseconds>(now - self->last_heard).count()) + " ms");
+      if (self->phase == Phase::Streaming && self->options.stall_timeout.count() > 0 &&
+          now - self->last_frame > self->options.stall_timeout)
+        return self->fail(gen,
+                          "stalled: no frame from " + self->where() + " for " +
+                              std::to_string(duration_cast<milliseconds>(now - self->last_frame).count()) + " ms; reconnecting",
+                          SourceState::Stalled);
       self->watch(gen);
     });
   }
@@ -311,7 +329,9 @@ struct NatNetSource::State : std::enable_shared_from_this<NatNetSource::State> {
     data_socket.close(ignored);
   }
 
-  void fail(uint64_t gen, const std::string& reason) { fail_connection(shared_from_this(), gen, reason); }
+  void fail(uint64_t gen, const std::string& reason, SourceState reported = SourceState::Disconnected) {
+    fail_connection(shared_from_this(), gen, reason, reported);
+  }
 };
 
 NatNetSource::NatNetSource(asio::io_context& io, NatNetSourceOptions options, SourceSink& sink)

@@ -13,10 +13,19 @@
 // flagging that the tracked models changed, asks for the definitions again (at most once a
 // second: model_request_interval) and is passed on without that set.
 //
-// The NatNet layout (3.x, 4.0, 4.1) is the server's, from its server info. No server info within
-// a second, or no datagram for stall_timeout once streaming, reports Disconnected and asks again
-// after a backoff of 0.25 s doubling to 5 s. Malformed datagrams are reported (on_bad_input) and
-// dropped. After the first frames, receiving a frame allocates nothing.
+// The command socket (which also takes the unicast frames) is bound to `bind_address`, or, when
+// that is 0.0.0.0, to this host's address toward the server, and takes datagrams from the
+// server's address only: others are counted and dropped (on_bad_input "foreign_datagram"), so a
+// stranger on the network can neither send frames nor change the model definitions (one bound to
+// 0.0.0.0 and taking anyone's once made the subject absent with one forged MODELDEF).
+//
+// The NatNet layout (3.x, 4.0, 4.1) is the server's, from its server info. No server info or no
+// model definitions within reply_timeout reports Disconnected; no frame for stall_timeout once
+// they came (a server that went silent, or sends only other datagrams) reports Stalled; both ask
+// again after a backoff of 0.25 s doubling to 5 s. NatNet announces no frame rate: it is
+// estimated from the frames' numbers and timestamps over a long window (source_rate_estimate.h).
+// Malformed datagrams are reported (on_bad_input) and dropped. After the first frames, receiving
+// a frame allocates nothing.
 
 #include <chrono>
 #include <cstdint>
@@ -34,10 +43,11 @@ struct NatNetSourceOptions {
   std::string host = "127.0.0.1";
   uint16_t command_port = natnet::kCommandPort;
   std::string interface_address = "0.0.0.0";  // where to join the multicast group
+  std::string bind_address = "0.0.0.0";  // the command socket's; 0.0.0.0: this host's address toward the server
   double initial_backoff_seconds = 0.25;
   double max_backoff_seconds = 5.0;
-  std::chrono::milliseconds reply_timeout{1000};
-  std::chrono::milliseconds stall_timeout{2000};
+  std::chrono::milliseconds reply_timeout{3000};  // server info, then model definitions
+  std::chrono::milliseconds stall_timeout{1000};  // without a frame once streaming; 0: wait forever
   std::chrono::milliseconds keep_alive_interval{1000};
   std::chrono::milliseconds model_request_interval{1000};  // at most one re-request of the definitions
 };

@@ -51,6 +51,7 @@ struct QtmSource::State : std::enable_shared_from_this<QtmSource::State> {
         udp_socket(io),
         resolver(io),
         stall_timer(io),
+        handshake_timer(io),
         reconnection(io, sink, options.initial_backoff_seconds, options.max_backoff_seconds) {
     udp_buffer.resize(65536);  // one datagram at most
   }
@@ -61,7 +62,7 @@ struct QtmSource::State : std::enable_shared_from_this<QtmSource::State> {
   tcp::socket socket;
   udp::socket udp_socket;
   tcp::resolver resolver;
-  asio::steady_timer stall_timer;
+  asio::steady_timer stall_timer, handshake_timer;
   SourceReconnection reconnection;
   qtm::PacketFramer framer;
   std::vector<unsigned char> udp_buffer;
@@ -72,6 +73,8 @@ struct QtmSource::State : std::enable_shared_from_this<QtmSource::State> {
   Phase phase = Phase::Welcome;
   bool have_labels = false;
   bool parameters_pending = false;  // a GetParameters is on its way; mismatching frames wait for it
+  bool expecting_frames = false;    // StreamFrames sent and no NoMoreData since: silence is a stall
+  std::chrono::steady_clock::time_point last_parameters_request{};
   uint64_t generation = 0;  // bumps with every connection: stale handlers see another one
   int64_t last_frame_ns = 0;
   std::atomic<bool> stopped{false};
@@ -85,6 +88,8 @@ struct QtmSource::State : std::enable_shared_from_this<QtmSource::State> {
     framer.reserve(2 * kReadBytes);
     phase = Phase::Welcome;
     parameters_pending = false;
+    expecting_frames = false;
+    watch_handshake(gen);
     resolver.async_resolve(
         options.host, std::to_string(options.port),
         [self = shared_from_this(), gen](const boost::system::error_code& ec, const tcp::resolver::results_type& results) {
@@ -171,6 +176,7 @@ struct QtmSource::State : std::enable_shared_from_this<QtmSource::State> {
       case qtm::PacketType::NoMoreData:
         sink.on_source_state(SourceState::Finished, "QTM has no more frames (" + where() + ")");
         reconnection.frames_stopped();
+        expecting_frames = false;  // until the next measurement: silence is expected
         return true;
       default:
         sink.on_bad_input("unknown_packet", std::string("QTM: skipping a packet of type ") + std::to_string(type) +
@@ -203,8 +209,17 @@ struct QtmSource::State : std::enable_shared_from_this<QtmSource::State> {
     }
   }
 
+  // While streaming, at most once per parameters_request_interval: a QTM whose frames keep
+  // disagreeing with its own parameters was asked again after every frame.
   void ask_parameters(uint64_t gen) {
     if (parameters_pending) return;
+    const auto now = std::chrono::steady_clock::now();
+    if (phase == Phase::Streaming) {
+      if (last_parameters_request != std::chrono::steady_clock::time_point{} &&
+          now - last_parameters_request < options.parameters_request_interval)
+        return;
+      last_parameters_request = now;
+    }
     parameters_pending = true;
     send(gen, qtm::encode_text(qtm::PacketType::Command, "GetParameters General 3D"));
   }
@@ -271,7 +286,9 @@ struct QtmSource::State : std::enable_shared_from_this<QtmSource::State> {
       if (udp_socket.is_open()) udp_port = udp_socket.local_endpoint(ec).port();
     }
     send(gen, qtm::encode_text(qtm::PacketType::Command, qtm::stream_frames_command(kComponents, udp_port)));
+    handshake_timer.cancel();
     last_frame_ns = system_now_ns();
+    expecting_frames = true;
     watch_stall(gen);
   }
 
@@ -336,21 +353,37 @@ struct QtmSource::State : std::enable_shared_from_this<QtmSource::State> {
     frame.frame_number = data.frame_number;
     frame.source_time_ns = data.timestamp_us * 1000;
     frame.receive_time_ns = last_frame_ns = system_now_ns();
+    expecting_frames = true;
     reconnection.frame_arrived(where());
     sink.on_frame(frame);
   }
 
+  // Checked a few times per stall_timeout, so a stall is seen within a quarter of it.
   void watch_stall(uint64_t gen) {
     if (options.stall_timeout.count() <= 0) return;
-    stall_timer.expires_after(options.stall_timeout);
+    stall_timer.expires_after(std::max<std::chrono::milliseconds>(options.stall_timeout / 4, std::chrono::milliseconds(10)));
     stall_timer.async_wait([self = shared_from_this(), gen](const boost::system::error_code& ec) {
       if (ec || self->stopped || gen != self->generation) return;
       const auto silent = std::chrono::nanoseconds(system_now_ns() - self->last_frame_ns);
-      if (self->reconnection.streaming() && silent > self->options.stall_timeout)
-        return self->fail(gen, "no frame from " + self->where() + " for " +
-                                   std::to_string(std::chrono::duration_cast<std::chrono::milliseconds>(silent).count()) +
-                                   " ms");
+      if (self->expecting_frames && silent > self->options.stall_timeout)
+        return self->fail(gen,
+                          "stalled: no frame from " + self->where() + " for " +
+                              std::to_string(std::chrono::duration_cast<std::chrono::milliseconds>(silent).count()) +
+                              " ms with the connection open; reconnecting",
+                          SourceState::Stalled);
       self->watch_stall(gen);
+    });
+  }
+
+  // From connecting to StreamFrames: a server that accepts and then says nothing (or stops
+  // half-way) is left after handshake_timeout.
+  void watch_handshake(uint64_t gen) {
+    handshake_timer.expires_after(options.handshake_timeout);
+    handshake_timer.async_wait([self = shared_from_this(), gen](const boost::system::error_code& ec) {
+      if (ec || self->stopped || gen != self->generation || self->phase == Phase::Streaming) return;
+      static const char* const kWaitingFor[] = {"the welcome", "the answer to Version", "the parameters", ""};
+      self->fail(gen, "no handshake with " + self->where() + " within " + std::to_string(self->options.handshake_timeout.count()) +
+                          " ms (waiting for " + kWaitingFor[static_cast<int>(self->phase)] + ")");
     });
   }
 
@@ -368,12 +401,15 @@ struct QtmSource::State : std::enable_shared_from_this<QtmSource::State> {
     boost::system::error_code ignored;
     resolver.cancel();
     stall_timer.cancel();
+    handshake_timer.cancel();
     socket.shutdown(tcp::socket::shutdown_both, ignored);
     socket.close(ignored);
     udp_socket.close(ignored);
   }
 
-  void fail(uint64_t gen, const std::string& reason) { fail_connection(shared_from_this(), gen, reason); }
+  void fail(uint64_t gen, const std::string& reason, SourceState reported = SourceState::Disconnected) {
+    fail_connection(shared_from_this(), gen, reason, reported);
+  }
 };
 
 QtmSource::QtmSource(asio::io_context& io, QtmSourceOptions options, SourceSink& sink)

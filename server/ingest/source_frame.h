@@ -56,8 +56,9 @@ struct SourceFrame {
 enum class SourceState {
   Connecting,    // trying to reach the source (with backoff after a failure)
   Streaming,     // frames arriving
-  Disconnected,  // the source went away; retrying
-  Finished,      // a replay reached its end (without --loop)
+  Disconnected,  // the source went away, refused, or did not finish its handshake; retrying
+  Finished,      // a replay reached its end (without --loop), or a QTM measurement ended
+  Stalled,       // connected, but no frame for the stall time: reconnecting (Disconnected on the wire)
 };
 
 const char* to_string(SourceState state);

@@ -31,15 +31,20 @@ void stop_source(const std::shared_ptr<State>& state) {
   });
 }
 
-// Ends connection `gen` (nothing if it is already over) and schedules the next one.
+// Ends connection `gen` (nothing if it is already over) and schedules the next one; reports
+// `reported` (Disconnected, or Stalled for a connection that went silent) once per outage.
 template <typename State>
-void fail_connection(const std::shared_ptr<State>& state, uint64_t gen, const std::string& reason) {
+void fail_connection(const std::shared_ptr<State>& state, uint64_t gen, const std::string& reason,
+                     SourceState reported = SourceState::Disconnected) {
   if (state->stopped || gen != state->generation) return;
   ++state->generation;
   state->close_sockets();
-  state->reconnection.failed(reason, [state] {
-    if (!state->stopped) state->connect();
-  });
+  state->reconnection.failed(
+      reason,
+      [state] {
+        if (!state->stopped) state->connect();
+      },
+      reported);
 }
 
 }  // namespace skinstream::server

@@ -13,11 +13,11 @@ SourceReconnection::SourceReconnection(asio::io_context& io, SourceSink& sink, d
       max_seconds_(max_seconds),
       backoff_seconds_(initial_seconds) {}
 
-void SourceReconnection::failed(const std::string& reason, std::function<void()> retry) {
+void SourceReconnection::failed(const std::string& reason, std::function<void()> retry, SourceState state) {
   streaming_ = false;
   if (!disconnected_reported_) {
     disconnected_reported_ = true;
-    sink_.on_source_state(SourceState::Disconnected, reason);
+    sink_.on_source_state(state, reason);
   }
   timer_.expires_after(std::chrono::duration_cast<asio::steady_timer::duration>(
       std::chrono::duration<double>(backoff_seconds_)));

@@ -1,6 +1,6 @@
 #pragma once
-// How a network source reports its connection and comes back after a failure: Disconnected is
-// reported once per outage (with the first reason), a retry follows after a backoff that doubles
+// How a network source reports its connection and comes back after a failure: Disconnected (or
+// Stalled) is reported once per outage (with the first reason), a retry follows after a backoff that doubles
 // from initial_seconds to max_seconds, and once frames flow again Streaming is reported once and
 // the backoff starts from initial_seconds again. Shared by the QTM RT and NatNet sources.
 //
@@ -19,8 +19,9 @@ class SourceReconnection {
  public:
   SourceReconnection(asio::io_context& io, SourceSink& sink, double initial_seconds, double max_seconds);
 
-  // The connection failed: report (once per outage), then `retry` after the backoff.
-  void failed(const std::string& reason, std::function<void()> retry);
+  // The connection failed: report `state` (once per outage: Disconnected, or Stalled for a
+  // source that went silent), then `retry` after the backoff.
+  void failed(const std::string& reason, std::function<void()> retry, SourceState state = SourceState::Disconnected);
   // A frame arrived: Streaming is reported on the first one of a connection.
   void frame_arrived(std::string_view where);
   // Frames stopped without a failure (a replay ended): the next frame reports Streaming again.

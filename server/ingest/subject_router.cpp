@@ -48,7 +48,8 @@ SubjectRouter::Target::Target(SubjectTarget c) : config(std::move(c)) {
   last_seen.assign(config.marker_names.size(), missing_point());
 }
 
-SubjectRouter::SubjectRouter(std::vector<SubjectTarget> targets, Observer& observer) : observer_(observer) {
+SubjectRouter::SubjectRouter(std::vector<SubjectTarget> targets, Observer& observer, double max_coordinate_mm)
+    : observer_(observer), max_coordinate_mm_(max_coordinate_mm) {
   targets_.reserve(targets.size());
   for (SubjectTarget& t : targets) targets_.emplace_back(std::move(t));
   candidates_.reserve(targets_.size());
@@ -162,8 +163,9 @@ void SubjectRouter::fill_labelled(Target& target, const SourceFrame& frame, Mark
     // Bounds checked: a source whose positions do not match its labels loses those, not memory.
     if (slot.subject >= frame.labelled.size() || slot.label >= frame.labelled[slot.subject].size()) continue;
     const Vec3& p = frame.labelled[slot.subject][slot.label];
-    if (!is_present(p)) {
-      if (!p.array().isNaN().all()) ++out.rejected_points;  // NaN is "occluded"; anything else is broken
+    if (!plausible(p)) {
+      if (is_present(p)) ++out.implausible_points;
+      else if (!p.array().isNaN().all()) ++out.rejected_points;  // NaN is "occluded"; anything else is broken
       continue;
     }
     if (slot.marker == kUnknownLabel) {
@@ -200,8 +202,8 @@ void SubjectRouter::give_unlabelled(const SourceFrame& frame, std::span<MarkerFr
   const bool has_ids = frame.unlabelled_ids.size() == frame.unlabelled.size();
   for (size_t i = 0; i < frame.unlabelled.size(); ++i) {
     const Vec3& p = frame.unlabelled[i];
-    if (!is_present(p)) {
-      ++stats.rejected_points;
+    if (!plausible(p)) {
+      ++(is_present(p) ? stats.implausible_points : stats.rejected_points);
       continue;
     }
     int owner = candidates_.size() == 1 ? candidates_.front() : -1;

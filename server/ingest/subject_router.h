@@ -15,6 +15,12 @@
 // several, each point goes to the subject with a marker nearest to it (the markers' latest
 // measured positions), so no point is given to two subjects in one frame.
 //
+// Every position is checked before it goes anywhere, the same for every source: one that is not
+// finite, or farther from the capture system's origin than max_coordinate_mm along any axis (no
+// stage is that large: a source sending 3.4e38 mm or 1e36 m once made the daemon publish
+// infinite parameters, and 1e7 mm put vertices 612 m away), is taken as missing and counted
+// (MarkerFrame::rejected_points and implausible_points, Stats). NaN alone is "occluded".
+//
 // The matching is redone only when the source's structure_version changes (and allocates then);
 // otherwise route() allocates nothing. What it reports about names is bounded: each unknown
 // source subject name and each unknown label is reported once, at most kMaxRememberedNames of
@@ -64,11 +70,15 @@ class SubjectRouter {
   };
 
   struct Stats {
-    int unassigned_points = 0;  // unlabelled points near none of the present subjects' markers
-    int rejected_points = 0;    // unlabelled points that were not finite
+    int unassigned_points = 0;    // unlabelled points near none of the present subjects' markers
+    int rejected_points = 0;      // unlabelled points that were not finite
+    int implausible_points = 0;   // unlabelled points outside the capture volume
   };
 
-  SubjectRouter(std::vector<SubjectTarget> targets, Observer& observer);
+  // No coordinate farther than this from the origin, by default (mm): 50 m.
+  static constexpr double kDefaultMaxCoordinateMm = 50'000.0;
+
+  SubjectRouter(std::vector<SubjectTarget> targets, Observer& observer, double max_coordinate_mm = kDefaultMaxCoordinateMm);
 
   int target_count() const { return static_cast<int>(targets_.size()); }
   const SubjectTarget& target(int t) const { return targets_[static_cast<size_t>(t)].config; }
@@ -112,8 +122,12 @@ class SubjectRouter {
   void give_unlabelled(const SourceFrame& frame, std::span<MarkerFrame* const> out, Stats& stats);
   double distance_to(const Target& target, const Vec3& p, double below) const;
 
+  // Finite and within the capture volume.
+  bool plausible(const Vec3& p) const { return is_present(p) && p.cwiseAbs().maxCoeff() <= max_coordinate_mm_; }
+
   std::vector<Target> targets_;
   Observer& observer_;
+  double max_coordinate_mm_;
   bool matched_ = false;
   uint64_t structure_version_ = 0;
   BoundedNameSet unknown_subjects_{kMaxRememberedNames};

@@ -216,6 +216,7 @@ struct ViconSource::State : std::enable_shared_from_this<ViconSource::State> {
         socket(io),
         resolver(io),
         timer(io),
+        watchdog(io),
         framer(vicon::kMaxPacketLength, options.limits),
         backoff(options.initial_backoff_seconds) {
     pull_request = vicon::encode_packet(vicon::RequestFrame{false});
@@ -230,6 +231,8 @@ struct ViconSource::State : std::enable_shared_from_this<ViconSource::State> {
   tcp::socket socket;
   tcp::resolver resolver;
   asio::steady_timer timer;
+  asio::steady_timer watchdog;  // the handshake's and the stream's silences
+  std::chrono::steady_clock::time_point connected_at, last_frame;
   vicon::PacketFramer framer;
   std::vector<unsigned char> pull_request;
   std::vector<unsigned char> out_pending;   // bytes waiting for the write in flight
@@ -256,6 +259,8 @@ struct ViconSource::State : std::enable_shared_from_this<ViconSource::State> {
     streaming = false;
     writing = false;
     out_pending.clear();
+    connected_at = std::chrono::steady_clock::now();
+    watch(gen);
     resolver.async_resolve(options.host, std::to_string(options.port),
                            [self = shared_from_this(), gen](const boost::system::error_code& ec,
                                                             const tcp::resolver::results_type& results) {
@@ -311,6 +316,7 @@ struct ViconSource::State : std::enable_shared_from_this<ViconSource::State> {
       }
       if (!handshake_sent && assembler.saw_object_enums()) send_handshake(gen);
       if (result == ViconFrameAssembler::Result::Frame) {
+        last_frame = std::chrono::steady_clock::now();
         if (!streaming) {
           streaming = true;
           disconnected_reported = false;
@@ -327,6 +333,7 @@ struct ViconSource::State : std::enable_shared_from_this<ViconSource::State> {
 
   void send_handshake(uint64_t gen) {
     handshake_sent = true;
+    last_frame = std::chrono::steady_clock::now();  // the stall time runs from here
     vicon::ObjectEnums wanted;
     for (uint32_t t : kWantedTypes)
       if (std::find(assembler.offered().types.begin(), assembler.offered().types.end(), t) !=
@@ -370,21 +377,45 @@ struct ViconSource::State : std::enable_shared_from_this<ViconSource::State> {
                       });
   }
 
+  // No ObjectEnums within handshake_timeout of connecting (a server that accepts and says
+  // nothing), or no frame for stall_timeout after it (one that went silent with its connection
+  // open): the connection is left and retried. Checked ten times a second.
+  void watch(uint64_t gen) {
+    watchdog.expires_after(std::chrono::milliseconds(100));
+    watchdog.async_wait([self = shared_from_this(), gen](const boost::system::error_code& ec) {
+      if (ec || self->stopped || gen != self->generation) return;
+      using std::chrono::duration_cast;
+      using std::chrono::milliseconds;
+      const auto now = std::chrono::steady_clock::now();
+      if (!self->handshake_sent && now - self->connected_at > self->options.handshake_timeout)
+        return self->fail(gen, "no ObjectEnums from " + self->where() + " within " +
+                                   std::to_string(self->options.handshake_timeout.count()) + " ms of connecting");
+      if (self->handshake_sent && self->options.stall_timeout.count() > 0 && now - self->last_frame > self->options.stall_timeout)
+        return self->fail(gen,
+                          "stalled: no frame from " + self->where() + " for " +
+                              std::to_string(duration_cast<milliseconds>(now - self->last_frame).count()) +
+                              " ms with the connection open; reconnecting",
+                          SourceState::Stalled);
+      self->watch(gen);
+    });
+  }
+
   void close_socket() {
     boost::system::error_code ignored;
+    watchdog.cancel();
     resolver.cancel();
     socket.shutdown(tcp::socket::shutdown_both, ignored);
     socket.close(ignored);
   }
 
-  void fail(uint64_t gen, const std::string& reason) {
+  void fail(uint64_t gen, const std::string& reason, SourceState reported = SourceState::Disconnected) {
     if (stopped || gen != generation) return;
     ++generation;  // whatever is still pending for this connection is now stale
     close_socket();
     streaming = false;
     if (!disconnected_reported) {
       disconnected_reported = true;
-      sink.on_source_state(SourceState::Disconnected, reason);
+      sink.on_source_state(reported, reason);
     }
     timer.expires_after(std::chrono::duration_cast<std::chrono::steady_clock::duration>(
         std::chrono::duration<double>(backoff)));

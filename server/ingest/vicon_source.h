@@ -6,9 +6,11 @@
 // Handshake: the server sends ObjectEnums; we answer with the types we read (StreamInfo,
 // SubjectInfo, FrameInfo, LabeledRecons, UnlabeledRecons, Timecode, Contents) and RequestFrame
 // {true} (ServerPush) or, in ClientPull, RequestFrame{false} after every frame.
-// Any failure (refused, reset, end of stream, malformed packet) closes the connection, reports
-// Disconnected with the reason and retries after a backoff of 0.25 s doubling to 5 s; the backoff
-// returns to 0.25 s once frames flow again (Streaming).
+// Any failure (refused, reset, end of stream, malformed packet, no ObjectEnums within
+// handshake_timeout of connecting) closes the connection, reports Disconnected with the reason
+// and retries after a backoff of 0.25 s doubling to 5 s; the backoff returns to 0.25 s once frames
+// flow again (Streaming). A server that sends no frame for stall_timeout after the handshake
+// (connected, but silent) is reported Stalled and retried the same way.
 //
 // Subjects: SourceFrame::subjects are the SubjectInfo objects (name, marker names in the order
 // SubjectInfo lists them), decoded only when their bytes change (structure_version then bumps).
@@ -21,6 +23,7 @@
 // After the first frames, receiving a frame allocates nothing.
 
 #include <array>
+#include <chrono>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -79,6 +82,8 @@ struct ViconSourceOptions {
   Mode mode = Mode::ServerPush;
   double initial_backoff_seconds = 0.25;
   double max_backoff_seconds = 5.0;
+  std::chrono::milliseconds handshake_timeout{3000};  // connecting to ObjectEnums
+  std::chrono::milliseconds stall_timeout{1000};      // without a frame after the handshake; 0: wait forever
   vicon::DescriptionLimits limits{};  // the subjects a packet may describe (beyond them: malformed)
 };
 

@@ -144,6 +144,10 @@ std::string render_prometheus(const Metrics& source, const std::vector<SubjectMe
   daemon_counter("subscribers_refused_limit_total", "Subscribers refused as they connected: max_subscribers or max_subscribers_per_address reached.",
                  source.subscribers_refused_limit);
   daemon_counter("subscribers_refused_token_total", "Subscribers refused for a missing or wrong subscriber_token.", source.subscribers_refused_token);
+  daemon_counter("subscribers_refused_unauthenticated_total",
+                 "Connections refused as they connected: too many without the subscriber_token yet (max_unauthenticated_subscribers, "
+                 "max_unauthenticated_per_address).",
+                 source.subscribers_refused_unauthenticated);
   per_subject("frames_received_total", "Marker frames of the subject received from the source.", &Metrics::frames_received);
   per_subject("frames_processed_total", "Frames through the gap filler.", &Metrics::frames_processed);
   per_subject("frames_published_total", "Frames handed to the publishers.", &Metrics::frames_published);
@@ -152,6 +156,8 @@ std::string render_prometheus(const Metrics& source, const std::vector<SubjectMe
   per_subject("markers_filled_total", "Marker samples filled (PCA, rigid or held).", &Metrics::markers_filled);
   per_subject("markers_relabelled_total", "Marker samples taken from unlabelled points.", &Metrics::markers_relabelled);
   per_subject("markers_held_total", "Marker samples held relative to their anchors.", &Metrics::markers_held);
+  per_subject("source_rate_changes_total", "Times the gap filler was rebuilt for a new source rate (the rate became known, or changed by more than 0.1%).",
+              &Metrics::source_rate_changes);
   per_subject("bad_subscriber_messages_total", "Subscriber messages that broke the protocol.", &Metrics::bad_subscriber_messages);
   per_subject("subscribers_accepted_total", "Subscriber connections accepted.", &Metrics::subscribers_connected);
   per_subject("subscribers_refused_total", "Subscribers refused after their Hello (unknown subject, ...).", &Metrics::subscribers_refused);

@@ -69,11 +69,16 @@ class Metrics {
   std::atomic<uint64_t> markers_filled{0};
   std::atomic<uint64_t> markers_relabelled{0};
   std::atomic<uint64_t> markers_held{0};
+  // Times the pipeline's filler was rebuilt for a new source rate (once when the rate becomes
+  // known, again only when it really changes: server/pipeline/pipeline.h).
+  std::atomic<uint64_t> source_rate_changes{0};
   std::atomic<uint64_t> bad_subscriber_messages{0};
   std::atomic<uint64_t> subscribers_connected{0};  // total accepted
   std::atomic<uint64_t> subscribers_refused{0};    // Hello refused (unknown subject, ...)
   // Refused when they connected (server/publish/subscriber_admission.h), and for their token.
   std::atomic<uint64_t> subscribers_refused_not_allowed{0}, subscribers_refused_limit{0}, subscribers_refused_token{0};
+  // With a token: connections refused for the places kept for those without it (all taken).
+  std::atomic<uint64_t> subscribers_refused_unauthenticated{0};
   std::atomic<uint64_t> subscribers_dropped_write_stall{0};  // a write that did not progress for subscriber_write_stall_ms
   std::atomic<uint64_t> accepts_failed_no_descriptor{0};  // both ports: each pauses that port's accepts (server/listener.h)
   std::atomic<uint64_t> frame_buffers_allocated{0};              // every encoded frame buffer made

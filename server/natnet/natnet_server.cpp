@@ -1,6 +1,7 @@
 #include "server/natnet/natnet_server.h"
 
 #include <algorithm>
+#include <deque>
 #include <stdexcept>
 
 #include <spdlog/spdlog.h>
@@ -27,6 +28,7 @@ struct NatNetServer::State : std::enable_shared_from_this<NatNetServer::State> {
         command_socket(io),
         timeline(io, encoder.rate_hz(), options.speed, static_cast<uint64_t>(encoder.frame_count()), options.loop) {
     receive_buffer.resize(natnet::kMaxMessageBytes);
+    encoder.set_clock({options.timestamp_jitter_us * 1e-6, options.timestamp_clock_hz});
   }
 
   struct Client {
@@ -42,7 +44,8 @@ struct NatNetServer::State : std::enable_shared_from_this<NatNetServer::State> {
   std::vector<unsigned char> receive_buffer;
   udp::endpoint sender;
   udp::endpoint multicast_destination;
-  std::vector<Client> clients;
+  std::vector<Client> clients;  // unicast: frames go to them
+  std::deque<udp::endpoint> connected;  // the last senders of a CONNECT, newest last
   natnet::ByteVector frame_bytes;
   Packet latest;
   bool running = false;
@@ -120,6 +123,13 @@ struct NatNetServer::State : std::enable_shared_from_this<NatNetServer::State> {
     ++stats.requests;
     switch (id) {
       case natnet::message::Connect: {
+        if (!options.multicast && !is_client(from) && clients.size() >= options.max_clients) {
+          ++stats.clients_refused;
+          log.warn("natnet_too_many_clients", "natnet server: not answering a CONNECT from " + from.address().to_string() +
+                                                  ": " + std::to_string(options.max_clients) + " unicast clients already");
+          break;
+        }
+        note_connected(from);
         natnet::ServerInfo info;
         info.application_name = "skinstream-replay";
         info.application_version = {0, 1, 0, 0};
@@ -134,13 +144,15 @@ struct NatNetServer::State : std::enable_shared_from_this<NatNetServer::State> {
         break;
       }
       case natnet::message::RequestModelDef:
+        if (!was_connected(from)) break;
         reply(natnet::encode_model_definitions(encoder.model_definitions(), options.version), from);
         break;
       case natnet::message::RequestFrameOfData:
+        if (!was_connected(from)) break;
         if (latest) send(latest, from);
         break;
       case natnet::message::KeepAlive:
-        if (!options.multicast) remember(from);
+        if (!options.multicast && is_client(from)) remember(from);  // keeps a client; makes none
         break;
       case natnet::message::Disconnect:
         clients.erase(std::remove_if(clients.begin(), clients.end(), [&](const Client& c) { return c.endpoint == from; }),
@@ -152,6 +164,24 @@ struct NatNetServer::State : std::enable_shared_from_this<NatNetServer::State> {
       default:  // answers and frames from another server: never answered, so two servers cannot ping-pong
         break;
     }
+  }
+
+  bool is_client(const udp::endpoint& from) const {
+    return std::any_of(clients.begin(), clients.end(), [&](const Client& c) { return c.endpoint == from; });
+  }
+
+  void note_connected(const udp::endpoint& from) {
+    connected.erase(std::remove(connected.begin(), connected.end(), from), connected.end());
+    connected.push_back(from);
+    while (connected.size() > std::max<size_t>(1, options.max_clients)) connected.pop_front();
+  }
+
+  bool was_connected(const udp::endpoint& from) {
+    if (std::find(connected.begin(), connected.end(), from) != connected.end()) return true;
+    ++stats.requests_not_connected;
+    log.warn("natnet_not_connected", "natnet server: not answering a request from " + from.address().to_string() + ":" +
+                                         std::to_string(from.port()) + ", which did not CONNECT");
+    return false;
   }
 
   void remember(const udp::endpoint& from) {

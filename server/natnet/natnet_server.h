@@ -12,7 +12,11 @@
 //   REQUEST (text)        UNRECOGNIZED_REQUEST: a replay takes no text commands
 //   anything else         ignored (never answered)
 // Frames go to group:data_port (multicast), or to every connected client's command socket
-// (unicast), on the replay clock (server/replay/replay_timeline.h). The timeline starts with the
+// (unicast, at most max_clients: a CONNECT beyond them is not answered, and counted), on the
+// replay clock (server/replay/replay_timeline.h). REQUEST_MODELDEF and REQUEST_FRAMEOFDATA are
+// answered only to a sender that CONNECTed (the last max_clients of them): a request from
+// anyone else, perhaps with a forged source address, would have the server send a victim ~1,000
+// times the bytes it cost. The timeline starts with the
 // first CONNECT unless start_on_first_request is false. Malformed datagrams are counted, logged at
 // a limited rate and ignored.
 //
@@ -46,6 +50,12 @@ struct NatNetServerOptions {
   bool loop = false;
   bool start_on_first_request = true;
   std::chrono::milliseconds client_timeout{10'000};  // unicast clients without a keep-alive
+  size_t max_clients = 16;                           // unicast clients served, and senders remembered as connected
+  // The frames' timestamps as a real capture clock stamps them, for tests and benchmarks of the
+  // clients (0: exact): moved by up to +-timestamp_jitter_us, then quantised to the ticks of a
+  // timestamp_clock_hz clock (protocol/natnet_capture_encoder.h).
+  double timestamp_jitter_us = 0.0;
+  double timestamp_clock_hz = 0.0;
 };
 
 struct NatNetServerStats {
@@ -56,6 +66,8 @@ struct NatNetServerStats {
   std::atomic<uint64_t> frames_produced{0};
   std::atomic<uint64_t> datagrams_sent{0};
   std::atomic<uint64_t> frames_too_large{0};  // over one UDP datagram: not sent
+  std::atomic<uint64_t> clients_refused{0};   // CONNECTs beyond max_clients
+  std::atomic<uint64_t> requests_not_connected{0};  // model or frame requests from a sender that did not CONNECT
 };
 
 class NatNetServer {

@@ -3,8 +3,10 @@
 #include <spdlog/spdlog.h>
 
 #include <chrono>
+#include <cmath>
 #include <stdexcept>
 
+#include "protocol/finite_values.h"
 #include "protocol/frame_parameters.h"
 #include "protocol/subscriber_stream.h"
 #include "server/pipeline/deform_cpus.h"
@@ -37,6 +39,13 @@ struct FrameNeeds {
   bool compressed_normals = false;
 };
 
+bool all_finite(const FrameParameters& parameters) {
+  for (const PartParameters& part : parameters.parts)
+    if (!skinstream::all_finite(part.quadratic) || !skinstream::all_finite(part.rotation) || !skinstream::all_finite(part.translation))
+      return false;
+  return skinstream::all_finite(parameters.weights);
+}
+
 FrameNeeds needs_of(const StreamKeySet& wanted) {
   FrameNeeds needs;
   wanted.for_each([&](StreamKey key) {
@@ -54,6 +63,17 @@ FrameNeeds needs_of(const StreamKeySet& wanted) {
     }
   });
   return needs;
+}
+
+// What of a frame about to be encoded is not all finite ("markers", "vertices", ...), or null.
+const char* non_finite_output(const FrameNeeds& needs, std::span<const float> markers, const MeshDeformer* deformer,
+                              std::span<const float> positions, std::span<const float> normals) {
+  if (!skinstream::all_finite(markers)) return "markers";
+  if (!deformer) return nullptr;
+  if (needs.vertices && !skinstream::all_finite(positions)) return "vertices";
+  if (needs.vertices && needs.normals && !skinstream::all_finite(normals)) return "normals";
+  if (needs.parameters && !all_finite(deformer->parameters())) return "parameters";
+  return nullptr;
 }
 
 }  // namespace
@@ -146,11 +166,13 @@ void Pipeline::process(const MarkerFrame& frame, uint64_t generation) {
     generation_ = generation;
     has_generation_ = true;
   }
-  if (frame.source_rate_hz > 0 && std::abs(frame.source_rate_hz - filler_rate_hz_) > 1e-6) {
-    // Rare (the rate becomes known): rebuilding allocates, which is fine here.
+  if (rate_changed(frame.source_rate_hz)) {
+    // Rare (the rate becomes known, the operator changes it): rebuilding allocates, which is fine here.
     filler_rate_hz_ = frame.source_rate_hz;
+    last_rate_change_ = std::chrono::steady_clock::now();
     filler_.emplace(model_, filler_options(filler_rate_hz_));
     blender_.reset();
+    metrics_.source_rate_changes.fetch_add(1, std::memory_order_relaxed);
     spdlog::info("pipeline: source rate {} Hz", frame.source_rate_hz);
   }
 
@@ -178,6 +200,12 @@ void Pipeline::process(const MarkerFrame& frame, uint64_t generation) {
   long released = 0;
   if (blender_.push(filled_, filled_status_, sequence, {released_positions_, released_status_}, released, filled_revoked_))
     publish(held_[static_cast<size_t>(released) % held_.size()], released_positions_, released_status_);
+}
+
+bool Pipeline::rate_changed(double source_rate_hz) const {
+  if (!(source_rate_hz > 0.0) || std::abs(source_rate_hz - filler_rate_hz_) <= kRateTolerance * filler_rate_hz_) return false;
+  return last_rate_change_ == std::chrono::steady_clock::time_point{} ||
+         std::chrono::steady_clock::now() - last_rate_change_ >= kMinRateChangeInterval;
 }
 
 size_t Pipeline::message_bytes(StreamKey key) const {
@@ -272,6 +300,15 @@ void Pipeline::publish(const Released& meta, std::span<const Vec3> positions, st
   for (size_t m = 0; m < status.size(); ++m) {
     for (int a = 0; a < 3; ++a) marker_floats_[3 * m + a] = static_cast<float>(positions[m][a]);
     marker_status_bytes_[m] = static_cast<uint8_t>(status[m]);
+  }
+  // Nothing that is not finite is encoded: a frame whose markers, vertices or parameters are not
+  // all finite (a value the router should have refused, a deformation that overflowed) is
+  // counted and not sent; subscribers keep the last good one.
+  if (const char* what = non_finite_output(needs, marker_floats_, deformer_.get(), positions_, normals_)) {
+    metrics_.count_bad_input("non_finite_frame");
+    non_finite_log_.warn("non_finite_frame", "pipeline: frame " + std::to_string(meta.frame_number) + " not sent: its " + what +
+                                                 " are not all finite");
+    return;
   }
   subscriber::FrameInfo info;
   info.frame_number = meta.frame_number;

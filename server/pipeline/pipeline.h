@@ -23,6 +23,7 @@
 #include "core/gap_end_blender.h"
 #include "core/gap_filler.h"
 #include "core/subject_model.h"
+#include "server/logging.h"
 #include "server/metrics/metrics.h"
 #include "server/pipeline/deform_workers.h"
 #include "server/pipeline/encoded_frame.h"
@@ -119,6 +120,8 @@ class Pipeline {
   void run();
   void keep_pool();  // the pool keeper's job
   GapFillerOptions filler_options(double rate_hz) const;
+  // Whether the filler must be rebuilt for the source's rate (0: not known).
+  bool rate_changed(double source_rate_hz) const;
   void process(const MarkerFrame& frame, uint64_t generation);
   void publish(const Released& meta, std::span<const Vec3> positions, std::span<const MarkerStatus> status);
   FrameRef encode(const StreamKeySet& keys, subscriber::FrameInfo info, bool has_timecode, const subscriber::CompressedBlocks& compressed);
@@ -152,8 +155,17 @@ class Pipeline {
   std::function<void(StreamKey)> encoding_ready_callback_;
   OnDemandThread pool_keeper_;  // last of these: its thread starts as it is made
 
+  // A source rate within this (relative) of the filler's is the same rate: the filler's time
+  // constants do not notice 0.1%, and a source's clock must never rebuild it (a NatNet rate once
+  // read from each pair of timestamps rebuilt it on every frame: 952 rebuilds in 12 s, processing
+  // p99 1.5 -> 50 ms).
+  static constexpr double kRateTolerance = 1e-3;
+  // A source whose rate changes more often than this is broken or hostile: the filler follows it
+  // at most this often (each rebuild allocates on this thread).
+  static constexpr std::chrono::seconds kMinRateChangeInterval{2};
   std::optional<GapFiller> filler_;
   double filler_rate_hz_ = 0.0;
+  std::chrono::steady_clock::time_point last_rate_change_{};
   GapEndBlender blender_;
   std::unique_ptr<MeshDeformer> deformer_;
   std::unique_ptr<DeformWorkers> workers_;
@@ -173,6 +185,8 @@ class Pipeline {
   std::vector<uint32_t> compressed_order_;
   std::unique_ptr<subscriber::CompressedVertexEncoder> compressed_;
   std::vector<unsigned char> compressed_blocks_;
+
+  RateLimitedLog non_finite_log_;
 
   std::atomic<bool> running_{false};
   std::atomic<uint64_t> published_{0};

@@ -45,11 +45,20 @@ MulticastSender::MulticastSender(FrameConsumer& next, const MulticastSenderOptio
     close(fd_);
     throw std::runtime_error(where(options) + ": cannot set " + failed + ": " + reason);
   }
+  if (!options.key.empty()) {
+    try {
+      authenticator_ = std::make_unique<wire::DatagramAuthenticator>(options.key);
+    } catch (const std::invalid_argument& e) {
+      close(fd_);
+      throw std::runtime_error(where(options) + ": " + e.what());
+    }
+  }
   std::memset(datagrams_, 0, sizeof datagrams_);
   for (int i = 0; i < wire::kMaxFragments; ++i) {
-    pieces_[2 * i] = {headers_[i], wire::kDatagramHeaderBytes};
-    datagrams_[i].msg_hdr.msg_iov = &pieces_[2 * i];
-    datagrams_[i].msg_hdr.msg_iovlen = 2;
+    pieces_[3 * i] = {headers_[i], wire::kDatagramHeaderBytes};
+    pieces_[3 * i + 2] = {tags_[i].data(), tags_[i].size()};
+    datagrams_[i].msg_hdr.msg_iov = &pieces_[3 * i];
+    datagrams_[i].msg_hdr.msg_iovlen = authenticator_ ? 3 : 2;
   }
 }
 
@@ -73,20 +82,27 @@ void MulticastSender::publish(const FrameRef& frame) {
   if (!has_model_ || !frame->has(sent_key())) return;  // no Model yet; or a later hand-over of the frame (compressed)
   const auto start = std::chrono::steady_clock::now();
   const std::span<const unsigned char> message = frame->message(sent_key());
-  const uint16_t count = wire::fragment_count(message.size());
+  const bool signed_datagrams = authenticator_ != nullptr;
+  const uint16_t count = wire::fragment_count(message.size(), signed_datagrams);
   if (count == 0) {
     frames_too_large_.fetch_add(1, std::memory_order_relaxed);
     error_log_.warn("too_large", where(options_) + ": a frame of " + std::to_string(message.size()) + " bytes is over the " +
-                                     std::to_string(wire::kMaxDatagramMessageBytes) + " 64 datagrams carry; not sent");
+                                     std::to_string(signed_datagrams ? wire::kMaxAuthenticatedMessageBytes : wire::kMaxDatagramMessageBytes) +
+                                     " 64 datagrams carry; not sent");
     return;
   }
-  wire::DatagramHeader header{options_.stream_id, model_id_, sequence_++, 0, count, static_cast<uint32_t>(message.size())};
+  wire::DatagramHeader header{options_.stream_id, model_id_, sequence_++, 0, count, static_cast<uint32_t>(message.size()), signed_datagrams};
   for (uint16_t i = 0; i < count; ++i) {
     header.index = i;
     wire::encode_datagram_header(header, headers_[i]);
+    const std::span<const unsigned char> fragment =
+        message.subspan(wire::fragment_offset(message.size(), count, i), wire::fragment_bytes(message.size(), count, i));
     // sendmmsg only reads the fragment; iovec has no const.
-    pieces_[2 * i + 1] = {const_cast<unsigned char*>(message.data()) + wire::fragment_offset(message.size(), count, i),
-                          wire::fragment_bytes(message.size(), count, i)};
+    pieces_[3 * i + 1] = {const_cast<unsigned char*>(fragment.data()), fragment.size()};
+    if (signed_datagrams) {
+      const std::span<const unsigned char> parts[] = {headers_[i], fragment};
+      tags_[i] = authenticator_->tag(parts);
+    }
   }
   int sent = 0;
   while (sent < count) {
@@ -107,7 +123,8 @@ void MulticastSender::publish(const FrameRef& frame) {
   if (sent == count) frames_sent_.fetch_add(1, std::memory_order_relaxed);
   datagrams_sent_.fetch_add(static_cast<uint64_t>(sent), std::memory_order_relaxed);
   uint64_t bytes = 0;
-  for (int i = 0; i < sent; ++i) bytes += wire::kDatagramHeaderBytes + pieces_[2 * i + 1].iov_len;
+  for (int i = 0; i < sent; ++i)
+    bytes += wire::kDatagramHeaderBytes + pieces_[3 * i + 1].iov_len + (signed_datagrams ? wire::kDatagramTagBytes : 0);
   bytes_sent_.fetch_add(bytes, std::memory_order_relaxed);
   send_time_.observe_ns(std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - start).count());
 }
@@ -119,6 +136,7 @@ nlohmann::json MulticastSender::health() const {
           {"interface", options_.interface_address},
           {"ttl", options_.ttl},
           {"stream_id", options_.stream_id},
+          {"authenticated", authenticator_ != nullptr},
           {"model_id", model_id_},
           {"frames_sent", frames_sent_.load()},
           {"datagrams_sent", datagrams_sent_.load()},

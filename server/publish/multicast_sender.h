@@ -7,17 +7,22 @@
 //
 // Called on the pipeline thread, so it never waits: the socket is non-blocking, the datagrams
 // point into the pooled frame (one sendmmsg, no copy, no allocation), and a datagram the socket
-// has no room for is dropped and counted (receivers lose that frame, nothing else).
+// has no room for is dropped and counted (receivers lose that frame, nothing else). With a key,
+// every datagram carries the HMAC-SHA-256 tag of its header and fragment
+// (protocol/datagram_authentication.h), so receivers given the key take no forged datagram.
 
 #include <atomic>
 #include <cstdint>
 #include <span>
+#include <memory>
 #include <string>
+#include <vector>
 #include <sys/socket.h>
 #include <sys/uio.h>
 
 #include <nlohmann/json_fwd.hpp>
 
+#include "protocol/datagram_authentication.h"
 #include "protocol/multicast_datagram.h"
 #include "server/logging.h"
 #include "server/metrics/metrics.h"
@@ -31,6 +36,7 @@ struct MulticastSenderOptions {
   std::string interface_address = "0.0.0.0";  // this host's address to send from; 0.0.0.0: the system's route
   int ttl = 1;                               // 1: the link only
   uint32_t stream_id = 0;                    // the subject's stream
+  std::vector<unsigned char> key{};          // the shared key (at least 16 bytes); empty: datagrams are not signed
 };
 
 class MulticastSender : public FrameConsumer {
@@ -62,9 +68,11 @@ class MulticastSender : public FrameConsumer {
   bool has_model_ = false;
   int fd_ = -1;
   uint32_t sequence_ = 0;  // pipeline thread only
-  // One header and two pieces (header, fragment) per datagram, made once.
+  std::unique_ptr<subscriber::DatagramAuthenticator> authenticator_;  // with a key
+  // One header, tag and three pieces (header, fragment, tag) per datagram, made once.
   unsigned char headers_[subscriber::kMaxFragments][subscriber::kDatagramHeaderBytes];
-  iovec pieces_[2 * subscriber::kMaxFragments];
+  subscriber::DatagramTag tags_[subscriber::kMaxFragments];
+  iovec pieces_[3 * subscriber::kMaxFragments];
   mmsghdr datagrams_[subscriber::kMaxFragments];
   std::atomic<uint64_t> frames_sent_{0}, datagrams_sent_{0}, bytes_sent_{0};
   std::atomic<uint64_t> datagrams_dropped_{0};  // the socket buffer was full (EAGAIN, ENOBUFS)

@@ -27,6 +27,9 @@ struct HubOptions {
   int queue_frames = 32;  // per subscriber, at most
   std::chrono::nanoseconds frame_max_wait = std::chrono::milliseconds(25);  // in a subscriber's queue
   std::chrono::milliseconds hello_timeout{2000};
+  // A connection that must give the token (or was refused as it connected) and sends no Hello
+  // within this is refused and closed.
+  std::chrono::milliseconds unauthenticated_hello_timeout{1000};
 };
 
 class SubscriberHub : public FrameConsumer {

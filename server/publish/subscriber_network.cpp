@@ -33,7 +33,14 @@ std::optional<SubscriberNetwork> SubscriberNetwork::parse(std::string_view text)
     if (digits.empty() || error != std::errc() || end != digits.data() + digits.size()) return std::nullopt;
     if (network.prefix_bits_ < 0 || network.prefix_bits_ > max_bits) return std::nullopt;
   }
-  if (network.v6_) {
+  if (network.v6_ && address.to_v6().is_v4_mapped()) {
+    // An IPv4 network written as IPv6: what the peers it means are compared as.
+    if (network.prefix_bits_ < 96) return std::nullopt;
+    network.v6_ = false;
+    network.prefix_bits_ -= 96;
+    const auto v4 = asio::ip::make_address_v4(asio::ip::v4_mapped, address.to_v6()).to_bytes();
+    std::copy(v4.begin(), v4.end(), network.bytes_.begin());
+  } else if (network.v6_) {
     network.bytes_ = address.to_v6().to_bytes();
   } else {
     const auto v4 = address.to_v4().to_bytes();

@@ -43,11 +43,12 @@ void SubscriberSession::close_from_any_thread() {
   else asio::post(io_, [self = shared_from_this()] { self->close(); });
 }
 
-void SubscriberSession::set_admission(SubscriberAdmission::Decision decision,
-                                      std::shared_ptr<const SubscriberAdmission> token_check) {
+void SubscriberSession::set_admission(SubscriberAdmission::Decision decision, std::shared_ptr<SubscriberAdmission> authenticate,
+                                      asio::ip::address peer) {
   admission_ = std::move(decision.ticket);
   refusal_ = std::move(decision.reason);
-  token_check_ = std::move(token_check);
+  authenticate_ = std::move(authenticate);
+  peer_ = peer;
 }
 
 std::chrono::nanoseconds SubscriberSession::write_stalled_for(std::chrono::steady_clock::time_point now) const {
@@ -73,11 +74,19 @@ SubscriberMetrics SubscriberSession::stats() const {
 }
 
 void SubscriberSession::start_hello_timer(std::chrono::milliseconds timeout) {
+  // A connection that is to give a token, or was refused, is not kept waiting long.
+  const bool unauthenticated = authenticate_ || !refusal_.empty();
+  if (unauthenticated) timeout = std::min(timeout, hub_->options().unauthenticated_hello_timeout);
   hello_timer_.expires_after(timeout);
-  hello_timer_.async_wait([self = shared_from_this()](const boost::system::error_code& ec) {
+  hello_timer_.async_wait([self = shared_from_this(), unauthenticated, timeout](const boost::system::error_code& ec) {
     if (ec || self->greeted_ || self->closed_) return;
-    connection_log.info("subscriber_no_hello", fmt::format("subscriber {} ({} {}): no Hello within the timeout, sending positions only",
-                                                           self->id_, self->transport_, self->remote_));
+    if (unauthenticated && self->refusal_.empty()) {
+      self->refusal_ = "no Hello with the token within " + std::to_string(timeout.count()) + " ms";
+      self->authenticate_.reset();
+    } else if (!unauthenticated) {
+      connection_log.info("subscriber_no_hello", fmt::format("subscriber {} ({} {}): no Hello within the timeout, sending positions only",
+                                                             self->id_, self->transport_, self->remote_));
+    }
     self->on_hello(subscriber::Hello{});
   });
 }
@@ -111,12 +120,16 @@ void SubscriberSession::on_hello(const subscriber::Hello& hello) {
   if (closed_ || close_after_write_) return;
   version_ = hello.version;
   if (!refusal_.empty()) return refuse(refusal_);
-  if (token_check_) {
-    if (!token_check_->token_matches(hello.token)) {
+  if (authenticate_) {
+    const std::shared_ptr<SubscriberAdmission> admission = std::move(authenticate_);  // a later Hello changes what it wants, not who it is
+    if (!admission->token_matches(hello.token)) {
       return refuse(hello.token.empty() ? "this daemon asks for a token (Hello version 2's token field, or ?token= on the WebSocket URL)"
                                         : "wrong token");
     }
-    token_check_.reset();  // a later Hello changes what the subscriber wants, not who it is
+    // Only now a subscriber: its place among them instead of the one kept for connections without the token.
+    SubscriberAdmission::Decision admitted = admission->admit(peer_);
+    if (!admitted.ticket) return refuse(admitted.reason);
+    admission_ = std::move(admitted.ticket);
   }
   paced_ = (hello.wants & subscriber::kWantPaced) != 0;
   // Version 2: the encoding asked for, or what can be served instead, and why.

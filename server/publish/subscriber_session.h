@@ -43,9 +43,12 @@ class SubscriberSession : public std::enable_shared_from_this<SubscriberSession>
 
   // Before the session starts (the accepting thread): what admission decided. A refused
   // subscriber gets a Status saying why, in the version of its Hello (version 1 after the Hello
-  // timeout), and is closed. `token_check` (null: no token asked, or it came on the URL) checks
-  // the token of its first Hello.
-  void set_admission(SubscriberAdmission::Decision decision, std::shared_ptr<const SubscriberAdmission> token_check);
+  // timeout), and is closed. `authenticate` (null: no token asked, or it came on the URL) checks
+  // the token of the first Hello and only then admits the subscriber from `peer`: until then the
+  // decision's ticket is one of the places kept for connections without the token, and the
+  // Hello timeout is the short unauthenticated one (HubOptions), after which it is refused.
+  void set_admission(SubscriberAdmission::Decision decision, std::shared_ptr<SubscriberAdmission> authenticate = nullptr,
+                     asio::ip::address peer = {});
   // Any thread: how long the write under way has made no progress (zero when none is under way).
   std::chrono::nanoseconds write_stalled_for(std::chrono::steady_clock::time_point now) const;
   // Any thread, once: closes the subscriber whose write stalled, and counts it.
@@ -104,7 +107,8 @@ class SubscriberSession : public std::enable_shared_from_this<SubscriberSession>
   std::atomic<bool> dropped_for_stall_{false};
   SubscriberAdmission::Ticket admission_;  // its place among the subscribers, freed when it goes
   std::string refusal_;                    // refused as it connected: said after its Hello
-  std::shared_ptr<const SubscriberAdmission> token_check_;
+  std::shared_ptr<SubscriberAdmission> authenticate_;  // set until the token came
+  asio::ip::address peer_;
 };
 
 }  // namespace skinstream::server

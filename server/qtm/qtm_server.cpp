@@ -16,6 +16,7 @@
 #include "protocol/qtm_packet_framer.h"
 #include "protocol/qtm_packet_reader.h"
 #include "protocol/qtm_packet_writer.h"
+#include "server/listener.h"
 #include "server/logging.h"
 #include "server/replay/replay_timeline.h"
 
@@ -45,7 +46,6 @@ struct QtmServer::State : std::enable_shared_from_this<QtmServer::State> {
       : io(io_context),
         options(std::move(opts)),
         encoder(std::move(subjects), options.rate_hz),
-        acceptor(io),
         udp_socket(io),
         timeline(io, encoder.rate_hz(), options.speed, static_cast<uint64_t>(encoder.frame_count()), options.loop) {}
 
@@ -53,7 +53,7 @@ struct QtmServer::State : std::enable_shared_from_this<QtmServer::State> {
   QtmServerOptions options;
   qtm::CaptureEncoder encoder;
   qtm::DataPacketWriter writer;
-  tcp::acceptor acceptor;
+  std::unique_ptr<Listener> listener;
   udp::socket udp_socket;
   ReplayTimeline timeline;
   std::vector<std::shared_ptr<Session>> sessions;
@@ -76,7 +76,9 @@ struct QtmServer::State : std::enable_shared_from_this<QtmServer::State> {
       bool is_frame;
     };
     std::deque<Outgoing> queue;  // front is being written while `writing`
+    size_t replies_waiting = 0;  // of the queue, not frames
     bool writing = false;
+    bool reading_paused = false;  // commands wait in the framer until the replies are read
     bool open = true;
     bool streaming = false;
     bool labelled = true, unlabelled = true;
@@ -103,10 +105,16 @@ struct QtmServer::State : std::enable_shared_from_this<QtmServer::State> {
         return;
       }
       framer.commit(n);
+      handle_commands();
+    }
+
+    // The commands read so far, until the replies waiting reach their bound; then the rest wait
+    // (in the framer, and in the client's socket) until the client reads its replies.
+    void handle_commands() {
       qtm::Bytes packet;
-      for (;;) {
+      while (replies_waiting < state.options.max_queued_replies) {
         const auto status = framer.next(packet);
-        if (status == qtm::PacketFramer::Status::NeedMore) break;
+        if (status == qtm::PacketFramer::Status::NeedMore) return read();
         std::string error;
         if (status == qtm::PacketFramer::Status::Error || !handle(packet, error)) {
           reject(status == qtm::PacketFramer::Status::Error ? framer.error() : error);
@@ -114,7 +122,8 @@ struct QtmServer::State : std::enable_shared_from_this<QtmServer::State> {
         }
         if (!open) return;
       }
-      read();
+      reading_paused = true;
+      ++state.stats.reads_paused;
     }
 
     void send(std::vector<unsigned char> bytes) { enqueue(shared(std::move(bytes)), false); }
@@ -204,10 +213,15 @@ struct QtmServer::State : std::enable_shared_from_this<QtmServer::State> {
       udp_destination.reset();
       if (command.udp) {
         boost::system::error_code ec;
-        const auto address = command.udp_address.empty() ? socket.remote_endpoint(ec).address()
-                                                          : asio::ip::make_address(command.udp_address, ec);
+        const auto own = socket.remote_endpoint(ec).address();
+        const auto address = ec || command.udp_address.empty() ? own : asio::ip::make_address(command.udp_address, ec);
         if (ec) {
           refuse("StreamFrames: bad UDP address " + quoted_text(command.udp_address));
+          return;
+        }
+        // Only to the client's own address: the server is no one's relay toward a third party.
+        if (address != own) {
+          refuse("StreamFrames: UDP only to this client's own address " + own.to_string() + ", not " + quoted_text(command.udp_address));
           return;
         }
         udp_destination = udp::endpoint(address, command.udp_port);
@@ -230,6 +244,7 @@ struct QtmServer::State : std::enable_shared_from_this<QtmServer::State> {
         }
       }
       queue.push_back({std::move(packet), is_frame});
+      replies_waiting += is_frame ? 0 : 1;
       write();
     }
 
@@ -242,8 +257,14 @@ struct QtmServer::State : std::enable_shared_from_this<QtmServer::State> {
                           if (!self->open) return;
                           if (ec) return self->close();
                           if (self->queue.front().is_frame) ++self->state.stats.frame_packets_sent;
+                          else --self->replies_waiting;
                           self->queue.pop_front();
                           self->write();
+                          // Half the replies read: its commands are taken again.
+                          if (self->reading_paused && self->open && self->replies_waiting <= self->state.options.max_queued_replies / 2) {
+                            self->reading_paused = false;
+                            self->handle_commands();
+                          }
                         });
     }
 
@@ -260,6 +281,7 @@ struct QtmServer::State : std::enable_shared_from_this<QtmServer::State> {
       socket.shutdown(tcp::socket::shutdown_both, ignored);
       socket.close(ignored);
       queue.clear();
+      replies_waiting = 0;
       --state.stats.clients_open;
       state.forget(this);
     }
@@ -280,44 +302,41 @@ struct QtmServer::State : std::enable_shared_from_this<QtmServer::State> {
   }
 
   void start() {
-    const tcp::endpoint endpoint(asio::ip::make_address(options.bind_address), options.port);
-    boost::system::error_code ec;
-    acceptor.open(endpoint.protocol(), ec);
-    if (!ec) acceptor.set_option(tcp::acceptor::reuse_address(true), ec);
-    if (!ec) acceptor.bind(endpoint, ec);
-    if (!ec) acceptor.listen(asio::socket_base::max_listen_connections, ec);
-    if (ec)
-      throw std::runtime_error("cannot listen on " + options.bind_address + ":" + std::to_string(options.port) + ": " +
-                               ec.message());
+    // The shared Listener: out of descriptors it pauses its accepts instead of spinning.
+    listener = std::make_unique<Listener>(io, options.bind_address, options.port, "qtm server",
+                                          [self = weak_from_this()](tcp::socket socket) {
+                                            if (const auto state = self.lock()) state->accepted(std::move(socket));
+                                          });
     running = true;
     timeline.set_on_frame([this](uint64_t k) { produce(k); });
     timeline.set_on_finished([this] { finish(); });
-    accept();
+    listener->start();
     if (!options.start_on_first_request) timeline.start();
   }
 
-  void accept() {
-    acceptor.async_accept([self = shared_from_this()](const boost::system::error_code& ec, tcp::socket socket) {
-      if (!self->running) return;
-      if (ec == asio::error::operation_aborted) return;
-      if (!ec) {
-        boost::system::error_code ignored;
-        socket.set_option(tcp::no_delay(true), ignored);
-        auto session = std::make_shared<Session>(*self, std::move(socket));
-        self->sessions.push_back(session);
-        ++self->stats.clients_accepted;
-        ++self->stats.clients_open;
-        session->begin();
-      }
-      self->accept();
-    });
+  void accepted(tcp::socket socket) {
+    if (!running) return;
+    if (static_cast<size_t>(stats.clients_open.load()) >= options.max_clients) {
+      ++stats.clients_refused;
+      log.warn("qtm_too_many_clients", "qtm server: closing a connection beyond the " + std::to_string(options.max_clients) +
+                                           " clients served at once");
+      return;  // the socket closes as it goes
+    }
+    auto session = std::make_shared<Session>(*this, std::move(socket));
+    sessions.push_back(session);
+    ++stats.clients_accepted;
+    ++stats.clients_open;
+    session->begin();
   }
 
   void stop() {
     if (!running) return;
     running = false;
     boost::system::error_code ignored;
-    acceptor.close(ignored);
+    if (listener) {
+      listener->stop();
+      asio::post(io, [done = std::move(listener)] {});  // after its cancelled accept's handler
+    }
     udp_socket.close(ignored);
     timeline.stop();
     for (auto& session : std::vector<std::shared_ptr<Session>>(sessions)) session->close();
@@ -369,11 +388,7 @@ QtmServer::~QtmServer() { stop(); }
 
 void QtmServer::start() { state_->start(); }
 void QtmServer::stop() { state_->stop(); }
-uint16_t QtmServer::port() const {
-  boost::system::error_code ec;
-  const auto endpoint = state_->acceptor.local_endpoint(ec);
-  return ec ? 0 : endpoint.port();
-}
+uint16_t QtmServer::port() const { return state_->listener ? static_cast<uint16_t>(state_->listener->port()) : 0; }
 void QtmServer::set_on_finished(std::function<void()> on_finished) { state_->on_finished = std::move(on_finished); }
 void QtmServer::set_frame_hook(FrameHook hook) { state_->frame_hook = std::move(hook); }
 bool QtmServer::finished() const { return state_->timeline.finished(); }

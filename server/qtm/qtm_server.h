@@ -18,8 +18,14 @@
 // NoMoreData packet.
 //
 // Each client has a bounded queue: when it is full the oldest waiting frame is dropped (the
-// newest wins) and counted, so a slow client never delays the others. A client sending
-// malformed packets is closed and counted; the others go on.
+// newest wins) and counted, so a slow client never delays the others. Command replies are
+// bounded too: with max_queued_replies waiting, the client's next commands are not read until
+// it reads its replies (20,000 GetParameters once took 630 MB). A client sending malformed
+// packets is closed and counted; the others go on. At most max_clients are served at once (more
+// are closed as they come, counted), and accepts pause when descriptors run out (the shared
+// Listener), instead of retrying at once on a full core. Frames go over UDP only to the address
+// of the client that asked (StreamFrames ... UDP:address:port naming another is refused): the
+// server is no one's relay toward a third party.
 //
 // Threading: everything but stats() runs on the io_context's thread (or before it runs).
 
@@ -44,6 +50,8 @@ struct QtmServerOptions {
   bool loop = false;
   bool start_on_first_request = true;
   size_t max_queued_frames = 4;  // per client, frames waiting behind the one being written
+  size_t max_queued_replies = 64;  // per client, command replies waiting; then its commands wait
+  size_t max_clients = 64;         // served at once
 };
 
 struct QtmServerStats {
@@ -56,6 +64,8 @@ struct QtmServerStats {
   std::atomic<uint64_t> frame_packets_sent{0};
   std::atomic<uint64_t> frames_dropped{0};  // newest-wins drops in client queues
   std::atomic<uint64_t> datagrams_sent{0};  // StreamFrames ... UDP
+  std::atomic<uint64_t> clients_refused{0};  // beyond max_clients
+  std::atomic<uint64_t> reads_paused{0};     // a client's commands left unread while its replies wait
 };
 
 class QtmServer {

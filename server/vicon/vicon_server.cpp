@@ -14,6 +14,7 @@
 #include "protocol/vicon_packet_reader.h"
 #include "protocol/vicon_packet_writer.h"
 #include "server/listener.h"
+#include "server/logging.h"
 
 namespace skinstream::server {
 namespace {
@@ -64,9 +65,14 @@ struct ViconServer::State : std::enable_shared_from_this<ViconServer::State> {
   vicon::CaptureFrameEncoder encoder;
   vicon::PacketWriter writer;
   std::unique_ptr<Listener> listener;  // from start() until stop()
+  RateLimitedLog log;                  // refusals, which come in floods
   asio::steady_timer timer;
   udp::socket multicast_socket;
-  std::vector<udp::endpoint> multicast_destinations;
+  struct MulticastDestination {
+    udp::endpoint endpoint;
+    const void* client = nullptr;  // the session that asked (null: the operator, start_multicast)
+  };
+  std::vector<MulticastDestination> multicast_destinations;
   std::vector<std::shared_ptr<Session>> sessions;
   Packet object_enums_packet;
 
@@ -90,7 +96,7 @@ struct ViconServer::State : std::enable_shared_from_this<ViconServer::State> {
 
     State& state;  // sessions never outlive State: State closes them in stop()
     tcp::socket socket;
-    vicon::PacketFramer framer;
+    vicon::PacketFramer framer{kMaxClientPacketBytes};
     struct Outgoing {
       Packet packet;
       bool is_frame;
@@ -174,11 +180,11 @@ struct ViconServer::State : std::enable_shared_from_this<ViconServer::State> {
           case type::StartMulticastSender: {
             vicon::StartMulticastSender request;
             if (!vicon::decode(object.payload, request, error)) return false;
-            state.add_multicast(udp::endpoint(asio::ip::address_v4(request.multicast_address), request.port));
+            state.add_multicast(udp::endpoint(asio::ip::address_v4(request.multicast_address), request.port), this);
             break;
           }
           case type::StopMulticastSender:
-            state.multicast_destinations.clear();
+            state.remove_multicast(this);
             break;
           case type::Filter: {  // accepted; a single-subject stream has nothing to filter
             vicon::Filter filter;
@@ -243,6 +249,7 @@ struct ViconServer::State : std::enable_shared_from_this<ViconServer::State> {
       socket.close(ignored);
       queue.clear();
       --state.stats.clients_open;
+      state.remove_multicast(this);  // nothing is sent for it once it left
       state.forget(this);
     }
   };
@@ -271,6 +278,12 @@ struct ViconServer::State : std::enable_shared_from_this<ViconServer::State> {
 
   void on_accept(tcp::socket socket) {
     if (!running) return;
+    if (static_cast<size_t>(stats.clients_open.load()) >= options.max_clients) {
+      ++stats.clients_refused;
+      log.warn("vicon_too_many_clients",
+               "vicon server: closing a connection beyond the " + std::to_string(options.max_clients) + " clients served at once");
+      return;  // the socket closes as it goes
+    }
     boost::system::error_code ignored;
     if (options.socket_send_buffer_bytes > 0)
       socket.set_option(asio::socket_base::send_buffer_size(options.socket_send_buffer_bytes), ignored);
@@ -375,8 +388,25 @@ struct ViconServer::State : std::enable_shared_from_this<ViconServer::State> {
     session.enqueue(std::move(packet), true);
   }
 
-  void add_multicast(const udp::endpoint& destination) {
+  // `client`: the session that asked (null: the operator). A client may name a multicast group
+  // or its own address, nothing else: the server is no one's relay toward a third party.
+  void add_multicast(const udp::endpoint& destination, const Session* client = nullptr) {
     boost::system::error_code ec;
+    if (client) {
+      const auto own = client->socket.remote_endpoint(ec).address();
+      const bool own_address = !ec && destination.address() == (own.is_v6() && own.to_v6().is_v4_mapped()
+                                                                    ? asio::ip::address(asio::ip::make_address_v4(asio::ip::v4_mapped, own.to_v6()))
+                                                                    : own);
+      const bool full = multicast_destinations.size() >= options.max_multicast_destinations;
+      if ((!destination.address().is_multicast() && !own_address) || full) {
+        ++stats.multicast_requests_refused;
+        log.warn("vicon_multicast_refused", "vicon server: not sending to " + destination.address().to_string() + ":" +
+                                                std::to_string(destination.port()) +
+                                                (full ? ": already sending to as many as allowed" : ": neither a multicast group nor the asking client's address"));
+        return;
+      }
+      ec.clear();
+    }
     if (!multicast_socket.is_open()) {
       multicast_socket.open(udp::v4(), ec);
       if (!ec) multicast_socket.set_option(asio::ip::multicast::hops(options.multicast_ttl), ec);
@@ -386,11 +416,16 @@ struct ViconServer::State : std::enable_shared_from_this<ViconServer::State> {
         return;
       }
     }
-    if (std::find(multicast_destinations.begin(), multicast_destinations.end(), destination) ==
-        multicast_destinations.end())
-      multicast_destinations.push_back(destination);
+    if (std::none_of(multicast_destinations.begin(), multicast_destinations.end(),
+                     [&](const MulticastDestination& d) { return d.endpoint == destination && d.client == client; }))
+      multicast_destinations.push_back({destination, client});
     spdlog::info("vicon server: multicasting to {}:{}", destination.address().to_string(), destination.port());
     start_timeline();
+  }
+
+  // What `client` asked for (StopMulticastSender, or it left).
+  void remove_multicast(const Session* client) {
+    std::erase_if(multicast_destinations, [client](const MulticastDestination& d) { return d.client == client; });
   }
 
   void send_multicast() {
@@ -400,8 +435,8 @@ struct ViconServer::State : std::enable_shared_from_this<ViconServer::State> {
       ++stats.datagrams_too_large;
       return;
     }
-    for (const udp::endpoint& destination : multicast_destinations) {
-      multicast_socket.async_send_to(asio::buffer(*packet), destination,
+    for (const MulticastDestination& destination : multicast_destinations) {
+      multicast_socket.async_send_to(asio::buffer(*packet), destination.endpoint,
                                      [self = shared_from_this(), packet](const boost::system::error_code& ec, size_t) {
                                        if (!ec) ++self->stats.datagrams_sent;
                                      });

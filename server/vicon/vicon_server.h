@@ -24,7 +24,13 @@
 // Each client has a bounded queue: when it is full the oldest waiting frame is dropped (the
 // newest wins) and counted, so a slow client never delays the others. A client sending malformed
 // input is closed and counted; the others go on.
-// Out of file descriptors, accepts pause and resume as the daemon's do (server/listener.h).
+// Out of file descriptors, accepts pause and resume as the daemon's do (server/listener.h). At
+// most max_clients are served at once (more are closed as they come, counted), and a client's
+// packet may be at most kMaxClientPacketBytes (20 clients each holding most of a 16 MiB packet
+// once took 350 MB). StartMulticastSender sends to a multicast group, or to the asking client's
+// own address, and only while that client stays (1,000 requests for other unicast destinations
+// were served after their clients left: 0.75 of a core, 5.4 MB/s each); at most
+// max_multicast_destinations at once.
 //
 // Threading: all member functions run on the io_context's thread (or before it runs); stats()
 // may be read from any thread.
@@ -58,6 +64,8 @@ struct ViconServerOptions {
   // at once even under BBR, and reno measured no different here (README).
   std::string tcp_congestion;
   int multicast_ttl = 1;
+  size_t max_clients = 64;                 // served at once
+  size_t max_multicast_destinations = 16;  // StartMulticastSender destinations at once
 };
 
 struct ViconServerStats {
@@ -69,7 +77,12 @@ struct ViconServerStats {
   std::atomic<uint64_t> frames_dropped{0};   // newest-wins drops in client queues
   std::atomic<uint64_t> datagrams_sent{0};
   std::atomic<uint64_t> datagrams_too_large{0};
+  std::atomic<uint64_t> clients_refused{0};             // beyond max_clients
+  std::atomic<uint64_t> multicast_requests_refused{0};  // another host's unicast address, or too many
 };
+
+// The largest packet a client may send (its requests are a few bytes; ObjectEnums a few hundred).
+inline constexpr uint32_t kMaxClientPacketBytes = 64 * 1024;
 
 class ViconServer {
  public:

@@ -15,10 +15,10 @@ if(TARGET skinstreamd AND TARGET skinstream_client)
     SKINSTREAM_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
     SKINSTREAM_TEST_TMP_DIR="${CMAKE_BINARY_DIR}/test_tmp/client_library")
   add_dependencies(client_library_tests skinstreamd)
-  gtest_discover_tests(client_library_tests TEST_FILTER "-ClientSubscriberDemo.*:EvaluatorCDemo.*:MulticastDemo.*" DISCOVERY_TIMEOUT 60
+  gtest_discover_tests(client_library_tests TEST_FILTER "-ClientSubscriberDemo.*:EvaluatorCDemo.*:MulticastDemo.*:MulticastKeyDemo.*" DISCOVERY_TIMEOUT 60
     PROPERTIES LABELS clients TIMEOUT ${time_limit_120})
   # MulticastDemo needs root and iproute2 (network namespaces on a bridge); without them it is
   # skipped with the reason.
-  gtest_discover_tests(client_library_tests TEST_FILTER "ClientSubscriberDemo.*:EvaluatorCDemo.*:MulticastDemo.*" DISCOVERY_TIMEOUT 60
+  gtest_discover_tests(client_library_tests TEST_FILTER "ClientSubscriberDemo.*:EvaluatorCDemo.*:MulticastDemo.*:MulticastKeyDemo.*" DISCOVERY_TIMEOUT 60
     PROPERTIES LABELS clients TIMEOUT ${time_limit_300} FIXTURES_REQUIRED demo_subject)
 endif()

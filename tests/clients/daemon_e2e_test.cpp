@@ -16,6 +16,7 @@
 #include <poll.h>
 #include <sys/socket.h>
 #include <netinet/in.h>
+#include <arpa/inet.h>
 #include <sys/wait.h>
 #include <thread>
 #include <unistd.h>
@@ -28,12 +29,18 @@
 #include "server/client/process_usage.h"
 #include "protocol/capture_file.h"
 #include "protocol/point_cache.h"
+#include "protocol/qtm_packet_writer.h"
 #include "protocol/subject_file.h"
 #include "server/client/subscriber_client.h"
 #include "support/loopback_peer.h"
 #include "support/program_processes.h"
 #include "support/program_run.h"
 #include "support/recording_match.h"
+#include "server/natnet/natnet_server.h"
+#include "server/qtm/qtm_server.h"
+#include "support/io_thread.h"
+#include "support/scripted_daemon.h"
+#include "support/silent_capture_servers.h"
 #include "support/test_data.h"
 
 namespace skinstream {
@@ -378,6 +385,92 @@ TEST_F(DaemonProgram, ViconReplayServerOutOfDescriptorsPausesAccepts) {
   close(client);
 }
 
+// The QTM RT replay server out of file descriptors (limited to 32) with clients still waiting:
+// its accepts pause as the daemon's do (it retried at once on a full core, without a word), and
+// it accepts again once they leave.
+TEST_F(DaemonProgram, QtmReplayServerOutOfDescriptorsPausesAccepts) {
+  if (kVptrCheckNeedsADescriptor) GTEST_SKIP() << "UndefinedBehaviorSanitizer's vptr check needs a free descriptor";
+  ReplayProcess replay(take_, 0, "--protocol qtm", "ulimit -n 32; ");
+  ASSERT_GT(replay.pid(), 0);
+  std::vector<int> flood;
+  ASSERT_NO_FATAL_FAILURE(expect_accepts_paused_when_flooded(replay.port, 100, replay.pid(), [&] { return replay.log(); }, flood));
+  for (int fd : flood) close(fd);
+  EXPECT_TRUE(eventually([&] { return replay.log().find("accepting again after") != std::string::npos; })) << replay.log();
+}
+
+// Bytes of a QTM RT command packet.
+std::vector<unsigned char> qtm_command(const std::string& text) { return qtm::encode_text(qtm::PacketType::Command, text); }
+
+long resident_kb_of(pid_t pid) {
+  std::ifstream status("/proc/" + std::to_string(pid) + "/status");
+  for (std::string line; std::getline(status, line);)
+    if (line.rfind("VmRSS:", 0) == 0) return std::stol(line.substr(6));
+  return 0;
+}
+
+// A QTM RT client that sends 20,000 GetParameters and reads none of the replies: the replay
+// server queued every reply (RSS 21 -> 652 MB, kept). Now its commands wait, unread, once 64
+// replies do; another client is served meanwhile, and the server's memory stays where it was.
+TEST_F(DaemonProgram, QtmReplayServerQueuesFewRepliesForAClientThatDoesNotRead) {
+  ReplayProcess replay(take_, 0, "--protocol qtm");
+  const long before = resident_kb_of(replay.pid());
+  const int greedy = connect_loopback(replay.port, "", 4096);
+  ASSERT_GE(greedy, 0);
+  std::vector<unsigned char> commands;
+  for (int i = 0; i < 20000; ++i) {
+    const std::vector<unsigned char> one = qtm_command("GetParameters General 3D");
+    commands.insert(commands.end(), one.begin(), one.end());
+  }
+  // Sent from a thread: once the server stops reading, the send waits.
+  std::thread sender([&] { send(greedy, commands.data(), commands.size(), MSG_NOSIGNAL); });
+  std::this_thread::sleep_for(std::chrono::seconds(2));
+  const long after = resident_kb_of(replay.pid());
+  // Another client: welcomed at once.
+  const int polite = connect_loopback(replay.port);
+  pollfd readable{polite, POLLIN, 0};
+  EXPECT_EQ(poll(&readable, 1, 10'000), 1) << "no welcome to another client";
+  close(polite);
+  shutdown(greedy, SHUT_RDWR);
+  sender.join();
+  close(greedy);
+  std::printf("replay server RSS: %ld kB before, %ld kB after 20,000 unread GetParameters\n", before, after);
+  EXPECT_LT(after - before, 64 * 1024) << replay.log();
+}
+
+// StreamFrames asking for UDP to another address than the client's own: the replay server sent
+// its frames there (a relay toward anyone). Refused now, with an Error, and nothing is sent.
+TEST_F(DaemonProgram, QtmReplayServerStreamsUdpOnlyToTheClientsOwnAddress) {
+  ReplayProcess replay(take_, 0, "--protocol qtm");
+  const int victim = socket(AF_INET, SOCK_DGRAM, 0);
+  sockaddr_in address{};
+  address.sin_family = AF_INET;
+  inet_pton(AF_INET, "127.0.0.2", &address.sin_addr);
+  ASSERT_EQ(bind(victim, reinterpret_cast<sockaddr*>(&address), sizeof address), 0);
+  socklen_t length = sizeof address;
+  getsockname(victim, reinterpret_cast<sockaddr*>(&address), &length);
+  const int client = connect_loopback(replay.port, "127.0.0.1");
+  ASSERT_GE(client, 0);
+  const std::vector<unsigned char> command =
+      qtm_command("StreamFrames AllFrames UDP:127.0.0.2:" + std::to_string(ntohs(address.sin_port)) + " 3D");
+  ASSERT_EQ(send(client, command.data(), command.size(), MSG_NOSIGNAL), static_cast<ssize_t>(command.size()));
+  // The welcome, then the refusal.
+  std::string replies;
+  for (auto end = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+       replies.find("UDP only to") == std::string::npos && std::chrono::steady_clock::now() < end;) {
+    pollfd readable{client, POLLIN, 0};
+    if (poll(&readable, 1, 200) != 1) continue;
+    char buffer[4096];
+    const ssize_t n = recv(client, buffer, sizeof buffer, 0);
+    if (n <= 0) break;
+    replies.append(buffer, static_cast<size_t>(n));
+  }
+  EXPECT_NE(replies.find("StreamFrames: UDP only to this client's own address 127.0.0.1"), std::string::npos) << replies;
+  pollfd datagram{victim, POLLIN, 0};
+  EXPECT_EQ(poll(&datagram, 1, 1000), 0) << "the replay server sent frames to another address";
+  close(client);
+  close(victim);
+}
+
 // skinstream-replay -> skinstreamd --vicon -> skinstream-sub, in both Vicon modes (and the same
 // with --qtm and --natnet): frames arrive in order, and a measured marker is the recording's
 // sample of the same frame number (so the numbering and the marker mapping survive the round trip
@@ -436,6 +529,70 @@ TEST_F(DaemonProgram, ViconUdpDatagramsReachTheSubscriberInOrder) { expect_vicon
 TEST_F(DaemonProgram, QtmReachesTheSubscriberInOrder) { expect_vicon_stream_in_order(subject_, take_, ViconMode::Qtm); }
 
 TEST_F(DaemonProgram, NatNetReachesTheSubscriberInOrder) { expect_vicon_stream_in_order(subject_, take_, ViconMode::NatNet); }
+
+// A NatNet server whose timestamps jitter by +-20 us, or tick on a 10 MHz clock (83,333 or 83,334
+// ticks a frame at 120 Hz), as real capture clocks do: the daemon's source rate is the nominal
+// 120 Hz and never changes, the gap filler is never rebuilt, and the log says the rate once at
+// most. (The rate read from each pair of frames rebuilt the filler on every frame: 952 "source
+// rate" lines in 12 s, processing p99 1.5 -> 50 ms.)
+void expect_natnet_clock_changes_nothing(const std::string& subject, const std::string& take, const std::string& clock) {
+  ReplayProcess replay(take, 0, "--protocol natnet --unicast " + clock);
+  DaemonProcess daemon("--subject " + subject + " --natnet 127.0.0.1:" + std::to_string(replay.port));
+  const ProgramRun sub = run(std::string(SKINSTREAM_SUB) + " 127.0.0.1:" + std::to_string(daemon.sub_port) + " --markers --no-mesh --frames 360");
+  const nlohmann::json health = server::fetch_health(daemon.http_port);
+  EXPECT_EQ(daemon.stop(), 0) << daemon.log();
+  ASSERT_EQ(sub.exit_code, 0) << sub.output << daemon.log();
+  EXPECT_EQ(health["source"]["rate_hz"], 120.0) << health.dump();
+  EXPECT_EQ(health["subjects"][0]["source_rate_changes"], 0) << health.dump();
+  EXPECT_LE(count_lines_with(daemon.log(), "source rate"), 1) << daemon.log().substr(0, 4000);
+}
+
+TEST_F(DaemonProgram, NatNetClockJitterChangesNoRate) {
+  expect_natnet_clock_changes_nothing(subject_, take_, "--natnet-timestamp-jitter-us 20");
+}
+
+TEST_F(DaemonProgram, NatNetTenMegahertzClockChangesNoRate) {
+  expect_natnet_clock_changes_nothing(subject_, take_, "--natnet-clock-hz 10000000");
+}
+
+// A capture server that answers the handshake, sends a few frames and then nothing with its
+// connection open (a QTM, Motive or Nexus whose stream stopped) was shown "streaming" at 120 Hz
+// while the frames stayed frozen: with the daemon's defaults it is "stalled" on /health, in the
+// status line and (as disconnected, saying "stalled") in Status, and the daemon connects again.
+template <typename Server>
+void expect_silence_is_a_stall(const std::string& subject, const std::string& source_flag) {
+  Server server({.frames = 5});
+  const std::string config = test::scratch_path("stall_" + std::to_string(getpid()) + ".json");
+  { std::ofstream(config) << R"({"status_log_seconds": 1})"; }
+  DaemonProcess daemon("--config " + config + " --subject " + subject + " " + source_flag + " 127.0.0.1:" + std::to_string(server.port()));
+  BackgroundSubscriber subscriber(daemon.sub_port, subscriber::kWantMarkers | subscriber::kWantNoMesh);
+  EXPECT_TRUE(eventually([&] { return server::fetch_health(daemon.http_port)["source"]["state"] == "stalled"; })) << daemon.log();
+  EXPECT_TRUE(eventually([&] { return server.connections() >= 2; })) << daemon.log();
+  EXPECT_TRUE(eventually([&] { return daemon.log().find("; source stalled") != std::string::npos; })) << daemon.log();
+  EXPECT_TRUE(eventually([&] { return subscriber.last_status_detail().find("stalled: no frame from") == 0; }))
+      << subscriber.last_status_detail();
+  EXPECT_FALSE(subscriber.closed()) << subscriber.error();
+  EXPECT_EQ(daemon.stop(), 0) << daemon.log();
+}
+
+TEST_F(DaemonProgram, QtmServerThatGoesSilentIsStalled) { expect_silence_is_a_stall<test::SilentQtmServer>(subject_, "--qtm"); }
+
+TEST_F(DaemonProgram, NatNetServerThatGoesSilentIsStalled) { expect_silence_is_a_stall<test::SilentNatNetServer>(subject_, "--natnet"); }
+
+TEST_F(DaemonProgram, ViconServerThatGoesSilentIsStalled) { expect_silence_is_a_stall<test::SilentViconServer>(subject_, "--vicon"); }
+
+// A QTM server that accepts and never answers kept the daemon "connecting" for ever: it is left
+// after the handshake timeout, reported, and tried again.
+TEST_F(DaemonProgram, QtmServerThatNeverAnswersIsLeftAndTriedAgain) {
+  test::SilentQtmServer server({.handshake = false});
+  DaemonProcess daemon("--subject " + subject_ + " --qtm 127.0.0.1:" + std::to_string(server.port()));
+  EXPECT_TRUE(eventually([&] {
+    const nlohmann::json source = server::fetch_health(daemon.http_port)["source"];
+    return source["state"] == "disconnected" && source["detail"].get<std::string>().find("no handshake with") == 0;
+  })) << daemon.log();
+  EXPECT_TRUE(eventually([&] { return server.connections() >= 2; })) << daemon.log();
+  EXPECT_EQ(daemon.stop(), 0) << daemon.log();
+}
 
 TEST_F(DaemonProgram, ViconUnreachableIsReportedAndServingGoesOn) {
   const int port = test::free_loopback_port(SOCK_STREAM);  // nobody listens on it
@@ -510,6 +667,77 @@ TEST_F(DaemonProgram, ViconSourceDisconnectsAndReturns) {
   EXPECT_EQ(daemon.stop(), 0) << daemon.log();
 }
 
+// skinstream-sub meeting a Frame that is not finite (a daemon that published one) says so on
+// stderr, counts it, and goes on with the next; it exited 1 at the first.
+TEST(SubscriberProgram, ABrokenFrameIsSkippedWithAWarningAndTheStreamGoesOn) {
+  test::ScriptedDaemon daemon(test::broken_frame_stream(10, 4));
+  const ProgramRun sub = run(std::string(SKINSTREAM_SUB) + " 127.0.0.1:" + std::to_string(daemon.port) +
+                             " --encoding parameters --evaluate --json --frames 9");
+  ASSERT_EQ(sub.exit_code, 0) << sub.output;
+  std::vector<int> numbers;
+  nlohmann::json summary;
+  std::istringstream lines(sub.output);
+  for (std::string line; std::getline(lines, line);) {
+    if (line.empty() || line[0] != '{') continue;
+    const nlohmann::json j = nlohmann::json::parse(line);
+    if (j.contains("frame")) numbers.push_back(j["frame"]);
+    else summary = j["summary"];
+  }
+  EXPECT_EQ(numbers, (std::vector<int>{1, 2, 3, 5, 6, 7, 8, 9, 10}));
+  EXPECT_EQ(summary["frames_rejected"], 1) << sub.output;
+  EXPECT_NE(sub.output.find("skinstream-sub: warning: frame skipped: parameters: an RBF weight is not finite (1 frames skipped so far)"),
+            std::string::npos)
+      << sub.output;
+}
+
+// skinstream-sub with the token in a file, or in the environment's SKINSTREAM_TOKEN: the Hello
+// carries it, and it is on no command line (--token put it in the process list for all to read).
+TEST(SubscriberProgram, TheTokenComesFromAFileOrTheEnvironment) {
+  const std::string token_file = test::scratch_path("sub_token_" + std::to_string(getpid()) + ".txt");
+  std::ofstream(token_file) << "stage-7/east\n";
+  subscriber::Status refused;
+  refused.state = subscriber::SourceStateCode::Refused;
+  refused.detail = "enough";
+  for (const std::string& how : {"--token-file " + token_file, std::string("env")}) {
+    test::ScriptedDaemon daemon(subscriber::encode_status(refused, subscriber::kVersion2));
+    const std::string command = (how == "env" ? "SKINSTREAM_TOKEN=stage-7/east " : "") + std::string(SKINSTREAM_SUB) + " 127.0.0.1:" +
+                                std::to_string(daemon.port) + (how == "env" ? "" : " " + how) + " --frames 1";
+    const ProgramRun sub = run(command);
+    EXPECT_EQ(sub.exit_code, 1) << sub.output;
+    const std::vector<unsigned char> hello = daemon.hello();
+    ASSERT_GE(hello.size(), subscriber::kHeaderBytes) << how;
+    const subscriber::MessageHeader header = subscriber::decode_header(hello);
+    const subscriber::Hello decoded =
+        subscriber::decode_hello(std::span(hello).subspan(subscriber::kHeaderBytes, header.payload_bytes), header.version);
+    EXPECT_EQ(decoded.token, "stage-7/east") << how;
+  }
+}
+
+// A daemon that sends MeshInfo, then half a message, then nothing with its connection open:
+// skinstream-sub waited without a word. After --timeout it says so and exits 1.
+TEST(SubscriberProgram, ADaemonThatFallsSilentEndsTheRunWithAnError) {
+  std::vector<unsigned char> reply = test::broken_frame_stream(0, 0);
+  reply.resize(reply.size() - 10);  // the Model cut short
+  test::ScriptedDaemon daemon(reply);
+  const ProgramRun sub = run(std::string(SKINSTREAM_SUB) + " 127.0.0.1:" + std::to_string(daemon.port) + " --encoding parameters --timeout 1");
+  EXPECT_EQ(sub.exit_code, 1) << sub.output;
+  EXPECT_NE(sub.output.find("skinstream-sub: error: nothing from the daemon for 1000 ms"), std::string::npos) << sub.output;
+}
+
+// The daemon's words reach the terminal made printable: a refusal whose detail holds a line
+// break, a terminal escape and a second "skinstream-sub:" line is one line.
+TEST(SubscriberProgram, TheDaemonsWordsArePrintedPrintable) {
+  subscriber::Status refused;
+  refused.state = subscriber::SourceStateCode::Refused;
+  refused.detail = "no\n\x1b[2Jskinstream-sub: all is well";
+  test::ScriptedDaemon daemon(subscriber::encode_status(refused, subscriber::kVersion2));
+  const ProgramRun sub = run(std::string(SKINSTREAM_SUB) + " 127.0.0.1:" + std::to_string(daemon.port));
+  EXPECT_EQ(sub.exit_code, 1) << sub.output;
+  EXPECT_EQ(count_lines_with(sub.output, "skinstream-sub:"), 1) << sub.output;
+  EXPECT_EQ(sub.output.find('\x1b'), std::string::npos) << sub.output;
+  EXPECT_NE(sub.output.find("refused this subscriber: no\\x0a\\x1b[2Jskinstream-sub: all is well"), std::string::npos) << sub.output;
+}
+
 // The demo subject (ctest fixture demo_subject): the vertex buffers skinstreamd publishes equal
 // the offline pipeline, `skinstream fill` (causal, lookahead 0) then `skinstream deform`.
 class DaemonDemo : public ::testing::Test {
@@ -535,6 +763,74 @@ class DaemonDemo : public ::testing::Test {
   static inline PointCache offline_;
   static inline int first_frame_ = 0;
 };
+
+// A capture server sending absurd coordinates now and then (QTM RT: 3.4e38 mm, its float's
+// largest; NatNet: 1e36 m; both: 1e7 mm, 10 km) once made the daemon publish a parameter block
+// that was not finite: skinstream-sub exited 1 ("an RBF weight is not finite"), and 1e7 mm put
+// vertices 612 m away. They are missing now, counted as implausible points: every subscriber
+// goes on, and every filled marker it receives lies within the capture volume (50 m).
+enum class AbsurdSource { Qtm, NatNet };
+
+void expect_absurd_coordinates_are_missing(const std::string& subject, const std::string& live, AbsurdSource kind) {
+  Capture take = read_capture(live);
+  const double absurd = kind == AbsurdSource::Qtm ? 3.4e38 : 1e39;  // mm
+  for (int f = 5; f + 10 < take.frame_count; f += 30) {
+    take.at(f, 0) = Vec3(absurd, 0.0, 0.0);
+    take.at(f + 10, 1) = Vec3(0.0, 1e7, 0.0);
+  }
+  test::IoThread server_io;
+  std::unique_ptr<server::QtmServer> qtm;
+  std::unique_ptr<server::NatNetServer> natnet;
+  std::string source;
+  if (kind == AbsurdSource::Qtm) {
+    server::QtmServerOptions options;
+    options.bind_address = "127.0.0.1";
+    options.port = 0;
+    options.loop = true;
+    qtm = std::make_unique<server::QtmServer>(server_io.io, std::vector<ReplaySubject>{{"demo", &take}}, options);
+    source = "--qtm 127.0.0.1:" + std::to_string(server_io.call([&] {
+               qtm->start();
+               return qtm->port();
+             }));
+  } else {
+    server::NatNetServerOptions options;
+    options.bind_address = "127.0.0.1";
+    options.command_port = 0;
+    options.multicast = false;
+    options.loop = true;
+    natnet = std::make_unique<server::NatNetServer>(server_io.io, std::vector<ReplaySubject>{{"demo", &take}}, options);
+    source = "--natnet 127.0.0.1:" + std::to_string(server_io.call([&] {
+               natnet->start();
+               return natnet->command_port();
+             }));
+  }
+  DaemonProcess daemon("--subject " + subject + " " + source);
+  const ProgramRun sub = run(std::string(SKINSTREAM_SUB) + " 127.0.0.1:" + std::to_string(daemon.sub_port) +
+                             " --encoding parameters --evaluate --markers --json --frames 240");
+  const std::string metrics = http_get_within(daemon.http_port, "/metrics", std::chrono::seconds(10));
+  EXPECT_EQ(daemon.stop(), 0) << daemon.log();
+  server_io.call([&] {
+    if (qtm) qtm->stop();
+    if (natnet) natnet->stop();
+  });
+  ASSERT_EQ(sub.exit_code, 0) << sub.output.substr(sub.output.size() > 3000 ? sub.output.size() - 3000 : 0) << daemon.log();
+  const std::vector<nlohmann::json> frames = test::frames_of(sub.output);
+  ASSERT_EQ(frames.size(), 240u);
+  for (const nlohmann::json& frame : frames)
+    for (const float coordinate : frame["markers"].get<std::vector<float>>())
+      ASSERT_LE(std::abs(coordinate), 50'000.0f) << "frame " << frame["frame"];
+  EXPECT_NE(sub.output.find("\"frames_rejected\":0"), std::string::npos) << sub.output.substr(sub.output.rfind('\n', sub.output.size() - 2));
+  EXPECT_NE(metrics.find("category=\"implausible_point\"}"), std::string::npos) << metrics;
+  EXPECT_EQ(metrics.find("category=\"non_finite_frame\"}"), std::string::npos) << metrics;
+}
+
+TEST_F(DaemonDemo, AbsurdQtmCoordinatesAreMissingAndParameterSubscribersGoOn) {
+  expect_absurd_coordinates_are_missing(subject_, live_, AbsurdSource::Qtm);
+}
+
+TEST_F(DaemonDemo, AbsurdNatNetCoordinatesAreMissingAndParameterSubscribersGoOn) {
+  expect_absurd_coordinates_are_missing(subject_, live_, AbsurdSource::NatNet);
+}
 
 // One pass of the replay as a subscriber saw it: the frames from the first one of a pass (a new
 // take for the filler) on, `count` of them, with their positions.

@@ -273,6 +273,45 @@ TEST_F(DaemonAdmission, ASharedTokenIsAskedInHelloOrOnTheUrl) {
   EXPECT_EQ(daemon->stop(), 0) << daemon->log();
 }
 
+// Idle connections that never give the token, 64 from each of four addresses, once held all 256
+// places, and a subscriber with the right token was refused. They now hold places of their own,
+// at most 4 from one address; the rest are refused as they connect (counted), and a token holder
+// is served on either port. (Both Hello timeouts are long here: the idle ones stay.)
+TEST_F(DaemonAdmission, IdleConnectionsWithoutTheTokenCannotKeepATokenHolderOut) {
+  auto daemon = start({{"subscriber_token", "stage-7/east"}, {"hello_timeout_ms", 60000}, {"unauthenticated_hello_timeout_ms", 60000}});
+  ASSERT_GT(daemon->sub_port, 0);
+  std::vector<std::unique_ptr<RawSubscriber>> idle;
+  for (int host = 2; host <= 5; ++host)
+    for (int i = 0; i < 64; ++i) {
+      idle.push_back(std::make_unique<RawSubscriber>(daemon->sub_port, "127.0.0." + std::to_string(host)));
+      ASSERT_TRUE(idle.back()->connected());
+    }
+  EXPECT_TRUE(eventually([&] { return health_of(daemon->http_port)["subscriber_limits"]["refused_unauthenticated"] == 240; }))
+      << health_of(daemon->http_port)["subscriber_limits"];
+  RawSubscriber holder(daemon->sub_port, "127.0.0.6");
+  EXPECT_TRUE(served(holder, hello_v2("stage-7/east")));
+  EXPECT_EQ(upgrade_reply(daemon->http_port, "/stream?token=stage-7%2Feast", "127.0.0.6").rfind("HTTP/1.1 101", 0), 0u);
+  const nlohmann::json limits = health_of(daemon->http_port)["subscriber_limits"];
+  EXPECT_EQ(limits["unauthenticated"], 16) << limits;
+  EXPECT_EQ(limits["refused_limit"], 0) << limits;
+  EXPECT_GE(limits["admitted"], 1) << limits;
+  // One of the idle ones that holds a place gives the token late: it becomes a subscriber.
+  EXPECT_TRUE(served(*idle.front(), hello_v2("stage-7/east")));
+  EXPECT_EQ(daemon->stop(), 0) << daemon->log();
+}
+
+// A connection that is to give the token and says nothing is refused after the short Hello
+// timeout for those (it waited the subscribers' 2 s, holding a subscriber's place).
+TEST_F(DaemonAdmission, AConnectionThatNeverGivesTheTokenIsClosedSoon) {
+  auto daemon = start({{"subscriber_token", "stage-7/east"}, {"unauthenticated_hello_timeout_ms", 300}});
+  ASSERT_GT(daemon->sub_port, 0);
+  RawSubscriber silent(daemon->sub_port, "127.0.0.7");
+  EXPECT_TRUE(refused(silent, "no Hello with the token within 300 ms"));
+  EXPECT_TRUE(eventually([&] { return health_of(daemon->http_port)["subscriber_limits"]["unauthenticated"] == 0; }));
+  EXPECT_EQ(health_of(daemon->http_port)["subscriber_limits"]["admitted"], 0);
+  EXPECT_EQ(daemon->stop(), 0) << daemon->log();
+}
+
 // A subscriber that says Hello and never reads: once its socket buffers are full (a frame of the
 // demo body is 640 kB), its write makes no progress, and after subscriber_write_stall_ms it is
 // closed and counted, while a subscriber that reads goes on.

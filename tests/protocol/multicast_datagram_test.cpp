@@ -36,7 +36,8 @@ TEST(MulticastDatagram, BadDatagramsAreRejectedWithTheRuleTheyBreak) {
   EXPECT_NE(rejection(oversized).find("over the 1400"), std::string::npos);
   EXPECT_NE(rejection(with<uint32_t>(good, 0, 0x46534B53)).find("bad magic"), std::string::npos);  // a TCP message's magic
   EXPECT_NE(rejection(with<uint16_t>(good, 4, 2)).find("version 2"), std::string::npos);
-  EXPECT_NE(rejection(with<uint16_t>(good, 6, 1)).find("reserved"), std::string::npos);
+  EXPECT_NE(rejection(with<uint16_t>(good, 6, 2)).find("reserved"), std::string::npos);
+  EXPECT_NE(rejection(with<uint16_t>(good, 6, kDatagramAuthenticated)).find("holds 932 bytes, not 964"), std::string::npos);  // no tag
   EXPECT_NE(rejection(with<uint16_t>(good, 20, 2)).find("fragment 2 of 2"), std::string::npos);
   EXPECT_NE(rejection(with<uint16_t>(good, 22, 0)).find("fragment count 0"), std::string::npos);
   EXPECT_NE(rejection(with<uint16_t>(good, 22, 65)).find("fragment count 65"), std::string::npos);

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include <cstring>
 #include <fstream>
 #include <iterator>
@@ -349,6 +351,49 @@ TEST_F(SubjectFile, CorruptDeformationSectionIsRejected) {
   bytes[bytes.size() - 60] ^= 0x5a;
   spit(path, bytes);
   EXPECT_NE(message_of(path).find("CRC"), std::string::npos) << message_of(path);
+}
+
+// Values the model's shape check lets through, written as they are and refused on reading, each
+// with what is wrong: NaN and 1e300 went into the filler (and non-finite markers were published),
+// duplicate names and names with control characters into the matching and the logs.
+TEST_F(SubjectFile, EveryValueReadIsChecked) {
+  const std::string path = test::scratch_path("bad_values.subject");
+  auto refusal = [&](const SubjectModel& model, const DeformationModel* deformation = nullptr) {
+    write_subject(model, deformation, path);
+    return message_of(path);
+  };
+  SubjectModel m = model_;
+  m.reference_positions[0].x() = 1e300;
+  EXPECT_NE(refusal(m).find("bad value: marker 0's reference position is not finite or beyond 1 km"), std::string::npos) << refusal(m);
+  m = model_;
+  m.local_reference_frames[1](0, 0) = std::nan("");
+  EXPECT_NE(refusal(m).find("marker 1's local reference frame is not a rotation"), std::string::npos) << refusal(m);
+  m = model_;
+  m.ring_local_reference[0] = Vec3(0, 0, 1e300);
+  EXPECT_NE(refusal(m).find("a one-ring member's local position is not finite"), std::string::npos) << refusal(m);
+  m = model_;
+  m.parameters.alpha1 = std::nan("");
+  EXPECT_NE(refusal(m).find("alpha1 and alpha2 must be in (0, 10]"), std::string::npos) << refusal(m);
+  m = model_;
+  m.pca[2].basis(0, 0) = 1e300;
+  EXPECT_NE(refusal(m).find("marker 2's PCA model has a basis value outside [-1, 1]"), std::string::npos) << refusal(m);
+  m = model_;
+  m.marker_names[2] = m.marker_names[0];
+  EXPECT_NE(refusal(m).find("marker 2's name '" + m.marker_names[0] + "' is another marker's too"), std::string::npos) << refusal(m);
+  m = model_;
+  m.marker_names[1] = "LFH\x1b[31mD";
+  EXPECT_NE(refusal(m).find("marker 1's name is empty, longer than 256 bytes or holds a control character"), std::string::npos)
+      << refusal(m);
+  DeformationModel d = limb_deformation(model_);
+  d.reference_vertices[0] = Vec3(1e300, 0, 0);
+  EXPECT_NE(refusal(model_, &d).find("a mesh vertex is not finite or beyond 1 km"), std::string::npos) << refusal(model_, &d);
+  d = limb_deformation(model_);
+  d.part_names[0] = "arm\x07";
+  EXPECT_NE(refusal(model_, &d).find("a part's name is empty, longer than 256 bytes or holds a control character"), std::string::npos)
+      << refusal(model_, &d);
+  // The model as built reads back.
+  write_subject(model_, path);
+  EXPECT_NO_THROW(read_subject_file(path));
 }
 
 }  // namespace

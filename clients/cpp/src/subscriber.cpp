@@ -5,8 +5,10 @@
 #include "core/deform/mesh_evaluator.h"
 #include "multicast_socket.h"
 #include "protocol/compressed_vertices.h"
+#include "protocol/finite_values.h"
 #include "protocol/datagram_reassembler.h"
 #include "protocol/frame_parameters.h"
+#include "protocol/printable_text.h"
 #include "protocol/subscriber_model.h"
 #include "protocol/subscriber_stream.h"
 #include "skinstream/client.h"
@@ -52,8 +54,11 @@ struct Subscriber::State {
   bool has_mesh = false;
   SourceStatus status;
   uint64_t skipped = 0;
+  uint64_t rejected = 0;  // Frame messages that broke the protocol on their own
+  std::string last_rejection;
   uint64_t bytes = 0;
   int64_t arrival_ns = 0;  // of the last bytes read
+  std::chrono::steady_clock::time_point last_heard;  // bytes from the daemon over TCP (or connected)
 
   // Parameters.
   std::vector<unsigned char> model_payload;
@@ -67,6 +72,9 @@ struct Subscriber::State {
   std::optional<wire::DatagramReassembler> reassembler;
   std::vector<unsigned char> datagram;
   uint32_t model_id = 0;
+  wire::Hello hello;  // what was asked, to fetch the Model again
+  uint64_t frames_other_model = 0, model_fetches = 0;
+  std::chrono::steady_clock::time_point other_model_since{}, last_own_frame{};
   std::vector<unsigned char> ready_message;  // the newest complete frame, not yet handed out
   int64_t ready_arrival_ns = 0;
   uint64_t superseded = 0;
@@ -89,7 +97,14 @@ struct Subscriber::State {
   // Decodes and evaluates ready_message into `frame` (false: it broke the protocol; counted).
   bool take_ready_message(Frame& frame);
   void reject(const std::string& what);
+  // A complete group frame of another Model than ours: skipped; after a second of those alone,
+  // the daemon's subject changed: MeshInfo and the Model are fetched again over TCP (true).
+  bool other_model(uint32_t id, std::chrono::steady_clock::time_point now);
+  void connect();  // to the daemon over TCP, with the Hello
 };
+
+// Frames of another Model alone for this long: the daemon's, not a forger's.
+constexpr auto kModelChangeAfter = std::chrono::seconds(1);
 
 Subscriber::Subscriber(Options options) : state_(std::make_unique<State>()) {
   State& s = *state_;
@@ -113,15 +128,26 @@ Subscriber::Subscriber(Options options) : state_(std::make_unique<State>()) {
   if (!o.multicast.group.empty()) {
     if (s.version != wire::kVersion2 || o.encoding != Encoding::Parameters || o.paced || !o.mesh)
       throw std::invalid_argument("multicast carries the parameters of the mesh only: encoding parameters, protocol 2, not paced");
+    wire::DatagramReassembler::Options reassembly{o.multicast.stream_id, o.multicast.window};
+    if (!o.multicast.key.empty())
+      reassembly.authenticator = std::make_shared<wire::DatagramAuthenticator>(
+          std::span(reinterpret_cast<const unsigned char*>(o.multicast.key.data()), o.multicast.key.size()));
     // Joined first, so the group's datagrams wait in the socket while the Model comes.
     s.group.emplace(o.multicast.group, o.multicast.port, o.multicast.interface_address);
-    s.reassembler.emplace(wire::DatagramReassembler::Options{o.multicast.stream_id, o.multicast.window});
+    s.reassembler.emplace(reassembly);
     s.datagram.resize(kDatagramReadBytes);
     s.ready_message.reserve(wire::kMaxDatagramMessageBytes);
     hello.wants &= ~(wire::kWantMarkers);  // the group's frames carry none
   }
-  s.connection.emplace(o.host, o.port, o.connect_timeout);
-  s.connection->send_all(wire::encode_hello(hello));
+  s.hello = hello;
+  s.connect();
+}
+
+void Subscriber::State::connect() {
+  decoder = wire::StreamDecoder();
+  connection.emplace(options.host, options.port, options.connect_timeout);
+  connection->send_all(wire::encode_hello(hello));
+  last_heard = std::chrono::steady_clock::now();
 }
 
 Subscriber::~Subscriber() = default;
@@ -152,12 +178,20 @@ bool Subscriber::State::read_connection(Frame& frame, std::chrono::steady_clock:
             break;
           case wire::MessageType::Status: s.on_status(message->payload); break;
           case wire::MessageType::Frame: {
-            const bool ready = s.on_frame(message->payload, frame);
+            // A frame that breaks the protocol on its own (its length framed it, so the stream
+            // is still in step) is skipped and counted: the next one is as good as ever.
+            bool ready = false;
+            try {
+              ready = s.on_frame(message->payload, frame);
+            } catch (const wire::DecodeError& e) {
+              ++s.rejected;
+              s.last_rejection = std::string("frame skipped: ") + e.what();
+            }
             // Paced: every Frame taken is acknowledged, a skipped one too (a compressed delta
             // without its key): the daemon sends nothing more while two wait for an Ack.
-            if (s.options.paced) {
+            if (s.options.paced && message->payload.size() >= sizeof(uint32_t)) {
               uint32_t number;
-              std::memcpy(&number, message->payload.data(), sizeof number);  // on_frame checked the size
+              std::memcpy(&number, message->payload.data(), sizeof number);
               s.connection->send_all(wire::encode_ack({number}, s.version));
             }
             if (ready) return true;
@@ -169,11 +203,20 @@ bool Subscriber::State::read_connection(Frame& frame, std::chrono::steady_clock:
     } catch (const wire::DecodeError& e) {
       throw Error(std::string("bad message from the daemon: ") + e.what());
     }
-    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
+    const auto now = std::chrono::steady_clock::now();
+    if (s.options.silence_timeout.count() > 0 && now - s.last_heard >= s.options.silence_timeout)
+      throw Error("nothing from the daemon for " + std::to_string(s.options.silence_timeout.count()) +
+                  " ms, and it says something every second: gone, or a message cut short (" + std::to_string(s.decoder.buffered()) +
+                  " bytes of one came)");
+    auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - now);
     if (left.count() < 0) return false;
+    if (s.options.silence_timeout.count() > 0)
+      left = std::min(left, std::chrono::duration_cast<std::chrono::milliseconds>(s.last_heard + s.options.silence_timeout - now) +
+                                std::chrono::milliseconds(1));
     const std::span<unsigned char> room = s.decoder.prepare(kReadBytes);
     const size_t n = s.connection->receive(room, left);
     s.decoder.commit(n);
+    if (n > 0) s.last_heard = std::chrono::steady_clock::now();
     if (n == 0 && std::chrono::steady_clock::now() >= deadline) return false;
     s.bytes += n;
     s.arrival_ns = wall_clock_ns();
@@ -212,11 +255,11 @@ bool Subscriber::State::read_group(Frame& frame, std::chrono::steady_clock::time
     }
     if (!message) continue;
     if (message->header.model_id != model_id) {
-      char text[160];
-      std::snprintf(text, sizeof text, "the multicast frames fit another Model (id %08x, this receiver holds %08x): the daemon's subject changed",
-                    message->header.model_id, model_id);
-      throw Error(text);
+      if (other_model(message->header.model_id, std::chrono::steady_clock::now())) return false;  // the Model comes over TCP
+      continue;
     }
+    other_model_since = {};
+    last_own_frame = std::chrono::steady_clock::now();
     if (have_one) ++superseded;
     ready_message.assign(message->bytes.begin(), message->bytes.end());  // within its capacity: allocates once
     ready_arrival_ns = arrival_ns;
@@ -246,13 +289,28 @@ bool Subscriber::State::take_ready_message(Frame& frame) {
   return ready;
 }
 
+bool Subscriber::State::other_model(uint32_t id, std::chrono::steady_clock::time_point now) {
+  ++frames_other_model;
+  char text[128];
+  std::snprintf(text, sizeof text, "a multicast frame of another Model (id %08x, this receiver holds %08x): skipped", id, model_id);
+  last_error = text;
+  if (other_model_since == std::chrono::steady_clock::time_point{}) other_model_since = now;
+  if (now - other_model_since < kModelChangeAfter || now - last_own_frame < kModelChangeAfter) return false;
+  ++model_fetches;
+  other_model_since = {};
+  ready_message.clear();  // of the Model that is going
+  last_own_frame = now;  // the next fetch, if it comes to that, a second from now at the soonest
+  connect();
+  return true;
+}
+
 void Subscriber::State::reject(const std::string& what) {
   ++messages_rejected;
   last_error = what;
 }
 
 void Subscriber::State::on_mesh_info(std::span<const unsigned char> payload) {
-  const wire::MeshInfo info = wire::decode_mesh_info(payload, version);
+  const wire::MeshInfo info = wire::decode_mesh_info(payload, version, {options.max_vertices, options.max_markers});
   mesh.subject = info.subject;
   mesh.encoding = version >= wire::kVersion2 ? static_cast<Encoding>(info.encoding)
                                              : (options.encoding == Encoding::Quantised ? Encoding::Quantised : Encoding::Float);
@@ -308,7 +366,7 @@ void Subscriber::State::on_status(std::span<const unsigned char> payload) {
   status.detail = in.detail;
   status.subject = in.subject;
   status.subject_present = in.subject_present;
-  if (in.state == wire::SourceStateCode::Refused) throw Error("the daemon refused this subscriber: " + in.detail);
+  if (in.state == wire::SourceStateCode::Refused) throw Error("the daemon refused this subscriber: " + printable_text(in.detail));
 }
 
 bool Subscriber::State::on_frame(std::span<const unsigned char> payload, Frame& frame) {
@@ -368,8 +426,12 @@ bool Subscriber::State::on_frame(std::span<const unsigned char> payload, Frame& 
   }
   const size_t m = view.marker_status.size();
   if (m > marker_status.size()) throw Error("a Frame with more markers than MeshInfo names");
+  // Nothing that is not finite reaches the renderer (the parameters were checked as they were read).
+  if (have_positions && !all_finite(positions)) throw wire::DecodeError("a Frame whose vertices are not all finite");
+  if (have_normals && !all_finite(normals)) throw wire::DecodeError("a Frame whose normals are not all finite");
   copy_bytes(markers.data(), view.markers.data(), 12 * m);
   copy_bytes(marker_status.data(), view.marker_status.data(), m);
+  if (!all_finite(std::span<const float>(markers).first(3 * m))) throw wire::DecodeError("a Frame whose markers are not all finite");
 
   frame.frame_number = info.frame_number;
   frame.source_time_ns = info.source_time_ns;
@@ -398,6 +460,8 @@ const Mesh& Subscriber::mesh() const { return state_->mesh; }
 const SourceStatus& Subscriber::status() const { return state_->status; }
 const Options& Subscriber::options() const { return state_->options; }
 uint64_t Subscriber::frames_skipped() const { return state_->skipped; }
+uint64_t Subscriber::frames_rejected() const { return state_->rejected; }
+std::string Subscriber::last_rejection() const { return state_->last_rejection; }
 uint64_t Subscriber::bytes_received() const { return state_->bytes; }
 size_t Subscriber::model_bytes() const { return state_->model_payload.empty() ? 0 : wire::kHeaderBytes + state_->model_payload.size(); }
 std::span<const unsigned char> Subscriber::parameter_block() const { return state_->parameter_block; }
@@ -407,8 +471,22 @@ MulticastStats Subscriber::multicast_stats() const {
   const State& s = *state_;
   if (!s.reassembler) return {};
   const wire::DatagramReassembler::Stats& r = s.reassembler->stats();
-  return {r.datagrams,          r.frames_completed,    r.frames_lost,    r.frames_incomplete,   r.datagrams_rejected,
-          r.datagrams_other_stream, r.datagrams_late, r.datagrams_duplicate, s.superseded, s.messages_rejected, s.last_error};
+  return {r.datagrams,
+          r.frames_completed,
+          r.frames_lost,
+          r.frames_incomplete,
+          r.datagrams_rejected,
+          r.datagrams_other_stream,
+          r.datagrams_late,
+          r.datagrams_duplicate,
+          s.superseded,
+          s.messages_rejected,
+          s.last_error,
+          r.datagrams_out_of_window,
+          r.datagrams_unauthenticated,
+          r.resyncs,
+          s.frames_other_model,
+          s.model_fetches};
 }
 
 }  // namespace skinstream::client

@@ -45,6 +45,13 @@ class ProtocolError(Error):
     """Bytes that do not follow the subscriber protocol; the message says which rule."""
 
 
+def printable(text, limit=256):
+    """Text from the daemon made fit for a one-line message: every character outside printable
+    ASCII (line breaks, terminal escapes) becomes \\xNN or \\uNNNN, and long text is cut."""
+    out = ''.join(c if ' ' <= c <= '~' else f'\\x{ord(c):02x}' if ord(c) < 256 else f'\\u{ord(c):04x}' for c in text[:limit])
+    return out + (f'... ({len(text)} characters)' if len(text) > limit else '')
+
+
 def padding_to_4(n):
     return (4 - n % 4) % 4
 
@@ -141,9 +148,14 @@ def encode_ack(version, frame_number):
 class MeshInfo:
     """What the daemon says of the subject once after Hello: topology, markers, encoding."""
 
-    def __init__(self, payload, version):
+    def __init__(self, payload, version, max_vertices=4_000_000, max_markers=4096):
         r = _Reader(payload, 'MeshInfo')
         v, f, m, self.part_count, self.source_rate_hz = r.unpack('<IIIIf', 'counts')
+        # Checked before anything is made for them: 67 million vertices fit in 64 MiB.
+        if v > max_vertices:
+            raise ProtocolError(f'MeshInfo: {v} vertices, more than this subscriber takes ({max_vertices}, its max_vertices)')
+        if m > max_markers:
+            raise ProtocolError(f'MeshInfo: {m} markers, more than this subscriber takes ({max_markers}, its max_markers)')
         self.vertex_count, self.marker_count = v, m
         self.faces = r.array('<u4', 3 * f, 'faces').reshape(f, 3)
         if f and int(self.faces.max()) >= v:

@@ -1,5 +1,6 @@
 """One subscription to a skinstreamd over TCP: Hello, then MeshInfo (and the Model for the
 parameter encoding), then Frames decoded into numpy arrays, read on the calling thread."""
+import logging
 import socket
 import struct
 import time
@@ -9,6 +10,8 @@ import numpy as np
 from . import protocol as wire
 from .decoder_choice import compressed_decoder, parameter_evaluator
 from .protocol import Error, ProtocolError
+
+_log = logging.getLogger('skinstream')
 
 
 class ConnectionLost(Error):
@@ -41,11 +44,17 @@ class Frame:
 class Subscriber:
     """A subscription. Connects and sends Hello on construction (ConnectionLost when the daemon
     cannot be reached); next_frame() and frames() read. Every error is an Error subclass with a
-    one-line message; after one, make a new Subscriber (Receiver does that with backoff).
+    one-line message (the daemon's own words made printable); after one, make a new Subscriber
+    (Receiver does that with backoff). A MeshInfo announcing more than max_vertices or
+    max_markers is an error before anything is made for it. A Frame
+    that breaks the protocol on its own (a value that is not finite, a block of the wrong size)
+    is skipped instead, counted in frames_rejected with the reason in last_rejection, and logged
+    as a warning ('skinstream' logger) at most once a second.
     libraries=False decodes in numpy even where libmeshoptimizer or libskinstream_client load."""
 
     def __init__(self, host='127.0.0.1', port=8481, encoding='parameters', normals=True, markers=False, mesh=True,
-                 paced=False, evaluate=True, subject='', token='', protocol_version=2, connect_timeout=5.0, libraries=True):
+                 paced=False, evaluate=True, subject='', token='', protocol_version=2, connect_timeout=5.0, libraries=True,
+                 max_vertices=4_000_000, max_markers=4096):
         if encoding not in wire.ENCODINGS:
             raise ValueError(f'unknown encoding "{encoding}" (float, quantised, compressed or parameters)')
         if protocol_version not in wire.VERSIONS:
@@ -56,6 +65,7 @@ class Subscriber:
         self.version = protocol_version
         self.paced, self.evaluate, self.want_normals = paced, evaluate, normals
         self.libraries = libraries  # decode with the system's libraries when they load (decoder_choice.py)
+        self.max_vertices, self.max_markers = max_vertices, max_markers  # of a MeshInfo, checked before anything is made
         wants = ((wire.WANT_NORMALS if normals else 0) | (wire.WANT_MARKERS if markers else 0) |
                  (0 if mesh else wire.WANT_NO_MESH) | (wire.WANT_PACED if paced else 0))
         if protocol_version == 1 and self.encoding_asked == wire.QUANTISED:
@@ -65,6 +75,9 @@ class Subscriber:
         self.model = None  # protocol.Model (parameter encoding)
         self.status = None  # protocol.Status, the latest
         self.frames_skipped = 0  # compressed deltas without their key
+        self.frames_rejected = 0  # Frames that broke the protocol on their own, skipped
+        self.last_rejection = ''
+        self._last_rejection_log = 0.0
         self.bytes_received = 0
         self._evaluator = self._compressed = None
         self._header = bytearray(wire.HEADER_BYTES)
@@ -132,9 +145,15 @@ class Subscriber:
             elif kind == wire.STATUS:
                 self.status = wire.Status(payload, version)
                 if self.status.refused:
-                    raise Refused(f'the daemon refused this subscriber: {self.status.detail}')
+                    raise Refused(f'the daemon refused this subscriber: {wire.printable(self.status.detail)}')
             elif kind == wire.FRAME:
-                frame = self._on_frame(payload)
+                self._check_frame_order(payload)
+                # Its length framed it, so the stream is still in step: a bad frame costs itself only.
+                try:
+                    frame = self._on_frame(payload)
+                except ProtocolError as e:
+                    frame = None
+                    self._reject(e)
                 if self.paced:  # every Frame taken, a skipped one too: the daemon waits while two are unacknowledged
                     self._send(wire.encode_ack(self.version, struct.unpack_from('<I', payload)[0]))
                 if frame is not None:
@@ -143,7 +162,7 @@ class Subscriber:
                 raise ProtocolError(f'unexpected {wire.MESSAGE_NAMES[kind]} message from the daemon')
 
     def _on_mesh_info(self, payload):
-        self.mesh = wire.MeshInfo(payload, self.version)
+        self.mesh = wire.MeshInfo(payload, self.version, self.max_vertices, self.max_markers)
         if self.version == 1:
             self.mesh.encoding = self.encoding_asked
         self.model = self._evaluator = self._compressed = None
@@ -159,11 +178,25 @@ class Subscriber:
         self._evaluator = parameter_evaluator(model, payload, self.mesh.faces, self.libraries)
         self.model = model
 
+    def _check_frame_order(self, payload):
+        """Frames out of order end the subscription (unlike a frame broken on its own)."""
+        if self.mesh is None:
+            raise ProtocolError('a Frame before MeshInfo')
+        flags = struct.unpack_from('<I', payload, 4)[0] if len(payload) >= 8 else 0
+        if flags & wire.FRAME_PARAMETERS and self._evaluator is None:
+            raise ProtocolError('a parameter Frame before the Model')
+
+    def _reject(self, error):
+        self.frames_rejected += 1
+        self.last_rejection = f'frame skipped: {error}'
+        now = time.monotonic()
+        if now - self._last_rejection_log >= 1.0:
+            self._last_rejection_log = now
+            _log.warning('%s: %s (%d frames skipped so far)', self.peer, self.last_rejection, self.frames_rejected)
+
     def _on_frame(self, payload):
         arrival = time.time_ns()
         mesh = self.mesh
-        if mesh is None:
-            raise ProtocolError('a Frame before MeshInfo')
         view = wire.FrameView(payload, self.version)
         v = view.vertex_count
         if view.positions is not None and not view.flags & wire.FRAME_PARAMETERS and v != mesh.vertex_count:
@@ -197,6 +230,11 @@ class Subscriber:
                 frame.vertices = wire.float_block(view.positions, v)
                 frame.normals = None if view.normals is None else wire.float_block(view.normals, v)
         frame.markers, frame.marker_status = view.markers, view.marker_status
+        # Nothing that is not finite reaches the renderer (the parameters were checked as they were read).
+        for name in ('vertices', 'normals', 'markers'):
+            values = getattr(frame, name)
+            if values is not None and not np.isfinite(values).all():
+                raise ProtocolError(f'a Frame whose {name} are not all finite')
         for name in ('frame_number', 'source_time_ns', 'receive_time_ns', 'publish_time_ns', 'timecode', 'markers_filled',
                      'markers_relabelled', 'pipeline_dropped', 'subscriber_dropped'):
             setattr(frame, name, getattr(view, name))

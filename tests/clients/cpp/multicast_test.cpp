@@ -12,10 +12,13 @@
 #include <algorithm>
 #include <atomic>
 #include <cstring>
+#include <fstream>
+#include <functional>
 #include <memory>
 #include <regex>
 #include <thread>
 
+#include "protocol/multicast_datagram.h"
 #include "skinstream/client.h"
 #include "support/bridged_namespaces.h"
 #include "support/client_frames.h"
@@ -62,7 +65,9 @@ constexpr int kHosts = 5;
 
 class MulticastDemo : public ::testing::Test {
  protected:
-  static void SetUpTestSuite() {
+  static void SetUpTestSuite() { start(""); }
+  // The LAN and the daemon on it, with `extra` on its command line.
+  static void start(const std::string& extra) {
     skip_reason_ = test::BridgedNamespaces::unavailable_reason();
     if (!skip_reason_.empty()) return;
     lan_ = std::make_unique<test::BridgedNamespaces>(kHosts);
@@ -71,7 +76,7 @@ class MulticastDemo : public ::testing::Test {
     server::DaemonLaunch launch;
     launch.program = SKINSTREAMD;
     launch.arguments = "--subject " + demo + "/subject.sksubj --replay " + demo + "/live.c3d --loop --speed 0.2 --multicast " + kGroup + ":" +
-                       std::to_string(kGroupPort) + " --multicast-interface " + lan_->address(kDaemonHost);
+                       std::to_string(kGroupPort) + " --multicast-interface " + lan_->address(kDaemonHost) + " " + extra;
     launch.exec_prefix = lan_->exec_prefix(kDaemonHost);
     launch.bind = "0.0.0.0";  // the receivers reach it over the bridge
     launch.files_stem = test::scratch_path("multicast_daemon_" + std::to_string(getpid()));
@@ -293,6 +298,252 @@ TEST_F(MulticastDemo, BadDatagramsOnTheGroupAreCountedAndTheStreamGoesOn) {
   std::printf("%llu bad datagrams rejected (last: %s), %llu of another stream; %zu frames\n",
               static_cast<unsigned long long>(stats.datagrams_rejected), stats.last_error.c_str(),
               static_cast<unsigned long long>(stats.datagrams_other_stream), received.size());
+}
+
+}  // namespace
+}  // namespace skinstream
+
+namespace skinstream {
+namespace {
+
+// A host of the LAN that copies the daemon's datagrams as they pass and sends altered copies to
+// the group: for each one it sees, `forge` makes the copies (a real datagram is `datagram`).
+class Forger {
+ public:
+  using Forge = std::function<std::vector<std::vector<unsigned char>>(const std::vector<unsigned char>& datagram)>;
+  Forger(const test::BridgedNamespaces& lan, int host, const std::string& daemon_address, Forge forge)
+      : thread_([this, &lan, host, daemon_address, forge] {
+          lan.enter(host);
+          const int fd = socket(AF_INET, SOCK_DGRAM, 0);
+          const int on = 1, off = 0;
+          setsockopt(fd, SOL_SOCKET, SO_REUSEADDR, &on, sizeof on);
+          setsockopt(fd, IPPROTO_IP, IP_MULTICAST_LOOP, &off, sizeof off);  // never copies of its own copies
+          sockaddr_in local{};
+          local.sin_family = AF_INET;
+          local.sin_port = htons(kGroupPort);
+          bind(fd, reinterpret_cast<const sockaddr*>(&local), sizeof local);
+          ip_mreq join{};
+          inet_pton(AF_INET, kGroup, &join.imr_multiaddr);
+          inet_pton(AF_INET, lan.address(host).c_str(), &join.imr_interface);
+          setsockopt(fd, IPPROTO_IP, IP_ADD_MEMBERSHIP, &join, sizeof join);
+          setsockopt(fd, IPPROTO_IP, IP_MULTICAST_IF, &join.imr_interface, sizeof join.imr_interface);
+          timeval timeout{0, 100'000};
+          setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &timeout, sizeof timeout);
+          sockaddr_in to{};
+          to.sin_family = AF_INET;
+          inet_pton(AF_INET, kGroup, &to.sin_addr);
+          to.sin_port = htons(kGroupPort);
+          in_addr daemon{};
+          inet_pton(AF_INET, daemon_address.c_str(), &daemon);
+          std::vector<unsigned char> buffer(65536);
+          while (!stop_.load()) {
+            sockaddr_in from{};
+            socklen_t from_length = sizeof from;
+            const ssize_t n = recvfrom(fd, buffer.data(), buffer.size(), 0, reinterpret_cast<sockaddr*>(&from), &from_length);
+            if (n <= 0 || from.sin_addr.s_addr != daemon.s_addr) continue;
+            for (const std::vector<unsigned char>& copy : forge({buffer.begin(), buffer.begin() + n})) {
+              sendto(fd, copy.data(), copy.size(), 0, reinterpret_cast<const sockaddr*>(&to), sizeof to);
+              ++sent;
+            }
+          }
+          close(fd);
+        }) {}
+  ~Forger() {
+    stop_ = true;
+    thread_.join();
+  }
+  std::atomic<uint64_t> sent{0};
+
+ private:
+  std::atomic<bool> stop_{false};
+  std::thread thread_;
+};
+
+// A datagram with a header field changed (offsets as the spec lays them out).
+template <typename T>
+std::vector<unsigned char> with_field(std::vector<unsigned char> datagram, size_t offset, T value) {
+  std::memcpy(datagram.data() + offset, &value, sizeof value);
+  return datagram;
+}
+template <typename T>
+T field(const std::vector<unsigned char>& datagram, size_t offset) {
+  T value;
+  std::memcpy(&value, datagram.data() + offset, sizeof value);
+  return value;
+}
+
+// The first fragment of a frame of 64 fragments that never comes, `ahead` of `datagram`'s sequence.
+std::vector<unsigned char> forged_first_fragment(const std::vector<unsigned char>& datagram, uint32_t ahead) {
+  std::vector<unsigned char> forged(datagram.begin(), datagram.begin() + 28);
+  const uint32_t sequence = field<uint32_t>(datagram, 16) + ahead, bytes = 64 * 1340;
+  const uint16_t index = 0, count = 64;
+  forged = with_field(with_field(with_field(with_field(forged, 16, sequence), 20, index), 22, count), 24, bytes);
+  forged.resize(28 + 1340 + (field<uint16_t>(datagram, 6) & 1 ? 32 : 0), 0x5A);  // a tag's room, when the real ones have one
+  return forged;
+}
+
+// A receiver on kClean for `seconds` while `forge` runs on kClean + 1: every frame it hands out,
+// the longest it waited between two, its stats, and any error.
+struct UnderAttack {
+  std::map<uint32_t, Stamped> received;
+  client::MulticastStats stats;
+  std::string error;
+  double longest_wait_s = 0;
+  uint64_t forged = 0;
+};
+
+UnderAttack receive_under_attack(const test::BridgedNamespaces& lan, const client::Options& options, Forger::Forge forge, int seconds) {
+  UnderAttack out;
+  std::thread receiver([&] {
+    try {
+      lan.enter(kClean);
+      client::Subscriber sub(options);
+      client::Frame frame;
+      while (!sub.next(frame, std::chrono::seconds(1))) {
+      }
+      Forger forger(lan, kClean + 1, lan.address(kDaemonHost), forge);
+      auto last = std::chrono::steady_clock::now();
+      const auto end = last + std::chrono::seconds(seconds);
+      while (std::chrono::steady_clock::now() < end) {
+        if (!sub.next(frame, std::chrono::milliseconds(200))) continue;
+        const auto now = std::chrono::steady_clock::now();
+        out.longest_wait_s = std::max(out.longest_wait_s, std::chrono::duration<double>(now - last).count());
+        last = now;
+        keep_stamped(frame, out.received[frame.frame_number]);
+      }
+      out.stats = sub.multicast_stats();
+      out.forged = forger.sent.load();
+    } catch (const std::exception& e) {
+      out.error = e.what();
+    }
+  });
+  receiver.join();
+  return out;
+}
+
+// Copies of the daemon's own datagrams, altered, from another host on the LAN: with another
+// model id (one ended every receiver: "fit another Model"), with the sequence 1,200 or 60,000
+// ahead (frames stopped for 10 s, and for the rest of the run), and first fragments of frames
+// that never come a few sequences ahead (about 360 a second stopped frames for the whole
+// attack). The receiver goes on with the daemon's frames, counting the copies; it waits for no
+// longer than between the daemon's frames (24 a second here), plus what this machine adds.
+TEST_F(MulticastDemo, ForgedCopiesOfRealDatagramsDoNotStopTheReceiver) {
+  std::map<uint32_t, Stamped> truth;
+  std::thread reference_thread([&] { truth = reference(60); });
+  const UnderAttack attack = receive_under_attack(*lan_, options_on(kClean), [](const std::vector<unsigned char>& d) {
+    return std::vector<std::vector<unsigned char>>{with_field<uint32_t>(d, 12, field<uint32_t>(d, 12) ^ 0x5A5A5A5Au),
+                                                   with_field<uint32_t>(d, 16, field<uint32_t>(d, 16) + 1200),
+                                                   with_field<uint32_t>(d, 16, field<uint32_t>(d, 16) + 60000),
+                                                   forged_first_fragment(d, 2), forged_first_fragment(d, 3), forged_first_fragment(d, 4)};
+  }, 4);
+  reference_thread.join();
+  ASSERT_EQ(attack.error, "");
+  EXPECT_GT(attack.forged, 1000u);
+  // 4 s at 24 frames a second: most of them, and the daemon's own (its float buffer's vertices).
+  EXPECT_GE(attack.received.size(), 48u);
+  EXPECT_EQ(attack.stats.model_fetches, 0u);
+  EXPECT_GT(attack.stats.datagrams_out_of_window, 0u);
+  const Difference d = compare_same(truth, attack.received);
+  EXPECT_GE(d.frames, 3);
+  EXPECT_LE(d.position_mm, 0.01);
+  std::printf("under attack (%llu forged datagrams): %zu frames, longest wait %.3f s; %llu of another model skipped, %llu out of the "
+              "window, %llu late, %llu rejected, %llu incomplete, %llu resyncs, %llu lost\n",
+              static_cast<unsigned long long>(attack.forged), attack.received.size(), attack.longest_wait_s,
+              static_cast<unsigned long long>(attack.stats.frames_other_model), static_cast<unsigned long long>(attack.stats.datagrams_out_of_window),
+              static_cast<unsigned long long>(attack.stats.datagrams_late), static_cast<unsigned long long>(attack.stats.datagrams_rejected),
+              static_cast<unsigned long long>(attack.stats.frames_incomplete), static_cast<unsigned long long>(attack.stats.resyncs),
+              static_cast<unsigned long long>(attack.stats.frames_lost));
+}
+
+// Frames of another Model than the one fetched, and nothing else, for more than a second: the
+// daemon's subject changed (restarted with another). The receiver ended with "the multicast
+// frames fit another Model"; now it fetches MeshInfo and the Model again over TCP and goes on.
+// (Here a host sends such frames to a group of its own, where the daemon sends nothing.)
+TEST_F(MulticastDemo, OnlyFramesOfAnotherModelMakeTheReceiverFetchTheModelAgain) {
+  constexpr const char* kOtherGroup = "239.255.77.2";
+  std::atomic<bool> sending{true};
+  std::thread other([&] {
+    lan_->enter(kClean + 1);
+    const int fd = socket(AF_INET, SOCK_DGRAM, 0);
+    in_addr interface{};
+    inet_pton(AF_INET, lan_->address(kClean + 1).c_str(), &interface);
+    setsockopt(fd, IPPROTO_IP, IP_MULTICAST_IF, &interface, sizeof interface);
+    sockaddr_in to{};
+    to.sin_family = AF_INET;
+    inet_pton(AF_INET, kOtherGroup, &to.sin_addr);
+    to.sin_port = htons(kGroupPort);
+    for (uint32_t sequence = 0; sending.load(); ++sequence) {
+      std::vector<unsigned char> datagram(28 + 100, 0x11);
+      subscriber::encode_datagram_header({0, 0x12345678u, sequence, 0, 1, 100},
+                                         std::span<unsigned char, 28>(datagram.data(), 28));
+      sendto(fd, datagram.data(), datagram.size(), 0, reinterpret_cast<const sockaddr*>(&to), sizeof to);
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    close(fd);
+  });
+  client::MulticastStats stats;
+  std::string error;
+  std::thread receiver([&] {
+    try {
+      lan_->enter(kClean);
+      client::Options options = options_on(kClean);
+      options.multicast.group = kOtherGroup;
+      client::Subscriber sub(options);
+      client::Frame frame;
+      for (const auto end = std::chrono::steady_clock::now() + std::chrono::milliseconds(3500); std::chrono::steady_clock::now() < end;)
+        sub.next(frame, std::chrono::milliseconds(200));
+      stats = sub.multicast_stats();
+    } catch (const std::exception& e) {
+      error = e.what();
+    }
+    sending = false;
+  });
+  receiver.join();
+  other.join();
+  ASSERT_EQ(error, "");
+  EXPECT_GE(stats.model_fetches, 1u);
+  EXPECT_GT(stats.frames_other_model, 50u);
+  EXPECT_EQ(stats.frames_completed, stats.frames_other_model);
+  std::printf("%llu frames of another Model skipped, the Model fetched again %llu times\n",
+              static_cast<unsigned long long>(stats.frames_other_model), static_cast<unsigned long long>(stats.model_fetches));
+}
+
+// The daemon signs its datagrams (--multicast-key-file); a receiver with the key takes none of
+// the forged copies (their tags are the real ones' or none) and loses no frame to them.
+class MulticastKeyDemo : public MulticastDemo {
+ protected:
+  static void SetUpTestSuite() {
+    key_file_ = test::scratch_path("multicast_key_" + std::to_string(getpid()) + ".txt");
+    std::ofstream(key_file_) << kKey << "\n";
+    start("--multicast-key-file " + key_file_);
+  }
+  static constexpr const char* kKey = "stage-7 multicast key";
+  static inline std::string key_file_;
+};
+
+TEST_F(MulticastKeyDemo, ForgedCopiesAreRefusedForTheirTags) {
+  std::map<uint32_t, Stamped> truth;
+  std::thread reference_thread([&] { truth = reference(60); });
+  client::Options options = options_on(kClean);
+  options.multicast.key = kKey;
+  const UnderAttack attack = receive_under_attack(*lan_, options, [](const std::vector<unsigned char>& d) {
+    return std::vector<std::vector<unsigned char>>{with_field<uint32_t>(d, 12, field<uint32_t>(d, 12) ^ 0x5A5A5A5Au),
+                                                   with_field<uint32_t>(d, 16, field<uint32_t>(d, 16) + 1),
+                                                   forged_first_fragment(d, 1)};
+  }, 4);
+  reference_thread.join();
+  ASSERT_EQ(attack.error, "");
+  EXPECT_GT(attack.forged, 500u);
+  EXPECT_GE(attack.stats.datagrams_unauthenticated, attack.forged * 9 / 10);  // a few may still be on their way
+  EXPECT_EQ(attack.stats.frames_other_model, 0u);
+  EXPECT_EQ(attack.stats.frames_lost, 0u);
+  EXPECT_GE(attack.received.size(), 48u);
+  const Difference d = compare_same(truth, attack.received);
+  EXPECT_GE(d.frames, 3);
+  EXPECT_LE(d.position_mm, 0.01);
+  std::printf("with a key, under attack (%llu forged datagrams): %zu frames, longest wait %.3f s, %llu refused for their tags\n",
+              static_cast<unsigned long long>(attack.forged), attack.received.size(), attack.longest_wait_s,
+              static_cast<unsigned long long>(attack.stats.datagrams_unauthenticated));
 }
 
 }  // namespace

@@ -9,10 +9,13 @@
 #include <unistd.h>
 
 #include <cmath>
+#include <fstream>
 #include <map>
 #include <mutex>
 #include <thread>
 
+#include "protocol/subscriber_stream.h"
+#include "support/scripted_daemon.h"
 #include "support/client_frames.h"
 #include "support/daemon_process.h"
 #include "support/received_vertices.h"
@@ -208,6 +211,105 @@ TEST(ClientSubscriber, BytesThatBreakTheProtocolAreOneLineErrors) {
   EXPECT_NE(error_for(frame_first).find("before the Model"), std::string::npos);
   for (const std::string& e : {error_for(bad_magic), error_for(version_one), error_for(frame_first)})
     EXPECT_EQ(e.find('\n'), std::string::npos) << e;
+}
+
+// One Frame whose parameters are not finite (an RBF weight) among good ones: skipped, counted and
+// said why; the frames after it arrive as before. (The library ended the stream with an Error.)
+TEST(ClientSubscriber, AFrameThatIsNotFiniteIsSkippedAndTheStreamGoesOn) {
+  test::ScriptedDaemon daemon(test::broken_frame_stream(10, 4));
+  client::Options options;
+  options.port = daemon.port;
+  options.encoding = Encoding::Parameters;
+  client::Subscriber sub(options);
+  std::vector<uint32_t> numbers;
+  client::Frame frame;
+  while (numbers.size() < 9 && sub.next(frame, std::chrono::seconds(5))) {
+    numbers.push_back(frame.frame_number);
+    ASSERT_EQ(frame.positions.size(), 9u);
+    for (float v : frame.positions) ASSERT_TRUE(std::isfinite(v)) << "frame " << frame.frame_number;
+  }
+  EXPECT_EQ(numbers, (std::vector<uint32_t>{1, 2, 3, 5, 6, 7, 8, 9, 10}));
+  EXPECT_EQ(sub.frames_rejected(), 1u);
+  EXPECT_EQ(sub.last_rejection(), "frame skipped: parameters: an RBF weight is not finite");
+}
+
+// A version 2 MeshInfo of `vertices` vertices (no faces, float) and `markers` empty marker names.
+std::vector<unsigned char> mesh_info_of(uint32_t vertices, uint32_t markers) {
+  std::vector<unsigned char> payload;
+  auto put = [&](const auto& value) {
+    const auto* b = reinterpret_cast<const unsigned char*>(&value);
+    payload.insert(payload.end(), b, b + sizeof value);
+  };
+  put(vertices);
+  put(uint32_t{0});  // faces
+  put(markers);
+  put(uint32_t{1});  // parts
+  put(120.0f);
+  payload.resize(payload.size() + vertices, 0);  // each vertex's part
+  put(uint32_t{0});                               // marker triangles
+  payload.resize(payload.size() + 2 * size_t{markers}, 0);  // empty names
+  put(uint16_t{0});  // subject
+  put(uint32_t{0});  // float
+  put(uint32_t{0});  // no compressed order
+  std::vector<unsigned char> message(subscriber::kHeaderBytes);
+  subscriber::write_header(subscriber::MessageType::MeshInfo, subscriber::kVersion2, payload.size(),
+                           std::span<unsigned char, subscriber::kHeaderBytes>(message.data(), subscriber::kHeaderBytes));
+  message.insert(message.end(), payload.begin(), payload.end());
+  return message;
+}
+
+long peak_resident_kb() {
+  std::ifstream status("/proc/self/status");
+  for (std::string line; std::getline(status, line);)
+    if (line.rfind("VmHWM:", 0) == 0) return std::stol(line.substr(6));
+  return 0;
+}
+
+// A MeshInfo announcing 67 million vertices (a 64 MiB message) or 8 million empty marker names:
+// the subscriber sized its buffers from them (3.35 GB, 651 MB). Now each count is checked
+// against the subscriber's limits before anything is made for it.
+TEST(ClientSubscriber, AMeshInfoBeyondTheLimitsIsAnErrorBeforeAnythingIsMade) {
+  const long before = peak_resident_kb();
+  const std::string vertices = error_for(mesh_info_of(67'000'000, 0), Encoding::Float);
+  const std::string markers = error_for(mesh_info_of(3, 8'000'000), Encoding::Float);
+  EXPECT_NE(vertices.find("MeshInfo: 67000000 vertices, more than this subscriber takes (4000000, its max_vertices)"), std::string::npos)
+      << vertices;
+  EXPECT_NE(markers.find("MeshInfo: 8000000 markers, more than this subscriber takes (4096, its max_markers)"), std::string::npos) << markers;
+  std::printf("peak resident memory grew by %ld kB (the 64 MiB message, kept by the daemon written here and read once)\n",
+              peak_resident_kb() - before);
+}
+
+// A daemon that sends MeshInfo and then half a message and nothing more, its connection open:
+// next() returned false for ever. After silence_timeout it is an Error that says so.
+TEST(ClientSubscriber, ADaemonThatFallsSilentIsAnErrorAfterTheSilenceTimeout) {
+  std::vector<unsigned char> reply = golden("mesh_info_v2.bin");
+  const std::vector<unsigned char> status = golden("status_v2.bin");
+  reply.insert(reply.end(), status.begin(), status.begin() + 20);  // its header and 8 bytes of it
+  test::ScriptedDaemon daemon(reply);
+  client::Options options;
+  options.port = daemon.port;
+  options.encoding = Encoding::Compressed;
+  options.silence_timeout = std::chrono::milliseconds(500);
+  client::Subscriber sub(options);
+  client::Frame frame;
+  std::string error = "no error within 10 s";
+  const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  try {
+    while (std::chrono::steady_clock::now() < give_up) sub.next(frame, std::chrono::milliseconds(200));
+  } catch (const client::Error& e) {
+    error = e.what();
+  }
+  EXPECT_EQ(error, "nothing from the daemon for 500 ms, and it says something every second: gone, or a message cut short (20 bytes of one came)");
+}
+
+// The daemon's words in an error are made printable: a refusal whose detail holds a line break
+// and a terminal escape cannot add a line of its own to the subscriber's output.
+TEST(ClientSubscriber, TheDaemonsWordsInAnErrorArePrintable) {
+  subscriber::Status status;
+  status.state = subscriber::SourceStateCode::Refused;
+  status.detail = "no\n\x1b[31mskinstream-sub: error: forged";
+  const std::string error = error_for(subscriber::encode_status(status, subscriber::kVersion2));
+  EXPECT_EQ(error, "the daemon refused this subscriber: no\\x0a\\x1b[31mskinstream-sub: error: forged");
 }
 
 // A paced subscriber acknowledges the compressed deltas it has to skip (their key gave way in its

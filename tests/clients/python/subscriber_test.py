@@ -173,6 +173,82 @@ class BadDaemons(unittest.TestCase):
                 self.assertNotIn('\n', error)
 
 
+def stream_with_a_broken_frame(frames, broken):
+    """MeshInfo (version 2, float, 3 vertices, 2 markers), then `frames` float Frames numbered 1,
+    2, ... (the golden frame_v2_float.bin's payload), the one numbered `broken` with a vertex
+    coordinate that is not finite."""
+    from skinstream import protocol as wire
+    mesh = struct.pack('<IIIIf', 3, 1, 2, 1, 120.0) + struct.pack('<3I', 0, 1, 2) + bytes([0, 0, 0])
+    mesh += struct.pack('<I', 0) + wire._short_string('A', 'marker') + wire._short_string('B', 'marker')
+    mesh += wire._short_string('fake', 'subject') + struct.pack('<II', wire.FLOAT, 0)
+    out = wire.message(wire.MESH_INFO, mesh, 2)
+    template = fixture('frame_v2_float.bin')
+    for n in range(1, frames + 1):
+        frame = bytearray(template)
+        frame[12:16] = struct.pack('<I', n)  # after the header: the frame number
+        if n == broken:
+            frame[80:84] = struct.pack('<f', float('inf'))  # the first coordinate, after the fixed part and the timecode
+        out += bytes(frame)
+    return out
+
+
+class BrokenFrames(unittest.TestCase):
+    def test_a_frame_that_is_not_finite_is_skipped_and_the_stream_goes_on(self):
+        # It raised at the first (the package stopped after 12 frames of the real daemon's).
+        listener = socket.create_server(('127.0.0.1', 0))
+
+        def serve():
+            peer, _ = listener.accept()
+            with peer:
+                peer.recv(1024)  # the Hello
+                peer.sendall(stream_with_a_broken_frame(10, 4))
+                while peer.recv(1024):
+                    pass
+
+        thread = threading.Thread(target=serve)
+        thread.start()
+        numbers = []
+        with self.assertLogs('skinstream', 'WARNING') as logged:
+            with skinstream.Subscriber(port=listener.getsockname()[1], encoding='float') as sub:
+                while len(numbers) < 9:
+                    frame = sub.next_frame(5)
+                    self.assertIsNotNone(frame)
+                    self.assertTrue(np.isfinite(frame.vertices).all())
+                    numbers.append(frame.frame_number)
+                self.assertEqual(sub.frames_rejected, 1)
+                self.assertEqual(sub.last_rejection, 'frame skipped: a Frame whose vertices are not all finite')
+        thread.join()
+        listener.close()
+        self.assertEqual(numbers, [1, 2, 3, 5, 6, 7, 8, 9, 10])
+        self.assertEqual(len(logged.output), 1)
+        self.assertIn('frame skipped: a Frame whose vertices are not all finite (1 frames skipped so far)', logged.output[0])
+
+
+def mesh_info_of(vertices, markers):
+    """A version 2 MeshInfo of `vertices` vertices (no faces, float) and `markers` empty names."""
+    from skinstream import protocol as wire
+    payload = struct.pack('<IIIIf', vertices, 0, markers, 1, 120.0) + bytes(vertices) + struct.pack('<I', 0)
+    payload += bytes(2 * markers) + struct.pack('<HII', 0, wire.FLOAT, 0)
+    return wire.message(wire.MESH_INFO, payload, 2)
+
+
+class Limits(unittest.TestCase):
+    def test_a_mesh_info_beyond_the_limits_is_an_error_before_anything_is_made(self):
+        # 67 million vertices in a 64 MiB message, 8 million empty marker names: the package
+        # peaked at 4.29 GB and 651 MB making arrays for them.
+        error = error_for(mesh_info_of(67_000_000, 0))
+        self.assertIn('MeshInfo: 67000000 vertices, more than this subscriber takes (4000000, its max_vertices)', error)
+        error = error_for(mesh_info_of(3, 8_000_000))
+        self.assertIn('MeshInfo: 8000000 markers, more than this subscriber takes (4096, its max_markers)', error)
+
+    def test_the_daemons_words_in_an_error_are_printable(self):
+        from skinstream import protocol as wire
+        detail = 'no\n\x1b[31mskinstream-sub: error: forged'.encode()
+        status = struct.pack('<IfQQ', 4, 0.0, 0, 0) + struct.pack('<H', len(detail)) + detail + struct.pack('<HII', 0, 0, 0)
+        error = error_for(wire.message(wire.STATUS, status, 2))
+        self.assertEqual(error, 'the daemon refused this subscriber: no\\x0a\\x1b[31mskinstream-sub: error: forged')
+
+
 class Paced(unittest.TestCase):
     def test_skipped_compressed_deltas_are_acknowledged_too(self):
         # A delta of a key the subscriber never saw (it gave way in the daemon's queue) is

@@ -4,7 +4,12 @@
 // scripted server that sends malformed, truncated and unknown input.
 #include <gtest/gtest.h>
 
+#include <arpa/inet.h>
+#include <sys/socket.h>
+
+#include <atomic>
 #include <cmath>
+#include <filesystem>
 #include <thread>
 
 #include "protocol/natnet_capture_encoder.h"
@@ -13,6 +18,7 @@
 #include "server/ingest/natnet_source.h"
 #include "server/natnet/natnet_server.h"
 #include "support/replay_capture.h"
+#include "support/silent_capture_servers.h"
 #include "support/source_sink_recorder.h"
 
 namespace skinstream::server {
@@ -89,7 +95,7 @@ TEST_P(NatNetLayouts, UnicastStreamsMarkerSetsInMillimetres) {
   SourceSinkRecorder sink;
   NatNetSource source(client_io.io, client_of(server_io.call([&] { return server.command_port(); })), sink);
   source.start();
-  ASSERT_TRUE(sink.wait_frames(30));
+  ASSERT_TRUE(sink.wait_frames(70));  // more than half a second of the source's clock: its rate known
   source.stop();
   client_io.call([] {});
   server_io.call([&] { server.stop(); });  // on its own thread, before it is destroyed
@@ -118,12 +124,12 @@ TEST(NatNetSource, Multicast) {
   SourceSinkRecorder sink;
   NatNetSource source(client_io.io, client, sink);
   source.start();
-  const bool got = sink.wait([&] { return sink.frames.size() >= 20 || !sink.bad_inputs.empty() ||
+  const bool got = sink.wait([&] { return sink.frames.size() >= 70 || !sink.bad_inputs.empty() ||
                                           sink.count_state(SourceState::Disconnected) > 0; });
   source.stop();
   client_io.call([] {});
   server_io.call([&] { server.stop(); });  // on its own thread, before it is destroyed
-  if (!got || sink.frames.size() < 20)
+  if (!got || sink.frames.size() < 70)
     GTEST_SKIP() << "multicast is not looped back here: " << sink.last_detail(SourceState::Disconnected);
   expect_frames_match(sink, walker, runner);
   EXPECT_EQ(server.stats().clients_connected.load(), 0u);  // multicast keeps no client list
@@ -141,8 +147,8 @@ TEST(NatNetSource, AServerThatVanishesIsReportedAndFoundAgain) {
   source.start();
   ASSERT_TRUE(sink.wait_frames(5));
   server_io.call([&] { server.reset(); });  // silent: UDP says nothing when a server goes
-  ASSERT_TRUE(sink.wait_state(SourceState::Disconnected));
-  EXPECT_NE(sink.last_detail(SourceState::Disconnected).find("nothing from"), std::string::npos);
+  ASSERT_TRUE(sink.wait_state(SourceState::Stalled));
+  EXPECT_NE(sink.last_detail(SourceState::Stalled).find("stalled: no frame from"), std::string::npos);
   const size_t before = sink.with_frames();
   server_io.call([&] {
     server = std::make_unique<NatNetServer>(server_io.io, std::vector<ReplaySubject>{{"walker", &walker}},
@@ -272,6 +278,97 @@ TEST(NatNetSource, NoAnswerAndOldServersDisconnect) {
   EXPECT_NE(b.last_detail(SourceState::Disconnected).find("NatNet 2.9"), std::string::npos);
 }
 
+// A server that answers the handshake and its first frames, then goes silent (its keep-alives
+// unanswered, as a server whose stream stopped): stalled, and asked again.
+TEST(NatNetSource, AServerThatGoesSilentIsStalledAndAskedAgain) {
+  test::SilentNatNetServer silent({.frames = 5});
+  IoThread client_io;
+  SourceSinkRecorder sink;
+  NatNetSource source(client_io.io, client_of(silent.port()), sink);
+  source.start();
+  ASSERT_TRUE(sink.wait_frames(5));
+  ASSERT_TRUE(sink.wait_state(SourceState::Stalled));
+  ASSERT_TRUE(test::eventually([&] { return silent.connections() >= 2; }));
+  source.stop();
+  client_io.call([] {});
+  EXPECT_NE(sink.last_detail(SourceState::Stalled).find("stalled: no frame from 127.0.0.1:"), std::string::npos)
+      << sink.last_detail(SourceState::Stalled);
+  EXPECT_EQ(sink.count_state(SourceState::Disconnected), 0u);
+}
+
+// This process's UDP socket bound to `port`: its local address ("" when there is none).
+std::string udp_address_of_port(uint16_t port) {
+  for (const auto& entry : std::filesystem::directory_iterator("/proc/self/fd")) {
+    const int fd = std::stoi(entry.path().filename().string());
+    int type = 0;
+    socklen_t type_length = sizeof type;
+    sockaddr_in own{};
+    socklen_t own_length = sizeof own;
+    if (::getsockopt(fd, SOL_SOCKET, SO_TYPE, &type, &type_length) != 0 || type != SOCK_DGRAM) continue;
+    if (::getsockname(fd, reinterpret_cast<sockaddr*>(&own), &own_length) != 0 || own.sin_family != AF_INET) continue;
+    if (ntohs(own.sin_port) == port) return asio::ip::address_v4(ntohl(own.sin_addr.s_addr)).to_string();
+  }
+  return "";
+}
+
+// Unicast: a stranger on another port (here, of the same host) sends the client model
+// definitions of another marker set and frames of its own. The client was bound to 0.0.0.0 and
+// took them (the subject went absent; 200 forged frames were taken): now its socket is bound to
+// the address toward the server and takes the server's datagrams only, counting the others.
+TEST(NatNetSource, UnicastTakesTheServersDatagramsOnly) {
+  const Capture walker = test::replay_capture(10, 0.0);
+  natnet::CaptureEncoder encoder({{"walker", &walker}});
+  natnet::CaptureEncoder stranger_encoder({{"stranger", &walker}});
+  asio::io_context stranger_io;
+  udp::socket stranger(stranger_io, udp::endpoint(asio::ip::make_address("127.0.0.2"), 0));
+  std::atomic<uint16_t> client_port{0};
+  ScriptedServer server([&](udp::socket& s, const udp::endpoint& client, uint16_t request) {
+    client_port = client.port();
+    natnet::ByteVector frame;
+    if (request == natnet::message::Connect) {
+      s.send_to(asio::buffer(unicast_info()), client);
+    } else if (request == natnet::message::RequestModelDef) {
+      s.send_to(asio::buffer(natnet::encode_model_definitions(encoder.model_definitions(), {4, 1})), client);
+      for (uint64_t k = 0; k < 3; ++k) {
+        encoder.encode(k, {4, 1}, frame);
+        s.send_to(asio::buffer(frame), client);
+      }
+      // The stranger: other definitions, then frames numbered far from the server's.
+      stranger.send_to(asio::buffer(natnet::encode_model_definitions(stranger_encoder.model_definitions(), {4, 1})), client);
+      for (uint64_t k = 1000; k < 1100; ++k) {
+        stranger_encoder.encode(k, {4, 1}, frame);
+        stranger.send_to(asio::buffer(frame), client);
+      }
+      for (uint64_t k = 3; k < 6; ++k) {
+        encoder.encode(k, {4, 1}, frame);
+        s.send_to(asio::buffer(frame), client);
+      }
+    }
+  });
+  IoThread client_io;
+  SourceSinkRecorder sink;
+  NatNetSourceOptions options = client_of(server.port());
+  options.stall_timeout = 5s;
+  NatNetSource source(client_io.io, options, sink);
+  source.start();
+  ASSERT_TRUE(sink.wait_frames(6));
+  ASSERT_TRUE(sink.wait([&] { return sink.bad_inputs.size() >= 101; }));
+  const std::string bound = udp_address_of_port(client_port);
+  source.stop();
+  client_io.call([] {});
+  std::lock_guard lock(sink.mutex);
+  EXPECT_EQ(bound, "127.0.0.1");
+  ASSERT_EQ(sink.frames.size(), 6u);
+  for (const SourceFrame& f : sink.frames) {
+    EXPECT_LT(f.frame_number, 106u);
+    ASSERT_EQ(f.subjects.size(), 1u);
+    EXPECT_EQ(f.subjects[0].name, "walker");
+  }
+  EXPECT_EQ(sink.bad_inputs.size(), 101u);
+  for (const std::string& b : sink.bad_inputs)
+    EXPECT_EQ(b.rfind("foreign_datagram: NatNet: dropped a datagram from 127.0.0.2, not the server 127.0.0.1", 0), 0u) << b;
+}
+
 TEST(NatNetServer, CountsMalformedDatagramsAndAnswersTheRest) {
   const Capture walker = test::replay_capture(10, 0.0);
   IoThread server_io;
@@ -282,23 +379,72 @@ TEST(NatNetServer, CountsMalformedDatagramsAndAnswersTheRest) {
   const udp::endpoint to(asio::ip::make_address("127.0.0.1"), server_io.call([&] { return server.command_port(); }));
   s.send_to(asio::buffer(natnet::ByteVector{4, 0, 9, 0}), to);  // 9 bytes announced, none follow
   s.send_to(asio::buffer(natnet::ByteVector{1}), to);            // shorter than a header
+  s.send_to(asio::buffer(natnet::encode_connect("test", {3, 1})), to);
   s.send_to(asio::buffer(natnet::encode_empty(natnet::message::RequestModelDef)), to);
   s.send_to(asio::buffer(natnet::encode_text(natnet::message::Request, "TimelinePlay")), to);
   std::vector<unsigned char> buffer(natnet::kMaxMessageBytes);
   udp::endpoint from;
-  const size_t n1 = s.receive_from(asio::buffer(buffer), from);  // the model definitions
   uint16_t id = 0;
   natnet::Bytes payload;
   std::string error;
-  ASSERT_TRUE(natnet::read_message({buffer.data(), n1}, id, payload, error)) << error;
+  const size_t n0 = s.receive_from(asio::buffer(buffer), from);  // the server info
+  ASSERT_TRUE(natnet::read_message({buffer.data(), n0}, id, payload, error)) << error;
+  EXPECT_EQ(id, natnet::message::ServerInfo);
+  // The next answer that is not a frame (the timeline started with the CONNECT).
+  auto next_answer = [&] {
+    for (;;) {
+      const size_t n = s.receive_from(asio::buffer(buffer), from);
+      if (!natnet::read_message({buffer.data(), n}, id, payload, error)) return false;
+      if (id != natnet::message::FrameOfData) return true;
+    }
+  };
+  ASSERT_TRUE(next_answer()) << error;  // the model definitions
   EXPECT_EQ(id, natnet::message::ModelDef);
   natnet::ModelDefinitions defs;
   ASSERT_TRUE(natnet::decode_model_definitions(payload, {3, 1}, defs, error)) << error;
   EXPECT_EQ(defs.marker_sets[0].markers, (std::vector<std::string>{"A", "B"}));
-  const size_t n2 = s.receive_from(asio::buffer(buffer), from);
-  ASSERT_TRUE(natnet::read_message({buffer.data(), n2}, id, payload, error)) << error;
+  ASSERT_TRUE(next_answer()) << error;
   EXPECT_EQ(id, natnet::message::UnrecognizedRequest);
   EXPECT_EQ(server.stats().bad_datagrams.load(), 2u);
+  server_io.call([&] { server.stop(); });
+}
+
+// A model request costs 4 bytes and its answer ~1,000 times that: answered only to a sender that
+// CONNECTed (a forged source address would have the server flood a victim). And CONNECTs from
+// many ports (2,000 once starved the real client of frames for 10 s) beyond max_clients are
+// not answered: the clients already served keep their frames.
+TEST(NatNetServer, AnswersRequestsOnlyToConnectedClientsAndServesAFew) {
+  const Capture walker = test::replay_capture(10, 0.0);
+  IoThread server_io;
+  NatNetServerOptions options = unicast_server({4, 1});
+  options.max_clients = 4;
+  NatNetServer server(server_io.io, {{"walker", &walker}}, options);
+  server_io.call([&] { server.start(); });
+  const udp::endpoint to(asio::ip::make_address("127.0.0.1"), server_io.call([&] { return server.command_port(); }));
+  asio::io_context io;
+  auto answered = [&](udp::socket& s) {
+    s.non_blocking(true);
+    std::vector<unsigned char> buffer(natnet::kMaxMessageBytes);
+    udp::endpoint from;
+    boost::system::error_code ec;
+    for (auto end = std::chrono::steady_clock::now() + 500ms; std::chrono::steady_clock::now() < end;) {
+      if (s.receive_from(asio::buffer(buffer), from, 0, ec) > 0) return true;
+      std::this_thread::sleep_for(5ms);
+    }
+    return false;
+  };
+  udp::socket stranger(io, udp::endpoint(asio::ip::make_address("127.0.0.1"), 0));
+  stranger.send_to(asio::buffer(natnet::encode_empty(natnet::message::RequestModelDef)), to);
+  EXPECT_FALSE(answered(stranger)) << "a model request answered to a sender that never connected";
+  std::vector<std::unique_ptr<udp::socket>> clients;
+  for (int i = 0; i < 6; ++i) {
+    clients.push_back(std::make_unique<udp::socket>(io, udp::endpoint(asio::ip::make_address("127.0.0.1"), 0)));
+    clients.back()->send_to(asio::buffer(natnet::encode_connect("test", {4, 1})), to);
+    EXPECT_EQ(answered(*clients.back()), i < 4) << "client " << i;
+  }
+  EXPECT_EQ(server.stats().clients_refused.load(), 2u);
+  EXPECT_EQ(server.stats().requests_not_connected.load(), 1u);
+  EXPECT_EQ(server.stats().clients_connected.load(), 4u);
   server_io.call([&] { server.stop(); });
 }
 

@@ -15,6 +15,7 @@
 #include "server/ingest/qtm_source.h"
 #include "server/qtm/qtm_server.h"
 #include "support/replay_capture.h"
+#include "support/silent_capture_servers.h"
 #include "support/source_sink_recorder.h"
 
 namespace skinstream::server {
@@ -282,6 +283,68 @@ TEST(QtmSource, WrongMarkerCountAsksForTheLabelsAgainAndInfinityIsMissing) {
   EXPECT_EQ(sink.frames[0].frame_number, 2u);
   EXPECT_FALSE(is_present(sink.frames[0].labelled[0][0]));
   EXPECT_EQ(sink.frames[0].labelled[0][1], Vec3(4, 5, 6));
+}
+
+// A server that accepts and never answers kept the source "connecting" for ever: it is left
+// after the handshake timeout, reported and tried again.
+TEST(QtmSource, ASilentServerIsLeftAfterTheHandshakeTimeoutAndTriedAgain) {
+  test::SilentQtmServer silent({.handshake = false});
+  IoThread client_io;
+  SourceSinkRecorder sink;
+  QtmSourceOptions options = client_of(silent.port());
+  options.handshake_timeout = 300ms;
+  QtmSource source(client_io.io, options, sink);
+  source.start();
+  ASSERT_TRUE(sink.wait_state(SourceState::Disconnected));
+  ASSERT_TRUE(test::eventually([&] { return silent.connections() >= 2; }));
+  source.stop();
+  client_io.call([] {});
+  EXPECT_NE(sink.last_detail(SourceState::Disconnected).find("within 300 ms (waiting for the welcome)"), std::string::npos)
+      << sink.last_detail(SourceState::Disconnected);
+  EXPECT_TRUE(sink.frames.empty());
+}
+
+// One that stops sending with its connection open was shown streaming while the frames stayed
+// frozen: it is reported stalled and tried again.
+TEST(QtmSource, AServerThatGoesSilentIsStalledAndTriedAgain) {
+  test::SilentQtmServer silent({.frames = 5});
+  IoThread client_io;
+  SourceSinkRecorder sink;
+  QtmSourceOptions options = client_of(silent.port());
+  options.stall_timeout = 300ms;
+  QtmSource source(client_io.io, options, sink);
+  source.start();
+  ASSERT_TRUE(sink.wait_frames(5));
+  ASSERT_TRUE(sink.wait_state(SourceState::Stalled));
+  ASSERT_TRUE(test::eventually([&] { return silent.connections() >= 2; }));
+  source.stop();
+  client_io.call([] {});
+  EXPECT_NE(sink.last_detail(SourceState::Stalled).find("stalled: no frame from 127.0.0.1:"), std::string::npos)
+      << sink.last_detail(SourceState::Stalled);
+  EXPECT_EQ(sink.count_state(SourceState::Disconnected), 0u);
+}
+
+// Silence after NoMoreData is a measurement that ended, not a stall: nothing is retried.
+TEST(QtmSource, SilenceAfterTheMeasurementEndedIsNoStall) {
+  ScriptedServer server([](tcp::socket& s, qtm::PacketFramer& framer) {
+    ScriptedServer::handshake(s, framer, {"P_A"});
+    ScriptedServer::send(s, ScriptedServer::frame(1, {{1, 2, 3}}));
+    ScriptedServer::send(s, qtm::encode_no_more_data());
+    std::this_thread::sleep_for(1500ms);
+  });
+  IoThread client_io;
+  SourceSinkRecorder sink;
+  QtmSourceOptions options = client_of(server.port());
+  options.stall_timeout = 300ms;
+  QtmSource source(client_io.io, options, sink);
+  source.start();
+  ASSERT_TRUE(sink.wait_state(SourceState::Finished));
+  std::this_thread::sleep_for(1000ms);  // more than three stall times of silence
+  source.stop();
+  client_io.call([] {});
+  EXPECT_EQ(sink.count_state(SourceState::Stalled), 0u);
+  EXPECT_EQ(sink.count_state(SourceState::Disconnected), 0u);
+  EXPECT_EQ(server.connections.load(), 1);
 }
 
 TEST(QtmServer, RefusesWhatItCannotDoAndClosesOnGarbage) {

@@ -232,6 +232,32 @@ TEST(SubjectRouter, NonFinitePointsAreRefusedAndCounted) {
   EXPECT_EQ(r.frames[0].unlabelled_ids[0], 2);
 }
 
+// Finite but absurd: 3.4e38 mm (QTM's float maximum), 1e39 mm (1e36 m over NatNet), 1e7 mm (10
+// km): no stage is that large. Missing and counted, as the non-finite are; the box they would
+// have spread for the unlabelled points is not touched.
+TEST(SubjectRouter, PointsOutsideTheCaptureVolumeAreMissingAndCounted) {
+  Recorder recorder;
+  SubjectRouter router({{"Actor1", kTemplate}, {"Actor2", kTemplate}}, recorder, 50'000.0);
+  SourceFrame frame = two_actors_one_with("X");
+  frame.labelled[0][0] = Vec3(3.4e38, 0, 0);
+  frame.labelled[0][1] = Vec3(0, -1e39, 0);
+  frame.labelled[0][2] = Vec3(0, 0, 1e7);
+  frame.labelled[1][3] = Vec3(50'000.0, -50'000.0, 0);  // at the edge: still a position
+  frame.unlabelled = {Vec3(1e7, 0, 0), Vec3(-2000, 50, 1000)};
+  frame.unlabelled_ids = {1, 2};
+  const Routed r = route(router, frame);
+  EXPECT_EQ(r.frames[0].implausible_points, 3);
+  EXPECT_EQ(r.frames[0].rejected_points, 0);
+  EXPECT_EQ(r.stats.implausible_points, 1);
+  EXPECT_EQ(r.stats.rejected_points, 0);
+  for (int m = 0; m < 3; ++m) EXPECT_FALSE(is_present(r.frames[0].labelled[m])) << m;
+  EXPECT_EQ(r.frames[1].labelled[3], Vec3(50'000.0, -50'000.0, 0));
+  // The one plausible unlabelled point went to Actor1, whose box the absurd markers did not stretch.
+  ASSERT_EQ(r.frames[0].unlabelled_count, 2);  // its own unknown label "X" and the point
+  EXPECT_EQ(r.frames[0].unlabelled_ids[1], 2);
+  EXPECT_EQ(r.frames[1].unlabelled_count, 0);
+}
+
 TEST(SubjectRouter, PositionsThatDoNotMatchTheLabelsAreSkipped) {
   Recorder recorder;
   SubjectRouter router({{"Actor1", kTemplate}}, recorder);

@@ -7,6 +7,8 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <cmath>
+#include <cstring>
 #include <condition_variable>
 #include <functional>
 #include <mutex>
@@ -209,6 +211,82 @@ TEST(Pipeline, MakesTheBuffersARequestAsksForOnItsOwnThread) {
   EXPECT_TRUE(pipeline.encoding_ready(key));
   EXPECT_EQ(metrics.frame_buffers_allocated.load(), pipeline.pool_frames()) << "one buffer per pooled frame";
   EXPECT_FALSE(pipeline.encoding_ready(stream_key(0, subscriber::kVersion2))) << "another key is not made with it";
+}
+
+// Takes the float positions with normals and markers, and the parameters; keeps each frame's
+// number and whether every float of its messages is finite.
+class RecordingConsumer : public FrameConsumer {
+ public:
+  StreamKeySet wanted_encodings() const override {
+    StreamKeySet keys;
+    keys.add(kFloats);
+    keys.add(kParameters);
+    return keys;
+  }
+  void publish(const FrameRef& frame) override {
+    bool finite = true;
+    for (const StreamKey key : {kFloats, kParameters}) {
+      const std::span<const unsigned char> message = frame->message(key);
+      if (message.size() < subscriber::kHeaderBytes) continue;
+      const subscriber::Frame decoded = subscriber::decode_frame(message.subspan(subscriber::kHeaderBytes), subscriber::kVersion2);
+      for (const std::vector<float>* values : {&decoded.positions, &decoded.normals, &decoded.markers})
+        for (float v : *values) finite = finite && std::isfinite(v);
+      const std::span<const unsigned char> block = decoded.coded_positions;  // the parameters
+      for (size_t i = 8; i + 4 <= block.size(); i += 4) {
+        float v;
+        std::memcpy(&v, block.data() + i, 4);
+        finite = finite && std::isfinite(v);
+      }
+    }
+    std::lock_guard lock(mutex);
+    frames.push_back(frame->frame_number);
+    all_finite = all_finite && finite;
+  }
+  static inline const StreamKey kFloats = stream_key(subscriber::kFrameNormals | subscriber::kFrameMarkers, subscriber::kVersion2);
+  static inline const StreamKey kParameters = stream_key(subscriber::kFrameParameters | subscriber::kFrameMarkers, subscriber::kVersion2);
+  std::mutex mutex;
+  std::vector<uint32_t> frames;
+  bool all_finite = true;
+};
+
+// Source values the router would refuse, given to the pipeline directly (every marker at 1e39
+// mm: infinite as a float): the frame is counted and never encoded; the frames before it go out,
+// all finite. (Before, it went out with infinite markers and parameters.)
+TEST(Pipeline, AFrameThatIsNotFiniteIsCountedAndNotEncoded) {
+  const SubjectModel subject = build_subject(read_capture(test::source_path("replay_data/cmu/85_02.c3d")), {});
+  const Capture take = read_capture(test::source_path("replay_data/cmu/85_12.c3d"));
+  const DeformationModel deformation = one_part_over(subject);
+  Metrics metrics;
+  FrameMailbox mailbox(subject.marker_count());
+  RecordingConsumer consumer;
+  Pipeline pipeline(subject, &deformation, PipelineOptions{}, mailbox, consumer, metrics);
+  pipeline.prepare_encoding(RecordingConsumer::kFloats);
+  pipeline.prepare_encoding(RecordingConsumer::kParameters);
+  pipeline.start();
+  constexpr int kBad = 10;
+  for (int f = 0; f <= kBad; ++f) {
+    MarkerFrame& frame = mailbox.writable();
+    frame.clear();
+    frame.frame_number = static_cast<uint32_t>(f);
+    frame.source_rate_hz = take.rate_hz;
+    for (int m = 0; m < subject.marker_count(); ++m) frame.labelled[m] = take.at(f, m);
+    if (f == kBad)
+      for (Vec3& p : frame.labelled) p = Vec3(1e39, 0, 0);  // every marker: none for the filler to fill from
+    mailbox.post(1);
+    const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+    while (metrics.frames_processed.load() < static_cast<uint64_t>(f + 1) && std::chrono::steady_clock::now() < give_up)
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+  while (metrics.bad_input("non_finite_frame") == 0 && std::chrono::steady_clock::now() < give_up)
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  pipeline.stop();
+  EXPECT_EQ(metrics.bad_input("non_finite_frame"), 1u);
+  std::lock_guard lock(consumer.mutex);
+  EXPECT_TRUE(consumer.all_finite);
+  std::vector<uint32_t> expected(kBad);
+  for (int f = 0; f < kBad; ++f) expected[static_cast<size_t>(f)] = static_cast<uint32_t>(f);
+  EXPECT_EQ(consumer.frames, expected);
 }
 
 }  // namespace

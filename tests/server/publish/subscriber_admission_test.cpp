@@ -36,6 +36,33 @@ TEST(SubscriberAdmission, CountsPlacesInAllAndPerAddressUntilTicketsGo) {
   EXPECT_EQ(metrics.subscribers_refused_limit.load(), 2u);
 }
 
+// Connections without the token have places of their own: they take none of the subscribers'.
+TEST(SubscriberAdmission, ConnectionsWithoutTheTokenHaveTheirOwnFewPlaces) {
+  Metrics metrics;
+  AdmissionOptions options{{}, 2, 2, "secret"};
+  options.max_unauthenticated = 3;
+  options.max_unauthenticated_per_address = 2;
+  auto admission = std::make_shared<SubscriberAdmission>(options, metrics);
+  auto a = admission->admit_unauthenticated(ip("10.0.0.1")), b = admission->admit_unauthenticated(ip("10.0.0.1"));
+  ASSERT_TRUE(a.ticket && b.ticket);
+  const auto third = admission->admit_unauthenticated(ip("::ffff:10.0.0.1"));
+  EXPECT_EQ(third.refusal, SubscriberAdmission::Refusal::TooManyUnauthenticated);
+  EXPECT_EQ(third.reason, "too many connections without the token from 10.0.0.1: at most 2 from one address (max_unauthenticated_per_address)");
+  auto c = admission->admit_unauthenticated(ip("10.0.0.2"));
+  ASSERT_TRUE(c.ticket);
+  EXPECT_EQ(admission->admit_unauthenticated(ip("10.0.0.3")).reason,
+            "too many connections without the token: at most 3 at once (max_unauthenticated_subscribers)");
+  EXPECT_EQ(admission->unauthenticated(), 3);
+  // The subscribers' places are all still free.
+  auto subscriber = admission->admit(ip("10.0.0.1"));
+  ASSERT_TRUE(subscriber.ticket);
+  EXPECT_EQ(admission->admitted(), 1);
+  a.ticket.reset();  // it gave the token: its place without it goes
+  EXPECT_EQ(admission->unauthenticated(), 2);
+  EXPECT_EQ(metrics.subscribers_refused_unauthenticated.load(), 2u);
+  EXPECT_EQ(metrics.subscribers_refused_limit.load(), 0u);
+}
+
 TEST(SubscriberAdmission, TicketsOutliveTheAdmission) {
   Metrics metrics;
   SubscriberAdmission::Ticket ticket;

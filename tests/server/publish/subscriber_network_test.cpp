@@ -40,5 +40,19 @@ TEST(SubscriberNetwork, MatchesIpv6AndIpv4SeenThroughIpv6) {
   EXPECT_FALSE(ten.contains(ip("fd00::1")));
 }
 
+// An IPv4 network written as IPv6 (::ffff:a.b.c.d) was taken and never matched, since peers are
+// compared as IPv4: it is that IPv4 network; one that splits no IPv4 address (below /96) is refused.
+TEST(SubscriberNetwork, Ipv4MappedEntriesAreTheirIpv4Networks) {
+  const auto mapped = *SubscriberNetwork::parse("::ffff:10.0.0.0/104");
+  EXPECT_EQ(mapped.to_string(), "10.0.0.0/8");
+  EXPECT_TRUE(mapped.contains(ip("10.9.8.7")));
+  EXPECT_TRUE(mapped.contains(ip("::ffff:10.9.8.7")));
+  EXPECT_FALSE(mapped.contains(ip("11.0.0.1")));
+  const auto host = *SubscriberNetwork::parse("::ffff:192.168.1.7");
+  EXPECT_EQ(host.to_string(), "192.168.1.7/32");
+  EXPECT_TRUE(host.contains(ip("192.168.1.7")));
+  EXPECT_FALSE(SubscriberNetwork::parse("::ffff:10.0.0.0/64"));
+}
+
 }  // namespace
 }  // namespace skinstream::server

@@ -26,6 +26,8 @@
 #include "server/vicon/vicon_server.h"
 #include "support/allocation_counter.h"
 #include "support/io_thread.h"
+#include "support/silent_capture_servers.h"
+#include "support/source_sink_recorder.h"
 #include "support/socket_lookup.h"
 #include "support/test_data.h"
 
@@ -372,6 +374,33 @@ TEST(ViconStream, ServerGoneThenBackGivesDisconnectedThenStreaming) {
   });
 }
 
+// A server that accepts and never sends ObjectEnums kept the source "connecting" for ever: it is
+// left after the handshake timeout and tried again. One that stops sending frames with its
+// connection open was shown streaming: it is reported stalled and tried again.
+TEST(ViconStream, ASilentServerIsLeftAndOneThatGoesSilentIsStalled) {
+  test::SilentViconServer silent({.handshake = false});
+  test::SilentViconServer goes_silent({.frames = 5});
+  IoThread client_io;
+  test::SourceSinkRecorder a, b;
+  ViconSource to_silent(client_io.io, {.host = "127.0.0.1", .port = silent.port(), .handshake_timeout = 300ms}, a);
+  ViconSource to_goes_silent(client_io.io, {.host = "127.0.0.1", .port = goes_silent.port(), .stall_timeout = 300ms}, b);
+  to_silent.start();
+  to_goes_silent.start();
+  ASSERT_TRUE(a.wait_state(SourceState::Disconnected));
+  ASSERT_TRUE(b.wait_frames(5));
+  ASSERT_TRUE(b.wait_state(SourceState::Stalled));
+  ASSERT_TRUE(test::eventually([&] { return silent.connections() >= 2 && goes_silent.connections() >= 2; }));
+  to_silent.stop();
+  to_goes_silent.stop();
+  client_io.call([] {});
+  EXPECT_NE(a.last_detail(SourceState::Disconnected).find("no ObjectEnums from 127.0.0.1:"), std::string::npos)
+      << a.last_detail(SourceState::Disconnected);
+  EXPECT_TRUE(a.frames.empty());
+  EXPECT_NE(b.last_detail(SourceState::Stalled).find("stalled: no frame from 127.0.0.1:"), std::string::npos)
+      << b.last_detail(SourceState::Stalled);
+  EXPECT_EQ(b.count_state(SourceState::Disconnected), 0u);
+}
+
 TEST(ViconStream, GarbageFromTheServerIsCountedNotFatal) {
   IoThread server_io, client_io;
   tcp::acceptor acceptor(server_io.io, tcp::endpoint(asio::ip::make_address("127.0.0.1"), 0));
@@ -561,6 +590,78 @@ TEST(ViconStream, MulticastRequestSendsWholePacketsAsDatagrams) {
          std::chrono::steady_clock::now() < give_up)
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   EXPECT_GE(net.server->stats().datagrams_sent.load(), static_cast<uint64_t>(capture.frame_count));
+}
+
+// StartMulticastSender naming another host's unicast address made the server a relay toward it,
+// and every destination was served after its client left (1,000 of them: 0.75 of a core). Now
+// only a group or the client's own address is taken, and only while the client stays; at most
+// max_clients clients are served, and a client's packet is at most kMaxClientPacketBytes.
+TEST(ViconStream, MulticastRequestsAreTheClientsOwnAndEndWithIt) {
+  const Capture capture = synthetic_capture();
+  ViconServerOptions options = fast_options(2.0);
+  options.start_on_first_request = false;
+  options.loop = true;
+  options.max_clients = 3;
+  Loopback net;
+  net.start_server(capture, options);
+  asio::io_context raw_io;
+  udp::socket victim(raw_io, udp::endpoint(asio::ip::make_address("127.0.0.2"), 0));
+  udp::socket own(raw_io, udp::endpoint(asio::ip::make_address("127.0.0.1"), 0));
+  victim.non_blocking(true);
+  own.non_blocking(true);
+  // The datagrams that came to `s` within `wait`.
+  auto datagrams = [](udp::socket& s, std::chrono::milliseconds wait) {
+    std::vector<unsigned char> buffer(65536);
+    int count = 0;
+    boost::system::error_code ec;
+    for (const auto end = std::chrono::steady_clock::now() + wait; std::chrono::steady_clock::now() < end;) {
+      if (s.receive(asio::buffer(buffer), 0, ec) > 0) ++count;
+      else std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    return count;
+  };
+  auto ask = [&](tcp::socket& client, udp::socket& to) {
+    vicon::StartMulticastSender request;
+    request.multicast_address = to.local_endpoint().address().to_v4().to_uint();
+    request.source_address = request.multicast_address;
+    request.port = to.local_endpoint().port();
+    asio::write(client, asio::buffer(vicon::encode_packet(request)));
+  };
+  tcp::socket client(raw_io);
+  client.connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), net.port));
+  ask(client, victim);
+  ask(client, own);
+  EXPECT_GT(datagrams(own, 500ms), 5);
+  EXPECT_EQ(datagrams(victim, 200ms), 0);
+  EXPECT_EQ(net.server->stats().multicast_requests_refused.load(), 1u);
+  client.close();  // it left: nothing more for it
+  datagrams(own, 200ms);  // those on their way
+  EXPECT_EQ(datagrams(own, 500ms), 0);
+
+  // Three clients at once; a fourth is closed as it comes. A packet over 64 kB closes its client.
+  std::vector<std::unique_ptr<tcp::socket>> clients;
+  for (int i = 0; i < 4; ++i) {
+    clients.push_back(std::make_unique<tcp::socket>(raw_io));
+    clients.back()->connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), net.port));
+  }
+  std::array<unsigned char, 64> first;
+  boost::system::error_code ec;
+  EXPECT_GT(clients[0]->read_some(asio::buffer(first), ec), 0u) << ec.message();  // ObjectEnums
+  clients[3]->read_some(asio::buffer(first), ec);
+  EXPECT_TRUE(ec == asio::error::eof || ec == asio::error::connection_reset) << ec.message();
+  EXPECT_EQ(net.server->stats().clients_refused.load(), 1u);
+  std::vector<unsigned char> huge(16, 0);
+  const uint32_t magic = 0x1A2B0001, length = 16u << 20;
+  std::memcpy(huge.data(), &magic, 4);
+  std::memcpy(huge.data() + 4, &length, 4);
+  asio::write(*clients[1], asio::buffer(huge));
+  for (;;) {
+    std::array<unsigned char, 4096> sink;
+    clients[1]->read_some(asio::buffer(sink), ec);
+    if (ec) break;
+  }
+  EXPECT_TRUE(ec == asio::error::eof || ec == asio::error::connection_reset) << ec.message();
+  EXPECT_EQ(net.server->stats().bad_clients.load(), 1u);
 }
 
 TEST(ViconStream, MulticastGroupOnLoopback) {

@@ -10,9 +10,10 @@
 //   while (sub.next(frame, std::chrono::seconds(1)))
 //     upload(frame.positions, frame.normals);  // 3 floats per vertex, mm; sub.mesh().indices
 //
-// Errors (no daemon, refused, a daemon that goes away, bytes that break the protocol) throw
-// skinstream::client::Error with a one-line reason; make a new Subscriber to try again. From a
-// multicast group, bad datagrams are counted instead (multicast_stats()): anyone can send to it.
+// Errors (no daemon, refused, a daemon that goes away or falls silent, bytes that break the
+// protocol) throw skinstream::client::Error with a one-line reason, the daemon's own words in it
+// made printable; make a new Subscriber to try again. From a multicast group, bad datagrams are
+// counted instead (multicast_stats()): anyone can send to it.
 
 #include <chrono>
 #include <cstdint>
@@ -35,13 +36,18 @@ Encoding encoding_from_string(const std::string& name);
 // Model over TCP from host:port, closes that connection, and then reads the parameters of every
 // frame from the group. A lost datagram costs the frame it carried; next() never waits for it,
 // and gives the newest complete frame (a reader slower than the stream skips frames instead of
-// falling behind by what the socket buffer holds).
+// falling behind by what the socket buffer holds). Anyone on the LAN can send to the group: with
+// the daemon's key (its multicast_key_file) only datagrams signed with it are taken; without
+// one, a forged or stale datagram costs at most 100 ms of frames. Frames of another Model than
+// the one fetched are counted and skipped; when only such frames came for a second, the
+// daemon's subject changed, and the Model is fetched again over TCP.
 struct MulticastOptions {
   std::string group{};                       // IPv4 multicast address; empty: frames over TCP
   uint16_t port = 0;
   std::string interface_address = "0.0.0.0";  // this host's address to join on (name the stage network's)
   uint32_t stream_id = 0;                    // the subject's stream (0: the daemon's first)
   std::chrono::milliseconds window{50};      // a frame's datagrams must all arrive within it
+  std::string key{};                         // the daemon's multicast key (at least 16 bytes); empty: none checked
 };
 
 // What arrived from the multicast group so far.
@@ -57,6 +63,11 @@ struct MulticastStats {
   uint64_t frames_superseded = 0;   // complete, and a newer one was complete before next() took it
   uint64_t messages_rejected = 0;   // whole messages that broke the protocol
   std::string last_error{};         // one line, of the last datagram or message rejected
+  uint64_t datagrams_out_of_window = 0;    // sequences far from the stream's: forged, or a sender that started again
+  uint64_t datagrams_unauthenticated = 0;  // with a key: datagrams without its tag (of the rejected)
+  uint64_t resyncs = 0;                    // the stream taken up afresh after 100 ms without a frame
+  uint64_t frames_other_model = 0;         // complete frames of another Model than the one fetched, skipped
+  uint64_t model_fetches = 0;              // the Model fetched again (the daemon's subject changed)
 };
 
 struct Options {
@@ -75,6 +86,13 @@ struct Options {
   std::string token{};       // the daemon's shared token, when it has one
   int protocol_version = 2;  // 1 speaks to a daemon older than version 2 (float or quantised)
   std::chrono::milliseconds connect_timeout{5000};
+  // The daemon says something at least every second (Status); silent this long over TCP (gone,
+  // or a message cut short), it is given up with an Error. 0: wait for ever.
+  std::chrono::milliseconds silence_timeout{10000};
+  // The largest mesh and marker set taken: a MeshInfo announcing more is an Error, before
+  // anything is made for it.
+  uint32_t max_vertices = 4'000'000;
+  uint32_t max_markers = 4096;
   MulticastOptions multicast{};  // group set: frames from it (encoding parameters, protocol 2)
 };
 
@@ -148,8 +166,11 @@ class Subscriber {
 
   // Reads until the next frame is ready and fills `frame`; false when none came within
   // `timeout`. Delta frames of a compressed stream that joined between key frames are skipped
-  // (counted in frames_skipped()). Throws Error when the daemon refuses this subscriber, closes
-  // the connection, or sends bytes that break the protocol.
+  // (counted in frames_skipped()). A Frame message that breaks the protocol on its own (a value
+  // that is not finite, a block of the wrong size) is skipped too, counted in frames_rejected()
+  // with the reason in last_rejection(): the next frame is as good as ever. Throws Error when
+  // the daemon refuses this subscriber, closes the connection, or sends bytes that break the
+  // protocol otherwise.
   bool next(Frame& frame, std::chrono::milliseconds timeout);
 
   bool has_mesh() const;
@@ -157,6 +178,8 @@ class Subscriber {
   const SourceStatus& status() const;
   const Options& options() const;
   uint64_t frames_skipped() const;  // compressed deltas without their key
+  uint64_t frames_rejected() const;  // Frame messages that broke the protocol, skipped
+  std::string last_rejection() const;  // one line: why the last of them was skipped
   uint64_t bytes_received() const;
   // Parameters: the size of the Model message (bytes, header included; 0 before it came).
   size_t model_bytes() const;
