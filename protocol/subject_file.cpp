@@ -306,6 +306,12 @@ std::string values_problem(const SubjectFile& file) {
   const DeformationModel& d = *file.deformation;
   for (const Vec3& v : d.reference_vertices)
     if (!position_ok(v)) return "a mesh vertex is not finite or beyond 1 km";
+  for (const Vec3& v : d.rest_vertices)
+    if (!position_ok(v)) return "a rest-pose vertex is not finite or beyond 1 km";
+  for (const SkeletonSegment& segment : d.skeleton.segments) {
+    if (!name_ok(segment.name)) return "a skeleton segment's name is empty, longer than 256 bytes or holds a control character";
+    if (!position_ok(segment.pivot)) return "skeleton segment " + quoted_text(segment.name) + "'s joint is not finite or beyond 1 km";
+  }
   std::unordered_set<std::string> parts;
   for (const std::string& name : d.part_names) {
     if (!name_ok(name)) return "a part's name is empty, longer than 256 bytes or holds a control character";

@@ -190,10 +190,10 @@ TEST_F(SubjectFile, DeformationModelRoundTripsExactly) {
 }
 
 // A sparse set's fitted body: the skeleton, each part's quadratic flag and the rest vertices.
-TEST_F(SubjectFile, FittedBodyRoundTripsExactly) {
-  DeformationModel d = limb_deformation(model_);
+DeformationModel fitted_deformation(const SubjectModel& model) {
+  DeformationModel d = limb_deformation(model);
   d.skeleton.segments = {{"pelvis", -1, Vec3(0, 0, 900)}, {"thigh", 0, Vec3(100, 0, 850)}};
-  for (int i = 0; i < model_.marker_count(); ++i) {
+  for (int i = 0; i < model.marker_count(); ++i) {
     if (i % 2) d.skeleton.marker_weights.push_back({1, 1.0});
     else d.skeleton.marker_weights.insert(d.skeleton.marker_weights.end(), {{0, 0.25}, {1, 0.75}});
     d.skeleton.marker_weight_offsets.push_back(static_cast<int>(d.skeleton.marker_weights.size()));
@@ -202,6 +202,11 @@ TEST_F(SubjectFile, FittedBodyRoundTripsExactly) {
   d.part_quadratic = {0};
   d.rest_vertices = d.reference_vertices;
   for (Vec3& v : d.rest_vertices) v += Vec3(1.5, -2.0, 0.25);
+  return d;
+}
+
+TEST_F(SubjectFile, FittedBodyRoundTripsExactly) {
+  const DeformationModel d = fitted_deformation(model_);
   const std::string path = test::scratch_path("limb_fitted.subject");
   write_subject(model_, &d, path);
   const auto back = read_subject_file(path);
@@ -391,6 +396,12 @@ TEST_F(SubjectFile, EveryValueReadIsChecked) {
   d.part_names[0] = "arm\x07";
   EXPECT_NE(refusal(model_, &d).find("a part's name is empty, longer than 256 bytes or holds a control character"), std::string::npos)
       << refusal(model_, &d);
+  d = fitted_deformation(model_);
+  d.rest_vertices[3] = Vec3(0, 2e6, 0);
+  EXPECT_NE(refusal(model_, &d).find("a rest-pose vertex is not finite or beyond 1 km"), std::string::npos) << refusal(model_, &d);
+  d = fitted_deformation(model_);
+  d.skeleton.segments[1].pivot.z() = 1e300;
+  EXPECT_NE(refusal(model_, &d).find("skeleton segment 'thigh''s joint is not finite"), std::string::npos) << refusal(model_, &d);
   // The model as built reads back.
   write_subject(model_, path);
   EXPECT_NO_THROW(read_subject_file(path));
