@@ -46,7 +46,10 @@ def angles_degrees(a, b):
 
 class DemoSubject(unittest.TestCase):
     def test_every_encoding_gives_the_daemons_vertices(self):
-        count = 30
+        # Each subscriber keeps the first 60 frames it gets; on a loaded machine the daemon's
+        # newest-wins queues give two of them a third of their frames in common (11 of 30 seen),
+        # so 60 are kept and at least 10 in common compared.
+        count, compared = 60, 10
         results = {}
         with demo_daemon() as daemon:
             threads = [threading.Thread(target=receive, args=(daemon.sub_port, e, libraries, count, results))
@@ -86,7 +89,7 @@ class DemoSubject(unittest.TestCase):
             frames, served, _, model, decoded_by = results[encoding, libraries]
             self.assertEqual((served, decoded_by), (encoding, decoder))
             common = sorted(set(frames) & set(reference))
-            self.assertGreaterEqual(len(common), count // 2, encoding)
+            self.assertGreaterEqual(len(common), compared, encoding)
             worst_mm = max(np.abs(frames[n].vertices.astype(np.float64) - reference[n].vertices).max() for n in common)
             worst_degrees = max(angles_degrees(frames[n].normals, reference[n].normals).max() for n in common)
             print(f'{encoding} by {decoder}: {len(common)} frames, largest differences {worst_mm:.4g} mm, {worst_degrees:.3g} degrees')

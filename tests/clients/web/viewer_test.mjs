@@ -99,8 +99,9 @@ async function compareWithDaemon(page, reference, count = 3) {
     const drawn = await readDrawnFrame(page, async (key) => {
       seen.add(key);
       expected = await reference.waitForFrame(key);
+      return expected !== null;
     });
-    if (expected === null) continue;
+    if (drawn === null) continue;
     result.frames.push(drawn.frameNumber);
     result.worstMm = Math.max(result.worstMm, worstDistance(drawn.positions, expected.positions).worst);
     result.worstNormalDegrees = Math.max(result.worstNormalDegrees, worstAngleDegrees(drawn.normals, expected.normals));

@@ -38,14 +38,14 @@ export const sleep = (ms) => new Promise((resolve) => setTimeout(resolve, ms));
 // base64 (a JSON array of 320,000 numbers took seconds). Copied in the page first, its key
 // (frame number @ daemon receive time) known at once: `whenKeyKnown(key)` is awaited before the
 // seconds the copy takes to move, so that a reference can take its own copy of that frame
-// before newer frames push it out.
+// before newer frames push it out; when it returns false, the copy is not moved (null).
 export async function readDrawnFrame(page, whenKeyKnown = null) {
   const key = await page.evaluate(() => {
     const drawn = window.skinstreamViewer.readDrawnFrame();
     window.skinstreamTestDrawnFrame = drawn;
     return `${drawn.frameNumber}@${drawn.receiveTimeNs}`;
   });
-  if (whenKeyKnown) await whenKeyKnown(key);
+  if (whenKeyKnown && (await whenKeyKnown(key)) === false) return null;
   const frame = await page.evaluate(() => {
     const drawn = window.skinstreamTestDrawnFrame;
     const base64 = (array) => {

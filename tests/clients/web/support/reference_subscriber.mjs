@@ -12,8 +12,8 @@ const protocol = await import(path.join(repoRoot, 'clients/web/src/protocol.js')
 
 export class ReferenceSubscriber {
   // keep: how many recent frames to hold (a float frame with normals is 1.3 MB on the demo body):
-  // a second, as a page on a loaded machine draws a frame 200-300 ms after the daemon got it.
-  constructor(url, { keep = 120, encoding = protocol.Encoding.FLOAT, wants = protocol.Wants.NORMALS } = {}) {
+  // two seconds, as a page on a loaded machine draws a frame 0.2-1 s after the daemon got it.
+  constructor(url, { keep = 240, encoding = protocol.Encoding.FLOAT, wants = protocol.Wants.NORMALS } = {}) {
     const WebSocket = requireWeb('ws');
     this.keep = keep;
     this.frames = new Map(); // "frame number@receive time" -> ArrayBuffer
@@ -76,16 +76,18 @@ export class ReferenceSubscriber {
   }
 
   // The frame of `key` once it is held: the page may draw a frame before this subscriber has
-  // read it (node busy on a loaded machine), so it is waited for; null when it never comes, or
-  // came and gave way to newer frames.
+  // read it (node busy on a loaded machine), so it is waited for; null as soon as a newer frame
+  // is held without it.
   async waitForFrame(key, timeoutMs = 2000) {
     const deadline = Date.now() + timeoutMs;
     const receiveTime = (k) => BigInt(k.split('@')[1]);
     for (;;) {
       const frame = this.frame(key);
       if (frame !== null || Date.now() >= deadline) return frame;
-      const oldest = this.frames.keys().next().value;
-      if (oldest !== undefined && receiveTime(key) < receiveTime(oldest)) return null;  // gone already
+      // Frames arrive in order: once a newer one is held, this one was skipped for this
+      // subscriber (the daemon's newest-wins queue on a loaded machine) or has gone already.
+      const newest = [...this.frames.keys()].pop();
+      if (newest !== undefined && receiveTime(newest) > receiveTime(key)) return null;
       await new Promise((resolve) => setTimeout(resolve, 20));
     }
   }
