@@ -49,10 +49,11 @@ struct ActorSubject {
 };
 
 // training: the take (labelled channels are the markers); body: the body to fit (the template
-// with its bones, fit_body_of(), or a scan made a skinned body, scan_body.h); priors: one per labelled marker (core/fitting/marker_priors.h).
-// Throws std::invalid_argument with one line when the take cannot make a subject (no complete
-// frame, too few markers, a take that does not articulate); a subject whose checks fail is returned with check.problem set (the
-// caller refuses it).
+// with its bones, fit_body_of(), or a scan made a skinned body, scan_body.h); priors: one per
+// labelled marker (core/fitting/marker_priors.h). Throws std::invalid_argument with one line
+// when the take cannot make a subject (no complete frame, too few markers, a take that does not
+// articulate); a subject whose checks fail is returned with check.problem set (the caller
+// refuses it).
 ActorSubject build_actor_subject(const Capture& training, const FitBody& body, std::span<const MarkerPrior> priors,
                                  const ActorSubjectOptions& options = {});
 
