@@ -230,20 +230,27 @@ TEST_F(MulticastDemo, ALossyReceiverLosesOnlyTheFramesItsDatagramsCarried) {
 namespace skinstream {
 namespace {
 
+// A UDP socket that sends to group:port out of the LAN address `from` (the calling thread must
+// have entered that host's namespace), and the destination to send to.
+std::pair<int, sockaddr_in> multicast_sender(const std::string& from, const char* group, uint16_t port) {
+  const int fd = socket(AF_INET, SOCK_DGRAM, 0);
+  in_addr interface{};
+  inet_pton(AF_INET, from.c_str(), &interface);
+  setsockopt(fd, IPPROTO_IP, IP_MULTICAST_IF, &interface, sizeof interface);
+  sockaddr_in to{};
+  to.sin_family = AF_INET;
+  inet_pton(AF_INET, group, &to.sin_addr);
+  to.sin_port = htons(port);
+  return {fd, to};
+}
+
 // Anyone on the LAN can send to the group: datagrams that break the protocol, from another
 // host, are counted by the receiver, which goes on with the daemon's frames.
 TEST_F(MulticastDemo, BadDatagramsOnTheGroupAreCountedAndTheStreamGoesOn) {
   std::atomic<bool> receiving{true};
   std::thread vandal([&] {
     lan_->enter(kClean + 1);
-    const int fd = socket(AF_INET, SOCK_DGRAM, 0);
-    in_addr interface{};
-    inet_pton(AF_INET, lan_->address(kClean + 1).c_str(), &interface);
-    setsockopt(fd, IPPROTO_IP, IP_MULTICAST_IF, &interface, sizeof interface);
-    sockaddr_in to{};
-    to.sin_family = AF_INET;
-    inet_pton(AF_INET, kGroup, &to.sin_addr);
-    to.sin_port = htons(kGroupPort);
+    const auto [fd, to] = multicast_sender(lan_->address(kClean + 1), kGroup, kGroupPort);
     // Foreign bytes; a header whose fragment is too short; one over 1,400 bytes; another stream's.
     std::vector<std::vector<unsigned char>> bad = {{1, 2, 3}};
     // A datagram header as the spec lays it out: magic SKSM, version 1, reserved, stream, model,
@@ -464,14 +471,7 @@ TEST_F(MulticastDemo, OnlyFramesOfAnotherModelMakeTheReceiverFetchTheModelAgain)
   std::atomic<bool> sending{true};
   std::thread other([&] {
     lan_->enter(kClean + 1);
-    const int fd = socket(AF_INET, SOCK_DGRAM, 0);
-    in_addr interface{};
-    inet_pton(AF_INET, lan_->address(kClean + 1).c_str(), &interface);
-    setsockopt(fd, IPPROTO_IP, IP_MULTICAST_IF, &interface, sizeof interface);
-    sockaddr_in to{};
-    to.sin_family = AF_INET;
-    inet_pton(AF_INET, kOtherGroup, &to.sin_addr);
-    to.sin_port = htons(kGroupPort);
+    const auto [fd, to] = multicast_sender(lan_->address(kClean + 1), kOtherGroup, kGroupPort);
     for (uint32_t sequence = 0; sending.load(); ++sequence) {
       std::vector<unsigned char> datagram(28 + 100, 0x11);
       subscriber::encode_datagram_header({0, 0x12345678u, sequence, 0, 1, 100},
