@@ -1,7 +1,8 @@
 #pragma once
 // The check of a function's inputs that names what it guards. A file declares one for itself,
-//   constexpr Precondition require{"part joints"};
-// and require(m > 0, "no markers") then throws std::invalid_argument("part joints: no markers").
+// named for the file (a unity build compiles several files as one),
+//   constexpr Precondition require_joints{"part joints"};
+// and require_joints(m > 0, "no markers") then throws std::invalid_argument("part joints: no markers").
 #include <stdexcept>
 #include <string>
 #include <string_view>

@@ -2,10 +2,12 @@
 // Little-endian byte writing and bounds-checked reading for the project's binary formats.
 // A read past the end throws std::out_of_range; callers turn that into a FileError.
 
+#include <cstddef>
 #include <cstdint>
 #include <cstring>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 namespace skinstream {
@@ -88,6 +90,27 @@ class ByteReader {
   size_t size_;
   size_t pos_ = 0;
 };
+
+// Fixed layouts whose size the caller has already checked (a header, a block of known length):
+// one value written or read at a cursor, which moves past it. Host byte order, little-endian.
+template <typename T>
+void put_at(unsigned char*& at, T value) {
+  static_assert(std::is_arithmetic_v<T>);
+  std::memcpy(at, &value, sizeof(T));
+  at += sizeof(T);
+}
+template <typename T>
+T get_at(const unsigned char*& at) {
+  static_assert(std::is_arithmetic_v<T>);
+  T value;
+  std::memcpy(&value, at, sizeof(T));
+  at += sizeof(T);
+  return value;
+}
+
+// The zero bytes that bring n bytes to a multiple of 4 (blocks of the subscriber protocol start
+// 4-aligned).
+constexpr size_t padding_to_4(size_t n) { return (4 - n % 4) % 4; }
 
 // CRC-32 (IEEE 802.3, reflected), to reject corrupted files.
 uint32_t crc32(const unsigned char* data, size_t size);

@@ -22,13 +22,14 @@
 #include <vector>
 
 #include "protocol/c3d.h"
+#include "protocol/c3d_format.h"
 #include "protocol/file_error.h"
 
 namespace skinstream {
 namespace {
 
-constexpr uint64_t kBlockBytes = 512;
-constexpr uint8_t kHeaderKey = 0x50;
+using c3d_format::kBlockBytes;
+using c3d_format::kHeaderKey;
 constexpr int kProcessorByteBase = 83;  // processor byte = 83 + {1 Intel, 2 DEC, 3 MIPS}
 // The parameter pointer and block count are single bytes, so the header and parameter section
 // always lie within the first 509 blocks.

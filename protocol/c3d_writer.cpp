@@ -10,14 +10,15 @@
 #include <vector>
 
 #include "protocol/c3d.h"
+#include "protocol/c3d_format.h"
 #include "protocol/capture_checks.h"
 #include "protocol/file_error.h"
 
 namespace skinstream {
 namespace {
 
-constexpr size_t kBlockBytes = 512;
-constexpr uint8_t kHeaderKey = 0x50;
+using c3d_format::kBlockBytes;
+using c3d_format::kHeaderKey;
 constexpr uint8_t kParameterBlock = 2;  // the parameter section follows the header directly
 constexpr size_t kMaxParameterBlocks = 255;
 constexpr int kMaxArrayDimension = 255;  // dimensions are stored as bytes
@@ -92,9 +93,9 @@ int processor_byte(C3dProcessor processor) {
 
 // Builds the parameter records. Each record: name length, group id (negative for a group),
 // name, link to the next record, then type/dimensions/data (parameters) and a description.
-class ParameterSection {
+class ParameterSectionWriter {
  public:
-  explicit ParameterSection(const WordEncoder& encode) : encode_(encode) {}
+  explicit ParameterSectionWriter(const WordEncoder& encode) : encode_(encode) {}
 
   void group(int8_t id, const std::string& name, const std::string& description) {
     std::vector<uint8_t> body;
@@ -181,7 +182,7 @@ std::vector<uint8_t> parameter_section(const Capture& capture, const WordEncoder
   enum : int8_t { kPoint = 1, kAnalog = 2, kTrial = 3 };
   const FrameRange frames{static_cast<uint64_t>(capture.first_frame),
                           static_cast<uint64_t>(capture.frame_count)};
-  ParameterSection p(encode);
+  ParameterSectionWriter p(encode);
   p.group(kPoint, "POINT", "3-D point parameters");
   p.int16(kPoint, "USED", static_cast<uint16_t>(capture.point_count()));
   // 16 bits read unsigned by readers; longer captures are described by the TRIAL fields.

@@ -9,6 +9,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "protocol/byte_buffer.h"
 #include "protocol/subscriber_stream.h"
 
 namespace skinstream::subscriber {
@@ -17,22 +18,6 @@ namespace {
 constexpr size_t kPositionHeaderBytes = 32;  // key frame number, origin, step, coded bytes
 constexpr size_t kPositionVertexBytes = 8;   // u16 x y z and a zero (the codec wants multiples of 4)
 constexpr size_t kNormalVertexBytes = 4;     // i8 octahedral x y, 127, 0
-
-size_t padding_to_4(size_t n) { return (4 - n % 4) % 4; }
-
-template <typename T>
-void put(unsigned char*& at, T value) {
-  std::memcpy(at, &value, sizeof(T));
-  at += sizeof(T);
-}
-
-template <typename T>
-T get(const unsigned char*& at) {
-  T value;
-  std::memcpy(&value, at, sizeof(T));
-  at += sizeof(T);
-  return value;
-}
 
 // The identity when `order` is empty; otherwise checked to be a permutation of 0..count-1.
 std::vector<uint32_t> checked_order(std::vector<uint32_t> order, int count) {
@@ -140,15 +125,15 @@ size_t CompressedVertexEncoder::encode_positions(uint32_t frame_number, std::spa
     ++since_key_;
   }
   unsigned char* at = out;
-  put<uint32_t>(at, key_frame_number_);
-  for (float o : origin_) put<float>(at, o);
-  for (float s : step_) put<float>(at, s);
+  put_at<uint32_t>(at, key_frame_number_);
+  for (float o : origin_) put_at<float>(at, o);
+  for (float s : step_) put_at<float>(at, s);
   unsigned char* count_at = at;
   at += 4;
   const size_t coded = meshopt_encodeVertexBuffer(at, meshopt_encodeVertexBufferBound(v, kPositionVertexBytes), vertices_.data(), v,
                                                   kPositionVertexBytes);
   if (coded == 0 && v > 0) throw std::runtime_error("meshopt_encodeVertexBuffer failed");
-  put<uint32_t>(count_at, static_cast<uint32_t>(coded));
+  put_at<uint32_t>(count_at, static_cast<uint32_t>(coded));
   std::memset(at + coded, 0, padding_to_4(coded));
   return kPositionHeaderBytes + coded + padding_to_4(coded);
 }
@@ -167,7 +152,7 @@ size_t CompressedVertexEncoder::encode_normals(std::span<const float> normals, u
                                                   kNormalVertexBytes);
   if (coded == 0 && v > 0) throw std::runtime_error("meshopt_encodeVertexBuffer failed");
   unsigned char* at = out;
-  put<uint32_t>(at, static_cast<uint32_t>(coded));
+  put_at<uint32_t>(at, static_cast<uint32_t>(coded));
   std::memset(out + 4 + coded, 0, padding_to_4(coded));
   return 4 + coded + padding_to_4(coded);
 }
@@ -188,11 +173,11 @@ CompressedVertexDecoder::Result CompressedVertexDecoder::decode(std::span<const 
     throw std::invalid_argument("CompressedVertexDecoder::decode: output smaller than the mesh");
   if (positions_block.size() < kPositionHeaderBytes) throw DecodeError("compressed positions: block truncated");
   const unsigned char* at = positions_block.data();
-  const uint32_t key_frame_number = get<uint32_t>(at);
+  const uint32_t key_frame_number = get_at<uint32_t>(at);
   float origin[3], step[3];
-  for (float& o : origin) o = get<float>(at);
-  for (float& s : step) s = get<float>(at);
-  const uint32_t coded = get<uint32_t>(at);
+  for (float& o : origin) o = get_at<float>(at);
+  for (float& s : step) s = get_at<float>(at);
+  const uint32_t coded = get_at<uint32_t>(at);
   if (kPositionHeaderBytes + coded + padding_to_4(coded) != positions_block.size())
     throw DecodeError("compressed positions: " + std::to_string(coded) + " coded bytes in a block of " + std::to_string(positions_block.size()));
   for (int a = 0; a < 3; ++a) {
@@ -221,7 +206,7 @@ CompressedVertexDecoder::Result CompressedVertexDecoder::decode(std::span<const 
   if (!normals.empty() && !normals_block.empty()) {
     if (normals_block.size() < 4) throw DecodeError("compressed normals: block truncated");
     const unsigned char* n = normals_block.data();
-    const uint32_t normal_bytes = get<uint32_t>(n);
+    const uint32_t normal_bytes = get_at<uint32_t>(n);
     if (4 + normal_bytes + padding_to_4(normal_bytes) != normals_block.size())
       throw DecodeError("compressed normals: " + std::to_string(normal_bytes) + " coded bytes in a block of " + std::to_string(normals_block.size()));
     if (meshopt_decodeVertexBuffer(octahedral_.data(), v, kNormalVertexBytes, n, normal_bytes) != 0)

@@ -5,24 +5,12 @@
 #include <stdexcept>
 #include <string>
 
+#include "protocol/byte_buffer.h"
+
 namespace skinstream::subscriber {
 namespace {
 
 // Values are copied as they are: the protocol's byte order is the host's (little-endian).
-template <typename T>
-void put(unsigned char*& at, T value) {
-  std::memcpy(at, &value, sizeof(T));
-  at += sizeof(T);
-}
-
-template <typename T>
-T get(const unsigned char*& at) {
-  T value;
-  std::memcpy(&value, at, sizeof(T));
-  at += sizeof(T);
-  return value;
-}
-
 template <size_t N>
 bool read_finite(const unsigned char*& at, std::array<float, N>& out) {
   std::memcpy(out.data(), at, N * sizeof(float));
@@ -43,8 +31,8 @@ void encode_parameter_block(const FrameParameters& parameters, std::span<unsigne
   if (out.size() != parameter_block_bytes(parts, members) || parameters.weights.size() % 3 != 0)
     throw std::invalid_argument("encode_parameter_block: the buffer does not fit the parameters");
   unsigned char* at = out.data();
-  put<uint32_t>(at, static_cast<uint32_t>(parts));
-  put<uint32_t>(at, static_cast<uint32_t>(members));
+  put_at<uint32_t>(at, static_cast<uint32_t>(parts));
+  put_at<uint32_t>(at, static_cast<uint32_t>(members));
   for (const PartParameters& part : parameters.parts) {
     std::memcpy(at, part.quadratic.data(), sizeof(part.quadratic));
     at += sizeof(part.quadratic);
@@ -52,7 +40,7 @@ void encode_parameter_block(const FrameParameters& parameters, std::span<unsigne
     at += sizeof(part.rotation);
     std::memcpy(at, part.translation.data(), sizeof(part.translation));
     at += sizeof(part.translation);
-    put<uint32_t>(at, part.rbf ? 1u : 0u);
+    put_at<uint32_t>(at, part.rbf ? 1u : 0u);
   }
   // A model of no members has no weights (and an empty vector's data() may be null).
   if (!parameters.weights.empty()) std::memcpy(at, parameters.weights.data(), parameters.weights.size() * sizeof(float));
@@ -61,7 +49,7 @@ void encode_parameter_block(const FrameParameters& parameters, std::span<unsigne
 void decode_parameter_block(std::span<const unsigned char> block, FrameParameters& out) {
   if (block.size() < 8) throw DecodeError("parameters: block of " + std::to_string(block.size()) + " bytes is truncated");
   const unsigned char* at = block.data();
-  const uint32_t parts = get<uint32_t>(at), members = get<uint32_t>(at);
+  const uint32_t parts = get_at<uint32_t>(at), members = get_at<uint32_t>(at);
   const size_t model_members = out.weights.size() / 3;
   if (parts != out.parts.size() || members != model_members)
     throw DecodeError("parameters: " + std::to_string(parts) + " parts and " + std::to_string(members) + " members, the model has " +
@@ -73,7 +61,7 @@ void decode_parameter_block(std::span<const unsigned char> block, FrameParameter
     PartParameters& part = out.parts[p];
     if (!read_finite(at, part.quadratic) || !read_finite(at, part.rotation) || !read_finite(at, part.translation))
       throw DecodeError("parameters: part " + std::to_string(p) + " has a value that is not finite");
-    const uint32_t flags = get<uint32_t>(at);
+    const uint32_t flags = get_at<uint32_t>(at);
     if (flags > 1) throw DecodeError("parameters: part " + std::to_string(p) + " has reserved flag bits set (" + std::to_string(flags) + ")");
     part.rbf = flags == 1;
   }

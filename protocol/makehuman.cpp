@@ -11,23 +11,16 @@
 #include <unordered_map>
 
 #include "protocol/file_error.h"
+#include "protocol/whole_file.h"
 
 namespace skinstream {
 
 namespace {
 
 
-std::string read_text(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw FileError(path, "cannot open");
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
 nlohmann::json read_json(const std::string& path) {
   try {
-    return nlohmann::json::parse(read_text(path));
+    return nlohmann::json::parse(read_whole_file(path));
   } catch (const nlohmann::json::exception& e) {
     throw FileError(path, std::string("not valid JSON: ") + e.what());
   }

@@ -11,6 +11,7 @@
 #include <stdexcept>
 
 #include "protocol/file_error.h"
+#include "protocol/whole_file.h"
 
 namespace skinstream {
 
@@ -20,18 +21,6 @@ using nlohmann::json;
 
 // A definition file is a few kilobytes; anything far larger is not one.
 constexpr std::uintmax_t kMaxFileBytes = 4u << 20;
-
-std::string read_text(const std::string& path) {
-  std::error_code ec;
-  const std::uintmax_t size = std::filesystem::file_size(path, ec);
-  if (!ec && size > kMaxFileBytes)
-    throw FileError(path, "is " + std::to_string(size) + " bytes, too large for a marker set");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw FileError(path, "cannot open");
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 
 // Parses, refusing a key repeated within one object (nlohmann would keep the last silently).
 json parse_strict(const std::string& text, const std::string& path) {
@@ -178,7 +167,7 @@ std::string lowered(std::string s) {
 }  // namespace
 
 MarkerSet read_marker_set(const std::string& path) {
-  const json doc = parse_strict(read_text(path), path);
+  const json doc = parse_strict(read_whole_file(path, {kMaxFileBytes, "marker set"}), path);
   Fields top(doc, "the marker set", path);
   MarkerSet set;
   set.name = top.text("name", true);

@@ -14,21 +14,13 @@
 
 #include "protocol/file_error.h"
 #include "protocol/mesh_ply.h"
+#include "protocol/whole_file.h"
 
 namespace skinstream {
 
 namespace {
 
 static_assert(std::endian::native == std::endian::little, "binary PLY reading assumes a little-endian host");
-
-std::string read_bytes(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw FileError(path, "cannot open");
-  std::ostringstream s;
-  s << in.rdbuf();
-  if (in.bad()) throw FileError(path, "read failed");
-  return s.str();
-}
 
 std::string lower_extension(const std::string& path) {
   const size_t slash = path.find_last_of('/');
@@ -447,7 +439,7 @@ TriangleMesh parse_mesh(const std::string& path, const std::string& ext, const s
 
 TriangleMesh read_mesh(const std::string& path) {
   const std::string ext = mesh_extension(path);
-  return parse_mesh(path, ext, read_bytes(path));
+  return parse_mesh(path, ext, read_whole_file(path));
 }
 
 TriangleMesh read_mesh_bytes(std::string_view bytes, const std::string& name) {

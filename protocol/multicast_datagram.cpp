@@ -11,20 +11,6 @@ namespace {
 
 size_t stride(size_t message_bytes, uint16_t count) { return (message_bytes + count - 1) / count; }
 
-template <typename T>
-void put(unsigned char*& p, T value) {
-  std::memcpy(p, &value, sizeof value);  // little-endian hosts only, as everywhere in the protocol
-  p += sizeof value;
-}
-
-template <typename T>
-T get(const unsigned char*& p) {
-  T value;
-  std::memcpy(&value, p, sizeof value);
-  p += sizeof value;
-  return value;
-}
-
 }  // namespace
 
 uint16_t fragment_count(size_t message_bytes, bool authenticated) {
@@ -42,15 +28,15 @@ size_t fragment_bytes(size_t message_bytes, uint16_t count, uint16_t index) {
 
 void encode_datagram_header(const DatagramHeader& h, std::span<unsigned char, kDatagramHeaderBytes> out) {
   unsigned char* p = out.data();
-  put<uint32_t>(p, kDatagramMagic);
-  put<uint16_t>(p, kDatagramVersion);
-  put<uint16_t>(p, h.authenticated ? kDatagramAuthenticated : 0);  // flags; the other bits reserved
-  put<uint32_t>(p, h.stream_id);
-  put<uint32_t>(p, h.model_id);
-  put<uint32_t>(p, h.sequence);
-  put<uint16_t>(p, h.index);
-  put<uint16_t>(p, h.count);
-  put<uint32_t>(p, h.message_bytes);
+  put_at<uint32_t>(p, kDatagramMagic);
+  put_at<uint16_t>(p, kDatagramVersion);
+  put_at<uint16_t>(p, h.authenticated ? kDatagramAuthenticated : 0);  // flags; the other bits reserved
+  put_at<uint32_t>(p, h.stream_id);
+  put_at<uint32_t>(p, h.model_id);
+  put_at<uint32_t>(p, h.sequence);
+  put_at<uint16_t>(p, h.index);
+  put_at<uint16_t>(p, h.count);
+  put_at<uint32_t>(p, h.message_bytes);
 }
 
 DatagramHeader decode_datagram_header(std::span<const unsigned char> datagram) {
@@ -60,21 +46,21 @@ DatagramHeader decode_datagram_header(std::span<const unsigned char> datagram) {
   if (datagram.size() > kMaxDatagramBytes)
     throw DecodeError("datagram of " + std::to_string(datagram.size()) + " bytes is over the " + std::to_string(kMaxDatagramBytes) + " allowed");
   const unsigned char* p = datagram.data();
-  if (get<uint32_t>(p) != kDatagramMagic) throw DecodeError("bad magic (not a skinstream multicast datagram)");
-  const uint16_t version = get<uint16_t>(p);
+  if (get_at<uint32_t>(p) != kDatagramMagic) throw DecodeError("bad magic (not a skinstream multicast datagram)");
+  const uint16_t version = get_at<uint16_t>(p);
   if (version != kDatagramVersion) throw DecodeError("multicast datagram version " + std::to_string(version) + " (this side speaks 1)");
-  const uint16_t flags = get<uint16_t>(p);
+  const uint16_t flags = get_at<uint16_t>(p);
   if (flags & ~kDatagramAuthenticated) throw DecodeError("reserved header bits set");
   DatagramHeader h;
   h.authenticated = (flags & kDatagramAuthenticated) != 0;
   const size_t largest = h.authenticated ? kMaxAuthenticatedFragmentBytes : kMaxFragmentBytes;
   const size_t trailer = h.authenticated ? kDatagramTrailerBytes : 0;
-  h.stream_id = get<uint32_t>(p);
-  h.model_id = get<uint32_t>(p);
-  h.sequence = get<uint32_t>(p);
-  h.index = get<uint16_t>(p);
-  h.count = get<uint16_t>(p);
-  h.message_bytes = get<uint32_t>(p);
+  h.stream_id = get_at<uint32_t>(p);
+  h.model_id = get_at<uint32_t>(p);
+  h.sequence = get_at<uint32_t>(p);
+  h.index = get_at<uint16_t>(p);
+  h.count = get_at<uint16_t>(p);
+  h.message_bytes = get_at<uint32_t>(p);
   if (h.count == 0 || h.count > kMaxFragments)
     throw DecodeError("fragment count " + std::to_string(h.count) + " (1-" + std::to_string(kMaxFragments) + ")");
   if (h.index >= h.count) throw DecodeError("fragment " + std::to_string(h.index) + " of " + std::to_string(h.count));

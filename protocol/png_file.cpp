@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "protocol/file_error.h"
+#include "protocol/whole_file.h"
 
 namespace skinstream {
 
@@ -83,11 +84,7 @@ void write_png(const std::string& path, const render::Image& image) {
 }
 
 render::Image read_png(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw FileError(path, "cannot open");
-  std::ostringstream s;
-  s << in.rdbuf();
-  const std::string file = s.str();
+  const std::string file = read_whole_file(path);
   const auto* bytes = reinterpret_cast<const unsigned char*>(file.data());
   if (file.size() < sizeof kSignature || std::memcmp(bytes, kSignature, sizeof kSignature) != 0)
     throw FileError(path, "not a PNG file (bad signature)");

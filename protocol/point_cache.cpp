@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "protocol/file_error.h"
+#include "protocol/whole_file.h"
 
 namespace skinstream {
 
@@ -91,11 +92,7 @@ void PointCacheWriter::close() {
 }
 
 PointCache read_point_cache(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw FileError(path, "cannot open");
-  std::ostringstream s;
-  s << in.rdbuf();
-  const std::string bytes = s.str();
+  const std::string bytes = read_whole_file(path);
   if (bytes.size() < kPointCacheHeaderBytes)
     throw FileError(path, "truncated: " + std::to_string(bytes.size()) + " bytes, a PC2 header has 32");
   if (std::memcmp(bytes.data(), kPointCacheSignature, sizeof kPointCacheSignature) != 0)

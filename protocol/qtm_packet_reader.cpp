@@ -14,7 +14,7 @@ T load(const unsigned char* p) {
   return value;
 }
 
-bool fail(std::string& out_error, std::string reason) {
+bool refuse_packet(std::string& out_error, std::string reason) {
   out_error = std::move(reason);
   return false;
 }
@@ -23,7 +23,7 @@ bool expect_type(Bytes packet, PacketType wanted, std::string& out_error) {
   uint32_t type = 0;
   if (!read_header(packet, type, out_error)) return false;
   if (type != static_cast<uint32_t>(wanted))
-    return fail(out_error, std::string("expected a ") + packet_type_name(static_cast<uint32_t>(wanted)) +
+    return refuse_packet(out_error, std::string("expected a ") + packet_type_name(static_cast<uint32_t>(wanted)) +
                                " packet, got type " + std::to_string(type) + " (" + packet_type_name(type) + ")");
   return true;
 }
@@ -31,7 +31,7 @@ bool expect_type(Bytes packet, PacketType wanted, std::string& out_error) {
 // One 3D-family component's markers (body = what follows the 8-byte component header).
 bool decode_markers(uint32_t type, Bytes body, DataFrame& out, std::string& out_error) {
   constexpr size_t kCountsBytes = 8;  // u32 count, u16 drop rate, u16 out-of-sync rate
-  if (body.size() < kCountsBytes) return fail(out_error, "3D component of " + std::to_string(body.size()) +
+  if (body.size() < kCountsBytes) return refuse_packet(out_error, "3D component of " + std::to_string(body.size()) +
                                                             " bytes is shorter than its marker count");
   const uint32_t count = load<uint32_t>(body.data());
   const bool unlabelled = type == component::k3dNoLabels || type == component::k3dNoLabelsResiduals;
@@ -39,7 +39,7 @@ bool decode_markers(uint32_t type, Bytes body, DataFrame& out, std::string& out_
   const size_t marker_bytes = 12 + (unlabelled ? 4 : 0) + (residuals ? 4 : 0);
   const size_t data_bytes = body.size() - kCountsBytes;
   if (data_bytes % marker_bytes != 0 || data_bytes / marker_bytes != count)
-    return fail(out_error, "3D component says " + std::to_string(count) + " markers of " +
+    return refuse_packet(out_error, "3D component says " + std::to_string(count) + " markers of " +
                                std::to_string(marker_bytes) + " bytes but holds " + std::to_string(data_bytes) +
                                " bytes");
   out.drop_rate_2d = load<uint16_t>(body.data() + 4);
@@ -83,14 +83,14 @@ const char* packet_type_name(uint32_t type) {
 
 bool read_header(Bytes packet, uint32_t& out_type, std::string& out_error) {
   if (packet.size() < kHeaderBytes)
-    return fail(out_error, "packet of " + std::to_string(packet.size()) + " bytes is shorter than its 8-byte header");
+    return refuse_packet(out_error, "packet of " + std::to_string(packet.size()) + " bytes is shorter than its 8-byte header");
   const uint32_t size = load<uint32_t>(packet.data());
-  if (size < kHeaderBytes) return fail(out_error, "packet size " + std::to_string(size) + " is less than its header");
+  if (size < kHeaderBytes) return refuse_packet(out_error, "packet size " + std::to_string(size) + " is less than its header");
   if (size > kMaxPacketBytes)
-    return fail(out_error, "packet size " + std::to_string(size) + " exceeds the limit of " +
+    return refuse_packet(out_error, "packet size " + std::to_string(size) + " exceeds the limit of " +
                                std::to_string(kMaxPacketBytes) + " bytes");
   if (size != packet.size())
-    return fail(out_error, "packet size field says " + std::to_string(size) + " bytes but " +
+    return refuse_packet(out_error, "packet size field says " + std::to_string(size) + " bytes but " +
                                std::to_string(packet.size()) + " were given");
   out_type = load<uint32_t>(packet.data() + 4);
   return true;
@@ -101,7 +101,7 @@ bool decode_text(Bytes packet, std::string& out_text, std::string& out_error) {
   if (!read_header(packet, type, out_error)) return false;
   if (type != static_cast<uint32_t>(PacketType::Command) && type != static_cast<uint32_t>(PacketType::Error) &&
       type != static_cast<uint32_t>(PacketType::Xml))
-    return fail(out_error, std::string("a ") + packet_type_name(type) + " packet holds no text");
+    return refuse_packet(out_error, std::string("a ") + packet_type_name(type) + " packet holds no text");
   const auto* text = reinterpret_cast<const char*>(packet.data() + kHeaderBytes);
   const size_t length = packet.size() - kHeaderBytes;
   out_text.assign(text, strnlen(text, length));
@@ -111,7 +111,7 @@ bool decode_text(Bytes packet, std::string& out_text, std::string& out_error) {
 bool decode_event(Bytes packet, Event& out_event, std::string& out_error) {
   if (!expect_type(packet, PacketType::Event, out_error)) return false;
   if (packet.size() != kHeaderBytes + 1)
-    return fail(out_error, "event packet of " + std::to_string(packet.size()) + " bytes (expected 9)");
+    return refuse_packet(out_error, "event packet of " + std::to_string(packet.size()) + " bytes (expected 9)");
   out_event = static_cast<Event>(packet[kHeaderBytes]);
   return true;
 }
@@ -120,7 +120,7 @@ bool decode_data(Bytes packet, DataFrame& out, std::string& out_error) {
   if (!expect_type(packet, PacketType::Data, out_error)) return false;
   constexpr size_t kFrameHeaderBytes = 16;  // i64 timestamp, u32 frame number, u32 component count
   if (packet.size() < kHeaderBytes + kFrameHeaderBytes)
-    return fail(out_error, "data packet of " + std::to_string(packet.size()) + " bytes is shorter than its header");
+    return refuse_packet(out_error, "data packet of " + std::to_string(packet.size()) + " bytes is shorter than its header");
   const unsigned char* p = packet.data() + kHeaderBytes;
   out.timestamp_us = load<int64_t>(p);
   out.frame_number = load<uint32_t>(p + 8);
@@ -135,23 +135,23 @@ bool decode_data(Bytes packet, DataFrame& out, std::string& out_error) {
   for (uint32_t i = 0; i < components; ++i) {
     const size_t left = packet.size() - offset;
     if (left < 8)
-      return fail(out_error, "data packet ends inside the header of component " + std::to_string(i + 1) + " of " +
+      return refuse_packet(out_error, "data packet ends inside the header of component " + std::to_string(i + 1) + " of " +
                                  std::to_string(components));
     const uint32_t size = load<uint32_t>(packet.data() + offset);
     const uint32_t type = load<uint32_t>(packet.data() + offset + 4);
     if (size < 8 || size > left)
-      return fail(out_error, "component " + std::to_string(i + 1) + " (type " + std::to_string(type) + ") says " +
+      return refuse_packet(out_error, "component " + std::to_string(i + 1) + " (type " + std::to_string(type) + ") says " +
                                  std::to_string(size) + " bytes with " + std::to_string(left) + " left");
     const Bytes body = packet.subspan(offset + 8, size - 8);
     switch (type) {
       case component::k3d:
       case component::k3dResiduals:
-        if (out.has_labelled) return fail(out_error, "data packet has two labelled 3D components");
+        if (out.has_labelled) return refuse_packet(out_error, "data packet has two labelled 3D components");
         if (!decode_markers(type, body, out, out_error)) return false;
         break;
       case component::k3dNoLabels:
       case component::k3dNoLabelsResiduals:
-        if (out.has_unlabelled) return fail(out_error, "data packet has two unlabelled 3D components");
+        if (out.has_unlabelled) return refuse_packet(out_error, "data packet has two unlabelled 3D components");
         if (!decode_markers(type, body, out, out_error)) return false;
         break;
       default:
@@ -161,7 +161,7 @@ bool decode_data(Bytes packet, DataFrame& out, std::string& out_error) {
     offset += size;
   }
   if (offset != packet.size())
-    return fail(out_error, "data packet has " + std::to_string(packet.size() - offset) + " bytes after its " +
+    return refuse_packet(out_error, "data packet has " + std::to_string(packet.size() - offset) + " bytes after its " +
                                std::to_string(components) + " components");
   return true;
 }
@@ -178,10 +178,10 @@ bool decode_packet(Bytes packet, Packet& out, std::string& out_error) {
     case PacketType::Data:
       return decode_data(packet, out.data, out_error);
     case PacketType::NoMoreData:
-      if (packet.size() != kHeaderBytes) return fail(out_error, "NoMoreData packet with a body");
+      if (packet.size() != kHeaderBytes) return refuse_packet(out_error, "NoMoreData packet with a body");
       return true;
     default:
-      return fail(out_error, "unsupported packet type " + std::to_string(out.type) + " (" +
+      return refuse_packet(out_error, "unsupported packet type " + std::to_string(out.type) + " (" +
                                  packet_type_name(out.type) + ")");
   }
 }

@@ -10,8 +10,6 @@ namespace {
 
 constexpr size_t kPartBytes = 80;
 
-size_t padding_to_4(size_t n) { return (4 - n % 4) % 4; }
-
 template <size_t N>
 void put_floats(ByteWriter& w, const std::array<float, N>& values) {
   for (float v : values) w.put<float>(v);

@@ -87,8 +87,6 @@ void check_version(uint16_t version) {
   if (version != kVersion1 && version != kVersion2) throw std::invalid_argument("subscriber protocol version " + std::to_string(version));
 }
 
-size_t padding_to_4(size_t n) { return (4 - n % 4) % 4; }
-
 // Runs a payload decoder, turning a read past the end into a DecodeError naming the message.
 template <typename F>
 auto decode_payload(const char* what, std::span<const unsigned char> payload, F&& body) {

@@ -21,6 +21,7 @@
 
 #include "protocol/file_error.h"
 #include "protocol/trc.h"
+#include "protocol/whole_file.h"
 
 namespace skinstream {
 namespace {
@@ -253,12 +254,7 @@ Capture parse_trc(const std::string& path, std::string text) {
 Capture read_trc(const std::string& path) {
   std::error_code error;
   if (!std::filesystem::exists(path, error)) throw FileError(path, "no such file");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw FileError(path, "cannot open for reading");
-  std::ostringstream buffer;
-  buffer << in.rdbuf();
-  if (in.bad()) throw FileError(path, "read error");
-  return parse_trc(path, std::move(buffer).str());
+  return parse_trc(path, read_whole_file(path));
 }
 
 Capture read_trc_bytes(std::string_view text, const std::string& name) { return parse_trc(name, std::string(text)); }

@@ -18,7 +18,7 @@
 namespace skinstream::cli {
 namespace {
 
-struct Method {
+struct FillMethod {
   std::string name;
   std::string description;
   std::function<Capture(const Capture&)> fill;
@@ -78,7 +78,7 @@ int run_eval_fill(const EvalFillOptions& o, std::FILE* out) {
   no_carry.filler.carry_from_gap_start = false;
   no_learning.filler.learn_regions = false;
   no_ring_calibration.filler.calibrate_rings = false;
-  std::vector<Method> methods = {
+  std::vector<FillMethod> methods = {
       {"linear", "linear interpolation (offline)", fill_linear},
       {"spline", "cubic spline (offline)", [](const Capture& c) { return fill_cubic_spline(c); }},
       {"gloersen_pca", "Gloersen & Federolf 2016 PCA (offline)", [](const Capture& c) { return fill_gloersen_pca(c); }},
@@ -113,7 +113,7 @@ int run_eval_fill(const EvalFillOptions& o, std::FILE* out) {
                 {"fraction_of_samples", double(gap_samples) / (double(truth.frame_count) * truth.point_count())}}},
       {"metric", "error = |filled - truth| over deleted samples; normalised = error / the marker's mean distance to its one-ring in the reference pose (Park & Hodgins Table 2); changed_measured_samples: samples left in the capture that the method moved"},
       {"methods", nlohmann::json::array()}};
-  for (const Method& method : methods) {
+  for (const FillMethod& method : methods) {
     const auto start = std::chrono::steady_clock::now();
     const Capture filled = method.fill(gapped);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

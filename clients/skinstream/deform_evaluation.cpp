@@ -24,13 +24,13 @@ using synth::SynthCapture;
 // Which skin weights a conventional (sparse-marker LBS) row uses; None: a part-based method.
 enum class Skinning { None, BoneHeat, TruthOracle };
 
-struct Method {
+struct DeformMethod {
   const char* name;
   const char* caption;
   Skinning skinning;
   DeformationMode mode;
 };
-constexpr Method kMethods[] = {
+constexpr DeformMethod kMethods[] = {
     {"rigid", "rigid", Skinning::None, DeformationMode::Rigid},
     {"quadratic", "quadratic", Skinning::None, DeformationMode::Quadratic},
     {"rigid_rbf", "rigid+rbf", Skinning::None, DeformationMode::RigidRbf},
@@ -233,7 +233,7 @@ nlohmann::ordered_json evaluate_deformation(const DeformationSetup& setup, const
   const int method_count = static_cast<int>(std::size(kMethods));
   std::vector<std::unique_ptr<MeshDeformer>> deformers;
   std::vector<std::unique_ptr<SegmentSkinning>> skinnings;
-  for (const Method& m : kMethods) {
+  for (const DeformMethod& m : kMethods) {
     const bool parts = m.skinning == Skinning::None;
     deformers.push_back(parts ? std::make_unique<MeshDeformer>(model, setup.subject, m.mode) : nullptr);
     skinnings.push_back(parts ? nullptr

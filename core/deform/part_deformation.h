@@ -17,6 +17,8 @@ namespace skinstream {
 
 // The paper's comparison variants (Figure 7 b-e).
 enum class DeformationMode { Rigid, Quadratic, RigidRbf, QuadraticRbf };
+inline constexpr DeformationMode kDeformationModes[] = {DeformationMode::Rigid, DeformationMode::Quadratic,
+                                                    DeformationMode::RigidRbf, DeformationMode::QuadraticRbf};
 
 class PartDeformer {
  public:

@@ -17,7 +17,7 @@
 namespace skinstream {
 namespace {
 
-constexpr Precondition require{"fold weight smoothing"};
+constexpr Precondition require_smoothing{"fold weight smoothing"};
 
 // A vertex's hold on its own weights when nothing else holds it (a piece of mesh in the fold with
 // no vertex around it keeping its weights): small enough not to matter anywhere else.
@@ -28,25 +28,25 @@ constexpr double kSelfHold = 1e-6;
 int smooth_fold_weights(std::span<const Vec3> vertices, std::span<const std::array<int, 3>> faces,
                         std::span<const char> under_marker, int part_count, VertexPartWeights& weights,
                         const FoldSmoothingOptions& options) {
-  require(options.band_mm >= 0.0 && std::isfinite(options.band_mm), "band_mm must be >= 0");
-  require(options.band_pull >= 0.0 && std::isfinite(options.band_pull), "band_pull must be >= 0");
-  require(options.min_weight >= 0.0 && options.min_weight < 1.0, "min_weight must be in [0, 1)");
+  require_smoothing(options.band_mm >= 0.0 && std::isfinite(options.band_mm), "band_mm must be >= 0");
+  require_smoothing(options.band_pull >= 0.0 && std::isfinite(options.band_pull), "band_pull must be >= 0");
+  require_smoothing(options.min_weight >= 0.0 && options.min_weight < 1.0, "min_weight must be in [0, 1)");
   const std::vector<int>& offsets = weights.vertex_influence_offsets;
-  require(!offsets.empty() && offsets.front() == 0 && offsets.back() == static_cast<int>(weights.vertex_influences.size()),
+  require_smoothing(!offsets.empty() && offsets.front() == 0 && offsets.back() == static_cast<int>(weights.vertex_influences.size()),
           "the influence offsets do not span the influences");
   const int v_count = static_cast<int>(offsets.size()) - 1;
-  require(vertices.size() == static_cast<size_t>(v_count),
+  require_smoothing(vertices.size() == static_cast<size_t>(v_count),
           std::to_string(vertices.size()) + " vertices for the weights of " + std::to_string(v_count));
-  for (int v = 0; v < v_count; ++v) require(vertices[v].allFinite(), "vertex " + std::to_string(v) + " is not finite");
-  require(weights.in_fold.size() == static_cast<size_t>(v_count),
+  for (int v = 0; v < v_count; ++v) require_smoothing(vertices[v].allFinite(), "vertex " + std::to_string(v) + " is not finite");
+  require_smoothing(weights.in_fold.size() == static_cast<size_t>(v_count),
           std::to_string(weights.in_fold.size()) + " fold flags for " + std::to_string(v_count) + " vertices");
-  require(under_marker.empty() || under_marker.size() == static_cast<size_t>(v_count),
+  require_smoothing(under_marker.empty() || under_marker.size() == static_cast<size_t>(v_count),
           std::to_string(under_marker.size()) + " under-marker flags for " + std::to_string(v_count) + " vertices");
   for (size_t f = 0; f < faces.size(); ++f)
     for (int c : faces[f])
-      require(c >= 0 && c < v_count, "face " + std::to_string(f) + " refers to vertex " + std::to_string(c) + " of " + std::to_string(v_count));
+      require_smoothing(c >= 0 && c < v_count, "face " + std::to_string(f) + " refers to vertex " + std::to_string(c) + " of " + std::to_string(v_count));
   for (const PartInfluence& b : weights.vertex_influences)
-    require(b.part >= 0 && b.part < part_count, "an influence names part " + std::to_string(b.part) + " of " + std::to_string(part_count));
+    require_smoothing(b.part >= 0 && b.part < part_count, "an influence names part " + std::to_string(b.part) + " of " + std::to_string(part_count));
 
   auto keeps = [&](int v) { return !under_marker.empty() && under_marker[v]; };
   // The fold's vertices, then the band around them: every vertex within band_mm of one along the
@@ -107,7 +107,7 @@ int smooth_fold_weights(std::span<const Vec3> vertices, std::span<const std::arr
   Eigen::SparseMatrix<double> laplacian(n, n);
   laplacian.setFromTriplets(entries.begin(), entries.end());
   const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(laplacian);
-  require(solver.info() == Eigen::Success, "the fold's system could not be factored");
+  require_smoothing(solver.info() == Eigen::Success, "the fold's system could not be factored");
   const Eigen::MatrixXd solved = solver.solve(rhs);
 
   VertexPartWeights out;

@@ -14,7 +14,7 @@
 namespace skinstream {
 namespace {
 
-constexpr Precondition require{"marker part weights"};
+constexpr Precondition require_marker_weights{"marker part weights"};
 
 // Weight given to a marker added to a part only to reach min_members, at least (before the
 // marker's row is renormalised): the part must not get a zero weight.
@@ -64,24 +64,24 @@ MarkerPartWeights marker_part_weights(std::span<const Vec3> reference, std::span
                                       std::span<const int> triangle_part, int part_count, std::span<const Vec3> positions,
                                       int frame_count, const MarkerWeightOptions& options) {
   const int m = static_cast<int>(reference.size());
-  require(m > 0, "no markers");
-  require(part_count >= 1, "no parts");
-  require(frame_count > 0, "no frames");
-  require(triangle_part.size() == triangles.size(),
+  require_marker_weights(m > 0, "no markers");
+  require_marker_weights(part_count >= 1, "no parts");
+  require_marker_weights(frame_count > 0, "no frames");
+  require_marker_weights(triangle_part.size() == triangles.size(),
           std::to_string(triangle_part.size()) + " part indices for " + std::to_string(triangles.size()) + " triangles");
-  require(positions.size() == static_cast<size_t>(frame_count) * m,
+  require_marker_weights(positions.size() == static_cast<size_t>(frame_count) * m,
           std::to_string(positions.size()) + " positions for " + std::to_string(frame_count) + " frames of " + std::to_string(m) + " markers");
-  require(options.threshold >= 0.0 && options.threshold < 1.0, "threshold must be in [0, 1)");
-  require(options.sigma_floor_mm > 0.0 && std::isfinite(options.sigma_floor_mm), "sigma_floor_mm must be > 0");
-  require(options.min_members >= 1 && options.min_members <= m, "min_members must be in [1, marker count]");
-  require(options.boundary_rings >= 0, "boundary_rings must be >= 0");
+  require_marker_weights(options.threshold >= 0.0 && options.threshold < 1.0, "threshold must be in [0, 1)");
+  require_marker_weights(options.sigma_floor_mm > 0.0 && std::isfinite(options.sigma_floor_mm), "sigma_floor_mm must be > 0");
+  require_marker_weights(options.min_members >= 1 && options.min_members <= m, "min_members must be in [1, marker count]");
+  require_marker_weights(options.boundary_rings >= 0, "boundary_rings must be >= 0");
   std::vector<std::vector<int>> part_markers(part_count);  // markers of the part's triangles
   std::vector<std::vector<int>> marker_parts(m);           // parts of the marker's triangles
   for (size_t t = 0; t < triangles.size(); ++t) {
     const int p = triangle_part[t];
-    require(p >= 0 && p < part_count, "triangle " + std::to_string(t) + " is in part " + std::to_string(p) + " of " + std::to_string(part_count));
+    require_marker_weights(p >= 0 && p < part_count, "triangle " + std::to_string(t) + " is in part " + std::to_string(p) + " of " + std::to_string(part_count));
     for (int v : triangles[t]) {
-      require(v >= 0 && v < m, "triangle " + std::to_string(t) + " refers to marker " + std::to_string(v) + " of " + std::to_string(m));
+      require_marker_weights(v >= 0 && v < m, "triangle " + std::to_string(t) + " refers to marker " + std::to_string(v) + " of " + std::to_string(m));
       part_markers[p].push_back(v);
       marker_parts[v].push_back(p);
     }
@@ -91,10 +91,10 @@ MarkerPartWeights marker_part_weights(std::span<const Vec3> reference, std::span
       std::sort(l.begin(), l.end());
       l.erase(std::unique(l.begin(), l.end()), l.end());
     }
-  for (int p = 0; p < part_count; ++p) require(!part_markers[p].empty(), "part " + std::to_string(p) + " has no triangle");
-  for (int i = 0; i < m; ++i) require(reference[i].allFinite(), "reference marker " + std::to_string(i) + " is not finite");
+  for (int p = 0; p < part_count; ++p) require_marker_weights(!part_markers[p].empty(), "part " + std::to_string(p) + " has no triangle");
+  for (int i = 0; i < m; ++i) require_marker_weights(reference[i].allFinite(), "reference marker " + std::to_string(i) + " is not finite");
   for (size_t k = 0; k < positions.size(); ++k)
-    require(positions[k].allFinite(), "marker " + std::to_string(k % m) + " is not finite at frame " + std::to_string(k / m));
+    require_marker_weights(positions[k].allFinite(), "marker " + std::to_string(k % m) + " is not finite at frame " + std::to_string(k / m));
 
   MarkerPartWeights out;
   out.inside_markers.assign(part_count, 0);

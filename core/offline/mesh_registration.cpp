@@ -20,21 +20,21 @@ namespace {
 
 using Triangles = std::span<const std::array<int, 3>>;
 
-constexpr Precondition require{"mesh registration"};
+constexpr Precondition require_registration{"mesh registration"};
 
 void check_points(std::span<const Vec3> points, const char* what) {
   for (size_t i = 0; i < points.size(); ++i)
-    require(points[i].allFinite(), std::string(what) + " " + std::to_string(i) + " is not finite");
+    require_registration(points[i].allFinite(), std::string(what) + " " + std::to_string(i) + " is not finite");
 }
 
 void check_mesh(std::span<const Vec3> vertices, Triangles triangles) {
-  require(!vertices.empty(), "the mesh has no vertices");
-  require(!triangles.empty(), "the mesh has no triangles");
+  require_registration(!vertices.empty(), "the mesh has no vertices");
+  require_registration(!triangles.empty(), "the mesh has no triangles");
   check_points(vertices, "vertex");
   const int n = static_cast<int>(vertices.size());
   for (size_t t = 0; t < triangles.size(); ++t)
     for (int v : triangles[t])
-      require(v >= 0 && v < n, "triangle " + std::to_string(t) + " refers to vertex " + std::to_string(v) + " of " +
+      require_registration(v >= 0 && v < n, "triangle " + std::to_string(t) + " refers to vertex " + std::to_string(v) + " of " +
                                    std::to_string(n));
 }
 
@@ -171,29 +171,29 @@ std::vector<Vec3> register_mesh(std::span<const Vec3> vertices, Triangles triang
                                 std::span<const RegistrationLandmark> landmarks, const RegistrationOptions& options,
                                 RegistrationReport* out_report) {
   check_mesh(vertices, triangles);
-  require(!markers.empty(), "no markers");
+  require_registration(!markers.empty(), "no markers");
   check_points(markers, "marker");
-  require(!landmarks.empty(), "no landmarks (give marker/vertex pairs or use guess_landmarks)");
+  require_registration(!landmarks.empty(), "no landmarks (give marker/vertex pairs or use guess_landmarks)");
   const int n = static_cast<int>(vertices.size());
   const int m = static_cast<int>(markers.size());
   for (size_t i = 0; i < landmarks.size(); ++i) {
-    require(landmarks[i].marker >= 0 && landmarks[i].marker < m,
+    require_registration(landmarks[i].marker >= 0 && landmarks[i].marker < m,
             "landmark " + std::to_string(i) + " names marker " + std::to_string(landmarks[i].marker) + " of " + std::to_string(m));
     if (landmarks[i].triangle >= 0) {
-      require(landmarks[i].triangle < static_cast<int>(triangles.size()),
+      require_registration(landmarks[i].triangle < static_cast<int>(triangles.size()),
               "landmark " + std::to_string(i) + " names triangle " + std::to_string(landmarks[i].triangle) + " of " +
                   std::to_string(triangles.size()));
-      require(landmarks[i].barycentric.allFinite(), "landmark " + std::to_string(i) + " has non-finite barycentric coordinates");
+      require_registration(landmarks[i].barycentric.allFinite(), "landmark " + std::to_string(i) + " has non-finite barycentric coordinates");
     } else {
-      require(landmarks[i].vertex >= 0 && landmarks[i].vertex < n,
+      require_registration(landmarks[i].vertex >= 0 && landmarks[i].vertex < n,
               "landmark " + std::to_string(i) + " names vertex " + std::to_string(landmarks[i].vertex) + " of " + std::to_string(n));
     }
   }
   for (double w : {options.data_weight, options.smoothness_weight, options.landmark_weight, options.damping_weight,
                    options.marker_offset_mm, options.tolerance_mm})
-    require(std::isfinite(w) && w >= 0.0, "weights, offset and tolerance must be finite and >= 0");
-  require(options.damping_weight > 0.0 || options.smoothness_weight > 0.0, "smoothness and damping are both 0");
-  require(options.max_iterations >= 0, "max_iterations must be >= 0");
+    require_registration(std::isfinite(w) && w >= 0.0, "weights, offset and tolerance must be finite and >= 0");
+  require_registration(options.damping_weight > 0.0 || options.smoothness_weight > 0.0, "smoothness and damping are both 0");
+  require_registration(options.max_iterations >= 0, "max_iterations must be >= 0");
 
   const Normalisation norm = normalisation_of(vertices);
   std::vector<Vec3> unit_vertices(vertices.size());
@@ -274,8 +274,8 @@ std::vector<Vec3> register_mesh(std::span<const Vec3> vertices, Triangles triang
 
 std::vector<RegistrationLandmark> guess_landmarks(std::span<const Vec3> vertices, std::span<const Vec3> markers,
                                                   const LandmarkGuessOptions& options) {
-  require(!vertices.empty(), "no vertices to guess landmarks on");
-  require(!markers.empty(), "no markers to guess landmarks for");
+  require_registration(!vertices.empty(), "no vertices to guess landmarks on");
+  require_registration(!markers.empty(), "no markers to guess landmarks for");
   check_points(vertices, "vertex");
   check_points(markers, "marker");
   const int m = static_cast<int>(markers.size());

@@ -13,7 +13,7 @@
 namespace skinstream {
 namespace {
 
-constexpr Precondition require{"part joints"};
+constexpr Precondition require_joints{"part joints"};
 
 // A weight this close to 1 means the part owns the marker outright.
 constexpr double kOwned = 1.0 - 1e-9;
@@ -30,26 +30,26 @@ std::vector<PartJoint> fit_part_joints(std::span<const Vec3> reference, std::spa
                                        std::span<const PartMember> part_members, std::span<const Vec3> training,
                                        int frame_count, const PartJointOptions& options) {
   const int m = static_cast<int>(reference.size());
-  require(m > 0, "no markers");
-  require(frame_count > 0 && training.size() == static_cast<size_t>(frame_count) * m,
+  require_joints(m > 0, "no markers");
+  require_joints(frame_count > 0 && training.size() == static_cast<size_t>(frame_count) * m,
           "training is not frame_count x marker_count");
-  require(options.max_residual_ratio > 0.0 && std::isfinite(options.max_residual_ratio),
+  require_joints(options.max_residual_ratio > 0.0 && std::isfinite(options.max_residual_ratio),
           "max_residual_ratio must be > 0");
-  require(options.max_axis_spread > 0.0 && std::isfinite(options.max_axis_spread), "max_axis_spread must be > 0");
-  require(!part_member_offsets.empty() && part_member_offsets.front() == 0 &&
+  require_joints(options.max_axis_spread > 0.0 && std::isfinite(options.max_axis_spread), "max_axis_spread must be > 0");
+  require_joints(!part_member_offsets.empty() && part_member_offsets.front() == 0 &&
               part_member_offsets.back() == static_cast<int>(part_members.size()),
           "part member offsets do not span the members");
-  for (int i = 0; i < m; ++i) require(reference[i].allFinite(), "reference marker " + std::to_string(i) + " is not finite");
+  for (int i = 0; i < m; ++i) require_joints(reference[i].allFinite(), "reference marker " + std::to_string(i) + " is not finite");
   for (size_t k = 0; k < training.size(); ++k)
-    require(training[k].allFinite(), "marker " + std::to_string(k % m) + " is not finite at frame " + std::to_string(k / m));
+    require_joints(training[k].allFinite(), "marker " + std::to_string(k % m) + " is not finite at frame " + std::to_string(k / m));
 
   const int part_count = static_cast<int>(part_member_offsets.size()) - 1;
   std::vector<std::vector<int>> members(part_count), fitted(part_count);
   for (int p = 0; p < part_count; ++p) {
-    require(part_member_offsets[p] <= part_member_offsets[p + 1], "part member offsets decrease at part " + std::to_string(p));
+    require_joints(part_member_offsets[p] <= part_member_offsets[p + 1], "part member offsets decrease at part " + std::to_string(p));
     for (int k = part_member_offsets[p]; k < part_member_offsets[p + 1]; ++k) {
       const int i = part_members[k].marker;
-      require(i >= 0 && i < m, "part " + std::to_string(p) + " names marker " + std::to_string(i) + " of " + std::to_string(m));
+      require_joints(i >= 0 && i < m, "part " + std::to_string(p) + " names marker " + std::to_string(i) + " of " + std::to_string(m));
       members[p].push_back(i);
       if (part_members[k].weight >= kOwned) fitted[p].push_back(i);
     }

@@ -17,24 +17,24 @@ namespace {
 
 using Triangles = std::span<const std::array<int, 3>>;
 
-constexpr Precondition require{"part segmentation"};
+constexpr Precondition require_segmentation{"part segmentation"};
 
 void check_inputs(std::span<const Vec3> reference, Triangles triangles, std::span<const Vec3> positions, int frame_count,
                   int sample_frames) {
   const int m = static_cast<int>(reference.size());
-  require(m > 0, "no markers");
-  require(!triangles.empty(), "no triangles");
-  require(frame_count > 0, "no frames");
-  require(sample_frames >= 1, "sample_frames must be >= 1");
-  require(positions.size() == static_cast<size_t>(frame_count) * m,
+  require_segmentation(m > 0, "no markers");
+  require_segmentation(!triangles.empty(), "no triangles");
+  require_segmentation(frame_count > 0, "no frames");
+  require_segmentation(sample_frames >= 1, "sample_frames must be >= 1");
+  require_segmentation(positions.size() == static_cast<size_t>(frame_count) * m,
           std::to_string(positions.size()) + " positions for " + std::to_string(frame_count) + " frames of " +
               std::to_string(m) + " markers");
   for (size_t t = 0; t < triangles.size(); ++t)
     for (int v : triangles[t])
-      require(v >= 0 && v < m, "triangle " + std::to_string(t) + " refers to marker " + std::to_string(v) + " of " + std::to_string(m));
-  for (int i = 0; i < m; ++i) require(reference[i].allFinite(), "reference marker " + std::to_string(i) + " is not finite");
+      require_segmentation(v >= 0 && v < m, "triangle " + std::to_string(t) + " refers to marker " + std::to_string(v) + " of " + std::to_string(m));
+  for (int i = 0; i < m; ++i) require_segmentation(reference[i].allFinite(), "reference marker " + std::to_string(i) + " is not finite");
   for (size_t k = 0; k < positions.size(); ++k)
-    require(positions[k].allFinite(), "marker " + std::to_string(k % m) + " is not finite at frame " + std::to_string(k / m));
+    require_segmentation(positions[k].allFinite(), "marker " + std::to_string(k % m) + " is not finite at frame " + std::to_string(k / m));
 }
 
 // Evenly spaced frames, first and last included.
@@ -285,9 +285,9 @@ PartSegmentation finish(Triangles triangles, std::vector<int> part, const RigidE
 PartSegmentation segment_parts(std::span<const Vec3> reference, Triangles triangles, std::span<const Vec3> positions,
                                int frame_count, const SegmentationOptions& options) {
   check_inputs(reference, triangles, positions, frame_count, options.sample_frames);
-  require(options.target_parts >= 1, "target_parts must be >= 1");
-  require(options.bandwidth_degrees > 0.0 && options.bandwidth_degrees <= 180.0, "bandwidth_degrees must be in (0, 180]");
-  require(options.max_mean_shift_iterations >= 0, "max_mean_shift_iterations must be >= 0");
+  require_segmentation(options.target_parts >= 1, "target_parts must be >= 1");
+  require_segmentation(options.bandwidth_degrees > 0.0 && options.bandwidth_degrees <= 180.0, "bandwidth_degrees must be in (0, 180]");
+  require_segmentation(options.max_mean_shift_iterations >= 0, "max_mean_shift_iterations must be >= 0");
   const int m = static_cast<int>(reference.size());
   const std::vector<int> frames = sample_frame_indices(frame_count, options.sample_frames);
 
@@ -326,12 +326,12 @@ PartSegmentation segmentation_from_assignment(std::span<const Vec3> reference, T
                                               int sample_frames) {
   check_inputs(reference, triangles, positions, frame_count, sample_frames);
   const size_t expected = kind == AssignmentKind::PerTriangle ? triangles.size() : reference.size();
-  require(assignment.size() == expected, std::to_string(assignment.size()) + " part indices for " + std::to_string(expected) +
+  require_segmentation(assignment.size() == expected, std::to_string(assignment.size()) + " part indices for " + std::to_string(expected) +
                                              (kind == AssignmentKind::PerTriangle ? " triangles" : " markers"));
   for (size_t k = 0; k < assignment.size(); ++k) {
-    require(assignment[k] >= 0, "part index " + std::to_string(assignment[k]) + " at " + std::to_string(k) + " is negative");
+    require_segmentation(assignment[k] >= 0, "part index " + std::to_string(assignment[k]) + " at " + std::to_string(k) + " is negative");
     // More parts than triangles cannot all hold one: a typo, not a segmentation.
-    require(assignment[k] < static_cast<int>(triangles.size()), "part index " + std::to_string(assignment[k]) + " at " +
+    require_segmentation(assignment[k] < static_cast<int>(triangles.size()), "part index " + std::to_string(assignment[k]) + " at " +
                                                                      std::to_string(k) + " is beyond the " +
                                                                      std::to_string(triangles.size()) + " triangles");
   }
@@ -361,12 +361,12 @@ PartSegmentation segmentation_from_assignment(std::span<const Vec3> reference, T
 }
 
 std::vector<int> marker_parts(Triangles triangles, std::span<const int> triangle_part, int marker_count) {
-  require(triangle_part.size() == triangles.size(), std::to_string(triangle_part.size()) + " part indices for " +
+  require_segmentation(triangle_part.size() == triangles.size(), std::to_string(triangle_part.size()) + " part indices for " +
                                                         std::to_string(triangles.size()) + " triangles");
   std::vector<std::map<int, int>> count(marker_count);  // marker -> part -> triangles
   for (size_t t = 0; t < triangles.size(); ++t)
     for (int v : triangles[t]) {
-      require(v >= 0 && v < marker_count, "triangle " + std::to_string(t) + " refers to marker " + std::to_string(v));
+      require_segmentation(v >= 0 && v < marker_count, "triangle " + std::to_string(t) + " refers to marker " + std::to_string(v));
       ++count[v][triangle_part[t]];
     }
   std::vector<int> out(marker_count, -1);

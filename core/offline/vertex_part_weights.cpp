@@ -13,7 +13,7 @@
 namespace skinstream {
 namespace {
 
-constexpr Precondition require{"vertex part weights"};
+constexpr Precondition require_vertex_weights{"vertex part weights"};
 
 // Below this, an interpolated weight counts as zero (a vertex on an edge or a vertex of the
 // triangle gets exactly what its markers have, not a trace of the opposite marker).
@@ -67,35 +67,35 @@ VertexPartWeights vertex_part_weights(std::span<const Vec3> vertices, std::span<
                                       std::span<const PartMember> part_members, std::span<const PartJoint> joints,
                                       std::span<const char> under_marker, bool blend_folds, double joint_blend_mm) {
   const int m = static_cast<int>(markers.size());
-  require(!triangles.empty(), "no marker-surface triangles");
-  require(!part_member_offsets.empty() && part_member_offsets.front() == 0 &&
+  require_vertex_weights(!triangles.empty(), "no marker-surface triangles");
+  require_vertex_weights(!part_member_offsets.empty() && part_member_offsets.front() == 0 &&
               part_member_offsets.back() == static_cast<int>(part_members.size()),
           "part member offsets do not span the members");
-  for (int i = 0; i < m; ++i) require(markers[i].allFinite(), "marker " + std::to_string(i) + " is not finite");
-  for (size_t j = 0; j < vertices.size(); ++j) require(vertices[j].allFinite(), "vertex " + std::to_string(j) + " is not finite");
+  for (int i = 0; i < m; ++i) require_vertex_weights(markers[i].allFinite(), "marker " + std::to_string(i) + " is not finite");
+  for (size_t j = 0; j < vertices.size(); ++j) require_vertex_weights(vertices[j].allFinite(), "vertex " + std::to_string(j) + " is not finite");
   for (size_t t = 0; t < triangles.size(); ++t)
     for (int v : triangles[t])
-      require(v >= 0 && v < m, "triangle " + std::to_string(t) + " refers to marker " + std::to_string(v) + " of " + std::to_string(m));
+      require_vertex_weights(v >= 0 && v < m, "triangle " + std::to_string(t) + " refers to marker " + std::to_string(v) + " of " + std::to_string(m));
 
   // alpha rows per marker, sorted by part.
   const int part_count = static_cast<int>(part_member_offsets.size()) - 1;
-  require(joint_blend_mm >= 0.0 && std::isfinite(joint_blend_mm),
+  require_vertex_weights(joint_blend_mm >= 0.0 && std::isfinite(joint_blend_mm),
           "the joint blend width " + std::to_string(joint_blend_mm) + " mm is not a distance");
-  require(under_marker.empty() || under_marker.size() == vertices.size(),
+  require_vertex_weights(under_marker.empty() || under_marker.size() == vertices.size(),
           std::to_string(under_marker.size()) + " under-marker flags for " + std::to_string(vertices.size()) + " vertices");
   for (const PartJoint& joint : joints)
-    require(joint.first >= 0 && joint.first < part_count && joint.second >= 0 && joint.second < part_count &&
+    require_vertex_weights(joint.first >= 0 && joint.first < part_count && joint.second >= 0 && joint.second < part_count &&
                 joint.first != joint.second && joint.centre.allFinite() && joint.axis.allFinite(),
             "a joint names parts " + std::to_string(joint.first) + " and " + std::to_string(joint.second) + " of " +
                 std::to_string(part_count) + " or is not finite");
   std::vector<std::vector<PartInfluence>> alpha(m);
   for (int p = 0; p < part_count; ++p) {
-    require(part_member_offsets[p] <= part_member_offsets[p + 1], "part member offsets decrease at part " + std::to_string(p));
+    require_vertex_weights(part_member_offsets[p] <= part_member_offsets[p + 1], "part member offsets decrease at part " + std::to_string(p));
     for (int k = part_member_offsets[p]; k < part_member_offsets[p + 1]; ++k) {
       const PartMember& member = part_members[k];
-      require(member.marker >= 0 && member.marker < m,
+      require_vertex_weights(member.marker >= 0 && member.marker < m,
               "part " + std::to_string(p) + " names marker " + std::to_string(member.marker) + " of " + std::to_string(m));
-      require(member.weight >= 0.0 && std::isfinite(member.weight),
+      require_vertex_weights(member.weight >= 0.0 && std::isfinite(member.weight),
               "marker " + std::to_string(member.marker) + " has weight " + std::to_string(member.weight) + " in part " + std::to_string(p));
       if (member.weight > 0.0) alpha[member.marker].push_back({p, member.weight});
     }
@@ -168,7 +168,7 @@ VertexPartWeights vertex_part_weights(std::span<const Vec3> vertices, std::span<
       }
     }
     std::erase_if(blend, [](const PartInfluence& b) { return !(b.weight > kZeroWeight); });
-    require(!blend.empty(), "the markers of triangle " + std::to_string(t) + " belong to no part");
+    require_vertex_weights(!blend.empty(), "the markers of triangle " + std::to_string(t) + " belong to no part");
     std::sort(blend.begin(), blend.end(), [](const PartInfluence& a, const PartInfluence& b) { return a.part < b.part; });
     normalize_influences(blend);
   };
@@ -209,11 +209,11 @@ VertexPartWeights vertex_part_weights(std::span<const Vec3> vertices, std::span<
 
 std::vector<char> vertices_under_markers(std::span<const Vec3> vertices, std::span<const std::array<int, 3>> faces,
                                          std::span<const Vec3> markers) {
-  require(!faces.empty(), "the mesh has no faces");
+  require_vertex_weights(!faces.empty(), "the mesh has no faces");
   const int v = static_cast<int>(vertices.size());
   for (size_t f = 0; f < faces.size(); ++f)
     for (int corner : faces[f])
-      require(corner >= 0 && corner < v, "face " + std::to_string(f) + " refers to vertex " + std::to_string(corner) + " of " + std::to_string(v));
+      require_vertex_weights(corner >= 0 && corner < v, "face " + std::to_string(f) + " refers to vertex " + std::to_string(corner) + " of " + std::to_string(v));
   const std::vector<Triangle> tris(faces.begin(), faces.end());
   const std::vector<Vec3> points(vertices.begin(), vertices.end());
   const TriangleBvh bvh(points, tris);

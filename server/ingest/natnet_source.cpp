@@ -10,16 +10,12 @@
 #include "server/ingest/source_lifecycle.h"
 #include "server/ingest/source_rate_estimate.h"
 #include "server/ingest/source_reconnection.h"
+#include "server/system_clock.h"
 
 namespace skinstream::server {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-int64_t system_now_ns() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch())
-      .count();
-}
 
 Vec3 millimetres(const natnet::Point& metres) {
   return Vec3(1000.0 * metres[0], 1000.0 * metres[1], 1000.0 * metres[2]);

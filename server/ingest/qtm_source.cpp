@@ -13,16 +13,12 @@
 #include "protocol/qtm_parameters.h"
 #include "server/ingest/source_lifecycle.h"
 #include "server/ingest/source_reconnection.h"
+#include "server/system_clock.h"
 
 namespace skinstream::server {
 namespace {
 
-int64_t system_now_ns() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch())
-      .count();
-}
-
-constexpr size_t kReadBytes = 64 * 1024;
+constexpr size_t kQtmReadBytes = 64 * 1024;
 const std::vector<std::string> kComponents = {"3D", "3DNoLabels"};
 
 // Events after which QTM's labels may differ: the parameters are asked for again.
@@ -85,7 +81,7 @@ struct QtmSource::State : std::enable_shared_from_this<QtmSource::State> {
     if (stopped) return;
     const uint64_t gen = ++generation;
     framer.reset();
-    framer.reserve(2 * kReadBytes);
+    framer.reserve(2 * kQtmReadBytes);
     phase = Phase::Welcome;
     parameters_pending = false;
     expecting_frames = false;
@@ -106,7 +102,7 @@ struct QtmSource::State : std::enable_shared_from_this<QtmSource::State> {
   }
 
   void read(uint64_t gen) {
-    const auto room = framer.prepare(kReadBytes);
+    const auto room = framer.prepare(kQtmReadBytes);
     socket.async_read_some(asio::buffer(room.data(), room.size()),
                            [self = shared_from_this(), gen](const boost::system::error_code& ec, size_t n) {
                              self->on_read(gen, ec, n);

@@ -5,16 +5,9 @@
 
 #include "protocol/vicon_packet_reader.h"
 #include "server/ingest/vicon_source.h"
+#include "server/system_clock.h"
 
 namespace skinstream::server {
-namespace {
-
-int64_t system_now_ns() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch())
-      .count();
-}
-
-}  // namespace
 
 struct ViconMulticastSource::State : std::enable_shared_from_this<ViconMulticastSource::State> {
   State(asio::io_context& io_context, ViconMulticastSourceOptions opts, SourceSink& frame_sink)

@@ -10,16 +10,12 @@
 
 #include "protocol/vicon_packet_framer.h"
 #include "protocol/vicon_packet_writer.h"
+#include "server/system_clock.h"
 
 namespace skinstream::server {
 namespace {
 
 namespace type = vicon::object_type;
-
-int64_t system_now_ns() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch())
-      .count();
-}
 
 uint64_t marker_key(uint32_t subject_id, uint32_t marker_id) {
   return (static_cast<uint64_t>(subject_id) << 32) | marker_id;

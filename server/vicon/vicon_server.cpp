@@ -15,17 +15,13 @@
 #include "protocol/vicon_packet_writer.h"
 #include "server/listener.h"
 #include "server/logging.h"
+#include "server/system_clock.h"
 
 namespace skinstream::server {
 namespace {
 
 using Packet = std::shared_ptr<const std::vector<unsigned char>>;
 using Clock = std::chrono::steady_clock;
-
-int64_t system_now_ns() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch())
-      .count();
-}
 
 Packet copy_packet(std::span<const unsigned char> bytes) {
   return std::make_shared<const std::vector<unsigned char>>(bytes.begin(), bytes.end());
