@@ -18,6 +18,7 @@
 #include "protocol/makehuman.h"
 #include "protocol/mesh_file.h"
 #include "protocol/subject_file.h"
+#include "support/cli_run.h"
 #include "support/program_run.h"
 #include "support/test_data.h"
 
@@ -25,12 +26,10 @@ namespace skinstream {
 namespace {
 
 using test::ProgramRun;
-ProgramRun run(const std::string& arguments, bool stderr_too = true) {
-  return test::run_program(std::string(SKINSTREAM_CLI) + " " + arguments, stderr_too);
-}
+using test::run_cli;
 
 const std::string kTemplate = test::source_path("replay_data/makehuman/makehuman_hm08_body_only.obj");
-const std::string kCmu02 = test::source_path("replay_data/cmu/85_02.c3d");
+using test::kCmu02;
 const std::string kTennis = test::shared_path("data/captures/kineticstoolkit/kinematics_tennis_serve.c3d");
 
 // A refusal: a non-zero exit, one line that says `why`, and no subject file.
@@ -61,7 +60,7 @@ TriangleMesh sphere(int rings, int segments) {
 
 TEST(SkinstreamActor, BuildsARealActorFromTheTemplateAndSaysWhatItMeasured) {
   const std::string subject = test::scratch_path("cmu02_actor.sksubj");
-  const ProgramRun r = run("build-subject --capture " + kCmu02 + " --mesh " + kTemplate + " --out " + subject, false);
+  const ProgramRun r = run_cli("build-subject --capture " + kCmu02 + " --mesh " + kTemplate + " --out " + subject, false);
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const nlohmann::json report = nlohmann::json::parse(r.output);
   const nlohmann::json& actor = report["actor"];
@@ -90,13 +89,13 @@ TEST(SkinstreamActor, ASphereIsNotABody) {
   const std::string mesh = test::scratch_path("sphere.ply");
   write_ply(mesh, sphere(24, 48));
   const std::string out = test::scratch_path("sphere.sksubj");
-  expect_refused(run("build-subject --capture " + kCmu02 + " --mesh " + mesh + " --out " + out), out, "not a body");
+  expect_refused(run_cli("build-subject --capture " + kCmu02 + " --mesh " + mesh + " --out " + out), out, "not a body");
 }
 
 TEST(SkinstreamActor, AWrongUnitFlagIsRefused) {
   const std::string out = test::scratch_path("wrong_unit.sksubj");
   // The template is in decimetres: in metres it would be 16.7 m tall.
-  expect_refused(run("build-subject --capture " + kCmu02 + " --mesh " + kTemplate + " --mesh-unit m --out " + out), out, "tall");
+  expect_refused(run_cli("build-subject --capture " + kCmu02 + " --mesh " + kTemplate + " --mesh-unit m --out " + out), out, "tall");
 }
 
 // Markers that wander about a room on their own: no body can carry them.
@@ -114,7 +113,7 @@ TEST(SkinstreamActor, MarkersThatNoBodyCarriesAreRefused) {
   const std::string capture = test::scratch_path("cloud.c3d");
   write_capture(cloud, capture);
   const std::string out = test::scratch_path("cloud.sksubj");
-  expect_refused(run("build-subject --capture " + capture + " --mesh " + kTemplate + " --out " + out), out,
+  expect_refused(run_cli("build-subject --capture " + capture + " --mesh " + kTemplate + " --out " + out), out,
                  "cannot be placed on a body");
 }
 
@@ -136,7 +135,7 @@ TEST(SkinstreamActor, MarkersOnABoxAreRefused) {
   const std::string capture = test::scratch_path("box.c3d");
   write_capture(box, capture);
   const std::string out = test::scratch_path("box.sksubj");
-  expect_refused(run("build-subject --capture " + capture + " --mesh " + kTemplate + " --out " + out), out, "rigid object");
+  expect_refused(run_cli("build-subject --capture " + capture + " --mesh " + kTemplate + " --out " + out), out, "rigid object");
 }
 
 // A calibration take of an actor standing still (one real frame held for two seconds, 1 mm of
@@ -151,7 +150,7 @@ TEST(SkinstreamActor, AnActorStandingStillIsRefused) {
   const std::string capture = test::scratch_path("still.c3d");
   write_capture(still, capture);
   const std::string out = test::scratch_path("still.sksubj");
-  expect_refused(run("build-subject --capture " + capture + " --mesh " + kTemplate + " --out " + out), out, "standing still");
+  expect_refused(run_cli("build-subject --capture " + capture + " --mesh " + kTemplate + " --out " + out), out, "standing still");
 }
 
 TEST(SkinstreamActor, ATakeWithNoCompleteFrameIsRefused) {
@@ -160,7 +159,7 @@ TEST(SkinstreamActor, ATakeWithNoCompleteFrameIsRefused) {
   const std::string capture = test::scratch_path("never_complete.c3d");
   write_capture(take, capture);
   const std::string out = test::scratch_path("never_complete.sksubj");
-  expect_refused(run("build-subject --capture " + capture + " --mesh " + kTemplate + " --out " + out), out,
+  expect_refused(run_cli("build-subject --capture " + capture + " --mesh " + kTemplate + " --out " + out), out,
                  "all 41 labelled markers");
 }
 
@@ -191,7 +190,7 @@ TEST(SkinstreamActor, AScanInItsOwnPoseUnitAndAxesGoesThroughTheTemplate) {
   write_ply(mesh, scan);
 
   const std::string subject = test::scratch_path("scan_actor.sksubj");
-  const ProgramRun r = run("build-subject --capture " + kCmu02 + " --mesh " + mesh + " --out " + subject, false);
+  const ProgramRun r = run_cli("build-subject --capture " + kCmu02 + " --mesh " + mesh + " --out " + subject, false);
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const nlohmann::json report = nlohmann::json::parse(r.output);
   const nlohmann::json& through = report["mesh"]["through_the_template"];
@@ -208,7 +207,7 @@ TEST(SkinstreamActor, AScanInItsOwnPoseUnitAndAxesGoesThroughTheTemplate) {
 
 // The measure on a real take: withheld markers followed through the second half, three methods.
 TEST(SkinstreamActor, EvalActorMeasuresHeldOutMarkersOnARealTake) {
-  const ProgramRun r = run("eval-actor --capture " + kTennis + " --folds 2 --stride 4 --json", false);
+  const ProgramRun r = run_cli("eval-actor --capture " + kTennis + " --folds 2 --stride 4 --json", false);
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const nlohmann::json report = nlohmann::json::parse(r.output);
   EXPECT_EQ(report["marker_set"], "Vicon Plug-in Gait (full body)");

@@ -10,6 +10,7 @@
 #include "core/evaluation/gap_plan.h"
 #include "protocol/capture_file.h"
 #include "protocol/subject_file.h"
+#include "support/cli_run.h"
 #include "support/program_run.h"
 #include "support/test_data.h"
 
@@ -17,8 +18,7 @@ namespace skinstream {
 namespace {
 
 using test::ProgramRun;
-// `skinstream ARGUMENTS`, stdout and stderr together.
-ProgramRun run(const std::string& arguments) { return test::run_program(std::string(SKINSTREAM_CLI) + " " + arguments); }
+using test::run_cli;  // `skinstream ARGUMENTS`, stdout and stderr together
 
 // eval-deform on one short breathe take from a 5 s training take: seconds, not minutes.
 std::string quick_eval_deform() {
@@ -32,18 +32,18 @@ std::pair<nlohmann::json, nlohmann::json> quick_eval_default_and(const std::stri
   std::pair<nlohmann::json, nlohmann::json> parsed;
   for (auto [arguments, to] : {std::pair{quick_eval_deform(), &parsed.first},
                                std::pair{quick_eval_deform() + " " + variant, &parsed.second}}) {
-    const ProgramRun r = run(arguments);
+    const ProgramRun r = run_cli(arguments);
     if (r.exit_code == 0) *to = nlohmann::json::parse(r.output);
     else ADD_FAILURE() << arguments << ":\n" << r.output;
   }
   return parsed;
 }
 
-const std::string kCmu02 = test::source_path("replay_data/cmu/85_02.c3d");
-const std::string kCmu12 = test::source_path("replay_data/cmu/85_12.c3d");
+using test::kCmu02;
+using test::kCmu12;
 
 TEST(SkinstreamCli, MissingFileFailsWithOneLineNamingIt) {
-  const ProgramRun r = run("info " + test::scratch_path("absent.c3d"));
+  const ProgramRun r = run_cli("info " + test::scratch_path("absent.c3d"));
   EXPECT_NE(r.exit_code, 0);
   EXPECT_NE(r.output.find("absent.c3d"), std::string::npos);
   EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
@@ -54,25 +54,25 @@ TEST(SkinstreamCli, TruncatedCaptureFailsCleanly) {
   std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   const std::string cut = test::scratch_path("cut.c3d");
   std::ofstream(cut, std::ios::binary) << bytes.substr(0, bytes.size() / 3);
-  const ProgramRun r = run("info " + cut);
+  const ProgramRun r = run_cli("info " + cut);
   EXPECT_NE(r.exit_code, 0);
   EXPECT_NE(r.output.find("cut.c3d"), std::string::npos);
 }
 
 TEST(SkinstreamCli, UnknownExtensionIsRefused) {
-  const ProgramRun r = run("convert " + kCmu02 + " " + test::scratch_path("out.xyz"));
+  const ProgramRun r = run_cli("convert " + kCmu02 + " " + test::scratch_path("out.xyz"));
   EXPECT_NE(r.exit_code, 0);
   EXPECT_NE(r.output.find("out.xyz"), std::string::npos);
 }
 
 TEST(SkinstreamCli, FillRefusesASubjectOfOtherMarkers) {
   const std::string subject = test::scratch_path("cmu.subject");
-  ASSERT_EQ(run("build-subject --capture " + kCmu12 + " --out " + subject).exit_code, 0);
+  ASSERT_EQ(run_cli("build-subject --capture " + kCmu12 + " --out " + subject).exit_code, 0);
   const std::string other = test::scratch_path("other_labels.trc");
   Capture c = read_capture(kCmu02);
   for (auto& l : c.labels) l = "X" + l;
   write_capture(c, other);
-  const ProgramRun r = run("fill --subject " + subject + " " + other + " --out " + test::scratch_path("x.c3d"));
+  const ProgramRun r = run_cli("fill --subject " + subject + " " + other + " --out " + test::scratch_path("x.c3d"));
   EXPECT_NE(r.exit_code, 0);
   EXPECT_NE(r.output.find("none of the subject"), std::string::npos) << r.output;
 }
@@ -80,13 +80,13 @@ TEST(SkinstreamCli, FillRefusesASubjectOfOtherMarkers) {
 TEST(SkinstreamCli, CorruptSubjectIsRefused) {
   const std::string bad = test::scratch_path("corrupt.subject");
   std::ofstream(bad) << "not a subject";
-  const ProgramRun r = run("fill --subject " + bad + " " + kCmu02 + " --out " + test::scratch_path("y.c3d"));
+  const ProgramRun r = run_cli("fill --subject " + bad + " " + kCmu02 + " --out " + test::scratch_path("y.c3d"));
   EXPECT_NE(r.exit_code, 0);
   EXPECT_NE(r.output.find("corrupt.subject"), std::string::npos);
 }
 
 TEST(SkinstreamCli, InfoReportsTheCapture) {
-  const ProgramRun r = run("info --json " + kCmu02);
+  const ProgramRun r = run_cli("info --json " + kCmu02);
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const auto j = nlohmann::json::parse(r.output);
   EXPECT_EQ(j["frames"], 810);
@@ -97,8 +97,8 @@ TEST(SkinstreamCli, InfoReportsTheCapture) {
 
 TEST(SkinstreamCli, ConvertsC3dToTrcAndBack) {
   const std::string trc = test::scratch_path("85_02.trc"), back = test::scratch_path("85_02_back.c3d");
-  ASSERT_EQ(run("convert " + kCmu02 + " " + trc).exit_code, 0);
-  ASSERT_EQ(run("convert " + trc + " " + back).exit_code, 0);
+  ASSERT_EQ(run_cli("convert " + kCmu02 + " " + trc).exit_code, 0);
+  ASSERT_EQ(run_cli("convert " + trc + " " + back).exit_code, 0);
   const Capture a = read_capture(kCmu02), b = read_capture(back);
   ASSERT_EQ(a.labels, b.labels);
   ASSERT_EQ(a.frame_count, b.frame_count);
@@ -112,7 +112,7 @@ TEST(SkinstreamCli, ConvertsC3dToTrcAndBack) {
 // Measured (seed 5): mean 16.7 mm, mean normalised 0.065 (linear interpolation: 340 mm).
 TEST(SkinstreamCli, FillsDeletedGapsOfARealCaptureAccurately) {
   const std::string subject = test::scratch_path("cmu12.subject");
-  ASSERT_EQ(run("build-subject --capture " + kCmu12 + " --out " + subject).exit_code, 0);
+  ASSERT_EQ(run_cli("build-subject --capture " + kCmu12 + " --out " + subject).exit_code, 0);
   const Capture truth = read_capture(kCmu02);
   GapPlanOptions plan;
   plan.seed = 5;
@@ -120,7 +120,7 @@ TEST(SkinstreamCli, FillsDeletedGapsOfARealCaptureAccurately) {
   ASSERT_GT(gaps.size(), 10u);
   const std::string gapped = test::scratch_path("85_02_gaps.c3d"), filled_path = test::scratch_path("85_02_filled.c3d");
   write_capture(apply_gaps(truth, gaps), gapped);
-  const ProgramRun r = run("fill --subject " + subject + " " + gapped + " --out " + filled_path);
+  const ProgramRun r = run_cli("fill --subject " + subject + " " + gapped + " --out " + filled_path);
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_EQ(nlohmann::json::parse(r.output)["latency_frames"], 0);
 
@@ -163,7 +163,7 @@ TEST(SkinstreamCli, EvalFillLongGapsHoldUpAgainstTheOfflinePca) {
                            Take{"hdm05/HDM_bd_05-01_01_120.c3d", 3, true}, Take{"hdm05/HDM_bd_05-01_01_120.c3d", 5, true},
                            Take{"kineticstoolkit/kinematics_tennis_serve.c3d", 6, false}}) {
     SCOPED_TRACE(take.capture + " seed " + std::to_string(take.seed));
-    const ProgramRun r = run("eval-fill --capture " + captures + take.capture + " --seed " + std::to_string(take.seed) +
+    const ProgramRun r = run_cli("eval-fill --capture " + captures + take.capture + " --seed " + std::to_string(take.seed) +
                              " --gap-protocol long --json");
     ASSERT_EQ(r.exit_code, 0) << r.output;
     const auto j = nlohmann::json::parse(r.output);
@@ -193,7 +193,7 @@ TEST(SkinstreamCli, EvalFillLongGapsHoldUpAgainstTheOfflinePca) {
 // motion. Measured when written: 1.006 trajectories per marker after merging, 0.2% wrongly
 // labelled fragments, 0.013 mean normalised error on deleted-then-filled samples.
 TEST(SkinstreamCli, SynthStatsOnAShortFlexTakeMeetTheRelabelAndFillTargets) {
-  const ProgramRun r = run("synth --motion flex --seconds 2 --seed 3 --train-seconds 10 --stats --out " +
+  const ProgramRun r = run_cli("synth --motion flex --seconds 2 --seed 3 --train-seconds 10 --stats --out " +
                            test::scratch_path("flex.c3d") + " --body " +
                            std::string(SKINSTREAM_SHARED_DIR) + "/data/meshes/makehuman");
   ASSERT_EQ(r.exit_code, 0) << r.output;
@@ -214,7 +214,7 @@ TEST(SkinstreamCli, SynthStatsOnAShortFlexTakeMeetTheRelabelAndFillTargets) {
 TEST(SkinstreamCli, SynthStatsRelabelAtMostThreePerMilleOnFastMotions) {
   for (const std::string motion : {"punch", "golf"}) {
     SCOPED_TRACE(motion);
-    const ProgramRun r = run("synth --motion " + motion + " --seed 1 --stats --out " + test::scratch_path(motion + ".c3d") +
+    const ProgramRun r = run_cli("synth --motion " + motion + " --seed 1 --stats --out " + test::scratch_path(motion + ".c3d") +
                              " --body " + std::string(SKINSTREAM_SHARED_DIR) + "/data/meshes/makehuman");
     ASSERT_EQ(r.exit_code, 0) << r.output;
     const auto s = nlohmann::json::parse(r.output)["skinstream"];
@@ -229,7 +229,7 @@ TEST(SkinstreamCli, SynthStatsRelabelAtMostThreePerMilleOnFastMotions) {
 // first of which carries the row's maximum, with the frame, the distance to the nearest marker
 // and (part-based methods only) the vertex's part weights.
 TEST(SkinstreamCli, EvalDeformNamesTheVerticesBehindEachMaximum) {
-  const ProgramRun r = run(quick_eval_deform());
+  const ProgramRun r = run_cli(quick_eval_deform());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const auto j = nlohmann::json::parse(r.output);
   const auto& take = j["takes"][0];
@@ -271,7 +271,7 @@ TEST(SkinstreamCli, EvalDeformNamesTheVerticesBehindEachMaximum) {
 // the full method with every row but the oracle, on mean and p95; the maxima are reported with
 // the method that has the lowest and where the full method's occurs.
 TEST(SkinstreamCli, EvalDeformHasAConventionalLbsRowBehindTheFullMethod) {
-  const ProgramRun r = run(quick_eval_deform());
+  const ProgramRun r = run_cli(quick_eval_deform());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const auto j = nlohmann::json::parse(r.output);
   const auto& methods = j["takes"][0]["methods"];
@@ -305,7 +305,7 @@ TEST(SkinstreamCli, EvalDeformHasAConventionalLbsRowBehindTheFullMethod) {
 // (breathe 1.25 and punch 3.71 mm against rigid + RBF's 1.12 and 3.26 mm, this command at
 // 40d6cd0).
 TEST(SkinstreamCli, EvalDeformFullMethodLeadsOnAHeldOutSubject) {
-  const ProgramRun r = run("eval-deform --seed 2 --motions breathe,punch --seconds 2 --json --body " +
+  const ProgramRun r = run_cli("eval-deform --seed 2 --motions breathe,punch --seconds 2 --json --body " +
                            std::string(SKINSTREAM_SHARED_DIR) + "/data/meshes/makehuman");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const auto j = nlohmann::json::parse(r.output);
@@ -352,7 +352,7 @@ TEST(SkinstreamCli, EvalDeformBoundaryRings) {
     EXPECT_EQ(w["part_sizes"][k]["triangles"], p["part_sizes"][k]["triangles"]);
   EXPECT_GT(w["boundary_markers"].get<int>(), p["boundary_markers"].get<int>());
   EXPECT_GT(w["mean_parts_per_vertex"].get<double>(), p["mean_parts_per_vertex"].get<double>());
-  const ProgramRun negative = run(quick_eval_deform() + " --boundary-rings -1");
+  const ProgramRun negative = run_cli(quick_eval_deform() + " --boundary-rings -1");
   EXPECT_NE(negative.exit_code, 0);
   EXPECT_NE(negative.output.find("--boundary-rings"), std::string::npos) << negative.output;
 }
@@ -379,7 +379,7 @@ TEST(SkinstreamCli, EvalDeformFoldSmoothing) {
 TEST(SkinstreamCli, EvalDeformReadsAndWritesPartFiles) {
   const std::string base = quick_eval_deform();
   const std::string written = test::scratch_path("eval_parts.json"), sides = test::scratch_path("eval_sides.json");
-  const ProgramRun automatic = run(base + " --part-file-out " + written);
+  const ProgramRun automatic = run_cli(base + " --part-file-out " + written);
   ASSERT_EQ(automatic.exit_code, 0) << automatic.output;
   const auto a = nlohmann::json::parse(automatic.output);
   ASSERT_EQ(a["part_sizes"].size(), a["parts"].get<size_t>());
@@ -390,7 +390,7 @@ TEST(SkinstreamCli, EvalDeformReadsAndWritesPartFiles) {
   nlohmann::json by_side = nlohmann::json::object();
   for (const auto& [name, part] : file.items()) by_side[name] = name.find("_L_") != std::string::npos ? 1 : 0;
   std::ofstream(sides) << by_side.dump();
-  const ProgramRun two = run(base + " --part-file " + sides);
+  const ProgramRun two = run_cli(base + " --part-file " + sides);
   ASSERT_EQ(two.exit_code, 0) << two.output;
   const auto b = nlohmann::json::parse(two.output);
   EXPECT_EQ(b["parts"], 2);
@@ -408,13 +408,13 @@ TEST(SkinstreamCli, EvalDeformReadsAndWritesPartFiles) {
   EXPECT_GT(mean_of(b, "rigid"), mean_of(a, "rigid"));
 
   std::ofstream(sides) << R"({"no_such_marker": 0})";
-  const ProgramRun bad = run(base + " --part-file " + sides);
+  const ProgramRun bad = run_cli(base + " --part-file " + sides);
   EXPECT_NE(bad.exit_code, 0);
   EXPECT_NE(bad.output.find("unknown marker \"no_such_marker\""), std::string::npos) << bad.output;
 }
 
 TEST(SkinstreamCli, SynthRefusesAnUnknownMotion) {
-  const ProgramRun r = run("synth --motion moonwalk --out " + test::scratch_path("m.c3d"));
+  const ProgramRun r = run_cli("synth --motion moonwalk --out " + test::scratch_path("m.c3d"));
   EXPECT_NE(r.exit_code, 0);
   EXPECT_NE(r.output.find("moonwalk"), std::string::npos) << r.output;
 }

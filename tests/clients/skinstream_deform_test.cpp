@@ -15,6 +15,7 @@
 #include "protocol/capture_file.h"
 #include "protocol/mesh_file.h"
 #include "protocol/point_cache.h"
+#include "support/cli_run.h"
 #include "support/program_run.h"
 #include "support/test_data.h"
 
@@ -23,8 +24,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using test::ProgramRun;
-
-ProgramRun run(const std::string& arguments) { return test::run_program(std::string(SKINSTREAM_CLI) + " " + arguments); }
+using test::run_cli;
 
 const std::string kSubject = std::string(SKINSTREAM_DEMO_DIR) + "/subject.sksubj";
 
@@ -34,7 +34,7 @@ struct ShortTake {
   std::string observed = test::scratch_path("punch.c3d");
   std::string truth = test::scratch_path("punch_truth.c3d");
   ShortTake() {
-    const ProgramRun r = run("synth --motion punch --seconds 0.1 --seed 1 --body " + test::source_path("replay_data/makehuman") +
+    const ProgramRun r = run_cli("synth --motion punch --seconds 0.1 --seed 1 --body " + test::source_path("replay_data/makehuman") +
                              " --out " + observed + " --truth " + truth);
     EXPECT_EQ(r.exit_code, 0) << r.output;
   }
@@ -57,7 +57,7 @@ nlohmann::json summary(const std::string& output) {
 TEST(SkinstreamDeform, PlyFramesAndThePointCacheHoldTheSameMeshes) {
   const ShortTake take;
   const std::string out = test::scratch_path("ply");
-  const ProgramRun r = run("deform --subject " + kSubject + " --capture " + take.truth + " --out " + out);
+  const ProgramRun r = run_cli("deform --subject " + kSubject + " --capture " + take.truth + " --out " + out);
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const nlohmann::json s = summary(r.output);
   EXPECT_EQ(s["frames"], 12);
@@ -95,7 +95,7 @@ TEST(SkinstreamDeform, PlyFramesAndThePointCacheHoldTheSameMeshes) {
 TEST(SkinstreamDeform, ObjFramesCarryUnitNormals) {
   const ShortTake take;
   const std::string out = test::scratch_path("obj");
-  const ProgramRun r = run("deform --subject " + kSubject + " --capture " + take.truth + " --out " + out + " --format obj --no-pc2");
+  const ProgramRun r = run_cli("deform --subject " + kSubject + " --capture " + take.truth + " --out " + out + " --format obj --no-pc2");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_FALSE(fs::exists(out + "/deformed.pc2"));
   const std::vector<std::string> frames = files_named(out, "frame_");
@@ -119,13 +119,13 @@ TEST(SkinstreamDeform, ObjFramesCarryUnitNormals) {
 TEST(SkinstreamDeform, Pc2FormatWritesThePointCacheAlone) {
   const ShortTake take;
   const std::string out = test::scratch_path("pc2");
-  const ProgramRun r = run("deform --subject " + kSubject + " --capture " + take.truth + " --out " + out + " --format pc2");
+  const ProgramRun r = run_cli("deform --subject " + kSubject + " --capture " + take.truth + " --out " + out + " --format pc2");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_TRUE(files_named(out, "frame_").empty());
   EXPECT_EQ(read_point_cache(out + "/deformed.pc2").sample_count, 12);
 
   const ProgramRun nothing =
-      run("deform --subject " + kSubject + " --capture " + take.truth + " --out " + out + " --format pc2 --no-pc2");
+      run_cli("deform --subject " + kSubject + " --capture " + take.truth + " --out " + out + " --format pc2 --no-pc2");
   EXPECT_NE(nothing.exit_code, 0);
   EXPECT_NE(nothing.output.find("nothing would be written"), std::string::npos) << nothing.output;
 }
@@ -145,13 +145,13 @@ TEST(SkinstreamDeform, GapsNeedFillAndAreReported) {
   ASSERT_GT(frames_with_gaps, 0) << "the synthetic take has no occlusion to test with";
 
   const std::string out = test::scratch_path("gaps");
-  const ProgramRun raw = run("deform --subject " + kSubject + " --capture " + take.observed + " --out " + out + " --format none");
+  const ProgramRun raw = run_cli("deform --subject " + kSubject + " --capture " + take.observed + " --out " + out + " --format none");
   EXPECT_EQ(raw.exit_code, 2) << raw.output;
   EXPECT_NE(raw.output.find("use --fill"), std::string::npos) << raw.output;
   EXPECT_GT(summary(raw.output)["frames_with_missing_markers"].get<int>(), 0);
 
   const ProgramRun filled =
-      run("deform --subject " + kSubject + " --capture " + take.observed + " --out " + out + " --format none --fill");
+      run_cli("deform --subject " + kSubject + " --capture " + take.observed + " --out " + out + " --format none --fill");
   ASSERT_EQ(filled.exit_code, 0) << filled.output;
   EXPECT_EQ(summary(filled.output)["frames_with_missing_markers"], 0);
   EXPECT_EQ(read_point_cache(out + "/deformed.pc2").sample_count, observed.frame_count);
@@ -159,8 +159,8 @@ TEST(SkinstreamDeform, GapsNeedFillAndAreReported) {
 
 TEST(SkinstreamDeform, RefusesASubjectWithoutAMesh) {
   const std::string subject = test::scratch_path("markers_only.sksubj");
-  ASSERT_EQ(run("build-subject --capture " + test::source_path("replay_data/cmu/85_12.c3d") + " --out " + subject).exit_code, 0);
-  const ProgramRun r = run("deform --subject " + subject + " --capture " + test::source_path("replay_data/cmu/85_12.c3d") +
+  ASSERT_EQ(run_cli("build-subject --capture " + test::source_path("replay_data/cmu/85_12.c3d") + " --out " + subject).exit_code, 0);
+  const ProgramRun r = run_cli("deform --subject " + subject + " --capture " + test::source_path("replay_data/cmu/85_12.c3d") +
                            " --out " + test::scratch_path("none"));
   EXPECT_NE(r.exit_code, 0);
   EXPECT_NE(r.output.find("no detailed mesh"), std::string::npos) << r.output;
@@ -172,7 +172,7 @@ TEST(SkinstreamDeform, RefusesACaptureOfOtherMarkers) {
   for (auto& label : other.labels) label = "X" + label;
   const std::string path = test::scratch_path("other.c3d");
   write_capture(other, path);
-  const ProgramRun r = run("deform --subject " + kSubject + " --capture " + path + " --out " + test::scratch_path("other"));
+  const ProgramRun r = run_cli("deform --subject " + kSubject + " --capture " + path + " --out " + test::scratch_path("other"));
   EXPECT_NE(r.exit_code, 0);
   EXPECT_NE(r.output.find("have no channel"), std::string::npos) << r.output;
 }
@@ -180,7 +180,7 @@ TEST(SkinstreamDeform, RefusesACaptureOfOtherMarkers) {
 TEST(SkinstreamDeform, RefusesAnUnknownFormat) {
   const ShortTake take;
   const ProgramRun r =
-      run("deform --subject " + kSubject + " --capture " + take.truth + " --out " + test::scratch_path("x") + " --format stl");
+      run_cli("deform --subject " + kSubject + " --capture " + take.truth + " --out " + test::scratch_path("x") + " --format stl");
   EXPECT_NE(r.exit_code, 0);
   EXPECT_NE(r.output.find("stl"), std::string::npos) << r.output;
 }
@@ -204,7 +204,7 @@ class SkinstreamPartFile : public ::testing::Test {
 
 TEST_F(SkinstreamPartFile, WrittenPartsReadBackAndUnusedOnesAreReported) {
   const std::string first = test::scratch_path("parts_a.json"), second = test::scratch_path("parts_b.json");
-  const ProgramRun a = run(build("--part-file-out " + first, "a"));
+  const ProgramRun a = run_cli(build("--part-file-out " + first, "a"));
   ASSERT_EQ(a.exit_code, 0) << a.output;
   const nlohmann::json report_a = summary(a.output)["mesh"];
   const int parts = report_a["parts"];
@@ -244,10 +244,10 @@ TEST_F(SkinstreamPartFile, WrittenPartsReadBackAndUnusedOnesAreReported) {
       EXPECT_NE(run_back.output.find("hold no triangle"), std::string::npos) << run_back.output;
     }
   };
-  const ProgramRun b = run(build("--part-file " + first + " --part-file-out " + second, "b"));
+  const ProgramRun b = run_cli(build("--part-file " + first + " --part-file-out " + second, "b"));
   ASSERT_EQ(b.exit_code, 0) << b.output;
   check_read_back(file_a, b);
-  const ProgramRun c = run(build("--part-file " + second, "c"));
+  const ProgramRun c = run_cli(build("--part-file " + second, "c"));
   ASSERT_EQ(c.exit_code, 0) << c.output;
   check_read_back(read_json(second), c);
 }
@@ -255,18 +255,18 @@ TEST_F(SkinstreamPartFile, WrittenPartsReadBackAndUnusedOnesAreReported) {
 TEST_F(SkinstreamPartFile, BadPartFilesAndMissingMeshAreRefused) {
   const std::string bad = test::scratch_path("parts_bad.json");
   std::ofstream(bad) << "{\"not_a_marker\": 0}\n";
-  const ProgramRun unknown = run(build("--part-file " + bad, "bad"));
+  const ProgramRun unknown = run_cli(build("--part-file " + bad, "bad"));
   EXPECT_NE(unknown.exit_code, 0);
   EXPECT_NE(unknown.output.find("unknown marker \"not_a_marker\""), std::string::npos) << unknown.output;
   std::ofstream(bad) << "{}\n";
-  const ProgramRun empty = run(build("--part-file " + bad, "empty"));
+  const ProgramRun empty = run_cli(build("--part-file " + bad, "empty"));
   EXPECT_NE(empty.exit_code, 0);
   EXPECT_NE(empty.output.find("has no part"), std::string::npos) << empty.output;
-  const ProgramRun no_mesh = run("build-subject --capture " + demo + "/rom_truth.c3d --out " + test::scratch_path("x.sksubj") +
+  const ProgramRun no_mesh = run_cli("build-subject --capture " + demo + "/rom_truth.c3d --out " + test::scratch_path("x.sksubj") +
                                  " --part-file-out " + test::scratch_path("x.json"));
   EXPECT_NE(no_mesh.exit_code, 0);
   EXPECT_NE(no_mesh.output.find("--part-file-out needs --mesh"), std::string::npos) << no_mesh.output;
-  const ProgramRun ignored = run("build-subject --capture " + demo + "/rom_truth.c3d --out " + test::scratch_path("y.sksubj") +
+  const ProgramRun ignored = run_cli("build-subject --capture " + demo + "/rom_truth.c3d --out " + test::scratch_path("y.sksubj") +
                                  " --part-file " + bad);
   EXPECT_NE(ignored.exit_code, 0);
   EXPECT_NE(ignored.output.find("--part-file needs --mesh"), std::string::npos) << ignored.output;

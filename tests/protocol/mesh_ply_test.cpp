@@ -14,8 +14,8 @@ namespace skinstream {
 namespace {
 
 TEST(MeshPly, RejectsBadIndicesUnwritablePathsAndForeignFiles) {
-  EXPECT_THROW(write_ply(test::scratch_path("bad.ply"), {Vec3::Zero()}, {{0, 1, 2, -1}}), FileError);
-  EXPECT_THROW(write_ply(test::scratch_path("no_dir/x.ply"), {Vec3::Zero()}, {}), FileError);
+  EXPECT_THROW(write_ply(test::scratch_path("bad.ply"), {Vec3::Zero()}, std::vector<Face>{{0, 1, 2, -1}}), FileError);
+  EXPECT_THROW(write_ply(test::scratch_path("no_dir/x.ply"), {Vec3::Zero()}, std::vector<Face>{}), FileError);
   EXPECT_THROW(read_ply(test::scratch_path("no_such.ply")), FileError);
   const std::string ascii = test::scratch_path("ascii.ply");
   std::ofstream(ascii) << "ply\nformat ascii 1.0\nelement vertex 0\nend_header\n";
@@ -31,7 +31,7 @@ TEST(MeshPly, FaceIndexOutOfRangeIsRefused) {
   const std::string fuzzed = test::source_path("tests/protocol/fixtures/fuzz/ply_face_index_out_of_range.ply");
   EXPECT_TRUE(test::throws_file_error([&] { read_ply(fuzzed); }, fuzzed, "uses vertex"));
   const std::string negative = test::scratch_path("negative_index.ply");
-  write_ply(negative, {Vec3::Zero(), Vec3::UnitX(), Vec3::UnitY()}, {{0, 1, 2, -1}});
+  write_ply(negative, {Vec3::Zero(), Vec3::UnitX(), Vec3::UnitY()}, std::vector<Face>{{0, 1, 2, -1}});
   std::string bytes;
   {
     std::ifstream in(negative, std::ios::binary);

@@ -18,7 +18,7 @@ Command parsed(const std::string& text) {
   return c;
 }
 
-std::string error_of(const std::string& text) {
+std::string command_error_of(const std::string& text) {
   Command c;
   std::string error;
   EXPECT_FALSE(parse_command(text, c, error)) << "accepted: " << text;
@@ -31,8 +31,8 @@ TEST(QtmCommand, Version) {
   EXPECT_EQ(c.major, 1);
   EXPECT_EQ(c.minor, 19);
   EXPECT_EQ(parsed("version").minor, -1);  // asks for the version in use
-  EXPECT_FALSE(error_of("Version one.two").empty());
-  EXPECT_FALSE(error_of("Version 1.").empty());
+  EXPECT_FALSE(command_error_of("Version one.two").empty());
+  EXPECT_FALSE(command_error_of("Version 1.").empty());
 }
 
 TEST(QtmCommand, StreamFramesWithRateUdpAndComponents) {
@@ -56,10 +56,10 @@ TEST(QtmCommand, StreamFramesWithRateUdpAndComponents) {
   EXPECT_TRUE(c.udp_address.empty());
 
   EXPECT_EQ(parsed("StreamFrames Stop").kind, Command::Kind::StreamFramesStop);
-  EXPECT_FALSE(error_of("StreamFrames Frequency:0 3D").empty());
-  EXPECT_FALSE(error_of("StreamFrames AllFrames").empty());
-  EXPECT_FALSE(error_of("StreamFrames AllFrames UDP:70000 3D").empty());
-  EXPECT_FALSE(error_of("StreamFrames").empty());
+  EXPECT_FALSE(command_error_of("StreamFrames Frequency:0 3D").empty());
+  EXPECT_FALSE(command_error_of("StreamFrames AllFrames").empty());
+  EXPECT_FALSE(command_error_of("StreamFrames AllFrames UDP:70000 3D").empty());
+  EXPECT_FALSE(command_error_of("StreamFrames").empty());
 }
 
 TEST(QtmCommand, OthersAndUnknown) {
@@ -69,7 +69,7 @@ TEST(QtmCommand, OthersAndUnknown) {
   EXPECT_EQ(p.components, (std::vector<std::string>{"General", "3D"}));
   EXPECT_EQ(parsed("TakeControl secret").kind, Command::Kind::Other);
   EXPECT_EQ(parsed("TakeControl secret").word, "TakeControl");
-  EXPECT_FALSE(error_of("   ").empty());
+  EXPECT_FALSE(command_error_of("   ").empty());
 }
 
 TEST(QtmCommand, StreamFramesCommandIsWrittenAsParsed) {
@@ -100,7 +100,7 @@ TEST(QtmCommand, ControlBytesInARefusedCommandAreEscapedInTheError) {
     return std::all_of(text.begin(), text.end(), [](char c) { return c >= 0x20 && c < 0x7f; });
   };
   const std::string stream_frames = test::read_bytes(test::source_path("tests/protocol/fixtures/fuzz/qtm_command_control_bytes.txt"));
-  const std::string rate_error = error_of(stream_frames);
+  const std::string rate_error = command_error_of(stream_frames);
   EXPECT_TRUE(printable(rate_error)) << rate_error;
   EXPECT_EQ(rate_error, "StreamFrames: bad rate 'AllFra\\x89es'");
 
@@ -108,7 +108,7 @@ TEST(QtmCommand, ControlBytesInARefusedCommandAreEscapedInTheError) {
   Packet decoded;
   std::string error;
   ASSERT_TRUE(decode_packet({reinterpret_cast<const unsigned char*>(packet.data()), packet.size()}, decoded, error)) << error;
-  const std::string version_error = error_of(decoded.text);
+  const std::string version_error = command_error_of(decoded.text);
   EXPECT_TRUE(printable(version_error)) << version_error;
   EXPECT_EQ(version_error.rfind("Version: bad version 'Version 1.1\\xba", 0), 0u) << version_error;
 }

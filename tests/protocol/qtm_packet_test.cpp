@@ -37,7 +37,7 @@ ByteVector data_3d_written() {
   return bytes_of(writer.finish());
 }
 
-std::string error_of(const ByteVector& packet) {
+std::string packet_error_of(const ByteVector& packet) {
   Packet out;
   std::string error;
   EXPECT_FALSE(decode_packet(packet, out, error)) << "accepted a bad packet";
@@ -148,7 +148,7 @@ TEST(QtmPacket, EveryTruncationIsRejected) {
     const ByteVector whole = fixture(name);
     for (size_t n = 0; n < whole.size(); ++n) {
       const ByteVector cut(whole.begin(), whole.begin() + static_cast<long>(n));
-      EXPECT_FALSE(error_of(cut).empty()) << name << " cut at " << n;
+      EXPECT_FALSE(packet_error_of(cut).empty()) << name << " cut at " << n;
     }
   }
 }
@@ -157,39 +157,39 @@ TEST(QtmPacket, InconsistentDataIsRejected) {
   const ByteVector good = fixture("data_3d.bin");
   ByteVector more_markers = good;
   put_u32(more_markers, 32, 3);  // the 3D component says 3 markers but holds 2
-  EXPECT_NE(error_of(more_markers).find("says 3 markers"), std::string::npos);
+  EXPECT_NE(packet_error_of(more_markers).find("says 3 markers"), std::string::npos);
 
   ByteVector overrun = good;
   put_u32(overrun, 24, 1000);  // the first component runs past the packet
-  EXPECT_NE(error_of(overrun).find("1000 bytes"), std::string::npos);
+  EXPECT_NE(packet_error_of(overrun).find("1000 bytes"), std::string::npos);
 
   ByteVector extra_component = good;
   put_u32(extra_component, 20, 3);  // three components announced, two present
-  EXPECT_NE(error_of(extra_component).find("component 3 of 3"), std::string::npos);
+  EXPECT_NE(packet_error_of(extra_component).find("component 3 of 3"), std::string::npos);
 
   ByteVector trailing = good;
   trailing.push_back(0);
   put_u32(trailing, 0, static_cast<uint32_t>(trailing.size()));
-  EXPECT_NE(error_of(trailing).find("after its 2 components"), std::string::npos);
+  EXPECT_NE(packet_error_of(trailing).find("after its 2 components"), std::string::npos);
 
   ByteVector twice = good;  // the 3D no labels component turned into a second 3D one
   put_u32(twice, 68, component::k3d);
-  EXPECT_FALSE(error_of(twice).empty());
+  EXPECT_FALSE(packet_error_of(twice).empty());
 
   ByteVector size_mismatch = good;
   put_u32(size_mismatch, 0, static_cast<uint32_t>(good.size() + 4));
-  EXPECT_NE(error_of(size_mismatch).find("size field"), std::string::npos);
+  EXPECT_NE(packet_error_of(size_mismatch).find("size field"), std::string::npos);
 
   ByteVector oversize = good;
   put_u32(oversize, 0, kMaxPacketBytes + 1);
-  EXPECT_NE(error_of(oversize).find("limit"), std::string::npos);
+  EXPECT_NE(packet_error_of(oversize).find("limit"), std::string::npos);
 
   ByteVector long_event = fixture("event_rt_from_file_started.bin");
   long_event.push_back(0);
   put_u32(long_event, 0, 10);
-  EXPECT_FALSE(error_of(long_event).empty());
+  EXPECT_FALSE(packet_error_of(long_event).empty());
 
-  EXPECT_NE(error_of({8, 0, 0, 0, 99, 0, 0, 0}).find("unsupported packet type 99"), std::string::npos);
+  EXPECT_NE(packet_error_of({8, 0, 0, 0, 99, 0, 0, 0}).find("unsupported packet type 99"), std::string::npos);
 }
 
 TEST(QtmPacket, FramerCutsAStreamFedByteByByte) {

@@ -7,25 +7,19 @@
 #include <fstream>
 #include <iterator>
 
+#include "support/subscriber_fixture.h"
 #include "support/test_data.h"
 
 namespace skinstream::subscriber {
 namespace {
 
-std::vector<unsigned char> fixture(const std::string& name) {
-  std::ifstream in(test::source_path("tests/protocol/fixtures/subscriber/" + name), std::ios::binary);
-  EXPECT_TRUE(in) << name;
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
-std::span<const unsigned char> payload_of(const std::vector<unsigned char>& message) {
-  return std::span<const unsigned char>(message).subspan(kHeaderBytes);
-}
+using test::payload_of;
+using test::subscriber_fixture;
 
 // model.bin, written from the spec by make_v2_fixtures.py: 3 vertices, 2 parts (2 and 1
 // members), vertex 0 blended 0.75 / 0.25 between them.
 TEST(SubscriberModel, MatchesGoldenBytesBothWays) {
-  const std::vector<unsigned char> golden = fixture("model.bin");
+  const std::vector<unsigned char> golden = subscriber_fixture("model.bin");
   const MessageHeader header = decode_header(golden);
   EXPECT_EQ(header.type, MessageType::Model);
   EXPECT_EQ(header.version, kVersion2);
@@ -47,7 +41,7 @@ TEST(SubscriberModel, MatchesGoldenBytesBothWays) {
 }
 
 TEST(SubscriberModel, EveryTruncationAndExtensionIsRejected) {
-  const std::vector<unsigned char> golden = fixture("model.bin");
+  const std::vector<unsigned char> golden = subscriber_fixture("model.bin");
   for (size_t n = kHeaderBytes; n < golden.size(); ++n)
     EXPECT_THROW(decode_model(std::span(golden).subspan(kHeaderBytes, n - kHeaderBytes)), DecodeError) << "cut at " << n;
   std::vector<unsigned char> longer(golden.begin() + kHeaderBytes, golden.end());
@@ -56,7 +50,7 @@ TEST(SubscriberModel, EveryTruncationAndExtensionIsRejected) {
 }
 
 TEST(SubscriberModel, InconsistentModelsAreRejectedWithTheReason) {
-  const std::vector<unsigned char> golden = fixture("model.bin");
+  const std::vector<unsigned char> golden = subscriber_fixture("model.bin");
   auto expect_rejected = [&](size_t payload_offset, const void* value, size_t bytes, const char* reason) {
     std::vector<unsigned char> bad(golden.begin() + kHeaderBytes, golden.end());
     std::memcpy(bad.data() + payload_offset, value, bytes);

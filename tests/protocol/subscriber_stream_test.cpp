@@ -9,22 +9,14 @@
 #include <iterator>
 #include <random>
 
+#include "support/subscriber_fixture.h"
 #include "support/test_data.h"
 
 namespace skinstream::subscriber {
 namespace {
 
-// The golden files were written independently of this encoder (byte by byte from the spec).
-std::vector<unsigned char> fixture(const std::string& name) {
-  const std::string path = test::source_path("tests/protocol/fixtures/subscriber/" + name);
-  std::ifstream in(path, std::ios::binary);
-  EXPECT_TRUE(in) << path;
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
-std::span<const unsigned char> payload_of(const std::vector<unsigned char>& message) {
-  return std::span<const unsigned char>(message).subspan(kHeaderBytes);
-}
+using test::payload_of;
+using test::subscriber_fixture;
 
 const std::vector<float> kPositions = {0, 100, 5, 65535, 131170, 5, 0, 2100, 5};
 const std::vector<float> kNormals = {1, 0, 0, 0, -1, 0, 0, 0, 1};
@@ -67,7 +59,7 @@ MeshInfo fixture_mesh_info() {
 }
 
 TEST(SubscriberStream, HeaderRejectsBadMagicVersionTypeAndSize) {
-  std::vector<unsigned char> good = fixture("hello.bin");
+  std::vector<unsigned char> good = subscriber_fixture("hello.bin");
   EXPECT_NO_THROW(decode_header(good));
   auto expect_reject = [&](size_t at, unsigned char value, const char* reason) {
     std::vector<unsigned char> bad = good;
@@ -88,8 +80,8 @@ TEST(SubscriberStream, HeaderRejectsBadMagicVersionTypeAndSize) {
 }
 
 TEST(SubscriberStream, HelloMatchesGoldenBytes) {
-  EXPECT_EQ(encode_hello({.wants = kWantNormals | kWantMarkers}), fixture("hello.bin"));
-  EXPECT_EQ(decode_hello(payload_of(fixture("hello.bin"))).wants, kWantNormals | kWantMarkers);
+  EXPECT_EQ(encode_hello({.wants = kWantNormals | kWantMarkers}), subscriber_fixture("hello.bin"));
+  EXPECT_EQ(decode_hello(payload_of(subscriber_fixture("hello.bin"))).wants, kWantNormals | kWantMarkers);
   const std::vector<unsigned char> reserved = encode_hello({.wants = 0x20});
   EXPECT_THROW(decode_hello(payload_of(reserved)), DecodeError);
   EXPECT_EQ(decode_hello(payload_of(encode_hello({.wants = kWantPaced}))).wants, kWantPaced);
@@ -97,14 +89,14 @@ TEST(SubscriberStream, HelloMatchesGoldenBytes) {
 
 // ack.bin was written with Python's struct: b'SKSF' + pack('<HHI', 1, 5, 4) + pack('<I', 123456).
 TEST(SubscriberStream, AckMatchesGoldenBytes) {
-  EXPECT_EQ(encode_ack({123456}), fixture("ack.bin"));
-  const std::vector<unsigned char> golden = fixture("ack.bin");
+  EXPECT_EQ(encode_ack({123456}), subscriber_fixture("ack.bin"));
+  const std::vector<unsigned char> golden = subscriber_fixture("ack.bin");
   EXPECT_EQ(decode_header(golden).type, MessageType::Ack);
   EXPECT_EQ(decode_ack(payload_of(golden)).frame_number, 123456u);
 }
 
 TEST(SubscriberStream, MeshInfoMatchesGoldenBytes) {
-  const std::vector<unsigned char> golden = fixture("mesh_info.bin");
+  const std::vector<unsigned char> golden = subscriber_fixture("mesh_info.bin");
   EXPECT_EQ(encode_mesh_info(fixture_mesh_info()), golden);
   const MeshInfo decoded = decode_mesh_info(payload_of(golden));
   EXPECT_EQ(decoded.vertex_count, 4u);
@@ -125,7 +117,7 @@ TEST(SubscriberStream, MeshInfoRejectsOutOfRangeIndices) {
 }
 
 TEST(SubscriberStream, FloatFrameMatchesGoldenBytes) {
-  const std::vector<unsigned char> golden = fixture("frame_float.bin");
+  const std::vector<unsigned char> golden = subscriber_fixture("frame_float.bin");
   EXPECT_EQ(encode(fixture_info(kFrameNormals | kFrameMarkers, 3)), golden);
   const Frame frame = decode_frame(payload_of(golden));
   EXPECT_EQ(frame.info.frame_number, 1234u);
@@ -141,7 +133,7 @@ TEST(SubscriberStream, FloatFrameMatchesGoldenBytes) {
 }
 
 TEST(SubscriberStream, QuantisedFrameMatchesGoldenBytes) {
-  const std::vector<unsigned char> golden = fixture("frame_quantised.bin");
+  const std::vector<unsigned char> golden = subscriber_fixture("frame_quantised.bin");
   EXPECT_EQ(encode(fixture_info(kFrameNormals | kFrameMarkers | kFrameQuantised, 3)), golden);
   const Frame frame = decode_frame(payload_of(golden));
   EXPECT_EQ(frame.positions, kPositions);  // this fixture's values are exact on the grid
@@ -150,7 +142,7 @@ TEST(SubscriberStream, QuantisedFrameMatchesGoldenBytes) {
 }
 
 TEST(SubscriberStream, MarkersOnlyFrameMatchesGoldenBytes) {
-  const std::vector<unsigned char> golden = fixture("frame_markers_only.bin");
+  const std::vector<unsigned char> golden = subscriber_fixture("frame_markers_only.bin");
   EXPECT_EQ(encode(fixture_info(kFrameNoPositions | kFrameMarkers, 0)), golden);
   const Frame frame = decode_frame(payload_of(golden));
   EXPECT_TRUE(frame.positions.empty());
@@ -168,7 +160,7 @@ TEST(SubscriberStream, EveryFrameBlockStaysFourByteAligned) {
 TEST(SubscriberStream, StatusMatchesGoldenBytes) {
   const Status status{.state = SourceStateCode::Disconnected, .source_rate_hz = 119.88f, .frames_received = 1000, .frames_published = 990,
                       .detail = "vicon 127.0.0.1:801: connection refused"};
-  const std::vector<unsigned char> golden = fixture("status.bin");
+  const std::vector<unsigned char> golden = subscriber_fixture("status.bin");
   EXPECT_EQ(encode_status(status), golden);
   const Status decoded = decode_status(payload_of(golden));
   EXPECT_EQ(decoded.state, SourceStateCode::Disconnected);
@@ -178,15 +170,15 @@ TEST(SubscriberStream, StatusMatchesGoldenBytes) {
 }
 
 TEST(SubscriberStream, PatchingSubscriberDropsChangesOnlyThatField) {
-  std::vector<unsigned char> message = fixture("frame_float.bin");
+  std::vector<unsigned char> message = subscriber_fixture("frame_float.bin");
   patch_subscriber_dropped(message, 99);
   EXPECT_EQ(decode_frame(payload_of(message)).info.subscriber_dropped, 99u);
   patch_subscriber_dropped(message, 2);
-  EXPECT_EQ(message, fixture("frame_float.bin"));
+  EXPECT_EQ(message, subscriber_fixture("frame_float.bin"));
 }
 
 TEST(SubscriberStream, PatchingThePublishTimeChangesOnlyThatField) {
-  const std::vector<unsigned char> original = fixture("frame_quantised.bin");
+  const std::vector<unsigned char> original = subscriber_fixture("frame_quantised.bin");
   const FrameInfo before = decode_frame(payload_of(original)).info;
   std::vector<unsigned char> message = original;
   patch_publish_time(message, 1'800'000'000'123'456'789);
@@ -211,7 +203,7 @@ TEST(SubscriberStream, EveryTruncationOfEveryMessageIsRejected) {
   for (const char* name : {"hello.bin", "ack.bin", "mesh_info.bin", "frame_float.bin", "frame_quantised.bin", "frame_markers_only.bin",
                            "status.bin", "hello_v2.bin", "mesh_info_v2.bin", "status_v2.bin", "frame_v2_float.bin",
                            "frame_v2_parameters.bin", "frame_v2_compressed.bin"}) {
-    const std::vector<unsigned char> message = fixture(name);
+    const std::vector<unsigned char> message = subscriber_fixture(name);
     const MessageHeader header = decode_header(message);
     const uint16_t v = header.version;
     for (size_t n = kHeaderBytes; n < message.size(); ++n) {
@@ -253,7 +245,7 @@ TEST(SubscriberStreamV2, HelloMatchesGoldenBytes) {
   hello.encoding = static_cast<uint32_t>(Encoding::Parameters);
   hello.subject = "Actor2";
   hello.token = "stage-token";
-  const std::vector<unsigned char> golden = fixture("hello_v2.bin");
+  const std::vector<unsigned char> golden = subscriber_fixture("hello_v2.bin");
   EXPECT_EQ(encode_hello(hello), golden);
   const MessageHeader header = decode_header(golden);
   EXPECT_EQ(header.version, kVersion2);
@@ -264,7 +256,7 @@ TEST(SubscriberStreamV2, HelloMatchesGoldenBytes) {
   EXPECT_EQ(decoded.token, "stage-token");
   // The version 1 payload is not a version 2 Hello, nor the other way round.
   EXPECT_THROW(decode_hello(payload_of(golden), kVersion1), DecodeError);
-  EXPECT_THROW(decode_hello(payload_of(fixture("hello.bin")), kVersion2), DecodeError);
+  EXPECT_THROW(decode_hello(payload_of(subscriber_fixture("hello.bin")), kVersion2), DecodeError);
 }
 
 TEST(SubscriberStreamV2, HelloKeepsAnUnknownEncodingAndRefusesTheQuantisedBitAndLongNames) {
@@ -293,7 +285,7 @@ TEST(SubscriberStreamV2, MeshInfoMatchesGoldenBytes) {
   info.subject = "Actor2";
   info.encoding = Encoding::Compressed;
   info.compressed_order = {2, 0, 3, 1};
-  const std::vector<unsigned char> golden = fixture("mesh_info_v2.bin");
+  const std::vector<unsigned char> golden = subscriber_fixture("mesh_info_v2.bin");
   EXPECT_EQ(encode_mesh_info(info, kVersion2), golden);
   const MeshInfo decoded = decode_mesh_info(payload_of(golden), kVersion2);
   EXPECT_EQ(decoded.faces, info.faces);
@@ -302,7 +294,7 @@ TEST(SubscriberStreamV2, MeshInfoMatchesGoldenBytes) {
   EXPECT_EQ(decoded.encoding, Encoding::Compressed);
   EXPECT_EQ(decoded.compressed_order, info.compressed_order);
   // Version 1's MeshInfo is the same bytes without the two version 2 fields.
-  const std::vector<unsigned char> v1 = fixture("mesh_info.bin");
+  const std::vector<unsigned char> v1 = subscriber_fixture("mesh_info.bin");
   EXPECT_TRUE(std::equal(v1.begin() + kHeaderBytes, v1.end(), golden.begin() + kHeaderBytes));
   std::vector<unsigned char> bad = golden;
   bad[bad.size() - 24] = 4;  // encoding 4 does not exist
@@ -320,7 +312,7 @@ TEST(SubscriberStreamV2, StatusMatchesGoldenBytesAndRefusalReadsAsDisconnectedIn
                 .detail = "no subject \"Actor3\" (subjects: Actor1, Actor2)"};
   status.subject = "Actor3";
   status.subject_present = false;
-  const std::vector<unsigned char> golden = fixture("status_v2.bin");
+  const std::vector<unsigned char> golden = subscriber_fixture("status_v2.bin");
   EXPECT_EQ(encode_status(status, kVersion2), golden);
   const Status decoded = decode_status(payload_of(golden), kVersion2);
   EXPECT_EQ(decoded.state, SourceStateCode::Refused);
@@ -343,7 +335,7 @@ TEST(SubscriberStreamV2, FloatFrameWithTimecodeMatchesGoldenBytes) {
   const FrameInfo info = fixture_info_v2(kFrameMarkers | kFrameTimecode, 3);
   std::vector<unsigned char> out(frame_message_bytes(info.flags, info.vertex_count, info.marker_count, kVersion2));
   encode_frame(info, kPositions, {}, kMarkers, kStatus, out, kVersion2);
-  const std::vector<unsigned char> golden = fixture("frame_v2_float.bin");
+  const std::vector<unsigned char> golden = subscriber_fixture("frame_v2_float.bin");
   EXPECT_EQ(out, golden);
   const Frame frame = decode_frame(payload_of(golden), kVersion2);
   EXPECT_EQ(frame.positions, kPositions);
@@ -366,7 +358,7 @@ TEST(SubscriberStreamV2, FloatFrameWithTimecodeMatchesGoldenBytes) {
 
 // The framing of blocks coded elsewhere: the bytes after the fixed part are passed through.
 void expect_block_frame_matches(const char* name, uint32_t flags, uint32_t vertex_count, size_t block_bytes) {
-  const std::vector<unsigned char> golden = fixture(name);
+  const std::vector<unsigned char> golden = subscriber_fixture(name);
   FrameInfo info = fixture_info_v2(flags, vertex_count);
   if (!(flags & kFrameMarkers)) info.marker_count = 0;
   const size_t block_at = kHeaderBytes + frame_info_bytes(kVersion2);
@@ -386,19 +378,19 @@ void expect_block_frame_matches(const char* name, uint32_t flags, uint32_t verte
 
 TEST(SubscriberStreamV2, ParameterFrameFraming) {
   expect_block_frame_matches("frame_v2_parameters.bin", kFrameMarkers | kFrameParameters, 0, 8 + 160 + 24);
-  const Frame frame = decode_frame(payload_of(fixture("frame_v2_parameters.bin")), kVersion2);
+  const Frame frame = decode_frame(payload_of(subscriber_fixture("frame_v2_parameters.bin")), kVersion2);
   EXPECT_EQ(frame.markers, kMarkers);
 }
 
 TEST(SubscriberStreamV2, CompressedFrameFraming) {
   expect_block_frame_matches("frame_v2_compressed.bin", kFrameNormals | kFrameCompressed | kFrameKey, 3, 40 + 12);
-  const FrameView view = view_frame(payload_of(fixture("frame_v2_compressed.bin")), kVersion2);
+  const FrameView view = view_frame(payload_of(subscriber_fixture("frame_v2_compressed.bin")), kVersion2);
   EXPECT_EQ(view.positions.size(), 40u);  // key, origin, step, count, 7 bytes padded to 8
   EXPECT_EQ(view.normals.size(), 12u);    // count, 5 bytes padded to 8
 }
 
 TEST(SubscriberStreamV2, InconsistentFlagsAreRejected) {
-  const std::vector<unsigned char> golden = fixture("frame_v2_parameters.bin");
+  const std::vector<unsigned char> golden = subscriber_fixture("frame_v2_parameters.bin");
   auto with_flags = [&](uint32_t flags) {
     std::vector<unsigned char> bad(golden.begin() + kHeaderBytes, golden.end());
     std::memcpy(bad.data() + 4, &flags, 4);
@@ -426,7 +418,7 @@ TEST(SubscriberStreamV2, FlagsFollowWantsAndEncoding) {
 }
 
 TEST(SubscriberStream, CorruptFrameCountsAndFlagsAreRejected) {
-  const std::vector<unsigned char> golden = fixture("frame_float.bin");
+  const std::vector<unsigned char> golden = subscriber_fixture("frame_float.bin");
   auto corrupt = [&](size_t payload_offset, uint32_t value) {
     std::vector<unsigned char> bad(golden.begin() + kHeaderBytes, golden.end());
     std::memcpy(bad.data() + payload_offset, &value, 4);
@@ -445,7 +437,7 @@ TEST(SubscriberStream, CorruptFrameCountsAndFlagsAreRejected) {
 TEST(SubscriberStream, StreamDecoderCutsMessagesAtAnyBoundary) {
   std::vector<unsigned char> stream;
   for (const char* name : {"status.bin", "mesh_info.bin", "frame_float.bin", "frame_quantised.bin"}) {
-    const std::vector<unsigned char> m = fixture(name);
+    const std::vector<unsigned char> m = subscriber_fixture(name);
     stream.insert(stream.end(), m.begin(), m.end());
   }
   for (size_t chunk : {size_t{1}, size_t{5}, size_t{13}, stream.size()}) {
@@ -468,7 +460,7 @@ TEST(SubscriberStream, StreamDecoderCutsMessagesAtAnyBoundary) {
 
 TEST(SubscriberStream, FrameInfoAloneMatchesTheWholeDecode) {
   for (const char* name : {"frame_float.bin", "frame_quantised.bin", "frame_markers_only.bin"}) {
-    const std::vector<unsigned char> message = fixture(name);
+    const std::vector<unsigned char> message = subscriber_fixture(name);
     const std::span<const unsigned char> payload = std::span(message).subspan(kHeaderBytes);
     const FrameInfo whole = decode_frame(payload).info, alone = decode_frame_info(payload);
     EXPECT_EQ(alone.frame_number, whole.frame_number) << name;
@@ -490,7 +482,7 @@ TEST(SubscriberStream, StreamDecoderTakesReadsStraightIntoItsBuffer) {
   std::vector<unsigned char> stream;
   for (int repeat = 0; repeat < 3; ++repeat)
     for (const char* name : {"status.bin", "frame_float.bin", "mesh_info.bin", "frame_quantised.bin"}) {
-      const std::vector<unsigned char> m = fixture(name);
+      const std::vector<unsigned char> m = subscriber_fixture(name);
       stream.insert(stream.end(), m.begin(), m.end());
     }
   for (size_t read_bytes : {size_t{1}, size_t{7}, size_t{100}, stream.size()}) {
@@ -524,7 +516,7 @@ TEST(SubscriberStream, StreamDecoderRejectsGarbageAndOversizedPayloads) {
   EXPECT_THROW(decoder.next(), DecodeError);
 
   StreamDecoder small(16);
-  small.feed(fixture("mesh_info.bin"));  // 80-byte payload
+  small.feed(subscriber_fixture("mesh_info.bin"));  // 80-byte payload
   EXPECT_THROW(small.next(), DecodeError);
 }
 

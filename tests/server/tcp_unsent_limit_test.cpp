@@ -15,11 +15,11 @@ namespace {
 
 // A connected pair on 127.0.0.1: the sending end non-blocking, the receiving end with a small
 // receive buffer and never read.
-struct LoopbackPair {
+struct UnreadLoopbackPair {
   asio::io_context io;
   tcp::socket receiver{io}, sender_socket{io};
   int sender = -1;
-  LoopbackPair() {
+  UnreadLoopbackPair() {
     tcp::acceptor acceptor(io, tcp::endpoint(asio::ip::make_address("127.0.0.1"), 0));
     receiver.open(tcp::v4());
     receiver.set_option(asio::socket_base::receive_buffer_size(4096));
@@ -42,11 +42,11 @@ struct LoopbackPair {
 };
 
 TEST(TcpUnsentLimit, ASocketThatIsNotReadTakesAboutTheLimitNotItsSendBuffer) {
-  const LoopbackPair unlimited;
+  const UnreadLoopbackPair unlimited;
   ASSERT_GE(unlimited.sender, 0);
   const size_t without = unlimited.bytes_taken();
 
-  const LoopbackPair limited;
+  const UnreadLoopbackPair limited;
   ASSERT_GE(limited.sender, 0);
   ASSERT_EQ(set_tcp_unsent_limit(limited.sender, 128 * 1024), "");
   EXPECT_EQ(tcp_unsent_limit_of(limited.sender), 128 * 1024);

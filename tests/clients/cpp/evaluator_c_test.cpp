@@ -178,21 +178,21 @@ TEST(EvaluatorC, BadBlocksAreOneLineErrorsAndLeaveTheOutputs) {
   EXPECT_STREQ(error, "parameters: no block");
 }
 
-struct Received {
+struct ReceivedFrame {
   std::vector<float> positions, normals;
   std::vector<unsigned char> block;
 };
 
 // Frames by number from one subscriber of the client library: the float encoding's vertices and
 // normals, or the parameter encoding's blocks (not evaluated) with the Model and the faces.
-std::map<uint32_t, Received> receive(uint16_t port, client::Encoding encoding, int count,
+std::map<uint32_t, ReceivedFrame> receive(uint16_t port, client::Encoding encoding, int count,
                                      std::vector<unsigned char>* model, std::vector<uint32_t>* faces) {
   client::Options options;
   options.port = port;
   options.encoding = encoding;
   options.evaluate = false;
   client::Subscriber sub(options);
-  auto frames = test::receive_frames<Received>(sub, count, [&sub](const client::Frame& frame, Received& r) {
+  auto frames = test::receive_frames<ReceivedFrame>(sub, count, [&sub](const client::Frame& frame, ReceivedFrame& r) {
     r.positions.assign(frame.positions.begin(), frame.positions.end());
     r.normals.assign(frame.normals.begin(), frame.normals.end());
     r.block.assign(sub.parameter_block().begin(), sub.parameter_block().end());
@@ -211,7 +211,7 @@ TEST(EvaluatorCDemo, EqualsTheDaemonsFloatBufferBitForBit) {
   ASSERT_GT(daemon.sub_port, 0);
   const uint16_t port = static_cast<uint16_t>(daemon.sub_port);
   constexpr int kFrames = 20;
-  std::map<uint32_t, Received> floats, parameters;
+  std::map<uint32_t, ReceivedFrame> floats, parameters;
   std::vector<unsigned char> model;
   std::vector<uint32_t> faces;
   std::thread float_thread(

@@ -7,6 +7,7 @@
 
 #include "protocol/capture_file.h"
 #include "support/capture_assertions.h"
+#include "support/cli_run.h"
 #include "support/file_error_assertion.h"
 #include "support/test_data.h"
 #include "tests/clients/skinstream/command_output.h"
@@ -14,7 +15,7 @@
 namespace skinstream {
 namespace {
 
-const std::string kCmu02 = test::source_path("replay_data/cmu/85_02.c3d");
+using test::kCmu02;
 
 TEST(ConvertCommand, C3dToTrcAndBackKeepsEverySample) {
   const Capture original = read_capture(kCmu02);

@@ -9,13 +9,14 @@
 #include <set>
 
 #include "protocol/capture_file.h"
+#include "support/cli_run.h"
 #include "support/test_data.h"
 #include "tests/clients/skinstream/command_output.h"
 
 namespace skinstream {
 namespace {
 
-const std::string kCmu02 = test::source_path("replay_data/cmu/85_02.c3d");
+using test::kCmu02;
 
 nlohmann::json run_json(cli::EvalFillOptions o) {
   o.json = true;

@@ -10,14 +10,15 @@
 #include "clients/skinstream/cmd_build_subject.h"
 #include "core/evaluation/gap_plan.h"
 #include "protocol/capture_file.h"
+#include "support/cli_run.h"
 #include "support/test_data.h"
 #include "tests/clients/skinstream/command_output.h"
 
 namespace skinstream {
 namespace {
 
-const std::string kCmu02 = test::source_path("replay_data/cmu/85_02.c3d");
-const std::string kCmu12 = test::source_path("replay_data/cmu/85_12.c3d");
+using test::kCmu02;
+using test::kCmu12;
 
 class FillCommand : public ::testing::Test {
  protected:

@@ -10,6 +10,7 @@
 #include "core/evaluation/fill_error.h"
 #include "core/evaluation/gap_plan.h"
 #include "synthetic_walker.h"
+#include "support/capture_gaps.h"
 
 // Real data: protocol/c3d.h exists, but core_tests links only core/'s libraries, so a CMU
 // comparison cannot live in this suite. The synthetic walker below (41 CMU-named markers on a
@@ -18,9 +19,7 @@
 namespace skinstream {
 namespace {
 
-void knock_out(Capture& capture, int point, int first, int length) {
-  for (int f = first; f < first + length; ++f) capture.at(f, point) = missing_point();
-}
+using test::knock_out;
 
 double largest_error(const Capture& filled, const Capture& truth, int point) {
   double worst = 0.0;

@@ -1,4 +1,5 @@
 #include "core/baselines/linear_interpolation_fill.h"
+#include "support/capture_gaps.h"
 
 #include <gtest/gtest.h>
 
@@ -17,9 +18,7 @@ Capture straight_lines(int frames) {
   return capture;
 }
 
-void knock_out(Capture& capture, int point, int first, int length) {
-  for (int f = first; f < first + length; ++f) capture.at(f, point) = missing_point();
-}
+using test::knock_out;
 
 TEST(LinearFill, RejectsPositionsThatDoNotMatchLabelsAndFrames) {
   Capture capture = straight_lines(10);

@@ -17,9 +17,6 @@ using deform_test::move_rigidly;
 using deform_test::random_motion;
 using deform_test::random_points;
 
-constexpr DeformationMode kAllModes[] = {DeformationMode::Rigid, DeformationMode::Quadratic,
-                                         DeformationMode::RigidRbf, DeformationMode::QuadraticRbf};
-
 // Two overlapping parts over 30 markers (part 0: markers 0-19, part 1: 10-29) and a detailed
 // "mesh" of 200 vertices scattered over the same region, half of them blended between the parts.
 struct TwoPartScene {
@@ -91,7 +88,7 @@ TEST(MeshDeformer, RejectsWrongMarkerCountAndMissingMarkersKeepingThePreviousFra
 
 TEST(MeshDeformer, RestPoseGivesReferenceVerticesInEveryMode) {
   TwoPartScene scene;
-  for (DeformationMode mode : kAllModes) {
+  for (DeformationMode mode : kDeformationModes) {
     MeshDeformer deformer(scene.model, scene.subject, mode);
     const std::vector<float> positions = deform_all(deformer, scene.subject.reference_positions);
     for (int v = 0; v < 200; ++v)
@@ -104,7 +101,7 @@ TEST(MeshDeformer, MatchesThePerPartReferenceImplementation) {
   TwoPartScene scene;
   std::mt19937_64 rng(8);
   const std::vector<Vec3> now = deform_non_rigidly(scene.subject.reference_positions, random_motion(rng));
-  for (DeformationMode mode : kAllModes) {
+  for (DeformationMode mode : kDeformationModes) {
     MeshDeformer deformer(scene.model, scene.subject, mode);
     const std::vector<float> positions = deform_all(deformer, now);
 
@@ -194,7 +191,7 @@ TEST(MeshDeformer, RigidMotionOfAllMarkersMovesTheMeshRigidly) {
   std::mt19937_64 rng(21);
   const RigidTransform motion = random_motion(rng);
   const std::vector<Vec3> moved = move_rigidly(scene.subject.reference_positions, motion);
-  for (DeformationMode mode : kAllModes) {
+  for (DeformationMode mode : kDeformationModes) {
     MeshDeformer deformer(scene.model, scene.subject, mode);
     const std::vector<float> positions = deform_all(deformer, moved);
     for (int v = 0; v < 200; ++v)

@@ -16,9 +16,6 @@ using deform_test::move_rigidly;
 using deform_test::random_motion;
 using deform_test::random_points;
 
-constexpr DeformationMode kAllModes[] = {DeformationMode::Rigid, DeformationMode::Quadratic,
-                                         DeformationMode::RigidRbf, DeformationMode::QuadraticRbf};
-
 double max_member_error(const PartDeformer& part, const std::vector<Vec3>& now) {
   double worst = 0.0;
   for (int i = 0; i < part.model().member_count(); ++i)
@@ -66,7 +63,7 @@ TEST(PartDeformer, RigidMotionReproducedForAnyVertexInAllModes) {
   const std::vector<Vec3> members = random_points(rng, 20, Vec3(120, 60, 40));
   const std::vector<Vec3> vertices = random_points(rng, 200, Vec3(200, 120, 80));  // also outside the hull
   const RigidTransform motion = random_motion(rng);
-  for (DeformationMode mode : kAllModes) {
+  for (DeformationMode mode : kDeformationModes) {
     PartDeformer part(build_part_model(members), mode);
     ASSERT_TRUE(part.solve(move_rigidly(members, motion)));
     double worst = 0.0;
@@ -83,7 +80,7 @@ TEST(PartDeformer, AGivenSegmentMotionMovesThePartExactly) {
   const std::vector<Vec3> members = random_points(rng, 5, Vec3(120, 60, 40));
   const std::vector<Vec3> vertices = random_points(rng, 100, Vec3(200, 120, 80));
   const RigidTransform motion = random_motion(rng);
-  for (DeformationMode mode : kAllModes) {
+  for (DeformationMode mode : kDeformationModes) {
     PartModel model = build_part_model(members);
     model.quadratic = false;  // as a part with a few members of a sparse set
     PartDeformer part(model, mode);
@@ -246,7 +243,7 @@ TEST(PartDeformer, DegenerateMemberSetsGiveNoNaN) {
   const std::vector<Vec3> vertices = random_points(rng, 50, Vec3(150, 150, 150), Vec3::Zero());
   const RigidTransform motion = random_motion(rng);
   for (size_t k = 0; k < cases.size(); ++k) {
-    for (DeformationMode mode : kAllModes) {
+    for (DeformationMode mode : kDeformationModes) {
       PartDeformer part(build_part_model(cases[k]), mode);
       const std::vector<Vec3> now = deform_non_rigidly(cases[k], motion);
       ASSERT_TRUE(part.solve(now));

@@ -13,14 +13,14 @@ namespace {
 using test::ArticulatedLimb;
 using test::make_articulated_limb;
 
-constexpr int kFrames = 240;
+constexpr int kMarkerWeightFrames = 240;
 
 // The limb cut by its segments: a triangle spanning a joint goes with two of its markers, so the
 // last ring before a joint and the first after it are the boundary markers.
-struct Fixture {
-  ArticulatedLimb limb = make_articulated_limb(3, kFrames);
+struct MarkerWeightsFixture {
+  ArticulatedLimb limb = make_articulated_limb(3, kMarkerWeightFrames);
   std::vector<int> triangle_part =
-      segmentation_from_assignment(limb.reference, limb.triangles, limb.positions, kFrames, limb.segment, AssignmentKind::PerMarker)
+      segmentation_from_assignment(limb.reference, limb.triangles, limb.positions, kMarkerWeightFrames, limb.segment, AssignmentKind::PerMarker)
           .triangle_part;
 };
 
@@ -31,35 +31,35 @@ std::vector<double> row_sums(const MarkerPartWeights& w, int markers) {
 }
 
 TEST(MarkerPartWeights, RejectsBadInputs) {
-  const Fixture f;
+  const MarkerWeightsFixture f;
   const auto& l = f.limb;
-  EXPECT_THROW(marker_part_weights(l.reference, l.triangles, std::vector<int>(3, 0), 3, l.positions, kFrames), std::invalid_argument);
+  EXPECT_THROW(marker_part_weights(l.reference, l.triangles, std::vector<int>(3, 0), 3, l.positions, kMarkerWeightFrames), std::invalid_argument);
   std::vector<int> out_of_range = f.triangle_part;
   out_of_range[5] = 3;
-  EXPECT_THROW(marker_part_weights(l.reference, l.triangles, out_of_range, 3, l.positions, kFrames), std::invalid_argument);
-  EXPECT_THROW(marker_part_weights(l.reference, l.triangles, f.triangle_part, 4, l.positions, kFrames),
+  EXPECT_THROW(marker_part_weights(l.reference, l.triangles, out_of_range, 3, l.positions, kMarkerWeightFrames), std::invalid_argument);
+  EXPECT_THROW(marker_part_weights(l.reference, l.triangles, f.triangle_part, 4, l.positions, kMarkerWeightFrames),
                std::invalid_argument);  // part 3 has no triangle
-  EXPECT_THROW(marker_part_weights(l.reference, l.triangles, f.triangle_part, 3, l.positions, kFrames - 1), std::invalid_argument);
+  EXPECT_THROW(marker_part_weights(l.reference, l.triangles, f.triangle_part, 3, l.positions, kMarkerWeightFrames - 1), std::invalid_argument);
   auto nan = l.positions;
   nan[100].y() = std::numeric_limits<double>::quiet_NaN();
-  EXPECT_THROW(marker_part_weights(l.reference, l.triangles, f.triangle_part, 3, nan, kFrames), std::invalid_argument);
+  EXPECT_THROW(marker_part_weights(l.reference, l.triangles, f.triangle_part, 3, nan, kMarkerWeightFrames), std::invalid_argument);
   MarkerWeightOptions o;
   o.threshold = 1.0;
-  EXPECT_THROW(marker_part_weights(l.reference, l.triangles, f.triangle_part, 3, l.positions, kFrames, o), std::invalid_argument);
+  EXPECT_THROW(marker_part_weights(l.reference, l.triangles, f.triangle_part, 3, l.positions, kMarkerWeightFrames, o), std::invalid_argument);
   MarkerWeightOptions rings;
   rings.boundary_rings = -1;
-  EXPECT_THROW(marker_part_weights(l.reference, l.triangles, f.triangle_part, 3, l.positions, kFrames, rings),
+  EXPECT_THROW(marker_part_weights(l.reference, l.triangles, f.triangle_part, 3, l.positions, kMarkerWeightFrames, rings),
                std::invalid_argument);
 }
 
 // With the paper's boundary (no rings added).
 TEST(MarkerPartWeights, InsideMarkersWeighOneAndBoundaryMarkersFollowTheirSegment) {
-  const Fixture f;
+  const MarkerWeightsFixture f;
   const auto& l = f.limb;
   const int m = static_cast<int>(l.reference.size());
   MarkerWeightOptions paper;
   paper.boundary_rings = 0;
-  const MarkerPartWeights w = marker_part_weights(l.reference, l.triangles, f.triangle_part, 3, l.positions, kFrames, paper);
+  const MarkerPartWeights w = marker_part_weights(l.reference, l.triangles, f.triangle_part, 3, l.positions, kMarkerWeightFrames, paper);
   ASSERT_EQ(w.part_member_offsets.size(), 4u);
   for (double s : row_sums(w, m)) EXPECT_NEAR(s, 1.0, 1e-12);
   EXPECT_EQ(w.boundary_markers, 4 * l.around);  // the rings on either side of the two joints
@@ -79,7 +79,7 @@ TEST(MarkerPartWeights, InsideMarkersWeighOneAndBoundaryMarkersFollowTheirSegmen
   for (int p = 0; p < 3; ++p) EXPECT_EQ(w.part_sigma_mm[p], 1.0);  // rigid parts: the floor
   // Deterministic.
   const MarkerPartWeights again =
-      marker_part_weights(l.reference, l.triangles, f.triangle_part, 3, l.positions, kFrames, paper);
+      marker_part_weights(l.reference, l.triangles, f.triangle_part, 3, l.positions, kMarkerWeightFrames, paper);
   ASSERT_EQ(again.part_members.size(), w.part_members.size());
   for (size_t k = 0; k < w.part_members.size(); ++k) EXPECT_EQ(again.part_members[k].weight, w.part_members[k].weight);
 }
@@ -87,12 +87,12 @@ TEST(MarkerPartWeights, InsideMarkersWeighOneAndBoundaryMarkersFollowTheirSegmen
 // A boundary marker moving halfway between its two parts gets half of each; a threshold above
 // one half keeps only the stronger (then weight 1).
 TEST(MarkerPartWeights, SplitsAMarkerBetweenPartsAndRespectsTheThreshold) {
-  Fixture f;
+  MarkerWeightsFixture f;
   auto& l = f.limb;
   const int m = static_cast<int>(l.reference.size());
   const int i = l.marker(3, 2);  // last ring of segment 0, boundary of parts 0 and 1
-  test::move_halfway(l, i, 5, kFrames);  // segment 1's ring 5
-  const MarkerPartWeights w = marker_part_weights(l.reference, l.triangles, f.triangle_part, 3, l.positions, kFrames);
+  test::move_halfway(l, i, 5, kMarkerWeightFrames);  // segment 1's ring 5
+  const MarkerPartWeights w = marker_part_weights(l.reference, l.triangles, f.triangle_part, 3, l.positions, kMarkerWeightFrames);
   for (double s : row_sums(w, m)) EXPECT_NEAR(s, 1.0, 1e-12);
   EXPECT_NEAR(w.weight(i, 0), 0.5, 1e-6);
   EXPECT_NEAR(w.weight(i, 1), 0.5, 1e-6);
@@ -100,7 +100,7 @@ TEST(MarkerPartWeights, SplitsAMarkerBetweenPartsAndRespectsTheThreshold) {
 
   MarkerWeightOptions strict;
   strict.threshold = 0.6;
-  const MarkerPartWeights one = marker_part_weights(l.reference, l.triangles, f.triangle_part, 3, l.positions, kFrames, strict);
+  const MarkerPartWeights one = marker_part_weights(l.reference, l.triangles, f.triangle_part, 3, l.positions, kMarkerWeightFrames, strict);
   EXPECT_EQ(one.weight(i, 0) + one.weight(i, 1), 1.0);
   EXPECT_TRUE(one.weight(i, 0) == 0.0 || one.weight(i, 1) == 0.0);
   for (double s : row_sums(one, m)) EXPECT_NEAR(s, 1.0, 1e-12);
@@ -110,18 +110,18 @@ TEST(MarkerPartWeights, SplitsAMarkerBetweenPartsAndRespectsTheThreshold) {
 // does) but weighed by likelihood with one ring added: moving wholly with the part across the
 // seam, it follows that part. Each ring widens the boundary band by a ring of the limb either side.
 TEST(MarkerPartWeights, AMarkerARingInFromASeamIsWeighedToo) {
-  Fixture f;
+  MarkerWeightsFixture f;
   auto& l = f.limb;
   const int m = static_cast<int>(l.reference.size());
   const int i = l.marker(2, 5);  // segment 0; ring 3 is the seam with segment 1
-  test::move_with_ring(l, i, 5, kFrames, 1.0);
+  test::move_with_ring(l, i, 5, kMarkerWeightFrames, 1.0);
   MarkerWeightOptions o;
   o.boundary_rings = 0;
-  const MarkerPartWeights paper = marker_part_weights(l.reference, l.triangles, f.triangle_part, 3, l.positions, kFrames, o);
+  const MarkerPartWeights paper = marker_part_weights(l.reference, l.triangles, f.triangle_part, 3, l.positions, kMarkerWeightFrames, o);
   EXPECT_EQ(paper.weight(i, 0), 1.0);
   EXPECT_EQ(paper.boundary_markers, 4 * l.around);  // rings 3-4 and 7-8
   o.boundary_rings = 1;
-  const MarkerPartWeights one = marker_part_weights(l.reference, l.triangles, f.triangle_part, 3, l.positions, kFrames, o);
+  const MarkerPartWeights one = marker_part_weights(l.reference, l.triangles, f.triangle_part, 3, l.positions, kMarkerWeightFrames, o);
   EXPECT_GT(one.weight(i, 1), 0.99);
   EXPECT_EQ(one.weight(i, 0), 0.0);  // under the threshold
   EXPECT_EQ(one.boundary_markers, 8 * l.around);  // rings 2-9
@@ -130,7 +130,7 @@ TEST(MarkerPartWeights, AMarkerARingInFromASeamIsWeighedToo) {
   EXPECT_GT(one.weight(l.marker(2, 4), 0), 0.99);
   EXPECT_GT(one.weight(l.marker(1, 5), 0), 0.99);
   o.boundary_rings = 2;
-  const MarkerPartWeights two = marker_part_weights(l.reference, l.triangles, f.triangle_part, 3, l.positions, kFrames, o);
+  const MarkerPartWeights two = marker_part_weights(l.reference, l.triangles, f.triangle_part, 3, l.positions, kMarkerWeightFrames, o);
   EXPECT_EQ(two.boundary_markers, 10 * l.around);  // rings 1-10: the end rings are two rings from any seam
   EXPECT_EQ(two.weight(l.marker(0, 0), 0), 1.0);
 }
@@ -138,14 +138,14 @@ TEST(MarkerPartWeights, AMarkerARingInFromASeamIsWeighedToo) {
 // A part of a single triangle has 3 markers: a fourth (the nearest) is added. (With the
 // paper's boundary: a ring added would weigh the triangle's 9 neighbours against it as well.)
 TEST(MarkerPartWeights, EveryPartKeepsFourMembers) {
-  const Fixture f;
+  const MarkerWeightsFixture f;
   const auto& l = f.limb;
   const int m = static_cast<int>(l.reference.size());
   std::vector<int> parts(l.triangles.size(), 0);
   parts[20] = 1;
   MarkerWeightOptions paper;
   paper.boundary_rings = 0;
-  const MarkerPartWeights w = marker_part_weights(l.reference, l.triangles, parts, 2, l.positions, kFrames, paper);
+  const MarkerPartWeights w = marker_part_weights(l.reference, l.triangles, parts, 2, l.positions, kMarkerWeightFrames, paper);
   EXPECT_EQ(w.part_member_offsets[2] - w.part_member_offsets[1], 4);
   EXPECT_EQ(w.markers_added_for_min_members, 1);
   for (double s : row_sums(w, m)) EXPECT_NEAR(s, 1.0, 1e-12);

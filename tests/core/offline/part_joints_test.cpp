@@ -14,19 +14,19 @@
 namespace skinstream {
 namespace {
 
-constexpr int kFrames = 240;
+constexpr int kJointFrames = 240;
 
 struct Limb {
   test::ArticulatedLimb limb;
   MarkerPartWeights alpha;
-  explicit Limb(int segments) : limb(test::make_articulated_limb(segments, kFrames)) {
-    const std::vector<int> parts = segmentation_from_assignment(limb.reference, limb.triangles, limb.positions, kFrames,
+  explicit Limb(int segments) : limb(test::make_articulated_limb(segments, kJointFrames)) {
+    const std::vector<int> parts = segmentation_from_assignment(limb.reference, limb.triangles, limb.positions, kJointFrames,
                                                                 limb.segment, AssignmentKind::PerMarker)
                                        .triangle_part;
-    alpha = marker_part_weights(limb.reference, limb.triangles, parts, segments, limb.positions, kFrames);
+    alpha = marker_part_weights(limb.reference, limb.triangles, parts, segments, limb.positions, kJointFrames);
   }
   std::vector<PartJoint> joints(const PartJointOptions& options = {}) const {
-    return fit_part_joints(limb.reference, alpha.part_member_offsets, alpha.part_members, limb.positions, kFrames, options);
+    return fit_part_joints(limb.reference, alpha.part_member_offsets, alpha.part_members, limb.positions, kJointFrames, options);
   }
 };
 
@@ -63,7 +63,7 @@ TEST(PartJoints, PartsWithoutACommonPivotAreNotJointed) {
   Limb l(2);
   // The second segment also slides 60 mm up and down (world z): no point stays shared.
   const size_t m = l.limb.reference.size();
-  for (int f = 0; f < kFrames; ++f)
+  for (int f = 0; f < kJointFrames; ++f)
     for (size_t i = 0; i < m; ++i)
       if (l.limb.segment[i] == 1) l.limb.positions[f * m + i] += Vec3(0.0, 0.0, 60.0 * std::sin(f / 9.0));
   EXPECT_TRUE(l.joints().empty());
@@ -79,7 +79,7 @@ Limb two_segments_turning(double turn_x, double turn_y) {
   Limb l(2);
   const size_t m = l.limb.reference.size();
   const Vec3 pivot(0.0, 0.0, 200.0);
-  for (int f = 0; f < kFrames; ++f) {
+  for (int f = 0; f < kJointFrames; ++f) {
     const double t = f / 60.0;
     const Eigen::Matrix3d turn = (Eigen::AngleAxisd(turn_x * std::sin(1.3 * t), Vec3::UnitX()) *
                                   Eigen::AngleAxisd(turn_y * std::sin(2.1 * t + 1.0), Vec3::UnitY()))
@@ -90,9 +90,9 @@ Limb two_segments_turning(double turn_x, double turn_y) {
     }
   }
   const std::vector<int> parts = segmentation_from_assignment(l.limb.reference, l.limb.triangles, l.limb.positions,
-                                                              kFrames, l.limb.segment, AssignmentKind::PerMarker)
+                                                              kJointFrames, l.limb.segment, AssignmentKind::PerMarker)
                                      .triangle_part;
-  l.alpha = marker_part_weights(l.limb.reference, l.limb.triangles, parts, 2, l.limb.positions, kFrames);
+  l.alpha = marker_part_weights(l.limb.reference, l.limb.triangles, parts, 2, l.limb.positions, kJointFrames);
   return l;
 }
 
@@ -117,22 +117,22 @@ TEST(PartJoints, RejectsBadInputs) {
   const Limb l(2);
   const auto& limb = l.limb;
   const auto& a = l.alpha;
-  EXPECT_THROW(fit_part_joints(limb.reference, a.part_member_offsets, a.part_members, limb.positions, kFrames - 1),
+  EXPECT_THROW(fit_part_joints(limb.reference, a.part_member_offsets, a.part_members, limb.positions, kJointFrames - 1),
                std::invalid_argument);
   PartJointOptions zero;
   zero.max_residual_ratio = 0.0;
-  EXPECT_THROW(fit_part_joints(limb.reference, a.part_member_offsets, a.part_members, limb.positions, kFrames, zero),
+  EXPECT_THROW(fit_part_joints(limb.reference, a.part_member_offsets, a.part_members, limb.positions, kJointFrames, zero),
                std::invalid_argument);
   PartJointOptions no_spread;
   no_spread.max_axis_spread = 0.0;
-  EXPECT_THROW(fit_part_joints(limb.reference, a.part_member_offsets, a.part_members, limb.positions, kFrames, no_spread),
+  EXPECT_THROW(fit_part_joints(limb.reference, a.part_member_offsets, a.part_members, limb.positions, kJointFrames, no_spread),
                std::invalid_argument);
   std::vector<PartMember> bad = a.part_members;
   bad[0].marker = static_cast<int>(limb.reference.size());
-  EXPECT_THROW(fit_part_joints(limb.reference, a.part_member_offsets, bad, limb.positions, kFrames), std::invalid_argument);
+  EXPECT_THROW(fit_part_joints(limb.reference, a.part_member_offsets, bad, limb.positions, kJointFrames), std::invalid_argument);
   std::vector<Vec3> nan = limb.positions;
   nan[5].x() = std::numeric_limits<double>::quiet_NaN();
-  EXPECT_THROW(fit_part_joints(limb.reference, a.part_member_offsets, a.part_members, nan, kFrames), std::invalid_argument);
+  EXPECT_THROW(fit_part_joints(limb.reference, a.part_member_offsets, a.part_members, nan, kJointFrames), std::invalid_argument);
 }
 
 }  // namespace

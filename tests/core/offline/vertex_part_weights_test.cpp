@@ -14,18 +14,18 @@
 namespace skinstream {
 namespace {
 
-constexpr int kFrames = 120;
+constexpr int kVertexWeightFrames = 120;
 
-struct Fixture {
-  test::ArticulatedLimb limb = test::make_articulated_limb(3, kFrames);
+struct VertexWeightsFixture {
+  test::ArticulatedLimb limb = test::make_articulated_limb(3, kVertexWeightFrames);
   MarkerPartWeights alpha;
-  Fixture() {
+  VertexWeightsFixture() {
     // A boundary marker of parts 0 and 1 moved halfway, so that some vertices blend two parts.
-    const std::vector<int> parts = segmentation_from_assignment(limb.reference, limb.triangles, limb.positions, kFrames,
+    const std::vector<int> parts = segmentation_from_assignment(limb.reference, limb.triangles, limb.positions, kVertexWeightFrames,
                                                                 limb.segment, AssignmentKind::PerMarker)
                                        .triangle_part;
-    test::move_halfway(limb, limb.marker(3, 2), 5, kFrames);
-    alpha = marker_part_weights(limb.reference, limb.triangles, parts, 3, limb.positions, kFrames);
+    test::move_halfway(limb, limb.marker(3, 2), 5, kVertexWeightFrames);
+    alpha = marker_part_weights(limb.reference, limb.triangles, parts, 3, limb.positions, kVertexWeightFrames);
   }
   VertexPartWeights weights(const std::vector<Vec3>& vertices, std::span<const PartJoint> joints = {},
                             std::span<const char> under_marker = {}, double joint_blend_mm = 0.0) const {
@@ -41,7 +41,7 @@ double beta(const VertexPartWeights& w, int vertex, int part) {
 }
 
 TEST(VertexPartWeights, RejectsBadInputs) {
-  const Fixture f;
+  const VertexWeightsFixture f;
   const auto& l = f.limb;
   const std::vector<Vec3> vertices{Vec3(40, 0, 100)};
   EXPECT_THROW(vertex_part_weights(vertices, l.reference, {}, f.alpha.part_member_offsets, f.alpha.part_members),
@@ -62,7 +62,7 @@ TEST(VertexPartWeights, RejectsBadInputs) {
 }
 
 TEST(VertexPartWeights, SumToOneAndFollowTheNearestTriangle) {
-  const Fixture f;
+  const VertexWeightsFixture f;
   const auto& l = f.limb;
   const int split = l.marker(3, 2);
   ASSERT_GT(f.alpha.weight(split, 0), 0.3);
@@ -115,10 +115,10 @@ Vec3 skin(double around, double z) {
 // The limb's first joint is at z = 200, between ring 3 (z = 175, segment 0) and ring 4 (z = 225,
 // segment 1). The nearest triangle of skin just past it has markers of both segments.
 TEST(VertexPartWeights, SkinPastAJointFollowsThePartBeyondIt) {
-  const Fixture f;
+  const VertexWeightsFixture f;
   const auto& l = f.limb;
   const std::vector<PartJoint> joints =
-      fit_part_joints(l.reference, f.alpha.part_member_offsets, f.alpha.part_members, l.positions, kFrames);
+      fit_part_joints(l.reference, f.alpha.part_member_offsets, f.alpha.part_members, l.positions, kVertexWeightFrames);
   ASSERT_EQ(joints.size(), 2u);
   const std::vector<Vec3> vertices{skin(5.5, 210.0), skin(5.5, 190.0)};
   const VertexPartWeights paper = f.weights(vertices), split = f.weights(vertices, joints);
@@ -138,7 +138,7 @@ TEST(VertexPartWeights, SkinPastAJointFollowsThePartBeyondIt) {
 // A marker that lies past the joint's plane yet moves with the part before it (an elbow marker
 // slightly below the pivot) speaks for the skin up to its own height, not beyond.
 TEST(VertexPartWeights, AMarkerPastTheJointSpeaksForTheSkinUpToItself) {
-  const Fixture f;
+  const VertexWeightsFixture f;
   PartJoint low;  // a plane at z = 150: ring 3 (z = 175, segment 0) lies 25 mm past it
   low.first = 0;
   low.second = 1;
@@ -161,7 +161,7 @@ TEST(VertexPartWeights, AMarkerPastTheJointSpeaksForTheSkinUpToItself) {
 // 225, all segment 1), the skin between the rings goes from segment 0 to segment 1 linearly:
 // half each on the plane, as a hinge's crease follows the bisector.
 TEST(VertexPartWeights, SkinAtAJointBlendsBothPartsOverARamp) {
-  const Fixture f;
+  const VertexWeightsFixture f;
   PartJoint joint;
   joint.first = 0;
   joint.second = 1;
@@ -191,7 +191,7 @@ TEST(VertexPartWeights, SkinAtAJointBlendsBothPartsOverARamp) {
 }
 
 TEST(VertexPartWeights, RejectsBadJointsAndFlags) {
-  const Fixture f;
+  const VertexWeightsFixture f;
   const std::vector<Vec3> vertices{skin(1.0, 100.0)};
   PartJoint bad;
   bad.first = 0;

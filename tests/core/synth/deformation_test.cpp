@@ -10,19 +10,19 @@
 namespace skinstream::synth {
 namespace {
 
-struct Fixture {
+struct DeformFixture {
   Body body = make_mannequin();
   Anatomy anatomy = Anatomy::from(body);
   DeformationModel model{body, anatomy, DeformOptions{}};
   DeformedSurface surface{body.rest, body.faces, body.weights, model};
 };
-const Fixture& fx() {
-  static const Fixture f;
+const DeformFixture& deform_fx() {
+  static const DeformFixture f;
   return f;
 }
 
 int effect_index(const std::string& name) {
-  const auto& names = fx().model.effect_names();
+  const auto& names = deform_fx().model.effect_names();
   for (size_t i = 0; i < names.size(); ++i)
     if (names[i] == name) return static_cast<int>(i);
   return -1;
@@ -35,23 +35,23 @@ struct Moved {
   Vec3 where = Vec3::Zero();
 };
 Moved displacement(const Pose& pose, const EffectFrame& effects) {
-  const BoneTransforms b = pose_bones(fx().body.skeleton, pose);
+  const BoneTransforms b = pose_bones(deform_fx().body.skeleton, pose);
   Moved m;
-  for (int v = 0; v < fx().surface.vertex_count(); ++v) {
-    const double d = fx().surface.effect_magnitude(v, b, effects);
+  for (int v = 0; v < deform_fx().surface.vertex_count(); ++v) {
+    const double d = deform_fx().surface.effect_magnitude(v, b, effects);
     if (d > m.max_mm) {
       m.max_mm = d;
-      m.where = fx().body.rest[static_cast<size_t>(v)];
+      m.where = deform_fx().body.rest[static_cast<size_t>(v)];
     }
   }
   return m;
 }
 
 TEST(SynthDeformation, RejectsMismatchedInputs) {
-  const Pose rest = Pose::rest(fx().body.skeleton);
-  EXPECT_THROW(fx().model.drive({rest}, {}, {0.0}, {0.0}, 120.0), std::invalid_argument);
-  EXPECT_THROW(simulate_jiggle(standard_jiggle(fx().body, fx().anatomy), {}, 0.0), std::invalid_argument);
-  EXPECT_THROW(DeformedSurface(fx().body.rest, fx().body.faces, SkinWeights{}, fx().model),
+  const Pose rest = Pose::rest(deform_fx().body.skeleton);
+  EXPECT_THROW(deform_fx().model.drive({rest}, {}, {0.0}, {0.0}, 120.0), std::invalid_argument);
+  EXPECT_THROW(simulate_jiggle(standard_jiggle(deform_fx().body, deform_fx().anatomy), {}, 0.0), std::invalid_argument);
+  EXPECT_THROW(DeformedSurface(deform_fx().body.rest, deform_fx().body.faces, SkinWeights{}, deform_fx().model),
                std::invalid_argument);
 }
 
@@ -69,45 +69,45 @@ TEST(SynthDeformation, RegionWeightFollowsFacingMaskAndDistance) {
 
 TEST(SynthDeformation, BicepsBulgesWithElbowFlexionAndEffort) {
   const Muscle* biceps = nullptr;
-  for (const Muscle& m : fx().model.muscles())
+  for (const Muscle& m : deform_fx().model.muscles())
     if (m.name == "biceps_L") biceps = &m;
   ASSERT_NE(biceps, nullptr);
   double previous = -1.0;
   for (double flex : {0.0, 40.0, 80.0, 120.0, 140.0}) {
-    PoseBuilder b(fx().body.skeleton, fx().anatomy);
+    PoseBuilder b(deform_fx().body.skeleton, deform_fx().anatomy);
     b.elbow(kLeft, flex);
     const double a = muscle_activation(*biceps, b.pose());
     EXPECT_GE(a, previous) << flex;
     previous = a;
   }
   EXPECT_GT(previous, 0.95);
-  PoseBuilder straight(fx().body.skeleton, fx().anatomy);
+  PoseBuilder straight(deform_fx().body.skeleton, deform_fx().anatomy);
   straight.elbow(kLeft, 0.0);
   EXPECT_LT(muscle_activation(*biceps, straight.pose()), 0.01);
-  PoseBuilder flexed(fx().body.skeleton, fx().anatomy);
+  PoseBuilder flexed(deform_fx().body.skeleton, deform_fx().anatomy);
   flexed.elbow(kLeft, 130.0);
   EXPECT_GT(muscle_bulge_mm(*biceps, flexed.pose(), 1.0), muscle_bulge_mm(*biceps, flexed.pose(), 0.0) + 5.0);
 
   // On the surface: the front of the left upper arm moves out by about the bulge.
-  EffectFrame effects(static_cast<size_t>(fx().model.effect_count()));
+  EffectFrame effects(static_cast<size_t>(deform_fx().model.effect_count()));
   effects[static_cast<size_t>(effect_index("muscle:biceps_L"))].normal_mm =
       muscle_bulge_mm(*biceps, flexed.pose(), 1.0);
   const Moved m = displacement(flexed.pose(), effects);
   EXPECT_GT(m.max_mm, 0.8 * muscle_bulge_mm(*biceps, flexed.pose(), 1.0));
-  const Vec3 mid = 0.5 * (fx().anatomy.shoulder_joint[kLeft] + fx().anatomy.elbow_joint[kLeft]);
+  const Vec3 mid = 0.5 * (deform_fx().anatomy.shoulder_joint[kLeft] + deform_fx().anatomy.elbow_joint[kLeft]);
   EXPECT_LT((m.where - mid).norm(), 120.0);  // on the upper arm
 }
 
 TEST(SynthDeformation, BreathingMovesTheBellyOut) {
-  std::vector<Pose> poses(2, Pose::rest(fx().body.skeleton));
-  std::vector<BoneTransforms> bones(2, pose_bones(fx().body.skeleton, poses[0]));
-  const auto frames = fx().model.drive(poses, bones, {0.0, 1.0}, {0.0, 0.0}, 120.0);
+  std::vector<Pose> poses(2, Pose::rest(deform_fx().body.skeleton));
+  std::vector<BoneTransforms> bones(2, pose_bones(deform_fx().body.skeleton, poses[0]));
+  const auto frames = deform_fx().model.drive(poses, bones, {0.0, 1.0}, {0.0, 0.0}, 120.0);
   EXPECT_LT(displacement(poses[0], frames[0]).max_mm, 1e-9);
   const Moved m = displacement(poses[1], frames[1]);
   EXPECT_GT(m.max_mm, 12.0);
   EXPECT_GT(m.where.y(), 40.0);  // on the front of the trunk
-  EXPECT_GT(m.where.z(), fx().anatomy.hip_joint[kLeft].z());
-  EXPECT_LT(m.where.z(), fx().anatomy.shoulder_joint[kLeft].z());
+  EXPECT_GT(m.where.z(), deform_fx().anatomy.hip_joint[kLeft].z());
+  EXPECT_LT(m.where.z(), deform_fx().anatomy.shoulder_joint[kLeft].z());
 }
 
 TEST(SynthDeformation, SoftTissueLagsOvershootsAndSettles) {
@@ -144,12 +144,12 @@ TEST(SynthDeformation, SoftTissueLagsOvershootsAndSettles) {
 }
 
 TEST(SynthDeformation, ZeroScalesMeanSkinningOnly) {
-  const DeformationModel off(fx().body, fx().anatomy, DeformOptions{0.0, 0.0, 0.0});
+  const DeformationModel off(deform_fx().body, deform_fx().anatomy, DeformOptions{0.0, 0.0, 0.0});
   std::vector<Pose> poses;
   std::vector<BoneTransforms> bones;
   for (int f = 0; f < 60; ++f) {
-    poses.push_back(sample_motion("jumprope", fx().body.skeleton, fx().anatomy, f / 120.0, 1.0).pose);
-    bones.push_back(pose_bones(fx().body.skeleton, poses.back()));
+    poses.push_back(sample_motion("jumprope", deform_fx().body.skeleton, deform_fx().anatomy, f / 120.0, 1.0).pose);
+    bones.push_back(pose_bones(deform_fx().body.skeleton, poses.back()));
   }
   const auto frames =
       off.drive(poses, bones, std::vector<double>(60, 1.0), std::vector<double>(60, 1.0), 120.0);

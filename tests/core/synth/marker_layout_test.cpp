@@ -11,19 +11,19 @@
 namespace skinstream::synth {
 namespace {
 
-struct Fixture {
+struct LayoutFixture {
   Body body = make_mannequin();
   std::vector<Triangle> tris = triangulate(body.faces);
   Anatomy anatomy = Anatomy::from(body);
 };
-const Fixture& fx() {
-  static const Fixture f;
+const LayoutFixture& layout_fx() {
+  static const LayoutFixture f;
   return f;
 }
 
 std::vector<MarkerSite> lay(int count, uint64_t seed, LayoutOptions o = {}) {
   o.count = count;
-  return layout_markers(fx().body.rest, fx().tris, fx().body.weights, fx().body.skeleton, fx().anatomy, o,
+  return layout_markers(layout_fx().body.rest, layout_fx().tris, layout_fx().body.weights, layout_fx().body.skeleton, layout_fx().anatomy, o,
                         seed);
 }
 
@@ -64,12 +64,12 @@ TEST(SynthMarkerLayout, ExactCountUniqueRegionNamesAndExtras) {
     if (s.extra && s.region.rfind("elbow_", 0) == 0) ++elbow_extras;
     if (s.extra && s.region.rfind("scapula_", 0) == 0) ++scapula_extras;
     // On the surface: the barycentric point of its triangle.
-    const Triangle& t = fx().tris[static_cast<size_t>(s.triangle)];
+    const Triangle& t = layout_fx().tris[static_cast<size_t>(s.triangle)];
     EXPECT_NEAR(s.barycentric.sum(), 1.0, 1e-12);
     EXPECT_GE(s.barycentric.minCoeff(), 0.0);
-    const Vec3 p = s.barycentric[0] * fx().body.rest[static_cast<size_t>(t[0])] +
-                   s.barycentric[1] * fx().body.rest[static_cast<size_t>(t[1])] +
-                   s.barycentric[2] * fx().body.rest[static_cast<size_t>(t[2])];
+    const Vec3 p = s.barycentric[0] * layout_fx().body.rest[static_cast<size_t>(t[0])] +
+                   s.barycentric[1] * layout_fx().body.rest[static_cast<size_t>(t[1])] +
+                   s.barycentric[2] * layout_fx().body.rest[static_cast<size_t>(t[2])];
     EXPECT_LT((p - s.rest_position).norm(), 1e-9);
     // Never on the head, hands or feet.
     EXPECT_EQ(s.region.find("hand"), std::string::npos);

@@ -9,27 +9,27 @@
 namespace skinstream::synth {
 namespace {
 
-struct Fixture {
+struct MotionFixture {
   Body body = make_mannequin();
   Anatomy anatomy = Anatomy::from(body);
 };
-const Fixture& fx() {
-  static const Fixture f;
+const MotionFixture& motion_fx() {
+  static const MotionFixture f;
   return f;
 }
 
 double lowest_sole(const MotionSample& s) {
-  const BoneTransforms b = pose_bones(fx().body.skeleton, s.pose);
+  const BoneTransforms b = pose_bones(motion_fx().body.skeleton, s.pose);
   double z = 1e18;
   for (Side side : {kLeft, kRight})
-    for (const Vec3& p : fx().anatomy.sole_points[side])
-      z = std::min(z, (b[static_cast<size_t>(fx().anatomy.leg[side].ankle)] * p).z());
+    for (const Vec3& p : motion_fx().anatomy.sole_points[side])
+      z = std::min(z, (b[static_cast<size_t>(motion_fx().anatomy.leg[side].ankle)] * p).z());
   return z;
 }
 
 TEST(SynthMotion, UnknownMotionAndMissingBonesAreRejected) {
   EXPECT_FALSE(is_motion("moonwalk"));
-  EXPECT_THROW(motion_angles("moonwalk", fx().anatomy, 0.0, 1.0), std::invalid_argument);
+  EXPECT_THROW(motion_angles("moonwalk", motion_fx().anatomy, 0.0, 1.0), std::invalid_argument);
   Body headless;
   headless.skeleton = Skeleton({{"root", -1, Vec3::Zero(), Vec3::UnitZ()}});
   EXPECT_THROW(Anatomy::from(headless), std::invalid_argument);
@@ -38,7 +38,7 @@ TEST(SynthMotion, UnknownMotionAndMissingBonesAreRejected) {
 
 TEST(SynthMotion, EveryMotionStartsInTheRestPoseOnTheFloor) {
   for (const std::string& name : motion_names()) {
-    const MotionSample s = sample_motion(name, fx().body.skeleton, fx().anatomy, 0.0, 5.0);
+    const MotionSample s = sample_motion(name, motion_fx().body.skeleton, motion_fx().anatomy, 0.0, 5.0);
     for (const auto& q : s.pose.local)
       EXPECT_LT(q.angularDistance(Eigen::Quaterniond::Identity()), 1e-9) << name;
     EXPECT_TRUE(s.pose.root.linear().isApprox(Eigen::Matrix3d::Identity())) << name;
@@ -50,9 +50,9 @@ TEST(SynthMotion, MotionsAreSmoothAtCaptureRateAndStayOnTheFloor) {
   const double dt = 1.0 / 120.0;
   for (const std::string& name : motion_names()) {
     double max_step = 0.0, max_clearance = 0.0, min_clearance = 1e18;
-    MotionSample prev = sample_motion(name, fx().body.skeleton, fx().anatomy, 0.0, 6.0);
+    MotionSample prev = sample_motion(name, motion_fx().body.skeleton, motion_fx().anatomy, 0.0, 6.0);
     for (int f = 1; f < 720; ++f) {
-      const MotionSample s = sample_motion(name, fx().body.skeleton, fx().anatomy, f * dt, 6.0);
+      const MotionSample s = sample_motion(name, motion_fx().body.skeleton, motion_fx().anatomy, f * dt, 6.0);
       for (size_t b = 0; b < s.pose.local.size(); ++b)
         max_step = std::max(max_step, s.pose.local[b].angularDistance(prev.pose.local[b]));
       const double c = lowest_sole(s);
@@ -72,24 +72,24 @@ TEST(SynthMotion, MotionsAreSmoothAtCaptureRateAndStayOnTheFloor) {
 }
 
 TEST(SynthMotion, RangeOfMotionRaisesTheArmsOverheadAndCrouches) {
-  const Skeleton& sk = fx().body.skeleton;
+  const Skeleton& sk = motion_fx().body.skeleton;
   double max_hand = 0.0, min_hip = 1e18;
   for (int f = 0; f < 20 * 30; ++f) {
-    const MotionSample s = sample_motion("rom", sk, fx().anatomy, f / 30.0, 20.0);
+    const MotionSample s = sample_motion("rom", sk, motion_fx().anatomy, f / 30.0, 20.0);
     const BoneTransforms b = pose_bones(sk, s.pose);
     max_hand = std::max(
         max_hand,
-        (b[static_cast<size_t>(fx().anatomy.arm[kLeft].wrist)] * fx().anatomy.wrist_joint[kLeft]).z());
+        (b[static_cast<size_t>(motion_fx().anatomy.arm[kLeft].wrist)] * motion_fx().anatomy.wrist_joint[kLeft]).z());
     min_hip = std::min(
-        min_hip, (b[static_cast<size_t>(fx().anatomy.leg[kLeft].hip)] * fx().anatomy.hip_joint[kLeft]).z());
+        min_hip, (b[static_cast<size_t>(motion_fx().anatomy.leg[kLeft].hip)] * motion_fx().anatomy.hip_joint[kLeft]).z());
   }
-  EXPECT_GT(max_hand, fx().anatomy.shoulder_joint[kLeft].z() + 300.0);  // hands well above the shoulders
-  EXPECT_LT(min_hip, fx().anatomy.hip_joint[kLeft].z() - 250.0);        // deep crouch
+  EXPECT_GT(max_hand, motion_fx().anatomy.shoulder_joint[kLeft].z() + 300.0);  // hands well above the shoulders
+  EXPECT_LT(min_hip, motion_fx().anatomy.hip_joint[kLeft].z() - 250.0);        // deep crouch
 }
 
 TEST(SynthMotion, PoseBuilderSpeaksAnatomy) {
-  const Skeleton& sk = fx().body.skeleton;
-  const Anatomy& a = fx().anatomy;
+  const Skeleton& sk = motion_fx().body.skeleton;
+  const Anatomy& a = motion_fx().anatomy;
   auto wrist_of = [&](const Pose& p, Side s) {
     return (pose_bones(sk, p)[static_cast<size_t>(a.arm[s].wrist)] * a.wrist_joint[s]).eval();
   };

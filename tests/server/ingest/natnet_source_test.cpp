@@ -39,7 +39,7 @@ NatNetServerOptions unicast_server(natnet::Version version, uint16_t port = 0) {
   return o;
 }
 
-NatNetSourceOptions client_of(uint16_t port) {
+NatNetSourceOptions natnet_client_of(uint16_t port) {
   NatNetSourceOptions o;
   o.command_port = port;
   o.initial_backoff_seconds = 0.05;
@@ -93,7 +93,7 @@ TEST_P(NatNetLayouts, UnicastStreamsMarkerSetsInMillimetres) {
   NatNetServer server(server_io.io, {{"walker", &walker}, {"runner_2", &runner}}, unicast_server(GetParam()));
   server_io.call([&] { server.start(); });
   SourceSinkRecorder sink;
-  NatNetSource source(client_io.io, client_of(server_io.call([&] { return server.command_port(); })), sink);
+  NatNetSource source(client_io.io, natnet_client_of(server_io.call([&] { return server.command_port(); })), sink);
   source.start();
   ASSERT_TRUE(sink.wait_frames(70));  // more than half a second of the source's clock: its rate known
   source.stop();
@@ -119,7 +119,7 @@ TEST(NatNetSource, Multicast) {
   options.data_port = free_udp_port();
   NatNetServer server(server_io.io, {{"walker", &walker}, {"runner_2", &runner}}, options);
   server_io.call([&] { server.start(); });
-  NatNetSourceOptions client = client_of(server_io.call([&] { return server.command_port(); }));
+  NatNetSourceOptions client = natnet_client_of(server_io.call([&] { return server.command_port(); }));
   client.interface_address = "127.0.0.1";
   SourceSinkRecorder sink;
   NatNetSource source(client_io.io, client, sink);
@@ -143,7 +143,7 @@ TEST(NatNetSource, AServerThatVanishesIsReportedAndFoundAgain) {
   server_io.call([&] { server->start(); });
   const uint16_t port = server_io.call([&] { return server->command_port(); });
   SourceSinkRecorder sink;
-  NatNetSource source(client_io.io, client_of(port), sink);
+  NatNetSource source(client_io.io, natnet_client_of(port), sink);
   source.start();
   ASSERT_TRUE(sink.wait_frames(5));
   server_io.call([&] { server.reset(); });  // silent: UDP says nothing when a server goes
@@ -163,10 +163,10 @@ TEST(NatNetSource, AServerThatVanishesIsReportedAndFoundAgain) {
 }
 
 // A NatNet command port answering from a script, for input a real server never sends.
-class ScriptedServer {
+class NatNetScriptedServer {
  public:
   using Script = std::function<void(udp::socket&, const udp::endpoint& client, uint16_t request)>;
-  explicit ScriptedServer(Script script)
+  explicit NatNetScriptedServer(Script script)
       : socket_(io_, udp::endpoint(asio::ip::make_address("127.0.0.1"), 0)), thread_([this, script] {
           std::vector<unsigned char> buffer(natnet::kMaxMessageBytes);
           for (;;) {
@@ -180,7 +180,7 @@ class ScriptedServer {
             script(socket_, client, request);
           }
         }) {}
-  ~ScriptedServer() {
+  ~NatNetScriptedServer() {
     done_ = true;
     boost::system::error_code ec;
     udp::socket poke(io_, udp::v4());
@@ -208,7 +208,7 @@ TEST(NatNetSource, MalformedTruncatedAndUnknownInputIsReportedAndSurvived) {
   natnet::CaptureEncoder encoder({{"walker", &walker}});
   natnet::CaptureEncoder stranger_encoder({{"stranger", &walker}});
   int answered_definitions = 0;
-  ScriptedServer server([&](udp::socket& s, const udp::endpoint& client, uint16_t request) {
+  NatNetScriptedServer server([&](udp::socket& s, const udp::endpoint& client, uint16_t request) {
     if (request == natnet::message::Connect) {
       s.send_to(asio::buffer(natnet::ByteVector{1, 0, 0xFF, 0xFF}), client);  // byte count past the datagram
       s.send_to(asio::buffer(unicast_info()), client);
@@ -231,7 +231,7 @@ TEST(NatNetSource, MalformedTruncatedAndUnknownInputIsReportedAndSurvived) {
   });
   IoThread client_io;
   SourceSinkRecorder sink;
-  NatNetSourceOptions options = client_of(server.port());
+  NatNetSourceOptions options = natnet_client_of(server.port());
   options.stall_timeout = 5s;  // the script goes quiet after its frames: no reconnection here
   options.model_request_interval = 0ms;
   NatNetSource source(client_io.io, options, sink);
@@ -255,8 +255,8 @@ TEST(NatNetSource, MalformedTruncatedAndUnknownInputIsReportedAndSurvived) {
 }
 
 TEST(NatNetSource, NoAnswerAndOldServersDisconnect) {
-  ScriptedServer silent([](udp::socket&, const udp::endpoint&, uint16_t) {});
-  ScriptedServer old([](udp::socket& s, const udp::endpoint& client, uint16_t request) {
+  NatNetScriptedServer silent([](udp::socket&, const udp::endpoint&, uint16_t) {});
+  NatNetScriptedServer old([](udp::socket& s, const udp::endpoint& client, uint16_t request) {
     if (request != natnet::message::Connect) return;
     natnet::ServerInfo info;
     info.natnet_version = {2, 9, 0, 0};
@@ -264,8 +264,8 @@ TEST(NatNetSource, NoAnswerAndOldServersDisconnect) {
   });
   IoThread client_io;
   SourceSinkRecorder a, b;
-  NatNetSource to_silent(client_io.io, client_of(silent.port()), a);
-  NatNetSource to_old(client_io.io, client_of(old.port()), b);
+  NatNetSource to_silent(client_io.io, natnet_client_of(silent.port()), a);
+  NatNetSource to_old(client_io.io, natnet_client_of(old.port()), b);
   to_silent.start();
   to_old.start();
   ASSERT_TRUE(a.wait_state(SourceState::Disconnected));
@@ -284,7 +284,7 @@ TEST(NatNetSource, AServerThatGoesSilentIsStalledAndAskedAgain) {
   test::SilentNatNetServer silent({.frames = 5});
   IoThread client_io;
   SourceSinkRecorder sink;
-  NatNetSource source(client_io.io, client_of(silent.port()), sink);
+  NatNetSource source(client_io.io, natnet_client_of(silent.port()), sink);
   source.start();
   ASSERT_TRUE(sink.wait_frames(5));
   ASSERT_TRUE(sink.wait_state(SourceState::Stalled));
@@ -322,7 +322,7 @@ TEST(NatNetSource, UnicastTakesTheServersDatagramsOnly) {
   asio::io_context stranger_io;
   udp::socket stranger(stranger_io, udp::endpoint(asio::ip::make_address("127.0.0.2"), 0));
   std::atomic<uint16_t> client_port{0};
-  ScriptedServer server([&](udp::socket& s, const udp::endpoint& client, uint16_t request) {
+  NatNetScriptedServer server([&](udp::socket& s, const udp::endpoint& client, uint16_t request) {
     client_port = client.port();
     natnet::ByteVector frame;
     if (request == natnet::message::Connect) {
@@ -347,7 +347,7 @@ TEST(NatNetSource, UnicastTakesTheServersDatagramsOnly) {
   });
   IoThread client_io;
   SourceSinkRecorder sink;
-  NatNetSourceOptions options = client_of(server.port());
+  NatNetSourceOptions options = natnet_client_of(server.port());
   options.stall_timeout = 5s;
   NatNetSource source(client_io.io, options, sink);
   source.start();

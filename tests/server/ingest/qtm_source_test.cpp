@@ -34,7 +34,7 @@ QtmServerOptions fast_server(uint16_t port = 0) {
   return o;
 }
 
-QtmSourceOptions client_of(uint16_t port) {
+QtmSourceOptions qtm_client_of(uint16_t port) {
   QtmSourceOptions o;
   o.port = port;
   o.initial_backoff_seconds = 0.05;
@@ -53,7 +53,7 @@ TEST(QtmSource, StreamsSeveralSubjectsAsRecorded) {
   QtmServer server(server_io.io, {{"walker", &walker}, {"runner_2", &runner}}, fast_server());
   server_io.call([&] { server.start(); });
   SourceSinkRecorder sink;
-  QtmSource source(client_io.io, client_of(server_io.call([&] { return server.port(); })), sink);
+  QtmSource source(client_io.io, qtm_client_of(server_io.call([&] { return server.port(); })), sink);
   source.start();
   ASSERT_TRUE(sink.wait_frames(30));
   source.stop();
@@ -99,7 +99,7 @@ TEST(QtmSource, StreamsOverUdp) {
     udp::socket probe(client_io.io, udp::endpoint(asio::ip::make_address("127.0.0.1"), 0));
     free_port = probe.local_endpoint().port();
   }
-  QtmSourceOptions options = client_of(server_io.call([&] { return server.port(); }));
+  QtmSourceOptions options = qtm_client_of(server_io.call([&] { return server.port(); }));
   options.udp_port = free_port;
   SourceSinkRecorder sink;
   QtmSource source(client_io.io, options, sink);
@@ -121,7 +121,7 @@ TEST(QtmSource, AServerThatVanishesIsReportedAndFoundAgain) {
   server_io.call([&] { server->start(); });
   const uint16_t port = server_io.call([&] { return server->port(); });
   SourceSinkRecorder sink;
-  QtmSource source(client_io.io, client_of(port), sink);
+  QtmSource source(client_io.io, qtm_client_of(port), sink);
   source.start();
   ASSERT_TRUE(sink.wait_frames(5));
   server_io.call([&] { server.reset(); });  // gone: connection closed, port closed
@@ -139,10 +139,10 @@ TEST(QtmSource, AServerThatVanishesIsReportedAndFoundAgain) {
 }
 
 // A QTM RT server played from a script on its own thread, for input a real server never sends.
-class ScriptedServer {
+class QtmScriptedServer {
  public:
   using Script = std::function<void(tcp::socket&, qtm::PacketFramer&)>;
-  explicit ScriptedServer(Script script)
+  explicit QtmScriptedServer(Script script)
       : acceptor_(io_, tcp::endpoint(asio::ip::make_address("127.0.0.1"), 0)), thread_([this, script] {
           for (;;) {
             tcp::socket socket(io_);
@@ -157,7 +157,7 @@ class ScriptedServer {
             }
           }
         }) {}
-  ~ScriptedServer() {
+  ~QtmScriptedServer() {
     done_ = true;
     boost::system::error_code ec;
     tcp::socket poke(io_);
@@ -210,15 +210,15 @@ class ScriptedServer {
 };
 
 TEST(QtmSource, MalformedPacketIsCountedAndTheConnectionRetried) {
-  ScriptedServer server([](tcp::socket& s, qtm::PacketFramer& framer) {
-    ScriptedServer::handshake(s, framer, {"P_A"});
-    ScriptedServer::send(s, ScriptedServer::frame(1, {{1, 2, 3}}));
-    ScriptedServer::send(s, {4, 0, 0, 0, 3, 0, 0, 0});  // a size below the header: unrecoverable
+  QtmScriptedServer server([](tcp::socket& s, qtm::PacketFramer& framer) {
+    QtmScriptedServer::handshake(s, framer, {"P_A"});
+    QtmScriptedServer::send(s, QtmScriptedServer::frame(1, {{1, 2, 3}}));
+    QtmScriptedServer::send(s, {4, 0, 0, 0, 3, 0, 0, 0});  // a size below the header: unrecoverable
     std::this_thread::sleep_for(200ms);
   });
   IoThread client_io;
   SourceSinkRecorder sink;
-  QtmSource source(client_io.io, client_of(server.port()), sink);
+  QtmSource source(client_io.io, qtm_client_of(server.port()), sink);
   source.start();
   ASSERT_TRUE(sink.wait_bad_input("malformed_packet"));
   ASSERT_TRUE(sink.wait_state(SourceState::Disconnected));
@@ -230,22 +230,22 @@ TEST(QtmSource, MalformedPacketIsCountedAndTheConnectionRetried) {
 }
 
 TEST(QtmSource, TruncatedStreamAndRefusedHandshakeDisconnect) {
-  ScriptedServer truncated([](tcp::socket& s, qtm::PacketFramer& framer) {
-    ScriptedServer::handshake(s, framer, {"P_A"});
-    auto f = ScriptedServer::frame(1, {{1, 2, 3}});
+  QtmScriptedServer truncated([](tcp::socket& s, qtm::PacketFramer& framer) {
+    QtmScriptedServer::handshake(s, framer, {"P_A"});
+    auto f = QtmScriptedServer::frame(1, {{1, 2, 3}});
     f.resize(f.size() / 2);  // half a packet, then the server closes
-    ScriptedServer::send(s, f);
+    QtmScriptedServer::send(s, f);
   });
-  ScriptedServer refusing([](tcp::socket& s, qtm::PacketFramer& framer) {
-    ScriptedServer::send(s, qtm::encode_text(qtm::PacketType::Command, qtm::kWelcome));
-    ScriptedServer::next_command(s, framer);
-    ScriptedServer::send(s, qtm::encode_text(qtm::PacketType::Error, "Version NOT supported"));
+  QtmScriptedServer refusing([](tcp::socket& s, qtm::PacketFramer& framer) {
+    QtmScriptedServer::send(s, qtm::encode_text(qtm::PacketType::Command, qtm::kWelcome));
+    QtmScriptedServer::next_command(s, framer);
+    QtmScriptedServer::send(s, qtm::encode_text(qtm::PacketType::Error, "Version NOT supported"));
     std::this_thread::sleep_for(200ms);
   });
   IoThread client_io;
   SourceSinkRecorder a, b;
-  QtmSource to_truncated(client_io.io, client_of(truncated.port()), a);
-  QtmSource to_refusing(client_io.io, client_of(refusing.port()), b);
+  QtmSource to_truncated(client_io.io, qtm_client_of(truncated.port()), a);
+  QtmSource to_refusing(client_io.io, qtm_client_of(refusing.port()), b);
   to_truncated.start();
   to_refusing.start();
   ASSERT_TRUE(a.wait_state(SourceState::Disconnected));
@@ -260,18 +260,18 @@ TEST(QtmSource, TruncatedStreamAndRefusedHandshakeDisconnect) {
 
 TEST(QtmSource, WrongMarkerCountAsksForTheLabelsAgainAndInfinityIsMissing) {
   std::atomic<int> parameter_requests{0};
-  ScriptedServer server([&](tcp::socket& s, qtm::PacketFramer& framer) {
-    ScriptedServer::handshake(s, framer, {"P_A", "P_B"});
+  QtmScriptedServer server([&](tcp::socket& s, qtm::PacketFramer& framer) {
+    QtmScriptedServer::handshake(s, framer, {"P_A", "P_B"});
     ++parameter_requests;
-    ScriptedServer::send(s, ScriptedServer::frame(1, {{1, 2, 3}, {4, 5, 6}, {7, 8, 9}}));  // 3 markers, 2 labels
-    if (ScriptedServer::next_command(s, framer).rfind("GetParameters", 0) == 0) ++parameter_requests;
+    QtmScriptedServer::send(s, QtmScriptedServer::frame(1, {{1, 2, 3}, {4, 5, 6}, {7, 8, 9}}));  // 3 markers, 2 labels
+    if (QtmScriptedServer::next_command(s, framer).rfind("GetParameters", 0) == 0) ++parameter_requests;
     const float inf = std::numeric_limits<float>::infinity();
-    ScriptedServer::send(s, ScriptedServer::frame(2, {{inf, 2, 3}, {4, 5, 6}}));
+    QtmScriptedServer::send(s, QtmScriptedServer::frame(2, {{inf, 2, 3}, {4, 5, 6}}));
     std::this_thread::sleep_for(500ms);
   });
   IoThread client_io;
   SourceSinkRecorder sink;
-  QtmSource source(client_io.io, client_of(server.port()), sink);
+  QtmSource source(client_io.io, qtm_client_of(server.port()), sink);
   source.start();
   ASSERT_TRUE(sink.wait_bad_input("label_count_mismatch"));
   ASSERT_TRUE(sink.wait_bad_input("non_finite_point"));
@@ -291,7 +291,7 @@ TEST(QtmSource, ASilentServerIsLeftAfterTheHandshakeTimeoutAndTriedAgain) {
   test::SilentQtmServer silent({.handshake = false});
   IoThread client_io;
   SourceSinkRecorder sink;
-  QtmSourceOptions options = client_of(silent.port());
+  QtmSourceOptions options = qtm_client_of(silent.port());
   options.handshake_timeout = 300ms;
   QtmSource source(client_io.io, options, sink);
   source.start();
@@ -310,7 +310,7 @@ TEST(QtmSource, AServerThatGoesSilentIsStalledAndTriedAgain) {
   test::SilentQtmServer silent({.frames = 5});
   IoThread client_io;
   SourceSinkRecorder sink;
-  QtmSourceOptions options = client_of(silent.port());
+  QtmSourceOptions options = qtm_client_of(silent.port());
   options.stall_timeout = 300ms;
   QtmSource source(client_io.io, options, sink);
   source.start();
@@ -326,15 +326,15 @@ TEST(QtmSource, AServerThatGoesSilentIsStalledAndTriedAgain) {
 
 // Silence after NoMoreData is a measurement that ended, not a stall: nothing is retried.
 TEST(QtmSource, SilenceAfterTheMeasurementEndedIsNoStall) {
-  ScriptedServer server([](tcp::socket& s, qtm::PacketFramer& framer) {
-    ScriptedServer::handshake(s, framer, {"P_A"});
-    ScriptedServer::send(s, ScriptedServer::frame(1, {{1, 2, 3}}));
-    ScriptedServer::send(s, qtm::encode_no_more_data());
+  QtmScriptedServer server([](tcp::socket& s, qtm::PacketFramer& framer) {
+    QtmScriptedServer::handshake(s, framer, {"P_A"});
+    QtmScriptedServer::send(s, QtmScriptedServer::frame(1, {{1, 2, 3}}));
+    QtmScriptedServer::send(s, qtm::encode_no_more_data());
     std::this_thread::sleep_for(1500ms);
   });
   IoThread client_io;
   SourceSinkRecorder sink;
-  QtmSourceOptions options = client_of(server.port());
+  QtmSourceOptions options = qtm_client_of(server.port());
   options.stall_timeout = 300ms;
   QtmSource source(client_io.io, options, sink);
   source.start();
@@ -371,14 +371,14 @@ TEST(QtmServer, RefusesWhatItCannotDoAndClosesOnGarbage) {
   };
   uint32_t type = 0;
   EXPECT_EQ(next(type), qtm::kWelcome);
-  ScriptedServer::send(s, qtm::encode_text(qtm::PacketType::Command, "Version 1.5"));
+  QtmScriptedServer::send(s, qtm::encode_text(qtm::PacketType::Command, "Version 1.5"));
   EXPECT_EQ(next(type), "Version NOT supported");
   EXPECT_EQ(type, static_cast<uint32_t>(qtm::PacketType::Error));
-  ScriptedServer::send(s, qtm::encode_text(qtm::PacketType::Command, "TakeControl"));
+  QtmScriptedServer::send(s, qtm::encode_text(qtm::PacketType::Command, "TakeControl"));
   EXPECT_NE(next(type).find("not supported"), std::string::npos);
-  ScriptedServer::send(s, qtm::encode_text(qtm::PacketType::Command, "StreamFrames AllFrames 6D"));
+  QtmScriptedServer::send(s, qtm::encode_text(qtm::PacketType::Command, "StreamFrames AllFrames 6D"));
   EXPECT_NE(next(type).find("3D"), std::string::npos);
-  ScriptedServer::send(s, {0xFF, 0xFF, 0xFF, 0xFF, 1, 0, 0, 0});  // a 4 GB packet: closed
+  QtmScriptedServer::send(s, {0xFF, 0xFF, 0xFF, 0xFF, 1, 0, 0, 0});  // a 4 GB packet: closed
   boost::system::error_code ec;
   char byte;
   s.read_some(asio::buffer(&byte, 1), ec);

@@ -2,10 +2,12 @@
 
 #include <gtest/gtest.h>
 
+#include "support/ip_address.h"
+
 namespace skinstream::server {
 namespace {
 
-asio::ip::address ip(const char* text) { return asio::ip::make_address(text); }
+using test::ip;
 
 TEST(SubscriberAdmission, RefusesAddressesOutsideTheAllowList) {
   Metrics metrics;

@@ -2,10 +2,12 @@
 
 #include <gtest/gtest.h>
 
+#include "support/ip_address.h"
+
 namespace skinstream::server {
 namespace {
 
-asio::ip::address ip(const char* text) { return asio::ip::make_address(text); }
+using test::ip;
 
 TEST(SubscriberNetwork, RefusesWhatIsNotANetwork) {
   for (const char* bad : {"", "10.0.0.0/", "10.0.0.0/33", "10.0.0.0/-1", "10.0.0.0/8x", "stage", "10.0.0/8", "fd00::/129", "/8"})
