@@ -24,9 +24,10 @@ RUN cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DSKINSTREAM_BUILD_T
  && bash scripts/make-demo.sh build/bin/skinstream build/demo
 
 FROM debian:12-slim
-# The shared libraries skinstreamd loads beyond libc and libstdc++ (ldd build/bin/skinstreamd).
+# The shared libraries skinstreamd loads beyond libc, libstdc++ and libgcc (ldd build/bin/skinstreamd:
+# libspdlog, libfmt, libmeshoptimizer, libcrypto, libexpat).
 RUN apt-get update \
- && apt-get install -y --no-install-recommends libspdlog1.10 libfmt9 libmeshoptimizer2d libssl3 libexpat1 zlib1g \
+ && apt-get install -y --no-install-recommends libspdlog1.10 libfmt9 libmeshoptimizer2d libssl3 libexpat1 \
  && rm -rf /var/lib/apt/lists/* \
  && useradd --system --user-group --no-create-home --home-dir /opt/skinstream --shell /usr/sbin/nologin skinstream
 COPY --from=build /src/skinstream/build/bin/skinstreamd /opt/skinstream/bin/
