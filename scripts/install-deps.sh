@@ -1,13 +1,32 @@
 #!/usr/bin/env bash
 # Installs the Debian 12 packages skinstream needs to build, test and run.
 # As root it runs apt-get itself; otherwise it prints the exact command and fails.
+# --build-only: only what building the programs and the web page needs (the Dockerfile's builder
+# stage): no test tools, Chromium, Blender, Python or clang.
 set -euo pipefail
 
+build_only=0
+case "${1:-}" in
+  "") ;;
+  --build-only) build_only=1 ;;
+  *) echo "usage: install-deps.sh [--build-only]" >&2; exit 2 ;;
+esac
+
+# What building skinstreamd, the CLI and the web page needs (--build-only installs these alone).
 packages=(
-  build-essential cmake ninja-build pkg-config ccache
-  libeigen3-dev libboost-dev libboost-system-dev nlohmann-json3-dev libspdlog-dev libfmt-dev
-  libopenmesh-dev libmeshoptimizer-dev libgtest-dev libgmock-dev libbenchmark-dev libcli11-dev zlib1g-dev libexpat1-dev
+  build-essential cmake ninja-build pkg-config
+  libeigen3-dev libboost-dev nlohmann-json3-dev libspdlog-dev libfmt-dev
+  libmeshoptimizer-dev libcli11-dev zlib1g-dev libexpat1-dev
   libssl-dev  # OpenSSL's libcrypto: SHA-256 for the multicast datagrams' HMAC (protocol/datagram_authentication.cpp)
+)
+# The web viewer's build (npm) and its browser test (node + playwright-core + chromium). A
+# machine with Node.js from elsewhere (e.g. NodeSource, which bundles npm) keeps it.
+if ! command -v node >/dev/null 2>&1 || ! command -v npm >/dev/null 2>&1; then
+  packages+=(nodejs npm)
+fi
+# The tests, the benchmarks, the fuzz targets and the other clients.
+[ "$build_only" -eq 1 ] || packages+=(
+  ccache libboost-system-dev libopenmesh-dev libgtest-dev libgmock-dev libbenchmark-dev
   chromium
   clang libclang-rt-14-dev  # scripts/fuzz.sh: libFuzzer and clang's sanitizer runtimes
   # The Python package (clients/python): Debian's python3 and numpy; pip, venv, setuptools and
@@ -20,11 +39,6 @@ packages=(
   # test between network namespaces on a bridge (ip), one receiver's datagrams dropped by nft.
   iproute2 nftables
 )
-# The web viewer's build (npm) and its browser test (node + playwright-core + chromium). A
-# machine with Node.js from elsewhere (e.g. NodeSource, which bundles npm) keeps it.
-if ! command -v node >/dev/null 2>&1 || ! command -v npm >/dev/null 2>&1; then
-  packages+=(nodejs npm)
-fi
 
 missing=()
 for p in "${packages[@]}"; do
