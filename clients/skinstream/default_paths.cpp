@@ -37,6 +37,7 @@ std::string default_marker_sets_dir() {
   if (!ec)
     for (fs::path p = exe.parent_path(); !p.empty() && p != p.root_path(); p = p.parent_path())
       if (fs::is_directory(p / "config" / "marker_sets", ec)) return (p / "config" / "marker_sets").string();
+  if (fs::is_directory(SKINSTREAM_BUNDLED_MARKER_SETS, ec)) return SKINSTREAM_BUNDLED_MARKER_SETS;  // the checkout built from
   return (fs::current_path(ec) / "config" / "marker_sets").string();
 }
 
