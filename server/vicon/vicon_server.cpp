@@ -15,12 +15,12 @@
 #include "protocol/vicon_packet_writer.h"
 #include "server/listener.h"
 #include "server/logging.h"
+#include "server/replay/replay_timeline.h"
 
 namespace skinstream::server {
 namespace {
 
 using Packet = std::shared_ptr<const std::vector<unsigned char>>;
-using Clock = std::chrono::steady_clock;
 
 int64_t system_now_ns() {
   return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch())
@@ -57,7 +57,8 @@ struct ViconServer::State : std::enable_shared_from_this<ViconServer::State> {
       : io(io_context),
         options(std::move(opts)),
         encoder(subjects, options.rate_hz, options.loop),
-        timer(io),
+        timeline(io, encoder.rate_hz(), options.speed, static_cast<uint64_t>(encoder.frame_count()),
+                 options.loop),
         multicast_socket(io) {}
 
   asio::io_context& io;
@@ -66,7 +67,7 @@ struct ViconServer::State : std::enable_shared_from_this<ViconServer::State> {
   vicon::PacketWriter writer;
   std::unique_ptr<Listener> listener;  // from start() until stop()
   RateLimitedLog log;                  // refusals, which come in floods
-  asio::steady_timer timer;
+  ReplayTimeline timeline;
   udp::socket multicast_socket;
   struct MulticastDestination {
     udp::endpoint endpoint;
@@ -77,11 +78,8 @@ struct ViconServer::State : std::enable_shared_from_this<ViconServer::State> {
   Packet object_enums_packet;
 
   bool running = false;
-  bool timeline_started = false;
-  bool done = false;
-  Clock::time_point timeline_start;
-  uint64_t next_sequence = 0;      // k of the next frame to produce
   uint64_t latest_sequence = 0;    // k of the newest produced frame (valid when produced > 0)
+  uint32_t latest_frame_number = 0;
   uint64_t latest_listed = 0;      // the subjects the newest frame lists (CaptureFrameEncoder::listed)
   Packet latest_plain;             // the newest frame without static objects
   Packet latest_with_static;       // ... and with them (made when a client first needs it)
@@ -272,6 +270,10 @@ struct ViconServer::State : std::enable_shared_from_this<ViconServer::State> {
         ListenerOptions{options.tcp_congestion});
     object_enums_packet = copy_packet(vicon::encode_packet(vicon::CaptureFrameEncoder::offered_types()));
     running = true;
+    timeline.set_on_frame([this](uint64_t k) { produce(k); });
+    timeline.set_on_finished([this] {
+      if (on_finished) on_finished();
+    });
     listener->start();
     if (!options.start_on_first_request) start_timeline();
   }
@@ -301,43 +303,26 @@ struct ViconServer::State : std::enable_shared_from_this<ViconServer::State> {
     listener->stop();
     // Its cancelled handlers are queued and use it: freed after them.
     asio::post(io, [done = std::move(listener)] {});
-    timer.cancel();
+    timeline.stop();
     multicast_socket.close(ignored);
     for (auto& session : std::vector<std::shared_ptr<Session>>(sessions)) session->close();
     sessions.clear();
   }
 
   void client_wants_frames(Session& session) {
-    if (!timeline_started) {
+    if (!timeline.started()) {
       start_timeline();
       return;  // the first frame goes out at once from the timer
     }
     serve(session);
   }
 
+  // Only while serving: a multicast destination named before start() waits for it.
   void start_timeline() {
-    if (timeline_started || !running || encoder.frame_count() <= 0) return;
-    timeline_started = true;
-    timeline_start = Clock::now();
-    schedule();
+    if (running) timeline.start();
   }
 
-  Clock::duration deadline_offset(uint64_t sequence) const {
-    const double rate = encoder.rate_hz() * (options.speed > 0.0 ? options.speed : 1.0);
-    const double seconds = static_cast<double>(sequence) / rate;
-    return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
-  }
-
-  void schedule() {
-    timer.expires_at(timeline_start + deadline_offset(next_sequence));
-    timer.async_wait([self = shared_from_this()](const boost::system::error_code& ec) {
-      if (ec || !self->running) return;
-      self->produce();
-    });
-  }
-
-  void produce() {
-    const uint64_t sequence = next_sequence++;
+  void produce(uint64_t sequence) {
     const auto frame_number = static_cast<uint32_t>(static_cast<int64_t>(encoder.first_frame()) + static_cast<int64_t>(sequence));
     encoder.encode_frame(sequence, frame_number, false, writer);
     latest_plain = copy_packet(writer.finish());
@@ -354,13 +339,6 @@ struct ViconServer::State : std::enable_shared_from_this<ViconServer::State> {
     if (frame_hook) frame_hook(frame_number, system_now_ns());
     for (auto& session : std::vector<std::shared_ptr<Session>>(sessions)) serve(*session);
     send_multicast();
-
-    if (!options.loop && next_sequence >= static_cast<uint64_t>(encoder.frame_count())) {
-      done = true;
-      if (on_finished) on_finished();
-      return;
-    }
-    schedule();
   }
 
   const Packet& with_static() {
@@ -442,8 +420,6 @@ struct ViconServer::State : std::enable_shared_from_this<ViconServer::State> {
                                      });
     }
   }
-
-  uint32_t latest_frame_number = 0;
 };
 
 ViconServer::ViconServer(asio::io_context& io, std::vector<ReplaySubject> subjects, ViconServerOptions options)
@@ -464,7 +440,7 @@ void ViconServer::set_on_finished(std::function<void()> on_finished) { state_->o
 void ViconServer::start_multicast(const std::string& address, uint16_t port) {
   state_->add_multicast(udp::endpoint(asio::ip::make_address(address), port));
 }
-bool ViconServer::finished() const { return state_->done; }
+bool ViconServer::finished() const { return state_->timeline.finished(); }
 bool ViconServer::all_clients_idle() const {
   return std::all_of(state_->sessions.begin(), state_->sessions.end(),
                      [](const auto& s) { return s->queue.empty() && !s->writing; });
