@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <deque>
 #include <stdexcept>
 #include <vector>
 
@@ -15,12 +14,14 @@
 #include "protocol/vicon_packet_writer.h"
 #include "server/listener.h"
 #include "server/logging.h"
+#include "server/replay/replay_client.h"
+#include "server/replay/replay_client_list.h"
 #include "server/replay/replay_timeline.h"
 
 namespace skinstream::server {
 namespace {
 
-using Packet = std::shared_ptr<const std::vector<unsigned char>>;
+using Packet = ReplayClient::Packet;
 
 int64_t system_now_ns() {
   return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch())
@@ -59,14 +60,15 @@ struct ViconServer::State : std::enable_shared_from_this<ViconServer::State> {
         encoder(subjects, options.rate_hz, options.loop),
         timeline(io, encoder.rate_hz(), options.speed, static_cast<uint64_t>(encoder.frame_count()),
                  options.loop),
-        multicast_socket(io) {}
+        multicast_socket(io),
+        sessions(io) {}
 
   asio::io_context& io;
   ViconServerOptions options;
   vicon::CaptureFrameEncoder encoder;
   vicon::PacketWriter writer;
   std::unique_ptr<Listener> listener;  // from start() until stop()
-  RateLimitedLog log;                  // refusals, which come in floods
+  RateLimitedLog log;                  // refusals and malformed clients, which come in floods
   ReplayTimeline timeline;
   udp::socket multicast_socket;
   struct MulticastDestination {
@@ -74,7 +76,7 @@ struct ViconServer::State : std::enable_shared_from_this<ViconServer::State> {
     const void* client = nullptr;  // the session that asked (null: the operator, start_multicast)
   };
   std::vector<MulticastDestination> multicast_destinations;
-  std::vector<std::shared_ptr<Session>> sessions;
+  ReplayClientList<Session> sessions;
   Packet object_enums_packet;
 
   bool running = false;
@@ -87,21 +89,16 @@ struct ViconServer::State : std::enable_shared_from_this<ViconServer::State> {
   FrameHook frame_hook;
   std::function<void()> on_finished;
   ViconServerStats stats;
+  const ReplayClientContext client_context{"vicon server", "vicon_bad_client", options.max_queued_frames, log,
+                                           stats.clients_open, stats.bad_clients, stats.frame_packets_sent,
+                                           stats.frames_dropped};
 
   // ---- one TCP client ----
-  struct Session : std::enable_shared_from_this<Session> {
-    Session(State& owner, tcp::socket s) : state(owner), socket(std::move(s)) {}
+  struct Session : ReplayClient {
+    Session(State& owner, tcp::socket s) : ReplayClient(std::move(s), owner.client_context), state(owner) {}
 
     State& state;  // sessions never outlive State: State closes them in stop()
-    tcp::socket socket;
     vicon::PacketFramer framer{kMaxClientPacketBytes};
-    struct Outgoing {
-      Packet packet;
-      bool is_frame;
-    };
-    std::deque<Outgoing> queue;  // front is being written while `writing`
-    bool writing = false;
-    bool open = true;
     bool push = false;
     int pull_requests = 0;
     bool sent_any_frame = false;
@@ -116,14 +113,15 @@ struct ViconServer::State : std::enable_shared_from_this<ViconServer::State> {
     }
 
     void read() {
-      auto self = shared_from_this();
       const auto room = framer.prepare(16 * 1024);
-      socket.async_read_some(asio::buffer(room.data(), room.size()),
-                             [self](const boost::system::error_code& ec, size_t n) { self->on_read(ec, n); });
+      auto handler = [keep = shared_from_this(), this](const boost::system::error_code& ec, size_t n) {
+        on_read(ec, n);
+      };
+      socket().async_read_some(asio::buffer(room.data(), room.size()), std::move(handler));
     }
 
     void on_read(const boost::system::error_code& ec, size_t n) {
-      if (!open) return;
+      if (!open()) return;
       if (ec) {
         if (ec != asio::error::eof && ec != asio::error::operation_aborted)
           spdlog::debug("vicon server: client read: {}", ec.message());
@@ -196,69 +194,11 @@ struct ViconServer::State : std::enable_shared_from_this<ViconServer::State> {
       return true;
     }
 
-    // Queues a packet; frames beyond the bound push out the oldest waiting frame.
-    void enqueue(Packet packet, bool is_frame) {
-      if (!open) return;
-      if (is_frame) {
-        size_t waiting = 0;
-        for (size_t i = writing ? 1 : 0; i < queue.size(); ++i) waiting += queue[i].is_frame ? 1 : 0;
-        if (waiting >= std::max<size_t>(1, state.options.max_queued_frames)) {
-          for (auto it = queue.begin() + (writing ? 1 : 0); it != queue.end(); ++it)
-            if (it->is_frame) {
-              queue.erase(it);
-              ++state.stats.frames_dropped;
-              break;
-            }
-        }
-      }
-      queue.push_back({std::move(packet), is_frame});
-      write();
-    }
-
-    void write() {
-      if (writing || queue.empty() || !open) return;
-      writing = true;
-      auto self = shared_from_this();
-      const Packet& packet = queue.front().packet;
-      asio::async_write(socket, asio::buffer(*packet), [self](const boost::system::error_code& ec, size_t) {
-        self->writing = false;
-        if (!self->open) return;
-        if (ec) {
-          self->close();
-          return;
-        }
-        if (self->queue.front().is_frame) ++self->state.stats.frame_packets_sent;
-        self->queue.pop_front();
-        self->write();
-      });
-    }
-
-    void reject(const std::string& reason) {
-      ++state.stats.bad_clients;
-      spdlog::warn("vicon server: closing a client that sent malformed input: {}", reason);
-      close();
-    }
-
-    void close() {
-      if (!open) return;
-      open = false;
-      boost::system::error_code ignored;
-      socket.shutdown(tcp::socket::shutdown_both, ignored);
-      socket.close(ignored);
-      queue.clear();
-      --state.stats.clients_open;
+    void closed() override {
       state.remove_multicast(this);  // nothing is sent for it once it left
-      state.forget(this);
+      state.sessions.forget(this);
     }
   };
-
-  void forget(Session* session) {
-    // Posted: the session may be in the middle of its own handler.
-    asio::post(io, [self = shared_from_this(), session] {
-      auto& s = self->sessions;
-      s.erase(std::remove_if(s.begin(), s.end(), [session](const auto& p) { return p.get() == session; }), s.end());
-    });
-  }
 
   void start() {
     // The daemon's listener: out of descriptors it pauses its accepts instead of retrying at once.
@@ -290,7 +230,7 @@ struct ViconServer::State : std::enable_shared_from_this<ViconServer::State> {
     if (options.socket_send_buffer_bytes > 0)
       socket.set_option(asio::socket_base::send_buffer_size(options.socket_send_buffer_bytes), ignored);
     auto session = std::make_shared<Session>(*this, std::move(socket));
-    sessions.push_back(session);
+    sessions.add(session);
     ++stats.clients_accepted;
     ++stats.clients_open;
     session->begin();
@@ -305,8 +245,7 @@ struct ViconServer::State : std::enable_shared_from_this<ViconServer::State> {
     asio::post(io, [done = std::move(listener)] {});
     timeline.stop();
     multicast_socket.close(ignored);
-    for (auto& session : std::vector<std::shared_ptr<Session>>(sessions)) session->close();
-    sessions.clear();
+    sessions.close_all();
   }
 
   void client_wants_frames(Session& session) {
@@ -337,7 +276,7 @@ struct ViconServer::State : std::enable_shared_from_this<ViconServer::State> {
     // hook called afterwards could be late (seen by skinstream-bench as frames without a send
     // time, 3 in 288,000).
     if (frame_hook) frame_hook(frame_number, system_now_ns());
-    for (auto& session : std::vector<std::shared_ptr<Session>>(sessions)) serve(*session);
+    for (auto& session : sessions.snapshot()) serve(*session);
     send_multicast();
   }
 
@@ -351,7 +290,7 @@ struct ViconServer::State : std::enable_shared_from_this<ViconServer::State> {
 
   // Sends the newest frame to a client that wants it and has not had it.
   void serve(Session& session) {
-    if (!session.open || stats.frames_produced == 0) return;
+    if (!session.open() || stats.frames_produced == 0) return;
     if (!session.push && session.pull_requests <= 0) return;
     if (session.has_last_sent && session.last_sent_sequence >= latest_sequence) return;
     // Static objects in a client's first frame and whenever the subjects listed changed.
@@ -371,7 +310,7 @@ struct ViconServer::State : std::enable_shared_from_this<ViconServer::State> {
   void add_multicast(const udp::endpoint& destination, const Session* client = nullptr) {
     boost::system::error_code ec;
     if (client) {
-      const auto own = client->socket.remote_endpoint(ec).address();
+      const auto own = client->socket().remote_endpoint(ec).address();
       const bool own_address = !ec && destination.address() == (own.is_v6() && own.to_v6().is_v4_mapped()
                                                                     ? asio::ip::address(asio::ip::make_address_v4(asio::ip::v4_mapped, own.to_v6()))
                                                                     : own);
@@ -441,10 +380,7 @@ void ViconServer::start_multicast(const std::string& address, uint16_t port) {
   state_->add_multicast(udp::endpoint(asio::ip::make_address(address), port));
 }
 bool ViconServer::finished() const { return state_->timeline.finished(); }
-bool ViconServer::all_clients_idle() const {
-  return std::all_of(state_->sessions.begin(), state_->sessions.end(),
-                     [](const auto& s) { return s->queue.empty() && !s->writing; });
-}
+bool ViconServer::all_clients_idle() const { return state_->sessions.all_idle(); }
 const ViconServerStats& ViconServer::stats() const { return state_->stats; }
 
 }  // namespace skinstream::server
