@@ -1,9 +1,9 @@
 #pragma once
-// The lifecycle the QTM RT and NatNet sources share, over their connection State (held by
-// shared_ptr, living on the io_context): start reports Connecting and connects on the io thread;
-// a failure of the current connection (by generation) closes it and retries after the backoff;
-// stop, once, cancels the retry and closes the sockets. State provides io, sink, stopped,
-// generation, reconnection, where(), connect() and close_sockets().
+// The lifecycle the Vicon DataStream, QTM RT and NatNet sources share, over their connection
+// State (held by shared_ptr, living on the io_context): start reports Connecting and connects on
+// the io thread; a failure of the current connection (by generation) closes it and retries after
+// the backoff; stop, once, cancels the retry and closes the sockets. State provides io, sink,
+// stopped, generation, reconnection, where(), connect() and close_sockets().
 #include <cstdint>
 #include <memory>
 #include <string>

@@ -2,7 +2,8 @@
 // How a network source reports its connection and comes back after a failure: Disconnected (or
 // Stalled) is reported once per outage (with the first reason), a retry follows after a backoff that doubles
 // from initial_seconds to max_seconds, and once frames flow again Streaming is reported once and
-// the backoff starts from initial_seconds again. Shared by the QTM RT and NatNet sources.
+// the backoff starts from initial_seconds again. Shared by the Vicon DataStream, QTM RT and
+// NatNet sources.
 //
 // Threading: every member runs on the source's io_context thread.
 

@@ -10,6 +10,8 @@
 
 #include "protocol/vicon_packet_framer.h"
 #include "protocol/vicon_packet_writer.h"
+#include "server/ingest/source_lifecycle.h"
+#include "server/ingest/source_reconnection.h"
 #include "server/system_clock.h"
 
 namespace skinstream::server {
@@ -211,10 +213,9 @@ struct ViconSource::State : std::enable_shared_from_this<ViconSource::State> {
         assembler(frame_sink, options.limits),
         socket(io),
         resolver(io),
-        timer(io),
         watchdog(io),
-        framer(vicon::kMaxPacketLength, options.limits),
-        backoff(options.initial_backoff_seconds) {
+        reconnection(io, sink, options.initial_backoff_seconds, options.max_backoff_seconds),
+        framer(vicon::kMaxPacketLength, options.limits) {
     pull_request = vicon::encode_packet(vicon::RequestFrame{false});
     out_pending.reserve(256);
     out_inflight.reserve(256);
@@ -226,8 +227,8 @@ struct ViconSource::State : std::enable_shared_from_this<ViconSource::State> {
   ViconFrameAssembler assembler;
   tcp::socket socket;
   tcp::resolver resolver;
-  asio::steady_timer timer;
   asio::steady_timer watchdog;  // the handshake's and the stream's silences
+  SourceReconnection reconnection;
   std::chrono::steady_clock::time_point connected_at, last_frame;
   vicon::PacketFramer framer;
   std::vector<unsigned char> pull_request;
@@ -235,10 +236,7 @@ struct ViconSource::State : std::enable_shared_from_this<ViconSource::State> {
   std::vector<unsigned char> out_inflight;
   bool writing = false;
   bool handshake_sent = false;
-  bool streaming = false;
-  bool disconnected_reported = false;
   uint64_t generation = 0;  // bumps on every new connection: stale handlers see a different one
-  double backoff;
   std::atomic<bool> stopped{false};
 
   std::string where() const { return options.host + ":" + std::to_string(options.port); }
@@ -252,7 +250,6 @@ struct ViconSource::State : std::enable_shared_from_this<ViconSource::State> {
     framer.reserve(2 * kReadBytes);
     assembler.reset();
     handshake_sent = false;
-    streaming = false;
     writing = false;
     out_pending.clear();
     connected_at = std::chrono::steady_clock::now();
@@ -313,12 +310,7 @@ struct ViconSource::State : std::enable_shared_from_this<ViconSource::State> {
       if (!handshake_sent && assembler.saw_object_enums()) send_handshake(gen);
       if (result == ViconFrameAssembler::Result::Frame) {
         last_frame = std::chrono::steady_clock::now();
-        if (!streaming) {
-          streaming = true;
-          disconnected_reported = false;
-          backoff = options.initial_backoff_seconds;
-          sink.on_source_state(SourceState::Streaming, where());
-        }
+        reconnection.frame_arrived(where());
         sink.on_frame(assembler.frame());
         if (stopped) return;
         if (options.mode == ViconSourceOptions::Mode::ClientPull) send(gen, pull_request);
@@ -396,7 +388,7 @@ struct ViconSource::State : std::enable_shared_from_this<ViconSource::State> {
     });
   }
 
-  void close_socket() {
+  void close_sockets() {
     boost::system::error_code ignored;
     watchdog.cancel();
     resolver.cancel();
@@ -405,20 +397,7 @@ struct ViconSource::State : std::enable_shared_from_this<ViconSource::State> {
   }
 
   void fail(uint64_t gen, const std::string& reason, SourceState reported = SourceState::Disconnected) {
-    if (stopped || gen != generation) return;
-    ++generation;  // whatever is still pending for this connection is now stale
-    close_socket();
-    streaming = false;
-    if (!disconnected_reported) {
-      disconnected_reported = true;
-      sink.on_source_state(reported, reason);
-    }
-    timer.expires_after(std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-        std::chrono::duration<double>(backoff)));
-    backoff = std::min(backoff * 2.0, options.max_backoff_seconds);
-    timer.async_wait([self = shared_from_this()](const boost::system::error_code& ec) {
-      if (!ec && !self->stopped) self->connect();
-    });
+    fail_connection(shared_from_this(), gen, reason, reported);
   }
 };
 
@@ -427,20 +406,7 @@ ViconSource::ViconSource(asio::io_context& io, ViconSourceOptions options, Sourc
 
 ViconSource::~ViconSource() { stop(); }
 
-void ViconSource::start() {
-  asio::post(state_->io, [state = state_] {
-    if (state->stopped) return;
-    state->sink.on_source_state(SourceState::Connecting, state->where());
-    state->connect();
-  });
-}
-
-void ViconSource::stop() {
-  if (state_->stopped.exchange(true)) return;
-  asio::post(state_->io, [state = state_] {
-    state->timer.cancel();
-    state->close_socket();
-  });
-}
+void ViconSource::start() { start_source(state_); }
+void ViconSource::stop() { stop_source(state_); }
 
 }  // namespace skinstream::server

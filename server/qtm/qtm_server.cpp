@@ -4,7 +4,6 @@
 #include <array>
 #include <chrono>
 #include <cmath>
-#include <deque>
 #include <optional>
 #include <stdexcept>
 
@@ -18,12 +17,14 @@
 #include "protocol/qtm_packet_writer.h"
 #include "server/listener.h"
 #include "server/logging.h"
+#include "server/replay/replay_client.h"
+#include "server/replay/replay_client_list.h"
 #include "server/replay/replay_timeline.h"
 
 namespace skinstream::server {
 namespace {
 
-using Packet = std::shared_ptr<const std::vector<unsigned char>>;
+using Packet = ReplayClient::Packet;
 
 Packet shared(std::vector<unsigned char> bytes) {
   return std::make_shared<const std::vector<unsigned char>>(std::move(bytes));
@@ -47,7 +48,9 @@ struct QtmServer::State : std::enable_shared_from_this<QtmServer::State> {
         options(std::move(opts)),
         encoder(std::move(subjects), options.rate_hz),
         udp_socket(io),
-        timeline(io, encoder.rate_hz(), options.speed, static_cast<uint64_t>(encoder.frame_count()), options.loop) {}
+        timeline(io, encoder.rate_hz(), options.speed, static_cast<uint64_t>(encoder.frame_count()),
+                 options.loop),
+        sessions(io) {}
 
   asio::io_context& io;
   QtmServerOptions options;
@@ -56,7 +59,7 @@ struct QtmServer::State : std::enable_shared_from_this<QtmServer::State> {
   std::unique_ptr<Listener> listener;
   udp::socket udp_socket;
   ReplayTimeline timeline;
-  std::vector<std::shared_ptr<Session>> sessions;
+  ReplayClientList<Session> sessions;
   bool running = false;
   uint64_t latest = 0;                  // stream index of the newest frame
   std::array<Packet, 3> latest_packets;  // 3D + no labels, 3D only, no labels only: made on demand
@@ -64,22 +67,16 @@ struct QtmServer::State : std::enable_shared_from_this<QtmServer::State> {
   QtmServer::FrameHook frame_hook;
   QtmServerStats stats;
   RateLimitedLog log;
+  const ReplayClientContext client_context{"qtm server", "qtm_bad_client", options.max_queued_frames, log,
+                                           stats.clients_open, stats.bad_clients, stats.frame_packets_sent,
+                                           stats.frames_dropped};
 
-  struct Session : std::enable_shared_from_this<Session> {
-    Session(State& owner, tcp::socket s) : state(owner), socket(std::move(s)) {}
+  struct Session : ReplayClient {
+    Session(State& owner, tcp::socket s) : ReplayClient(std::move(s), owner.client_context), state(owner) {}
 
     State& state;  // sessions never outlive State: State closes them in stop()
-    tcp::socket socket;
     qtm::PacketFramer framer{1u << 20};  // a client's commands are short; a megabyte is plenty
-    struct Outgoing {
-      Packet packet;
-      bool is_frame;
-    };
-    std::deque<Outgoing> queue;  // front is being written while `writing`
-    size_t replies_waiting = 0;  // of the queue, not frames
-    bool writing = false;
     bool reading_paused = false;  // commands wait in the framer until the replies are read
-    bool open = true;
     bool streaming = false;
     bool labelled = true, unlabelled = true;
     uint64_t divisor = 1;
@@ -92,14 +89,14 @@ struct QtmServer::State : std::enable_shared_from_this<QtmServer::State> {
 
     void read() {
       const auto room = framer.prepare(4096);
-      socket.async_read_some(asio::buffer(room.data(), room.size()),
-                             [self = shared_from_this()](const boost::system::error_code& ec, size_t n) {
-                               self->on_read(ec, n);
-                             });
+      auto handler = [keep = shared_from_this(), this](const boost::system::error_code& ec, size_t n) {
+        on_read(ec, n);
+      };
+      socket().async_read_some(asio::buffer(room.data(), room.size()), std::move(handler));
     }
 
     void on_read(const boost::system::error_code& ec, size_t n) {
-      if (!open) return;
+      if (!open()) return;
       if (ec) {
         close();
         return;
@@ -112,7 +109,7 @@ struct QtmServer::State : std::enable_shared_from_this<QtmServer::State> {
     // (in the framer, and in the client's socket) until the client reads its replies.
     void handle_commands() {
       qtm::Bytes packet;
-      while (replies_waiting < state.options.max_queued_replies) {
+      while (replies_waiting() < state.options.max_queued_replies) {
         const auto status = framer.next(packet);
         if (status == qtm::PacketFramer::Status::NeedMore) return read();
         std::string error;
@@ -120,7 +117,7 @@ struct QtmServer::State : std::enable_shared_from_this<QtmServer::State> {
           reject(status == qtm::PacketFramer::Status::Error ? framer.error() : error);
           return;
         }
-        if (!open) return;
+        if (!open()) return;
       }
       reading_paused = true;
       ++state.stats.reads_paused;
@@ -213,7 +210,7 @@ struct QtmServer::State : std::enable_shared_from_this<QtmServer::State> {
       udp_destination.reset();
       if (command.udp) {
         boost::system::error_code ec;
-        const auto own = socket.remote_endpoint(ec).address();
+        const auto own = socket().remote_endpoint(ec).address();
         const auto address = ec || command.udp_address.empty() ? own : asio::ip::make_address(command.udp_address, ec);
         if (ec) {
           refuse("StreamFrames: bad UDP address " + quoted_text(command.udp_address));
@@ -230,61 +227,15 @@ struct QtmServer::State : std::enable_shared_from_this<QtmServer::State> {
       state.timeline.start();
     }
 
-    // Queues a packet; frames beyond the bound push out the oldest waiting frame.
-    void enqueue(Packet packet, bool is_frame) {
-      if (!open) return;
-      if (is_frame) {
-        size_t waiting = 0;
-        for (size_t i = writing ? 1 : 0; i < queue.size(); ++i) waiting += queue[i].is_frame ? 1 : 0;
-        if (waiting >= std::max<size_t>(1, state.options.max_queued_frames)) {
-          const auto oldest = std::find_if(queue.begin() + (writing ? 1 : 0), queue.end(),
-                                           [](const Outgoing& o) { return o.is_frame; });
-          queue.erase(oldest);
-          ++state.stats.frames_dropped;
-        }
+    // Half the replies read: its commands are taken again.
+    void after_write() override {
+      if (reading_paused && open() && replies_waiting() <= state.options.max_queued_replies / 2) {
+        reading_paused = false;
+        handle_commands();
       }
-      queue.push_back({std::move(packet), is_frame});
-      replies_waiting += is_frame ? 0 : 1;
-      write();
     }
 
-    void write() {
-      if (writing || queue.empty() || !open) return;
-      writing = true;
-      asio::async_write(socket, asio::buffer(*queue.front().packet),
-                        [self = shared_from_this()](const boost::system::error_code& ec, size_t) {
-                          self->writing = false;
-                          if (!self->open) return;
-                          if (ec) return self->close();
-                          if (self->queue.front().is_frame) ++self->state.stats.frame_packets_sent;
-                          else --self->replies_waiting;
-                          self->queue.pop_front();
-                          self->write();
-                          // Half the replies read: its commands are taken again.
-                          if (self->reading_paused && self->open && self->replies_waiting <= self->state.options.max_queued_replies / 2) {
-                            self->reading_paused = false;
-                            self->handle_commands();
-                          }
-                        });
-    }
-
-    void reject(const std::string& reason) {
-      ++state.stats.bad_clients;
-      state.log.warn("qtm_bad_client", "qtm server: closing a client that sent malformed input: " + reason);
-      close();
-    }
-
-    void close() {
-      if (!open) return;
-      open = false;
-      boost::system::error_code ignored;
-      socket.shutdown(tcp::socket::shutdown_both, ignored);
-      socket.close(ignored);
-      queue.clear();
-      replies_waiting = 0;
-      --state.stats.clients_open;
-      state.forget(this);
-    }
+    void closed() override { state.sessions.forget(this); }
   };
 
   // The newest frame with the components asked for (encoded once per frame and combination).
@@ -292,13 +243,6 @@ struct QtmServer::State : std::enable_shared_from_this<QtmServer::State> {
     const size_t slot = labelled && unlabelled ? 0 : (labelled ? 1 : 2);
     if (!latest_packets[slot]) latest_packets[slot] = shared(encoder.encode_frame(latest, writer, labelled, unlabelled));
     return latest_packets[slot];
-  }
-
-  void forget(Session* session) {
-    asio::post(io, [self = shared_from_this(), session] {  // posted: the session may be in its own handler
-      auto& s = self->sessions;
-      s.erase(std::remove_if(s.begin(), s.end(), [session](const auto& p) { return p.get() == session; }), s.end());
-    });
   }
 
   void start() {
@@ -323,7 +267,7 @@ struct QtmServer::State : std::enable_shared_from_this<QtmServer::State> {
       return;  // the socket closes as it goes
     }
     auto session = std::make_shared<Session>(*this, std::move(socket));
-    sessions.push_back(session);
+    sessions.add(session);
     ++stats.clients_accepted;
     ++stats.clients_open;
     session->begin();
@@ -339,8 +283,7 @@ struct QtmServer::State : std::enable_shared_from_this<QtmServer::State> {
     }
     udp_socket.close(ignored);
     timeline.stop();
-    for (auto& session : std::vector<std::shared_ptr<Session>>(sessions)) session->close();
-    sessions.clear();
+    sessions.close_all();
   }
 
   void produce(uint64_t k) {
@@ -350,8 +293,8 @@ struct QtmServer::State : std::enable_shared_from_this<QtmServer::State> {
     if (frame_hook)
       frame_hook(encoder.frame_number(k),
                  std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch()).count());
-    for (auto& session : std::vector<std::shared_ptr<Session>>(sessions)) {
-      if (!session->open || !session->streaming || k % session->divisor != 0) continue;
+    for (auto& session : sessions.snapshot()) {
+      if (!session->open() || !session->streaming || k % session->divisor != 0) continue;
       Packet p = packet(session->labelled, session->unlabelled);
       if (session->udp_destination)
         send_datagram(std::move(p), *session->udp_destination);
@@ -371,8 +314,8 @@ struct QtmServer::State : std::enable_shared_from_this<QtmServer::State> {
   }
 
   void finish() {
-    for (auto& session : std::vector<std::shared_ptr<Session>>(sessions)) {
-      if (!session->open || !session->streaming) continue;
+    for (auto& session : sessions.snapshot()) {
+      if (!session->open() || !session->streaming) continue;
       session->send(qtm::encode_event(qtm::Event::RtFromFileStopped));
       session->send(qtm::encode_no_more_data());
       session->streaming = false;
@@ -392,10 +335,7 @@ uint16_t QtmServer::port() const { return state_->listener ? static_cast<uint16_
 void QtmServer::set_on_finished(std::function<void()> on_finished) { state_->on_finished = std::move(on_finished); }
 void QtmServer::set_frame_hook(FrameHook hook) { state_->frame_hook = std::move(hook); }
 bool QtmServer::finished() const { return state_->timeline.finished(); }
-bool QtmServer::all_clients_idle() const {
-  return std::all_of(state_->sessions.begin(), state_->sessions.end(),
-                     [](const auto& s) { return s->queue.empty() && !s->writing; });
-}
+bool QtmServer::all_clients_idle() const { return state_->sessions.all_idle(); }
 const QtmServerStats& QtmServer::stats() const { return state_->stats; }
 
 }  // namespace skinstream::server

@@ -22,8 +22,8 @@ void ReplayTimeline::stop() {
 void ReplayTimeline::schedule() {
   const std::chrono::duration<double> offset(static_cast<double>(next_) / (rate_hz_ * speed_));
   timer_.expires_at(start_ + std::chrono::duration_cast<asio::steady_timer::clock_type::duration>(offset));
-  timer_.async_wait([this](const boost::system::error_code& ec) {
-    if (ec || stopped_) return;
+  timer_.async_wait([this, alive = std::weak_ptr<bool>(alive_)](const boost::system::error_code& ec) {
+    if (ec || alive.expired() || stopped_) return;
     const uint64_t k = next_++;
     if (on_frame_) on_frame_(k);
     if (stopped_) return;

@@ -1,12 +1,13 @@
 #pragma once
 // The clock of a replay server: frame k of a recording leaves at start + k / (rate x speed) on
 // the steady clock, so the stream does not drift, and k keeps counting across loops. Shared by
-// the QTM RT and NatNet replay servers.
+// the Vicon DataStream, QTM RT and NatNet replay servers.
 //
 // Threading: every member runs on the io_context's thread (or before it runs).
 
 #include <cstdint>
 #include <functional>
+#include <memory>
 
 #include "server/asio.h"
 
@@ -41,6 +42,9 @@ class ReplayTimeline {
   asio::steady_timer::clock_type::time_point start_;
   std::function<void(uint64_t)> on_frame_;
   std::function<void()> on_finished_;
+  // A frame already due when the timeline is destroyed still has its handler run (with success):
+  // the handler checks this before it touches the timeline.
+  std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);
 };
 
 }  // namespace skinstream::server

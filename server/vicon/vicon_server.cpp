@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <deque>
 #include <stdexcept>
 #include <vector>
 
@@ -15,13 +14,15 @@
 #include "protocol/vicon_packet_writer.h"
 #include "server/listener.h"
 #include "server/logging.h"
+#include "server/replay/replay_client.h"
+#include "server/replay/replay_client_list.h"
+#include "server/replay/replay_timeline.h"
 #include "server/system_clock.h"
 
 namespace skinstream::server {
 namespace {
 
-using Packet = std::shared_ptr<const std::vector<unsigned char>>;
-using Clock = std::chrono::steady_clock;
+using Packet = ReplayClient::Packet;
 
 Packet copy_packet(std::span<const unsigned char> bytes) {
   return std::make_shared<const std::vector<unsigned char>>(bytes.begin(), bytes.end());
@@ -53,31 +54,30 @@ struct ViconServer::State : std::enable_shared_from_this<ViconServer::State> {
       : io(io_context),
         options(std::move(opts)),
         encoder(subjects, options.rate_hz, options.loop),
-        timer(io),
-        multicast_socket(io) {}
+        timeline(io, encoder.rate_hz(), options.speed, static_cast<uint64_t>(encoder.frame_count()),
+                 options.loop),
+        multicast_socket(io),
+        sessions(io) {}
 
   asio::io_context& io;
   ViconServerOptions options;
   vicon::CaptureFrameEncoder encoder;
   vicon::PacketWriter writer;
   std::unique_ptr<Listener> listener;  // from start() until stop()
-  RateLimitedLog log;                  // refusals, which come in floods
-  asio::steady_timer timer;
+  RateLimitedLog log;                  // refusals and malformed clients, which come in floods
+  ReplayTimeline timeline;
   udp::socket multicast_socket;
   struct MulticastDestination {
     udp::endpoint endpoint;
     const void* client = nullptr;  // the session that asked (null: the operator, start_multicast)
   };
   std::vector<MulticastDestination> multicast_destinations;
-  std::vector<std::shared_ptr<Session>> sessions;
+  ReplayClientList<Session> sessions;
   Packet object_enums_packet;
 
   bool running = false;
-  bool timeline_started = false;
-  bool done = false;
-  Clock::time_point timeline_start;
-  uint64_t next_sequence = 0;      // k of the next frame to produce
   uint64_t latest_sequence = 0;    // k of the newest produced frame (valid when produced > 0)
+  uint32_t latest_frame_number = 0;
   uint64_t latest_listed = 0;      // the subjects the newest frame lists (CaptureFrameEncoder::listed)
   Packet latest_plain;             // the newest frame without static objects
   Packet latest_with_static;       // ... and with them (made when a client first needs it)
@@ -85,21 +85,16 @@ struct ViconServer::State : std::enable_shared_from_this<ViconServer::State> {
   FrameHook frame_hook;
   std::function<void()> on_finished;
   ViconServerStats stats;
+  const ReplayClientContext client_context{"vicon server", "vicon_bad_client", options.max_queued_frames, log,
+                                           stats.clients_open, stats.bad_clients, stats.frame_packets_sent,
+                                           stats.frames_dropped};
 
   // ---- one TCP client ----
-  struct Session : std::enable_shared_from_this<Session> {
-    Session(State& owner, tcp::socket s) : state(owner), socket(std::move(s)) {}
+  struct Session : ReplayClient {
+    Session(State& owner, tcp::socket s) : ReplayClient(std::move(s), owner.client_context), state(owner) {}
 
     State& state;  // sessions never outlive State: State closes them in stop()
-    tcp::socket socket;
     vicon::PacketFramer framer{kMaxClientPacketBytes};
-    struct Outgoing {
-      Packet packet;
-      bool is_frame;
-    };
-    std::deque<Outgoing> queue;  // front is being written while `writing`
-    bool writing = false;
-    bool open = true;
     bool push = false;
     int pull_requests = 0;
     bool sent_any_frame = false;
@@ -114,14 +109,15 @@ struct ViconServer::State : std::enable_shared_from_this<ViconServer::State> {
     }
 
     void read() {
-      auto self = shared_from_this();
       const auto room = framer.prepare(16 * 1024);
-      socket.async_read_some(asio::buffer(room.data(), room.size()),
-                             [self](const boost::system::error_code& ec, size_t n) { self->on_read(ec, n); });
+      auto handler = [keep = shared_from_this(), this](const boost::system::error_code& ec, size_t n) {
+        on_read(ec, n);
+      };
+      socket().async_read_some(asio::buffer(room.data(), room.size()), std::move(handler));
     }
 
     void on_read(const boost::system::error_code& ec, size_t n) {
-      if (!open) return;
+      if (!open()) return;
       if (ec) {
         if (ec != asio::error::eof && ec != asio::error::operation_aborted)
           spdlog::debug("vicon server: client read: {}", ec.message());
@@ -194,69 +190,11 @@ struct ViconServer::State : std::enable_shared_from_this<ViconServer::State> {
       return true;
     }
 
-    // Queues a packet; frames beyond the bound push out the oldest waiting frame.
-    void enqueue(Packet packet, bool is_frame) {
-      if (!open) return;
-      if (is_frame) {
-        size_t waiting = 0;
-        for (size_t i = writing ? 1 : 0; i < queue.size(); ++i) waiting += queue[i].is_frame ? 1 : 0;
-        if (waiting >= std::max<size_t>(1, state.options.max_queued_frames)) {
-          for (auto it = queue.begin() + (writing ? 1 : 0); it != queue.end(); ++it)
-            if (it->is_frame) {
-              queue.erase(it);
-              ++state.stats.frames_dropped;
-              break;
-            }
-        }
-      }
-      queue.push_back({std::move(packet), is_frame});
-      write();
-    }
-
-    void write() {
-      if (writing || queue.empty() || !open) return;
-      writing = true;
-      auto self = shared_from_this();
-      const Packet& packet = queue.front().packet;
-      asio::async_write(socket, asio::buffer(*packet), [self](const boost::system::error_code& ec, size_t) {
-        self->writing = false;
-        if (!self->open) return;
-        if (ec) {
-          self->close();
-          return;
-        }
-        if (self->queue.front().is_frame) ++self->state.stats.frame_packets_sent;
-        self->queue.pop_front();
-        self->write();
-      });
-    }
-
-    void reject(const std::string& reason) {
-      ++state.stats.bad_clients;
-      spdlog::warn("vicon server: closing a client that sent malformed input: {}", reason);
-      close();
-    }
-
-    void close() {
-      if (!open) return;
-      open = false;
-      boost::system::error_code ignored;
-      socket.shutdown(tcp::socket::shutdown_both, ignored);
-      socket.close(ignored);
-      queue.clear();
-      --state.stats.clients_open;
+    void closed() override {
       state.remove_multicast(this);  // nothing is sent for it once it left
-      state.forget(this);
+      state.sessions.forget(this);
     }
   };
-
-  void forget(Session* session) {
-    // Posted: the session may be in the middle of its own handler.
-    asio::post(io, [self = shared_from_this(), session] {
-      auto& s = self->sessions;
-      s.erase(std::remove_if(s.begin(), s.end(), [session](const auto& p) { return p.get() == session; }), s.end());
-    });
-  }
 
   void start() {
     // The daemon's listener: out of descriptors it pauses its accepts instead of retrying at once.
@@ -268,6 +206,10 @@ struct ViconServer::State : std::enable_shared_from_this<ViconServer::State> {
         ListenerOptions{options.tcp_congestion});
     object_enums_packet = copy_packet(vicon::encode_packet(vicon::CaptureFrameEncoder::offered_types()));
     running = true;
+    timeline.set_on_frame([this](uint64_t k) { produce(k); });
+    timeline.set_on_finished([this] {
+      if (on_finished) on_finished();
+    });
     listener->start();
     if (!options.start_on_first_request) start_timeline();
   }
@@ -284,7 +226,7 @@ struct ViconServer::State : std::enable_shared_from_this<ViconServer::State> {
     if (options.socket_send_buffer_bytes > 0)
       socket.set_option(asio::socket_base::send_buffer_size(options.socket_send_buffer_bytes), ignored);
     auto session = std::make_shared<Session>(*this, std::move(socket));
-    sessions.push_back(session);
+    sessions.add(session);
     ++stats.clients_accepted;
     ++stats.clients_open;
     session->begin();
@@ -297,43 +239,25 @@ struct ViconServer::State : std::enable_shared_from_this<ViconServer::State> {
     listener->stop();
     // Its cancelled handlers are queued and use it: freed after them.
     asio::post(io, [done = std::move(listener)] {});
-    timer.cancel();
+    timeline.stop();
     multicast_socket.close(ignored);
-    for (auto& session : std::vector<std::shared_ptr<Session>>(sessions)) session->close();
-    sessions.clear();
+    sessions.close_all();
   }
 
   void client_wants_frames(Session& session) {
-    if (!timeline_started) {
+    if (!timeline.started()) {
       start_timeline();
       return;  // the first frame goes out at once from the timer
     }
     serve(session);
   }
 
+  // Only while serving: a multicast destination named before start() waits for it.
   void start_timeline() {
-    if (timeline_started || !running || encoder.frame_count() <= 0) return;
-    timeline_started = true;
-    timeline_start = Clock::now();
-    schedule();
+    if (running) timeline.start();
   }
 
-  Clock::duration deadline_offset(uint64_t sequence) const {
-    const double rate = encoder.rate_hz() * (options.speed > 0.0 ? options.speed : 1.0);
-    const double seconds = static_cast<double>(sequence) / rate;
-    return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
-  }
-
-  void schedule() {
-    timer.expires_at(timeline_start + deadline_offset(next_sequence));
-    timer.async_wait([self = shared_from_this()](const boost::system::error_code& ec) {
-      if (ec || !self->running) return;
-      self->produce();
-    });
-  }
-
-  void produce() {
-    const uint64_t sequence = next_sequence++;
+  void produce(uint64_t sequence) {
     const auto frame_number = static_cast<uint32_t>(static_cast<int64_t>(encoder.first_frame()) + static_cast<int64_t>(sequence));
     encoder.encode_frame(sequence, frame_number, false, writer);
     latest_plain = copy_packet(writer.finish());
@@ -348,15 +272,8 @@ struct ViconServer::State : std::enable_shared_from_this<ViconServer::State> {
     // hook called afterwards could be late (seen by skinstream-bench as frames without a send
     // time, 3 in 288,000).
     if (frame_hook) frame_hook(frame_number, system_now_ns());
-    for (auto& session : std::vector<std::shared_ptr<Session>>(sessions)) serve(*session);
+    for (auto& session : sessions.snapshot()) serve(*session);
     send_multicast();
-
-    if (!options.loop && next_sequence >= static_cast<uint64_t>(encoder.frame_count())) {
-      done = true;
-      if (on_finished) on_finished();
-      return;
-    }
-    schedule();
   }
 
   const Packet& with_static() {
@@ -369,7 +286,7 @@ struct ViconServer::State : std::enable_shared_from_this<ViconServer::State> {
 
   // Sends the newest frame to a client that wants it and has not had it.
   void serve(Session& session) {
-    if (!session.open || stats.frames_produced == 0) return;
+    if (!session.open() || stats.frames_produced == 0) return;
     if (!session.push && session.pull_requests <= 0) return;
     if (session.has_last_sent && session.last_sent_sequence >= latest_sequence) return;
     // Static objects in a client's first frame and whenever the subjects listed changed.
@@ -389,7 +306,7 @@ struct ViconServer::State : std::enable_shared_from_this<ViconServer::State> {
   void add_multicast(const udp::endpoint& destination, const Session* client = nullptr) {
     boost::system::error_code ec;
     if (client) {
-      const auto own = client->socket.remote_endpoint(ec).address();
+      const auto own = client->socket().remote_endpoint(ec).address();
       const bool own_address = !ec && destination.address() == (own.is_v6() && own.to_v6().is_v4_mapped()
                                                                     ? asio::ip::address(asio::ip::make_address_v4(asio::ip::v4_mapped, own.to_v6()))
                                                                     : own);
@@ -438,8 +355,6 @@ struct ViconServer::State : std::enable_shared_from_this<ViconServer::State> {
                                      });
     }
   }
-
-  uint32_t latest_frame_number = 0;
 };
 
 ViconServer::ViconServer(asio::io_context& io, std::vector<ReplaySubject> subjects, ViconServerOptions options)
@@ -460,11 +375,8 @@ void ViconServer::set_on_finished(std::function<void()> on_finished) { state_->o
 void ViconServer::start_multicast(const std::string& address, uint16_t port) {
   state_->add_multicast(udp::endpoint(asio::ip::make_address(address), port));
 }
-bool ViconServer::finished() const { return state_->done; }
-bool ViconServer::all_clients_idle() const {
-  return std::all_of(state_->sessions.begin(), state_->sessions.end(),
-                     [](const auto& s) { return s->queue.empty() && !s->writing; });
-}
+bool ViconServer::finished() const { return state_->timeline.finished(); }
+bool ViconServer::all_clients_idle() const { return state_->sessions.all_idle(); }
 const ViconServerStats& ViconServer::stats() const { return state_->stats; }
 
 }  // namespace skinstream::server

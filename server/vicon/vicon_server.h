@@ -17,9 +17,10 @@
 // not listed in it).
 //
 // Frames leave on absolute steady-clock deadlines (start + k * period / speed), so the stream
-// does not drift. The timeline starts when the first client asks for a frame (or at start() with
-// start_on_first_request = false). Frame numbers, as the SDK shows them, are
-// capture.first_frame + k, where k keeps counting across loops so numbers never go back.
+// does not drift (server/replay/replay_timeline.h). The timeline starts when the first client
+// asks for a frame (or at start() with start_on_first_request = false). Frame numbers, as the
+// SDK shows them, are capture.first_frame + k, where k keeps counting across loops so numbers
+// never go back.
 //
 // Each client has a bounded queue: when it is full the oldest waiting frame is dropped (the
 // newest wins) and counted, so a slow client never delays the others. A client sending malformed

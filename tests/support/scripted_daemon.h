@@ -1,7 +1,8 @@
 #pragma once
 // "Daemons" written for the clients' tests: a ScriptedDaemon answers a subscriber's Hello with the
 // bytes given (and keeps the Hello it got), then keeps the connection open, saying nothing more,
-// until the subscriber leaves. broken_frame_stream() is the stream of one of them whose frames
+// until the subscriber leaves (or, with Then::Close, closes it a moment later: a daemon whose
+// stream ends there). broken_frame_stream() is the stream of one of them whose frames
 // include a broken one: MeshInfo (version 2, the parameter encoding, the 3 vertices of the
 // protocol's golden Model, tests/protocol/fixtures/subscriber/model.bin), that Model, and `frames`
 // parameter Frames numbered 1, 2, ... in the Model's reference pose, the one numbered `broken`
@@ -11,6 +12,7 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <cstring>
 #include <limits>
 #include <mutex>
@@ -70,7 +72,10 @@ inline std::vector<unsigned char> broken_frame_stream(int frames, int broken) {
 
 class ScriptedDaemon {
  public:
-  explicit ScriptedDaemon(std::vector<unsigned char> reply) : reply_(std::move(reply)) {
+  enum class Then { WaitForTheSubscriber, Close };
+
+  explicit ScriptedDaemon(std::vector<unsigned char> reply, Then then = Then::WaitForTheSubscriber)
+      : reply_(std::move(reply)) {
     listener_ = socket(AF_INET, SOCK_STREAM, 0);
     sockaddr_in address{};
     address.sin_family = AF_INET;
@@ -80,7 +85,7 @@ class ScriptedDaemon {
     listen(listener_, 1);
     getsockname(listener_, reinterpret_cast<sockaddr*>(&address), &length);
     port = ntohs(address.sin_port);
-    thread_ = std::thread([this] {
+    thread_ = std::thread([this, then] {
       const int peer = accept(listener_, nullptr, nullptr);
       if (peer < 0) return;
       unsigned char buffer[4096];
@@ -92,7 +97,12 @@ class ScriptedDaemon {
         }
         send(peer, reply_.data(), reply_.size(), MSG_NOSIGNAL);
       }
-      while (recv(peer, buffer, sizeof buffer, 0) > 0) {
+      if (then == Then::Close) {
+        // A moment first: the subscriber reads what it was sent before it meets the end.
+        std::this_thread::sleep_for(std::chrono::milliseconds(200));
+      } else {
+        while (recv(peer, buffer, sizeof buffer, 0) > 0) {
+        }
       }
       close(peer);
     });

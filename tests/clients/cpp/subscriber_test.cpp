@@ -129,43 +129,11 @@ TEST(ClientSubscriber, NoDaemonIsAOneLineError) {
   EXPECT_THROW(client::Subscriber(client::Options{.encoding = Encoding::Parameters, .protocol_version = 1}), std::invalid_argument);
 }
 
-// A "daemon" that answers the Hello with the bytes given, then closes.
-class FakeDaemon {
- public:
-  explicit FakeDaemon(std::vector<unsigned char> reply) : reply_(std::move(reply)) {
-    listener_ = socket(AF_INET, SOCK_STREAM, 0);
-    sockaddr_in address{};
-    address.sin_family = AF_INET;
-    address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    socklen_t length = sizeof address;
-    bind(listener_, reinterpret_cast<sockaddr*>(&address), sizeof address);
-    listen(listener_, 1);
-    getsockname(listener_, reinterpret_cast<sockaddr*>(&address), &length);
-    port = ntohs(address.sin_port);
-    thread_ = std::thread([this] {
-      const int peer = accept(listener_, nullptr, nullptr);
-      unsigned char hello[1024];
-      if (recv(peer, hello, sizeof hello, 0) > 0) send(peer, reply_.data(), reply_.size(), MSG_NOSIGNAL);
-      std::this_thread::sleep_for(std::chrono::milliseconds(200));
-      close(peer);
-    });
-  }
-  ~FakeDaemon() {
-    thread_.join();
-    close(listener_);
-  }
-  uint16_t port = 0;
-
- private:
-  std::vector<unsigned char> reply_;
-  int listener_ = -1;
-  std::thread thread_;
-};
-
 std::string error_for(std::vector<unsigned char> reply, Encoding encoding = Encoding::Parameters) {
-  FakeDaemon fake(std::move(reply));
+  // Then closes: a stream that ends inside a message is an error too.
+  test::ScriptedDaemon daemon(std::move(reply), test::ScriptedDaemon::Then::Close);
   client::Options options;
-  options.port = fake.port;
+  options.port = daemon.port;
   options.encoding = encoding;
   client::Subscriber sub(options);
   client::Frame frame;
