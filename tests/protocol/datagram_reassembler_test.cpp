@@ -69,7 +69,9 @@ TEST(DatagramReassembler, FragmentsThatDisagreeArePutTogetherApart) {
   std::optional<DatagramReassembler::Message> message;
   for (size_t i = 0; i < real.size() && !message; ++i) {
     message = r.add(real[i], t0);
-    if (!message && i > 0) EXPECT_FALSE(r.add(copies[i], t0));  // each real fragment copied at once
+    if (!message && i > 0) {
+      EXPECT_FALSE(r.add(copies[i], t0));  // each real fragment copied at once
+    }
   }
   ASSERT_TRUE(message);
   EXPECT_TRUE(holds_message(message->bytes, 7788));
