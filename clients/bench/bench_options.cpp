@@ -2,7 +2,7 @@
 
 #include <CLI/CLI.hpp>
 
-#include "server/vicon/vicon_server.h"
+#include "server/replay/vicon/vicon_server.h"
 
 namespace skinstream::bench {
 

@@ -1,8 +1,8 @@
 #include "clients/bench/replay_engine.h"
 
-#include "server/natnet/natnet_server.h"
-#include "server/qtm/qtm_server.h"
-#include "server/vicon/vicon_server.h"
+#include "server/replay/natnet/natnet_server.h"
+#include "server/replay/qtm/qtm_server.h"
+#include "server/replay/vicon/vicon_server.h"
 
 namespace skinstream::bench {
 

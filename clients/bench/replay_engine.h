@@ -20,7 +20,7 @@ struct ReplayEngineOptions {
   CaptureProtocol protocol = CaptureProtocol::Vicon;
   std::string bind_address = "127.0.0.1";
   std::string tcp_congestion;  // Vicon's connection to the daemon ("" = the system's)
-  double natnet_timestamp_jitter_us = 0.0;  // NatNet: the replay's clock (server/natnet/natnet_server.h)
+  double natnet_timestamp_jitter_us = 0.0;  // NatNet: the replay's clock (server/replay/natnet/natnet_server.h)
   double natnet_clock_hz = 0.0;
 };
 

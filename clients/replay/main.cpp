@@ -1,8 +1,8 @@
 // skinstream-replay: streams recorded captures (C3D or TRC) as a capture system would, so that
 // skinstreamd, benchmarks and unmodified clients can run without a capture stage: a Vicon
 // DataStream, QTM RT or NatNet server; several recordings become several subjects of one stream
-// (a stage with several actors: server/vicon/vicon_server.h, server/qtm/qtm_server.h,
-// server/natnet/natnet_server.h).
+// (a stage with several actors: server/replay/vicon/vicon_server.h, server/replay/qtm/qtm_server.h,
+// server/replay/natnet/natnet_server.h).
 //
 //   skinstream-replay [--protocol vicon|qtm|natnet] RECORDING... --port P [--rate HZ] [--speed X]
 //                     [--loop | --hold] [--subject NAME]... [--multicast GROUP[:PORT]] [--multicast-ttl N]
@@ -25,11 +25,11 @@
 #include <spdlog/spdlog.h>
 
 #include "server/asio.h"
-#include "server/natnet/natnet_server.h"
-#include "server/qtm/qtm_server.h"
+#include "server/replay/natnet/natnet_server.h"
+#include "server/replay/qtm/qtm_server.h"
 #include "server/replay/replay_recordings.h"
 #include "server/tcp_congestion.h"
-#include "server/vicon/vicon_server.h"
+#include "server/replay/vicon/vicon_server.h"
 
 namespace {
 

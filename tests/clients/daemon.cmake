@@ -6,9 +6,10 @@ if(TARGET skinstreamd AND TARGET skinstream-sub AND TARGET skinstream-replay)
   add_executable(daemon_tests ${CMAKE_CURRENT_LIST_DIR}/daemon_e2e_test.cpp ${CMAKE_CURRENT_LIST_DIR}/daemon_subjects_e2e_test.cpp
     ${CMAKE_CURRENT_LIST_DIR}/daemon_subscribers_e2e_test.cpp
     ${PROJECT_SOURCE_DIR}/tests/support/test_data.cpp ${PROJECT_SOURCE_DIR}/tests/support/program_run.cpp
-    ${PROJECT_SOURCE_DIR}/tests/support/loopback_peer.cpp ${PROJECT_SOURCE_DIR}/tests/support/daemon_process.cpp)
+    ${PROJECT_SOURCE_DIR}/tests/support/loopback_peer.cpp ${PROJECT_SOURCE_DIR}/tests/support/daemon_process.cpp
+    ${PROJECT_SOURCE_DIR}/tests/support/subscriber_client.cpp)
   target_include_directories(daemon_tests PRIVATE ${PROJECT_SOURCE_DIR}/tests)
-  # skinstream_server for the blocking subscriber client (server/client/) the tests subscribe with.
+  # skinstream_server for the blocking subscriber client (tests/support/) the tests subscribe with.
   target_link_libraries(daemon_tests PRIVATE skinstream_server skinstream_protocol_offline nlohmann_json::nlohmann_json GTest::gtest_main)
   target_compile_definitions(daemon_tests PRIVATE
     SKINSTREAMD="$<TARGET_FILE:skinstreamd>"

@@ -19,7 +19,7 @@
 #include "protocol/vicon_capture_encoder.h"
 #include "protocol/vicon_packet_writer.h"
 #include "server/beast.h"
-#include "server/client/subscriber_client.h"
+#include "support/subscriber_client.h"
 #include "server/publish/subscriber_hub.h"
 #include "server/tcp_congestion.h"
 #include "support/socket_lookup.h"

@@ -22,7 +22,7 @@
 #include <thread>
 #include <vector>
 
-#include "server/client/subscriber_client.h"
+#include "support/subscriber_client.h"
 #include "support/daemon_process.h"
 #include "support/loopback_peer.h"  // eventually()
 #include "support/test_data.h"

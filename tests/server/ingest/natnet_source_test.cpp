@@ -1,4 +1,4 @@
-// The daemon's NatNetSource against the NatNet replay server (server/natnet/natnet_server) over
+// The daemon's NatNetSource against the NatNet replay server (server/replay/natnet/natnet_server) over
 // real loopback sockets: marker sets as subjects in millimetres, occlusion, unlabelled points,
 // the 3.1 and 4.1 layouts, unicast and multicast, a server that vanishes and comes back, and a
 // scripted server that sends malformed, truncated and unknown input.
@@ -16,7 +16,7 @@
 #include "protocol/natnet_reader.h"
 #include "protocol/natnet_writer.h"
 #include "server/ingest/natnet_source.h"
-#include "server/natnet/natnet_server.h"
+#include "server/replay/natnet/natnet_server.h"
 #include "support/replay_capture.h"
 #include "support/silent_capture_servers.h"
 #include "support/source_sink_recorder.h"

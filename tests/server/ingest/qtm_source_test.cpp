@@ -1,4 +1,4 @@
-// The daemon's QtmSource against the QTM RT replay server (server/qtm/qtm_server) over real
+// The daemon's QtmSource against the QTM RT replay server (server/replay/qtm/qtm_server) over real
 // loopback sockets: subjects from the label prefixes, exact positions, occlusion, unlabelled
 // points, TCP and UDP streaming, a server that vanishes and comes back, and scripted servers that
 // send malformed, truncated, inconsistent and non-finite input.
@@ -13,7 +13,7 @@
 #include "protocol/qtm_packet_writer.h"
 #include "protocol/qtm_parameters.h"
 #include "server/ingest/qtm_source.h"
-#include "server/qtm/qtm_server.h"
+#include "server/replay/qtm/qtm_server.h"
 #include "support/replay_capture.h"
 #include "support/silent_capture_servers.h"
 #include "support/source_sink_recorder.h"

@@ -17,7 +17,7 @@
 
 #include "core/offline/subject_builder.h"
 #include "protocol/capture_file.h"
-#include "server/client/subscriber_client.h"
+#include "support/subscriber_client.h"
 #include "server/publish/subscriber_hub.h"
 #include "server/publish/tcp_subscriber.h"
 #include "support/allocation_counter.h"

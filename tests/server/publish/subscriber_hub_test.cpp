@@ -11,7 +11,7 @@
 #include <thread>
 #include <vector>
 
-#include "server/client/subscriber_client.h"
+#include "support/subscriber_client.h"
 #include "server/publish/tcp_subscriber.h"
 
 namespace skinstream::server {

@@ -1,4 +1,4 @@
-#include "server/client/subscriber_client.h"
+#include "support/subscriber_client.h"
 
 #include <stdexcept>
 

@@ -1,7 +1,7 @@
 #pragma once
 // A blocking subscriber connection for one thread: connects, sends Hello, then hands each
-// message to the caller as it is cut from the stream. Used by skinstream-sub, skinstream-bench
-// and the tests.
+// message to the caller as it is cut from the stream: the tests' own view of the wire (the
+// programs subscribe through the client library, clients/cpp/).
 
 #include <chrono>
 #include <functional>

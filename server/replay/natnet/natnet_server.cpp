@@ -1,4 +1,4 @@
-#include "server/natnet/natnet_server.h"
+#include "server/replay/natnet/natnet_server.h"
 
 #include <algorithm>
 #include <deque>

@@ -23,7 +23,7 @@
 #include "server/ingest/vicon_multicast_source.h"
 #include "server/ingest/vicon_source.h"
 #include "server/tcp_congestion.h"
-#include "server/vicon/vicon_server.h"
+#include "server/replay/vicon/vicon_server.h"
 #include "support/allocation_counter.h"
 #include "support/io_thread.h"
 #include "support/silent_capture_servers.h"

@@ -1,6 +1,6 @@
 // The QTM RT replay server as a client meets it over a real loopback socket: what a client
 // wrote and the server quotes back in an Error packet stays one printable line.
-#include "server/qtm/qtm_server.h"
+#include "server/replay/qtm/qtm_server.h"
 
 #include <gtest/gtest.h>
 

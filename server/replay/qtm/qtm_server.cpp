@@ -1,4 +1,4 @@
-#include "server/qtm/qtm_server.h"
+#include "server/replay/qtm/qtm_server.h"
 
 #include <algorithm>
 #include <array>

@@ -1,4 +1,4 @@
-#include "server/vicon/vicon_server.h"
+#include "server/replay/vicon/vicon_server.h"
 
 #include <algorithm>
 #include <chrono>
