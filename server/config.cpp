@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "server/config_keys.h"
+#include "server/ingest/source_spec.h"
 
 namespace skinstream::server {
 
@@ -58,8 +59,7 @@ nlohmann::json printable(const DaemonConfig& c) {
 
 void validate(const DaemonConfig& c) {
   auto fail = [](const std::string& what) { throw ConfigError("configuration: " + what); };
-  if (!c.replay.empty() + !c.vicon.empty() + !c.vicon_multicast.empty() + !c.qtm.empty() + !c.natnet.empty() > 1)
-    fail("give one source: a replay file, a Vicon server, a Vicon multicast address, a QTM or a NatNet server");
+  source_spec_of(c);  // ConfigError when more than one source is given
   for (const ConfigKey& key : config_keys())
     if (key.problem)
       if (const std::string problem = key.problem(c); !problem.empty()) fail(problem);
