@@ -117,6 +117,7 @@ std::optional<HostPort> parse_host_with_port(const std::string& text, uint16_t d
 struct CommandLine {
   DaemonConfig config;
   bool print_config = false;
+  bool print_reference_config = false;  // config/skinstreamd.reference.json, from the key table
 };
 // Parses argv: --config FILE first, then every flag given overrides it. Throws ConfigError for
 // config problems; CLI11 parse errors are returned as an exit code via `out_exit_code`.

@@ -14,10 +14,7 @@
 #include "protocol/printable_text.h"
 #include "server/http/http_server.h"
 #include "server/ingest/file_replay_source.h"
-#include "server/ingest/natnet_source.h"
-#include "server/ingest/qtm_source.h"
-#include "server/ingest/vicon_multicast_source.h"
-#include "server/ingest/vicon_source.h"
+#include "server/ingest/source_spec.h"
 #include "server/listener.h"
 #include "server/pipeline/deform_cpus.h"
 #include "server/publish/multicast_sender.h"
@@ -96,21 +93,6 @@ HostPort host_port_of(const std::string& flag, const std::string& text) {
   return *parsed;
 }
 
-// A "HOST[:PORT]" key (qtm, natnet), likewise.
-HostPort host_port_of(const std::string& flag, const std::string& text, uint16_t default_port) {
-  const std::optional<HostPort> parsed = parse_host_with_port(text, default_port);
-  if (!parsed) throw ConfigError(flag + " " + text + ": expected HOST or HOST:PORT with a port of 1-65535");
-  return *parsed;
-}
-
-vicon::DescriptionLimits description_limits_of(const DaemonConfig& config) {
-  vicon::DescriptionLimits limits;
-  limits.max_subjects = static_cast<uint32_t>(config.source_max_subjects);
-  limits.max_markers_per_subject = static_cast<uint32_t>(config.source_max_markers_per_subject);
-  limits.max_name_bytes = static_cast<uint32_t>(config.source_max_name_bytes);
-  return limits;
-}
-
 MulticastSenderOptions multicast_options_of(const DaemonConfig& config, uint32_t stream_id) {
   const HostPort group = host_port_of("--multicast", config.multicast);
   MulticastSenderOptions options{group.host, group.port, config.multicast_interface, config.multicast_ttl, stream_id};
@@ -139,18 +121,6 @@ AdmissionOptions admission_options_of(const DaemonConfig& config) {
   return options;
 }
 
-ViconSourceOptions vicon_options_of(const DaemonConfig& config) {
-  const HostPort address = host_port_of("--vicon", config.vicon);
-  ViconSourceOptions options;
-  options.host = address.host;
-  options.port = address.port;
-  options.mode = config.vicon_pull ? ViconSourceOptions::Mode::ClientPull : ViconSourceOptions::Mode::ServerPush;
-  options.limits = description_limits_of(config);
-  options.handshake_timeout = std::chrono::milliseconds(config.source_handshake_timeout_ms);
-  options.stall_timeout = std::chrono::milliseconds(config.source_stall_ms);
-  return options;
-}
-
 }  // namespace
 
 Daemon::Daemon(const DaemonConfig& config)
@@ -167,54 +137,21 @@ Daemon::Daemon(const DaemonConfig& config)
     s->hub().set_directory(&directory_);
   }
   admission_ = std::make_shared<SubscriberAdmission>(admission_options_of(config), source_metrics_);
-  if (!config.replay.empty()) {
-    auto replay = std::make_unique<FileReplaySource>(io_, config.replay, static_cast<SourceSink&>(*this),
-                                                     ReplayOptions{config.loop, config.speed, config.replay_subject});
+  const SourceSpec source = source_spec_of(config);
+  source_ = make_source(io_, source, config, static_cast<SourceSink&>(*this));
+  if (source.kind == SourceSpec::Kind::Replay) {
+    const auto& replay = static_cast<const FileReplaySource&>(*source_);
     // A replay's one subject never changes: a subject that cannot follow it is an error now.
     for (int k = 0; k < subject_count(); ++k) {
       const SubjectStream& s = subject(k);
-      if (!s.config().name.empty() && s.config().name != replay->subject().name)
+      if (!s.config().name.empty() && s.config().name != replay.subject().name)
         throw ConfigError("subject \"" + s.config().name + "\" is not in the replay " + config.replay + ", whose subject is \"" +
-                          replay->subject().name + "\" (name it with --replay-subject)");
-      if (router_.markers_labelled_by(k, replay->subject()) == 0)
+                          replay.subject().name + "\" (name it with --replay-subject)");
+      if (router_.markers_labelled_by(k, replay.subject()) == 0)
         throw FileError(config.replay, "none of the subject's " + std::to_string(s.model().marker_count()) +
                                            " marker labels is in this capture (wrong subject file?)");
     }
-    source_ = std::move(replay);
-  } else if (!config.vicon_multicast.empty()) {
-    const HostPort address = host_port_of("--vicon-multicast", config.vicon_multicast);
-    ViconMulticastSourceOptions options;
-    options.group = address.host;
-    options.port = address.port;
-    options.limits = description_limits_of(config);
-    spdlog::info("source: Vicon DataStream multicast {}:{} (receive only)", options.group, options.port);
-    source_ = std::make_unique<ViconMulticastSource>(io_, std::move(options), static_cast<SourceSink&>(*this));
-  } else if (!config.vicon.empty()) {
-    ViconSourceOptions options = vicon_options_of(config);
-    spdlog::info("source: Vicon DataStream {}:{} ({})", options.host, options.port,
-                 options.mode == ViconSourceOptions::Mode::ClientPull ? "client pull" : "server push");
-    source_ = std::make_unique<ViconSource>(io_, std::move(options), static_cast<SourceSink&>(*this));
-  } else if (!config.qtm.empty()) {
-    const HostPort address = host_port_of("--qtm", config.qtm, qtm::kLittleEndianPort);
-    QtmSourceOptions options;
-    options.host = address.host;
-    options.port = address.port;
-    options.handshake_timeout = std::chrono::milliseconds(config.source_handshake_timeout_ms);
-    options.stall_timeout = std::chrono::milliseconds(config.source_stall_ms);
-    spdlog::info("source: QTM RT {}:{}", options.host, options.port);
-    source_ = std::make_unique<QtmSource>(io_, std::move(options), static_cast<SourceSink&>(*this));
-  } else if (!config.natnet.empty()) {
-    const HostPort address = host_port_of("--natnet", config.natnet, natnet::kCommandPort);
-    NatNetSourceOptions options;
-    options.host = address.host;
-    options.command_port = address.port;
-    options.interface_address = config.natnet_interface;
-    options.bind_address = config.bind_address;
-    options.reply_timeout = std::chrono::milliseconds(config.source_handshake_timeout_ms);
-    options.stall_timeout = std::chrono::milliseconds(config.source_stall_ms);
-    spdlog::info("source: NatNet {}:{}", options.host, options.command_port);
-    source_ = std::make_unique<NatNetSource>(io_, std::move(options), static_cast<SourceSink&>(*this));
-  } else {
+  } else if (source.kind == SourceSpec::Kind::None) {
     spdlog::warn("no source configured (--replay FILE, --vicon HOST:PORT, --vicon-multicast GROUP:PORT, --qtm HOST[:PORT] "
                  "or --natnet HOST[:PORT]): serving subscribers without frames");
   }

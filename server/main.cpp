@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "server/config.h"
+#include "server/config_keys.h"
 #include "server/daemon.h"
 #include "server/logging.h"
 
@@ -27,6 +28,10 @@ int main(int argc, char** argv) {
     if (!command_line) return exit_code;
     if (command_line->print_config) {
       std::printf("%s\n", printable(command_line->config).dump(2).c_str());
+      return 0;
+    }
+    if (command_line->print_reference_config) {
+      std::fputs(reference_config().c_str(), stdout);
       return 0;
     }
     set_log_level(command_line->config.log_level);
