@@ -1,0 +1,19 @@
+#!/usr/bin/env bash
+# Fails when a C++ line changed since .clang-format came to the project is not laid out as
+# clang-format lays it out, and prints what it would change. Lines older than that are left as
+# they are: the check covers what a change touches. Usage: scripts/format-check.sh [BASE]
+# (BASE: a commit to compare with instead; the working tree's uncommitted changes count too).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+base=${1:-$(git log -1 --format=%H -- .clang-format)}
+if [ -z "$base" ] || ! git cat-file -e "$base^{commit}" 2>/dev/null; then
+  echo "format-check: no commit to compare with (.clang-format not committed, or a shallow clone): nothing checked" >&2
+  exit 1
+fi
+changes=$(git diff -U0 --no-color "$base" -- '*.cpp' '*.h' | clang-format-diff -p1 || true)
+if [ -n "$changes" ]; then
+  echo "$changes"
+  echo "format-check: lines changed since ${base:0:7} are not as clang-format lays them out (above); run: git diff -U0 $base | clang-format-diff -p1 -i" >&2
+  exit 1
+fi
+echo "format-check: every C++ line changed since ${base:0:7} is formatted"
