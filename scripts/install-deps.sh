@@ -29,6 +29,7 @@ fi
   ccache libboost-system-dev libopenmesh-dev libgtest-dev libgmock-dev libbenchmark-dev
   chromium
   clang libclang-rt-14-dev  # scripts/fuzz.sh: libFuzzer and clang's sanitizer runtimes
+  clang-format  # scripts/format-check.sh
   # The Python package (clients/python): Debian's python3 and numpy; pip, venv, setuptools and
   # wheel for its offline `pip install` test; libmeshoptimizer2d (the .so.2d it decodes the
   # compressed encoding with, also pulled in by libmeshoptimizer-dev).
