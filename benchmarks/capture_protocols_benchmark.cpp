@@ -9,13 +9,13 @@
 #include <string>
 #include <vector>
 
-#include "protocol/capture_file.h"
-#include "protocol/natnet_capture_encoder.h"
-#include "protocol/natnet_reader.h"
-#include "protocol/qtm_capture_encoder.h"
-#include "protocol/qtm_packet_reader.h"
-#include "protocol/vicon_capture_encoder.h"
-#include "protocol/vicon_packet_reader.h"
+#include "protocol/files/capture_file.h"
+#include "protocol/natnet/natnet_capture_encoder.h"
+#include "protocol/natnet/natnet_reader.h"
+#include "protocol/qtm/qtm_capture_encoder.h"
+#include "protocol/qtm/qtm_packet_reader.h"
+#include "protocol/vicon/vicon_capture_encoder.h"
+#include "protocol/vicon/vicon_packet_reader.h"
 
 namespace skinstream {
 namespace {

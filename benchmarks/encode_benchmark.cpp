@@ -10,7 +10,7 @@
 #include <random>
 #include <vector>
 
-#include "protocol/subscriber_stream.h"
+#include "protocol/subscriber/subscriber_stream.h"
 
 namespace skinstream {
 namespace {

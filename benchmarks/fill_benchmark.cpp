@@ -19,13 +19,13 @@
 #include <chrono>
 #include <ctime>
 
-#include "core/evaluation/gap_plan.h"
 #include "core/capture_filler.h"
+#include "core/evaluation/gap_plan.h"
 #include "core/gap_filler.h"
-#include "core/synth/synth_capture.h"
-#include "protocol/makehuman.h"
 #include "core/offline/subject_builder.h"
-#include "protocol/capture_file.h"
+#include "core/synth/synth_capture.h"
+#include "protocol/files/capture_file.h"
+#include "protocol/offline/makehuman.h"
 #include "support/synthetic_limb.h"
 
 namespace skinstream {

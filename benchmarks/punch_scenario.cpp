@@ -3,7 +3,7 @@
 #include "core/offline/deformation_builder.h"
 #include "core/offline/subject_builder.h"
 #include "core/synth/synth_capture.h"
-#include "protocol/makehuman.h"
+#include "protocol/offline/makehuman.h"
 
 namespace skinstream {
 

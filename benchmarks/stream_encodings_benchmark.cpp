@@ -14,8 +14,8 @@
 #include "benchmarks/punch_scenario.h"
 #include "core/deform/mesh_deformer.h"
 #include "core/deform/mesh_evaluator.h"
-#include "protocol/compressed_vertices.h"
-#include "protocol/frame_parameters.h"
+#include "protocol/subscriber/compressed_vertices.h"
+#include "protocol/subscriber/frame_parameters.h"
 
 namespace skinstream {
 namespace {

@@ -17,7 +17,7 @@ packages=(
   build-essential cmake ninja-build pkg-config
   libeigen3-dev libboost-dev nlohmann-json3-dev libspdlog-dev libfmt-dev
   libmeshoptimizer-dev libcli11-dev zlib1g-dev libexpat1-dev
-  libssl-dev  # OpenSSL's libcrypto: SHA-256 for the multicast datagrams' HMAC (protocol/datagram_authentication.cpp)
+  libssl-dev  # OpenSSL's libcrypto: SHA-256 for the multicast datagrams' HMAC (protocol/subscriber/datagram_authentication.cpp)
 )
 # The web viewer's build (npm) and its browser test (node + playwright-core + chromium). A
 # machine with Node.js from elsewhere (e.g. NodeSource, which bundles npm) keeps it.

@@ -6,7 +6,7 @@
 #include <nlohmann/json.hpp>
 #include <type_traits>
 
-#include "protocol/subscriber_stream.h"
+#include "protocol/subscriber/subscriber_stream.h"
 #include "server/pipeline/deform_cpus.h"
 #include "server/publish/subscriber_network.h"
 #include "server/tcp_congestion.h"

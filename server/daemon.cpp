@@ -9,9 +9,9 @@
 #include <nlohmann/json.hpp>
 #include <unistd.h>
 
-#include "protocol/datagram_authentication.h"
-#include "protocol/file_error.h"
+#include "protocol/files/file_error.h"
 #include "protocol/printable_text.h"
+#include "protocol/subscriber/datagram_authentication.h"
 #include "server/http/http_server.h"
 #include "server/ingest/file_replay_source.h"
 #include "server/ingest/source_spec.h"

@@ -7,8 +7,8 @@
 #include <nlohmann/json.hpp>
 
 #include "core/deform/body_plausibility.h"
-#include "protocol/file_error.h"
-#include "protocol/subscriber_model.h"
+#include "protocol/files/file_error.h"
+#include "protocol/subscriber/subscriber_model.h"
 
 namespace skinstream::server {
 namespace {

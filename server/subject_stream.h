@@ -15,7 +15,7 @@
 
 #include <nlohmann/json_fwd.hpp>
 
-#include "protocol/subject_file.h"
+#include "protocol/files/subject_file.h"
 #include "server/config.h"
 #include "server/ingest/source_frame.h"
 #include "server/ingest/subject_router.h"

@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "protocol/subscriber_stream.h"
+#include "protocol/subscriber/subscriber_stream.h"
 
 namespace skinstream::bench {
 namespace {

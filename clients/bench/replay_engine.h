@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "protocol/replay_subject.h"
+#include "protocol/files/replay_subject.h"
 #include "server/asio.h"
 
 namespace skinstream::bench {

@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "core/capture.h"
-#include "protocol/vicon_capture_encoder.h"
+#include "protocol/vicon/vicon_capture_encoder.h"
 
 namespace skinstream::bench {
 

@@ -2,8 +2,8 @@
 
 #include <filesystem>
 
-#include "protocol/makehuman.h"
-#include "protocol/mesh_file.h"
+#include "protocol/meshes/mesh_file.h"
+#include "protocol/offline/makehuman.h"
 
 namespace skinstream::cli {
 

@@ -11,13 +11,13 @@
 #include "clients/skinstream/part_file.h"
 #include "core/capture_filler.h"
 #include "core/fitting/marker_priors.h"
-#include "protocol/capture_file.h"
-#include "protocol/file_error.h"
-#include "protocol/makehuman.h"
-#include "protocol/marker_set_file.h"
-#include "protocol/marker_surface_obj.h"
-#include "protocol/mesh_file.h"
-#include "protocol/subject_file.h"
+#include "protocol/files/capture_file.h"
+#include "protocol/files/file_error.h"
+#include "protocol/files/subject_file.h"
+#include "protocol/meshes/mesh_file.h"
+#include "protocol/offline/makehuman.h"
+#include "protocol/offline/marker_set_file.h"
+#include "protocol/offline/marker_surface_obj.h"
 
 namespace skinstream::cli {
 

@@ -1,6 +1,6 @@
 #include "clients/skinstream/cmd_convert.h"
 
-#include "protocol/capture_file.h"
+#include "protocol/files/capture_file.h"
 
 namespace skinstream::cli {
 

@@ -8,10 +8,10 @@
 
 #include "core/capture_filler.h"
 #include "core/deform/mesh_deformer.h"
-#include "protocol/capture_file.h"
-#include "protocol/mesh_file.h"
-#include "protocol/point_cache.h"
-#include "protocol/subject_file.h"
+#include "protocol/files/capture_file.h"
+#include "protocol/files/subject_file.h"
+#include "protocol/meshes/mesh_file.h"
+#include "protocol/offline/point_cache.h"
 
 namespace skinstream::cli {
 namespace {

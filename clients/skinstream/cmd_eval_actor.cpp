@@ -15,14 +15,14 @@
 #include "clients/skinstream/json_output.h"
 #include "core/absolute_orientation.h"
 #include "core/capture_filler.h"
-#include "core/fitting/marker_priors.h"
 #include "core/deform/mesh_deformer.h"
-#include "core/geometry/triangle_bvh.h"
 #include "core/deform/mesh_edges.h"
-#include "protocol/capture_file.h"
-#include "protocol/makehuman.h"
-#include "protocol/marker_set_file.h"
-#include "protocol/png_file.h"
+#include "core/fitting/marker_priors.h"
+#include "core/geometry/triangle_bvh.h"
+#include "protocol/files/capture_file.h"
+#include "protocol/offline/makehuman.h"
+#include "protocol/offline/marker_set_file.h"
+#include "protocol/research/png_file.h"
 
 namespace skinstream::cli {
 

@@ -7,7 +7,7 @@
 #include "clients/skinstream/json_output.h"
 #include "clients/skinstream/part_file.h"
 #include "core/synth/synth_capture.h"
-#include "protocol/makehuman.h"
+#include "protocol/offline/makehuman.h"
 
 namespace skinstream::cli {
 namespace {

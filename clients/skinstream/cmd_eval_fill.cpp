@@ -13,7 +13,7 @@
 #include "core/capture_filler.h"
 #include "core/evaluation/fill_error.h"
 #include "core/offline/subject_builder.h"
-#include "protocol/capture_file.h"
+#include "protocol/files/capture_file.h"
 
 namespace skinstream::cli {
 namespace {

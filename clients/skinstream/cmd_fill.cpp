@@ -4,8 +4,8 @@
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 
-#include "protocol/capture_file.h"
-#include "protocol/subject_file.h"
+#include "protocol/files/capture_file.h"
+#include "protocol/files/subject_file.h"
 
 namespace skinstream::cli {
 

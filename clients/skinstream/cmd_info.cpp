@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <nlohmann/json.hpp>
 
-#include "protocol/capture_file.h"
+#include "protocol/files/capture_file.h"
 
 namespace skinstream::cli {
 

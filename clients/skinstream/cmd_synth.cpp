@@ -6,9 +6,9 @@
 
 #include "clients/skinstream/default_paths.h"
 #include "clients/skinstream/synth_evaluation.h"
-#include "protocol/capture_file.h"
-#include "protocol/makehuman.h"
-#include "protocol/mesh_ply.h"
+#include "protocol/files/capture_file.h"
+#include "protocol/meshes/mesh_ply.h"
+#include "protocol/offline/makehuman.h"
 
 namespace skinstream::cli {
 

@@ -14,7 +14,7 @@
 #include "core/offline/subject_builder.h"
 #include "core/render/software_rasterizer.h"
 #include "core/synth/subdivision.h"
-#include "protocol/png_file.h"
+#include "protocol/research/png_file.h"
 
 namespace skinstream::cli {
 namespace {

@@ -4,7 +4,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
-#include "protocol/file_error.h"
+#include "protocol/files/file_error.h"
 
 namespace skinstream::cli {
 

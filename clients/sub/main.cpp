@@ -11,10 +11,10 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 
-#include "protocol/datagram_authentication.h"
-#include "protocol/mesh_ply.h"
-#include "protocol/point_cache.h"
+#include "protocol/meshes/mesh_ply.h"
+#include "protocol/offline/point_cache.h"
 #include "protocol/printable_text.h"
+#include "protocol/subscriber/datagram_authentication.h"
 #include "skinstream/client.h"
 
 namespace {

@@ -14,7 +14,7 @@
 //     characters) and only restricts them to the skin skinned mostly by `bones` (names, or globs
 //     such as "upperleg*.L"), optionally its front or back: a dense grid has no fixed points.
 // The shipped sets are JSON files in config/marker_sets/ (format: docs/marker-sets.md; reader:
-// protocol/marker_set_file.h).
+// protocol/offline/marker_set_file.h).
 //
 // Body axes at the template's rest pose (core/body/skeleton.h): millimetres, +X the subject's
 // right, +Y forward, +Z up.

@@ -1,7 +1,7 @@
 #pragma once
 // A small headless z-buffer rasteriser for looking at meshes without a GPU: reports, side by
 // side comparisons of deformation methods, and error heat maps. Pure (no I/O): it fills an RGB8
-// image in memory; protocol/png_file.h writes it out.
+// image in memory; protocol/research/png_file.h writes it out.
 //
 // Conventions: images are row-major with the top row first; meshes use skinstream's axes
 // (millimetres, Z up, the subject faces +Y); triangles are counter-clockwise seen from outside.

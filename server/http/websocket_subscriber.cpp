@@ -2,7 +2,7 @@
 
 #include <spdlog/spdlog.h>
 
-#include "protocol/subscriber_stream.h"
+#include "protocol/subscriber/subscriber_stream.h"
 #include "server/publish/subscriber_hub.h"
 
 namespace skinstream::server {

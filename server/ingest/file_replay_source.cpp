@@ -2,8 +2,8 @@
 
 #include <filesystem>
 
-#include "protocol/capture_file.h"
-#include "protocol/file_error.h"
+#include "protocol/files/capture_file.h"
+#include "protocol/files/file_error.h"
 
 namespace skinstream::server {
 

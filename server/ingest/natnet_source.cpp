@@ -5,8 +5,8 @@
 #include <cmath>
 #include <unordered_map>
 
-#include "protocol/natnet_reader.h"
-#include "protocol/natnet_writer.h"
+#include "protocol/natnet/natnet_reader.h"
+#include "protocol/natnet/natnet_writer.h"
 #include "server/ingest/source_lifecycle.h"
 #include "server/ingest/source_rate_estimate.h"
 #include "server/ingest/source_reconnection.h"

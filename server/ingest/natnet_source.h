@@ -32,7 +32,7 @@
 #include <memory>
 #include <string>
 
-#include "protocol/natnet.h"
+#include "protocol/natnet/natnet.h"
 #include "server/asio.h"
 #include "server/ingest/frame_source.h"
 #include "server/ingest/source_frame.h"

@@ -5,12 +5,12 @@
 #include <cmath>
 #include <unordered_map>
 
-#include "protocol/qtm_command.h"
-#include "protocol/qtm_labels.h"
-#include "protocol/qtm_packet_framer.h"
-#include "protocol/qtm_packet_reader.h"
-#include "protocol/qtm_packet_writer.h"
-#include "protocol/qtm_parameters.h"
+#include "protocol/qtm/qtm_command.h"
+#include "protocol/qtm/qtm_labels.h"
+#include "protocol/qtm/qtm_packet_framer.h"
+#include "protocol/qtm/qtm_packet_reader.h"
+#include "protocol/qtm/qtm_packet_writer.h"
+#include "protocol/qtm/qtm_parameters.h"
 #include "server/ingest/source_lifecycle.h"
 #include "server/ingest/source_reconnection.h"
 #include "server/system_clock.h"

@@ -6,11 +6,11 @@
 // Handshake: the welcome, `Version 1.19`, `GetParameters General 3D` (the frequency and the
 // labels), then `StreamFrames AllFrames 3D 3DNoLabels` (or with `UDP:port`, the frames arrive as
 // datagrams on a local UDP port while commands stay on TCP). The labels are grouped into subjects
-// by their actor prefix (protocol/qtm_labels.h); a new parameters XML (QTM sends one after
+// by their actor prefix (protocol/qtm/qtm_labels.h); a new parameters XML (QTM sends one after
 // `GetParameters`, which is asked again when QTM reports an event that may change the labels, or
 // when a frame's marker count disagrees with them, at most once per parameters_request_interval)
-// changes `subjects` and bumps structure_version. NaN positions are occluded; other non-finite values are reported and
-// passed on as NaN.
+// changes `subjects` and bumps structure_version. NaN positions are occluded; other non-finite values are
+// reported and passed on as NaN.
 //
 // Any failure (refused, reset, end of stream, malformed packet, an Error answer during the
 // handshake, a handshake not done within handshake_timeout) closes the connection, reports
@@ -27,7 +27,7 @@
 #include <memory>
 #include <string>
 
-#include "protocol/qtm_rt.h"
+#include "protocol/qtm/qtm_rt.h"
 #include "server/asio.h"
 #include "server/ingest/frame_source.h"
 #include "server/ingest/source_frame.h"

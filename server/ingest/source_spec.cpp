@@ -4,8 +4,8 @@
 
 #include <chrono>
 
-#include "protocol/natnet.h"
-#include "protocol/qtm_rt.h"
+#include "protocol/natnet/natnet.h"
+#include "protocol/qtm/qtm_rt.h"
 #include "server/ingest/file_replay_source.h"
 #include "server/ingest/natnet_source.h"
 #include "server/ingest/qtm_source.h"

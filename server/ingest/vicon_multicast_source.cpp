@@ -3,7 +3,7 @@
 #include <atomic>
 #include <chrono>
 
-#include "protocol/vicon_packet_reader.h"
+#include "protocol/vicon/vicon_packet_reader.h"
 #include "server/ingest/vicon_source.h"
 #include "server/system_clock.h"
 

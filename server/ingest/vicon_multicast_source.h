@@ -12,7 +12,7 @@
 #include <memory>
 #include <string>
 
-#include "protocol/vicon_datastream.h"
+#include "protocol/vicon/vicon_datastream.h"
 #include "server/asio.h"
 #include "server/ingest/frame_source.h"
 

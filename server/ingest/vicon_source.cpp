@@ -8,8 +8,8 @@
 #include <iterator>
 #include <utility>
 
-#include "protocol/vicon_packet_framer.h"
-#include "protocol/vicon_packet_writer.h"
+#include "protocol/vicon/vicon_packet_framer.h"
+#include "protocol/vicon/vicon_packet_writer.h"
 #include "server/ingest/source_lifecycle.h"
 #include "server/ingest/source_reconnection.h"
 #include "server/system_clock.h"

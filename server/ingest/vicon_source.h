@@ -31,8 +31,8 @@
 #include <unordered_set>
 #include <vector>
 
-#include "protocol/vicon_datastream.h"
-#include "protocol/vicon_packet_reader.h"
+#include "protocol/vicon/vicon_datastream.h"
+#include "protocol/vicon/vicon_packet_reader.h"
 #include "server/asio.h"
 #include "server/ingest/frame_source.h"
 #include "server/ingest/source_frame.h"

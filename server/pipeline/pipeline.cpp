@@ -6,9 +6,9 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "protocol/finite_values.h"
-#include "protocol/frame_parameters.h"
-#include "protocol/subscriber_stream.h"
+#include "protocol/subscriber/finite_values.h"
+#include "protocol/subscriber/frame_parameters.h"
+#include "protocol/subscriber/subscriber_stream.h"
 #include "server/pipeline/deform_cpus.h"
 #include "server/thread_name.h"
 

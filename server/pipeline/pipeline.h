@@ -23,6 +23,7 @@
 #include "core/gap_end_blender.h"
 #include "core/gap_filler.h"
 #include "core/subject_model.h"
+#include "protocol/subscriber/compressed_vertices.h"
 #include "server/logging.h"
 #include "server/metrics/metrics.h"
 #include "server/pipeline/deform_workers.h"
@@ -30,7 +31,6 @@
 #include "server/pipeline/frame_mailbox.h"
 #include "server/pipeline/on_demand_thread.h"
 #include "server/pipeline/stream_key.h"
-#include "protocol/compressed_vertices.h"
 
 namespace skinstream::server {
 
@@ -51,7 +51,8 @@ struct PipelineOptions {
   std::vector<int> deform_cpus;                   // DeformWorkerOptions; index 0 the pipeline thread's
   double default_rate_hz = 120.0;
   GapFillerOptions filler;
-  int compressed_key_interval = 10;  // frames; the compressed encoding's key frames (protocol/compressed_vertices.h)
+  int compressed_key_interval =
+      10;  // frames; the compressed encoding's key frames (protocol/subscriber/compressed_vertices.h)
   std::string thread_name = "pipeline";  // its deform workers: DeformWorkerOptions::thread_name
   std::string deform_thread_name = "deform";
 };

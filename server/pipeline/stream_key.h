@@ -7,7 +7,7 @@
 #include <array>
 #include <cstdint>
 
-#include "protocol/subscriber_stream.h"
+#include "protocol/subscriber/subscriber_stream.h"
 
 namespace skinstream::server {
 

@@ -9,7 +9,7 @@
 // point into the pooled frame (one sendmmsg, no copy, no allocation), and a datagram the socket
 // has no room for is dropped and counted (receivers lose that frame, nothing else). With a key,
 // every datagram carries the HMAC-SHA-256 tag of its header and fragment
-// (protocol/datagram_authentication.h), so receivers given the key take no forged datagram.
+// (protocol/subscriber/datagram_authentication.h), so receivers given the key take no forged datagram.
 
 #include <atomic>
 #include <cstdint>
@@ -22,8 +22,8 @@
 
 #include <nlohmann/json_fwd.hpp>
 
-#include "protocol/datagram_authentication.h"
-#include "protocol/multicast_datagram.h"
+#include "protocol/subscriber/datagram_authentication.h"
+#include "protocol/subscriber/multicast_datagram.h"
 #include "server/logging.h"
 #include "server/metrics/metrics.h"
 #include "server/pipeline/pipeline.h"

@@ -12,7 +12,7 @@
 #include <mutex>
 #include <vector>
 
-#include "protocol/subscriber_stream.h"
+#include "protocol/subscriber/subscriber_stream.h"
 #include "server/asio.h"
 #include "server/metrics/metrics.h"
 #include "server/pipeline/pipeline.h"

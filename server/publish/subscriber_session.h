@@ -12,12 +12,12 @@
 #include <span>
 #include <string>
 
+#include "protocol/subscriber/subscriber_stream.h"
 #include "server/asio.h"
 #include "server/metrics/metrics.h"
-#include "protocol/subscriber_stream.h"
+#include "server/pipeline/stream_key.h"
 #include "server/publish/handler_slot.h"
 #include "server/publish/subscriber_admission.h"
-#include "server/pipeline/stream_key.h"
 #include "server/publish/subscriber_queue.h"
 
 namespace skinstream::server {

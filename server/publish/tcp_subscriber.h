@@ -4,7 +4,7 @@
 
 #include <array>
 
-#include "protocol/subscriber_stream.h"
+#include "protocol/subscriber/subscriber_stream.h"
 #include "server/publish/subscriber_session.h"
 
 namespace skinstream::server {

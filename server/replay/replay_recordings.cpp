@@ -5,8 +5,8 @@
 #include <filesystem>
 #include <stdexcept>
 
-#include "protocol/capture_file.h"
-#include "protocol/file_error.h"
+#include "protocol/files/capture_file.h"
+#include "protocol/files/file_error.h"
 
 namespace skinstream::server {
 

@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "core/capture.h"
-#include "protocol/replay_subject.h"
+#include "protocol/files/replay_subject.h"
 
 namespace skinstream::server {
 

@@ -25,22 +25,22 @@
 #include <cmath>
 #include <mutex>
 
+#include "protocol/files/capture_file.h"
+#include "protocol/files/subject_file.h"
+#include "protocol/offline/point_cache.h"
+#include "protocol/qtm/qtm_packet_writer.h"
 #include "server/client/health_probe.h"
 #include "server/client/process_usage.h"
-#include "protocol/capture_file.h"
-#include "protocol/point_cache.h"
-#include "protocol/qtm_packet_writer.h"
-#include "protocol/subject_file.h"
-#include "support/subscriber_client.h"
+#include "server/replay/natnet/natnet_server.h"
+#include "server/replay/qtm/qtm_server.h"
+#include "support/io_thread.h"
 #include "support/loopback_peer.h"
 #include "support/program_processes.h"
 #include "support/program_run.h"
 #include "support/recording_match.h"
-#include "server/replay/natnet/natnet_server.h"
-#include "server/replay/qtm/qtm_server.h"
-#include "support/io_thread.h"
 #include "support/scripted_daemon.h"
 #include "support/silent_capture_servers.h"
+#include "support/subscriber_client.h"
 #include "support/test_data.h"
 
 namespace skinstream {

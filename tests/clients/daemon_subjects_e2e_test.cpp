@@ -6,7 +6,7 @@
 
 #include <thread>
 
-#include "protocol/capture_file.h"
+#include "protocol/files/capture_file.h"
 #include "server/client/health_probe.h"
 #include "support/program_processes.h"
 #include "support/program_run.h"

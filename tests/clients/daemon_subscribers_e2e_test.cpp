@@ -14,7 +14,7 @@
 #include <optional>
 #include <thread>
 
-#include "protocol/subscriber_stream.h"
+#include "protocol/subscriber/subscriber_stream.h"
 #include "support/daemon_process.h"
 #include "support/loopback_peer.h"
 #include "support/program_run.h"

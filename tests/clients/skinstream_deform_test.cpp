@@ -12,9 +12,9 @@
 #include <nlohmann/json.hpp>
 #include <set>
 
-#include "protocol/capture_file.h"
-#include "protocol/mesh_file.h"
-#include "protocol/point_cache.h"
+#include "protocol/files/capture_file.h"
+#include "protocol/meshes/mesh_file.h"
+#include "protocol/offline/point_cache.h"
 #include "support/cli_run.h"
 #include "support/program_run.h"
 #include "support/test_data.h"

@@ -2,7 +2,7 @@
 // (no other exception, no out-of-bounds read, no undefined behaviour). Read from memory; one
 // input in 16 also through a file, with the same result (fuzz/fuzz_input_file.h).
 #include "fuzz/fuzz_input_file.h"
-#include "protocol/c3d.h"
+#include "protocol/files/c3d.h"
 
 namespace fuzz = skinstream::fuzz;
 

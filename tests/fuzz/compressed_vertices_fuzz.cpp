@@ -12,8 +12,8 @@
 #include <vector>
 
 #include "fuzz/one_line_file_error.h"
-#include "protocol/compressed_vertices.h"
-#include "protocol/subscriber_stream.h"
+#include "protocol/subscriber/compressed_vertices.h"
+#include "protocol/subscriber/subscriber_stream.h"
 
 namespace subscriber = skinstream::subscriber;
 

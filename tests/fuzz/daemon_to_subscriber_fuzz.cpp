@@ -10,8 +10,8 @@
 #include <optional>
 
 #include "fuzz/one_line_file_error.h"
-#include "protocol/subscriber_model.h"
-#include "protocol/subscriber_stream.h"
+#include "protocol/subscriber/subscriber_model.h"
+#include "protocol/subscriber/subscriber_stream.h"
 
 namespace subscriber = skinstream::subscriber;
 

@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "fuzz/one_line_file_error.h"
-#include "protocol/frame_parameters.h"
+#include "protocol/subscriber/frame_parameters.h"
 
 namespace subscriber = skinstream::subscriber;
 

@@ -19,7 +19,7 @@
 
 #include "core/capture.h"
 #include "fuzz/one_line_file_error.h"
-#include "protocol/file_error.h"
+#include "protocol/files/file_error.h"
 
 namespace skinstream::fuzz {
 

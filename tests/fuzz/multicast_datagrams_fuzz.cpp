@@ -10,8 +10,8 @@
 #include <vector>
 
 #include "fuzz/one_line_file_error.h"
-#include "protocol/datagram_authentication.h"
-#include "protocol/datagram_reassembler.h"
+#include "protocol/subscriber/datagram_authentication.h"
+#include "protocol/subscriber/datagram_reassembler.h"
 
 namespace subscriber = skinstream::subscriber;
 

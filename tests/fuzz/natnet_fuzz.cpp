@@ -8,7 +8,7 @@
 #include <string>
 
 #include "fuzz/one_line_file_error.h"
-#include "protocol/natnet_reader.h"
+#include "protocol/natnet/natnet_reader.h"
 
 namespace natnet = skinstream::natnet;
 

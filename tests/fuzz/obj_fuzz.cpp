@@ -5,7 +5,7 @@
 #include <string_view>
 
 #include "fuzz/fuzz_input_file.h"
-#include "protocol/mesh_file.h"
+#include "protocol/meshes/mesh_file.h"
 
 namespace fuzz = skinstream::fuzz;
 using skinstream::TriangleMesh;

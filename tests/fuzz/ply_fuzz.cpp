@@ -6,8 +6,8 @@
 #include <string_view>
 
 #include "fuzz/fuzz_input_file.h"
-#include "protocol/mesh_file.h"
-#include "protocol/mesh_ply.h"
+#include "protocol/meshes/mesh_file.h"
+#include "protocol/meshes/mesh_ply.h"
 
 namespace fuzz = skinstream::fuzz;
 using skinstream::PlyMesh;

@@ -7,7 +7,7 @@
 #include <string_view>
 
 #include "fuzz/one_line_file_error.h"
-#include "protocol/qtm_command.h"
+#include "protocol/qtm/qtm_command.h"
 
 namespace qtm = skinstream::qtm;
 

@@ -9,10 +9,10 @@
 #include <string>
 
 #include "fuzz/one_line_file_error.h"
-#include "protocol/qtm_command.h"
-#include "protocol/qtm_packet_framer.h"
-#include "protocol/qtm_packet_reader.h"
-#include "protocol/qtm_parameters.h"
+#include "protocol/qtm/qtm_command.h"
+#include "protocol/qtm/qtm_packet_framer.h"
+#include "protocol/qtm/qtm_packet_reader.h"
+#include "protocol/qtm/qtm_parameters.h"
 
 namespace qtm = skinstream::qtm;
 using skinstream::fuzz::expect_one_printable_line;

@@ -8,7 +8,7 @@
 #include <string_view>
 
 #include "fuzz/one_line_file_error.h"
-#include "protocol/qtm_parameters.h"
+#include "protocol/qtm/qtm_parameters.h"
 
 namespace qtm = skinstream::qtm;
 

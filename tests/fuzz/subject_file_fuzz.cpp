@@ -8,7 +8,7 @@
 
 #include "fuzz/fuzz_input_file.h"
 #include "protocol/byte_buffer.h"
-#include "protocol/subject_file.h"
+#include "protocol/files/subject_file.h"
 
 namespace fuzz = skinstream::fuzz;
 using skinstream::SubjectFile;

@@ -8,7 +8,7 @@
 
 #include "core/deform/mesh_evaluator.h"
 #include "fuzz/one_line_file_error.h"
-#include "protocol/subscriber_model.h"
+#include "protocol/subscriber/subscriber_model.h"
 
 namespace subscriber = skinstream::subscriber;
 

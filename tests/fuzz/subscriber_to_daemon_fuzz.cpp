@@ -5,7 +5,7 @@
 #include <algorithm>
 
 #include "fuzz/one_line_file_error.h"
-#include "protocol/subscriber_stream.h"
+#include "protocol/subscriber/subscriber_stream.h"
 
 namespace subscriber = skinstream::subscriber;
 

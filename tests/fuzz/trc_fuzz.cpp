@@ -3,7 +3,7 @@
 #include <string_view>
 
 #include "fuzz/fuzz_input_file.h"
-#include "protocol/trc.h"
+#include "protocol/files/trc.h"
 
 namespace fuzz = skinstream::fuzz;
 

@@ -9,8 +9,8 @@
 #include <vector>
 
 #include "fuzz/one_line_file_error.h"
-#include "protocol/vicon_packet_framer.h"
-#include "protocol/vicon_packet_reader.h"
+#include "protocol/vicon/vicon_packet_framer.h"
+#include "protocol/vicon/vicon_packet_reader.h"
 
 namespace vicon = skinstream::vicon;
 

@@ -5,7 +5,7 @@
 
 #include <string>
 
-#include "protocol/file_error.h"
+#include "protocol/files/file_error.h"
 
 namespace skinstream {
 namespace {

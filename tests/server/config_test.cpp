@@ -5,7 +5,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
-#include "protocol/vicon_datastream.h"
+#include "protocol/vicon/vicon_datastream.h"
 #include "support/test_data.h"
 
 namespace skinstream::server {

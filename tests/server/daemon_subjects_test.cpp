@@ -14,10 +14,9 @@
 #include <tuple>
 
 #include "core/offline/subject_builder.h"
-#include "protocol/capture_file.h"
-#include "protocol/subject_file.h"
-#include "protocol/vicon_capture_encoder.h"
-#include "support/subscriber_client.h"
+#include "protocol/files/capture_file.h"
+#include "protocol/files/subject_file.h"
+#include "protocol/vicon/vicon_capture_encoder.h"
 #include "server/beast.h"
 #include "server/daemon.h"
 #include "server/replay/vicon/vicon_server.h"
@@ -25,6 +24,7 @@
 #include "support/loopback_config.h"
 #include "support/recording_match.h"
 #include "support/stalled_subscriber.h"
+#include "support/subscriber_client.h"
 #include "support/test_data.h"
 #include "support/wait_until.h"
 

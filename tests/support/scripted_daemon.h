@@ -20,7 +20,7 @@
 #include <thread>
 #include <vector>
 
-#include "protocol/subscriber_stream.h"
+#include "protocol/subscriber/subscriber_stream.h"
 #include "support/test_data.h"
 
 namespace skinstream::test {

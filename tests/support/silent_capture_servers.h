@@ -13,14 +13,14 @@
 #include <thread>
 #include <vector>
 
-#include "protocol/natnet.h"
-#include "protocol/natnet_writer.h"
-#include "protocol/qtm_packet_framer.h"
-#include "protocol/qtm_packet_reader.h"
-#include "protocol/qtm_packet_writer.h"
-#include "protocol/qtm_parameters.h"
-#include "protocol/qtm_rt.h"
-#include "protocol/vicon_packet_writer.h"
+#include "protocol/natnet/natnet.h"
+#include "protocol/natnet/natnet_writer.h"
+#include "protocol/qtm/qtm_packet_framer.h"
+#include "protocol/qtm/qtm_packet_reader.h"
+#include "protocol/qtm/qtm_packet_writer.h"
+#include "protocol/qtm/qtm_parameters.h"
+#include "protocol/qtm/qtm_rt.h"
+#include "protocol/vicon/vicon_packet_writer.h"
 #include "server/asio.h"
 
 namespace skinstream::test {

@@ -7,7 +7,7 @@
 #include <functional>
 #include <string>
 
-#include "protocol/subscriber_stream.h"
+#include "protocol/subscriber/subscriber_stream.h"
 #include "server/asio.h"
 
 namespace skinstream::sub {

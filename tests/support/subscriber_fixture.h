@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "protocol/subscriber_stream.h"
+#include "protocol/subscriber/subscriber_stream.h"
 #include "support/fixture_bytes.h"
 
 namespace skinstream::test {

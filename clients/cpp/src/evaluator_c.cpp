@@ -11,9 +11,9 @@
 #include <string>
 
 #include "core/deform/mesh_evaluator.h"
-#include "protocol/frame_parameters.h"
-#include "protocol/subscriber_model.h"
-#include "protocol/subscriber_stream.h"
+#include "protocol/subscriber/frame_parameters.h"
+#include "protocol/subscriber/subscriber_model.h"
+#include "protocol/subscriber/subscriber_stream.h"
 
 struct skinstream_evaluator {
   skinstream::MeshEvaluator evaluator;

@@ -6,9 +6,9 @@
 
 #include <spdlog/spdlog.h>
 
-#include "protocol/natnet_capture_encoder.h"
-#include "protocol/natnet_reader.h"
-#include "protocol/natnet_writer.h"
+#include "protocol/natnet/natnet_capture_encoder.h"
+#include "protocol/natnet/natnet_reader.h"
+#include "protocol/natnet/natnet_writer.h"
 #include "server/logging.h"
 #include "server/replay/replay_timeline.h"
 

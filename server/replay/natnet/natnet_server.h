@@ -1,6 +1,6 @@
 #pragma once
 // A NatNet server streaming recorded captures as Motive streams a take, so that NatNet clients
-// and skinstream's own NatNetSource run without a capture stage (protocol/natnet.h).
+// and skinstream's own NatNetSource run without a capture stage (protocol/natnet/natnet.h).
 //
 // Commands arrive on the command port (UDP, 1510 by default) and are answered to their sender:
 //   CONNECT               SERVERINFO (this server's NatNet version, data port, multicast group);
@@ -30,8 +30,8 @@
 #include <string>
 #include <vector>
 
-#include "protocol/natnet.h"
-#include "protocol/replay_subject.h"
+#include "protocol/files/replay_subject.h"
+#include "protocol/natnet/natnet.h"
 #include "server/asio.h"
 
 namespace skinstream::server {
@@ -53,7 +53,7 @@ struct NatNetServerOptions {
   size_t max_clients = 16;                           // unicast clients served, and senders remembered as connected
   // The frames' timestamps as a real capture clock stamps them, for tests and benchmarks of the
   // clients (0: exact): moved by up to +-timestamp_jitter_us, then quantised to the ticks of a
-  // timestamp_clock_hz clock (protocol/natnet_capture_encoder.h).
+  // timestamp_clock_hz clock (protocol/natnet/natnet_capture_encoder.h).
   double timestamp_jitter_us = 0.0;
   double timestamp_clock_hz = 0.0;
 };

@@ -10,11 +10,11 @@
 #include <spdlog/spdlog.h>
 
 #include "protocol/printable_text.h"
-#include "protocol/qtm_capture_encoder.h"
-#include "protocol/qtm_command.h"
-#include "protocol/qtm_packet_framer.h"
-#include "protocol/qtm_packet_reader.h"
-#include "protocol/qtm_packet_writer.h"
+#include "protocol/qtm/qtm_capture_encoder.h"
+#include "protocol/qtm/qtm_command.h"
+#include "protocol/qtm/qtm_packet_framer.h"
+#include "protocol/qtm/qtm_packet_reader.h"
+#include "protocol/qtm/qtm_packet_writer.h"
 #include "server/listener.h"
 #include "server/logging.h"
 #include "server/replay/replay_client.h"

@@ -2,15 +2,15 @@
 // A QTM RT server streaming recorded captures as Qualisys Track Manager streams a measurement in
 // real time, so that unmodified QTM RT clients (the Qualisys SDKs, the npm package qualisys-rt)
 // and skinstream's own QtmSource run without a capture stage. It speaks the little-endian port
-// (protocol/qtm_rt.h), 22223 by default.
+// (protocol/qtm/qtm_rt.h), 22223 by default.
 //
 // Per client: the welcome ("QTM RT Interface connected") at once; then commands, each answered
 // as QTM does: Version 1.8-1.28 ("Version set to 1.N"), QTMVersion, ByteOrder, GetState (an
 // Event: RT from file started, or stopped once a replay has ended), GetParameters General 3D
-// (XML: the frequency and the labels, protocol/qtm_parameters.h), GetCurrentFrame, StreamFrames
+// (XML: the frequency and the labels, protocol/qtm/qtm_parameters.h), GetCurrentFrame, StreamFrames
 // [AllFrames|Frequency:N|FrequencyDivisor:N] [UDP[:address]:port] 3D 3DNoLabels, StreamFrames Stop.
 // Other commands get an Error packet. Several recordings are several actors whose labels carry
-// their prefix (protocol/qtm_labels.h).
+// their prefix (protocol/qtm/qtm_labels.h).
 //
 // Frames leave on the replay clock (server/replay/replay_timeline.h); the timeline starts when
 // the first client asks for frames (StreamFrames) unless start_on_first_request is false. At the
@@ -36,8 +36,8 @@
 #include <string>
 #include <vector>
 
-#include "protocol/qtm_rt.h"
-#include "protocol/replay_subject.h"
+#include "protocol/files/replay_subject.h"
+#include "protocol/qtm/qtm_rt.h"
 #include "server/asio.h"
 
 namespace skinstream::server {

@@ -8,10 +8,10 @@
 
 #include <spdlog/spdlog.h>
 
-#include "protocol/vicon_capture_encoder.h"
-#include "protocol/vicon_packet_framer.h"
-#include "protocol/vicon_packet_reader.h"
-#include "protocol/vicon_packet_writer.h"
+#include "protocol/vicon/vicon_capture_encoder.h"
+#include "protocol/vicon/vicon_packet_framer.h"
+#include "protocol/vicon/vicon_packet_reader.h"
+#include "protocol/vicon/vicon_packet_writer.h"
 #include "server/listener.h"
 #include "server/logging.h"
 #include "server/replay/replay_client.h"

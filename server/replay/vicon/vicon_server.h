@@ -13,7 +13,7 @@
 // after the subjects listed changed (a subject came or went); every datagram carries them.
 //
 // Several recordings stream as several subjects of one stream, each frame holding one frame of
-// each (protocol/vicon_capture_encoder.h: a subject whose recording has no marker in a frame is
+// each (protocol/vicon/vicon_capture_encoder.h: a subject whose recording has no marker in a frame is
 // not listed in it).
 //
 // Frames leave on absolute steady-clock deadlines (start + k * period / speed), so the stream
@@ -44,8 +44,8 @@
 #include <vector>
 
 #include "core/capture.h"
-#include "protocol/vicon_capture_encoder.h"
-#include "protocol/vicon_datastream.h"
+#include "protocol/vicon/vicon_capture_encoder.h"
+#include "protocol/vicon/vicon_datastream.h"
 #include "server/asio.h"
 
 namespace skinstream::server {

@@ -18,14 +18,14 @@
 #include <regex>
 #include <thread>
 
-#include "protocol/multicast_datagram.h"
+#include "protocol/subscriber/multicast_datagram.h"
+#include "server/client/daemon_process.h"
 #include "skinstream/client.h"
 #include "support/bridged_namespaces.h"
 #include "support/client_frames.h"
-#include "server/client/daemon_process.h"
-#include "support/test_data.h"
 #include "support/program_run.h"
 #include "support/received_vertices.h"
+#include "support/test_data.h"
 
 namespace skinstream {
 namespace {

@@ -14,11 +14,11 @@
 #include <mutex>
 #include <thread>
 
-#include "protocol/subscriber_stream.h"
-#include "support/scripted_daemon.h"
+#include "protocol/subscriber/subscriber_stream.h"
 #include "support/client_frames.h"
 #include "support/daemon_process.h"
 #include "support/received_vertices.h"
+#include "support/scripted_daemon.h"
 #include "support/test_data.h"
 
 namespace skinstream {

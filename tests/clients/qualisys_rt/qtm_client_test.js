@@ -17,7 +17,7 @@ const Api = require('qualisys-rt').Api;
 const { toCamelCase } = require('qualisys-rt/src/helpers');
 
 const TOLERANCE_MM = 1e-3;  // float32 of a coordinate below 10 m is within 0.5 um of the double
-const ID_STRIDE = 1000000;  // protocol/qtm_capture_encoder.h: the n-th recording's unlabelled ids
+const ID_STRIDE = 1000000;  // protocol/qtm/qtm_capture_encoder.h: the n-th recording's unlabelled ids
 
 function fail(message) {
   console.error('FAIL: ' + message);

@@ -5,7 +5,7 @@
 
 #include <filesystem>
 
-#include "protocol/capture_file.h"
+#include "protocol/files/capture_file.h"
 #include "support/capture_assertions.h"
 #include "support/cli_run.h"
 #include "support/file_error_assertion.h"

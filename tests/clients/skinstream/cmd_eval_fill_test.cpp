@@ -8,7 +8,7 @@
 #include <nlohmann/json.hpp>
 #include <set>
 
-#include "protocol/capture_file.h"
+#include "protocol/files/capture_file.h"
 #include "support/cli_run.h"
 #include "support/test_data.h"
 #include "tests/clients/skinstream/command_output.h"

@@ -9,7 +9,7 @@
 
 #include "clients/skinstream/cmd_build_subject.h"
 #include "core/evaluation/gap_plan.h"
-#include "protocol/capture_file.h"
+#include "protocol/files/capture_file.h"
 #include "support/cli_run.h"
 #include "support/test_data.h"
 #include "tests/clients/skinstream/command_output.h"

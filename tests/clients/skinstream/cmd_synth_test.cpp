@@ -8,7 +8,7 @@
 #include <cstdio>
 #include <filesystem>
 
-#include "protocol/capture_file.h"
+#include "protocol/files/capture_file.h"
 #include "support/test_data.h"
 #include "tests/clients/skinstream/command_output.h"
 

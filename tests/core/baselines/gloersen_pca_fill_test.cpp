@@ -12,7 +12,7 @@
 #include "synthetic_walker.h"
 #include "support/capture_gaps.h"
 
-// Real data: protocol/c3d.h exists, but core_tests links only core/'s libraries, so a CMU
+// Real data: protocol/files/c3d.h exists, but core_tests links only core/'s libraries, so a CMU
 // comparison cannot live in this suite. The synthetic walker below (41 CMU-named markers on a
 // walking kinematic chain) stands in for it.
 

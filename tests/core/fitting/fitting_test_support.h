@@ -10,7 +10,7 @@
 #include "core/body/skinning.h"
 #include "core/capture.h"
 #include "core/geometry/triangle_mesh.h"
-#include "protocol/makehuman.h"
+#include "protocol/offline/makehuman.h"
 #include "support/test_data.h"
 
 namespace skinstream::test {

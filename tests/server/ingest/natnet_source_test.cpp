@@ -12,9 +12,9 @@
 #include <filesystem>
 #include <thread>
 
-#include "protocol/natnet_capture_encoder.h"
-#include "protocol/natnet_reader.h"
-#include "protocol/natnet_writer.h"
+#include "protocol/natnet/natnet_capture_encoder.h"
+#include "protocol/natnet/natnet_reader.h"
+#include "protocol/natnet/natnet_writer.h"
 #include "server/ingest/natnet_source.h"
 #include "server/replay/natnet/natnet_server.h"
 #include "support/replay_capture.h"

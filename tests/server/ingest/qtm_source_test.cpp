@@ -8,10 +8,10 @@
 #include <limits>
 #include <thread>
 
-#include "protocol/qtm_packet_framer.h"
-#include "protocol/qtm_packet_reader.h"
-#include "protocol/qtm_packet_writer.h"
-#include "protocol/qtm_parameters.h"
+#include "protocol/qtm/qtm_packet_framer.h"
+#include "protocol/qtm/qtm_packet_reader.h"
+#include "protocol/qtm/qtm_packet_writer.h"
+#include "protocol/qtm/qtm_parameters.h"
 #include "server/ingest/qtm_source.h"
 #include "server/replay/qtm/qtm_server.h"
 #include "support/replay_capture.h"

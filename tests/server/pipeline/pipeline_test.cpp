@@ -16,11 +16,11 @@
 #include <thread>
 
 #include "core/offline/subject_builder.h"
-#include "protocol/capture_file.h"
-#include "support/subscriber_client.h"
+#include "protocol/files/capture_file.h"
 #include "server/publish/subscriber_hub.h"
 #include "server/publish/tcp_subscriber.h"
 #include "support/allocation_counter.h"
+#include "support/subscriber_client.h"
 #include "support/test_data.h"
 
 namespace skinstream::server {

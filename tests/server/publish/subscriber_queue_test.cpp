@@ -4,7 +4,7 @@
 
 #include <thread>
 
-#include "protocol/subscriber_stream.h"
+#include "protocol/subscriber/subscriber_stream.h"
 #include "support/allocation_counter.h"
 
 namespace skinstream::server {

@@ -7,9 +7,9 @@
 #include <algorithm>
 #include <string>
 
-#include "protocol/qtm_packet_framer.h"
-#include "protocol/qtm_packet_reader.h"
-#include "protocol/qtm_packet_writer.h"
+#include "protocol/qtm/qtm_packet_framer.h"
+#include "protocol/qtm/qtm_packet_reader.h"
+#include "protocol/qtm/qtm_packet_writer.h"
 #include "support/replay_capture.h"
 #include "support/source_sink_recorder.h"
 

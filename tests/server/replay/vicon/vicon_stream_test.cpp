@@ -15,20 +15,20 @@
 #include <thread>
 #include <tuple>
 
-#include "protocol/capture_file.h"
-#include "protocol/vicon_packet_writer.h"
+#include "protocol/files/capture_file.h"
+#include "protocol/vicon/vicon_capture_encoder.h"
+#include "protocol/vicon/vicon_packet_writer.h"
 #include "server/asio.h"
-#include "protocol/vicon_capture_encoder.h"
 #include "server/ingest/subject_router.h"
 #include "server/ingest/vicon_multicast_source.h"
 #include "server/ingest/vicon_source.h"
-#include "server/tcp_congestion.h"
 #include "server/replay/vicon/vicon_server.h"
+#include "server/tcp_congestion.h"
 #include "support/allocation_counter.h"
 #include "support/io_thread.h"
 #include "support/silent_capture_servers.h"
-#include "support/source_sink_recorder.h"
 #include "support/socket_lookup.h"
+#include "support/source_sink_recorder.h"
 #include "support/test_data.h"
 
 namespace skinstream::server {

@@ -1,0 +1,80 @@
+#include "protocol/subscriber/multicast_datagram.h"
+
+#include <algorithm>
+#include <cstring>
+#include <string>
+
+#include "protocol/byte_buffer.h"
+
+namespace skinstream::subscriber {
+namespace {
+
+size_t stride(size_t message_bytes, uint16_t count) { return (message_bytes + count - 1) / count; }
+
+}  // namespace
+
+uint16_t fragment_count(size_t message_bytes, bool authenticated) {
+  const size_t largest = authenticated ? kMaxAuthenticatedFragmentBytes : kMaxFragmentBytes;
+  if (message_bytes == 0 || message_bytes > kMaxFragments * largest) return 0;
+  return static_cast<uint16_t>((message_bytes + largest - 1) / largest);
+}
+
+size_t fragment_offset(size_t message_bytes, uint16_t count, uint16_t index) { return index * stride(message_bytes, count); }
+
+size_t fragment_bytes(size_t message_bytes, uint16_t count, uint16_t index) {
+  const size_t start = fragment_offset(message_bytes, count, index);
+  return start >= message_bytes ? 0 : std::min(stride(message_bytes, count), message_bytes - start);
+}
+
+void encode_datagram_header(const DatagramHeader& h, std::span<unsigned char, kDatagramHeaderBytes> out) {
+  unsigned char* p = out.data();
+  put_at<uint32_t>(p, kDatagramMagic);
+  put_at<uint16_t>(p, kDatagramVersion);
+  put_at<uint16_t>(p, h.authenticated ? kDatagramAuthenticated : 0);  // flags; the other bits reserved
+  put_at<uint32_t>(p, h.stream_id);
+  put_at<uint32_t>(p, h.model_id);
+  put_at<uint32_t>(p, h.sequence);
+  put_at<uint16_t>(p, h.index);
+  put_at<uint16_t>(p, h.count);
+  put_at<uint32_t>(p, h.message_bytes);
+}
+
+DatagramHeader decode_datagram_header(std::span<const unsigned char> datagram) {
+  if (datagram.size() < kDatagramHeaderBytes)
+    throw DecodeError("datagram of " + std::to_string(datagram.size()) + " bytes is shorter than its " +
+                      std::to_string(kDatagramHeaderBytes) + "-byte header");
+  if (datagram.size() > kMaxDatagramBytes)
+    throw DecodeError("datagram of " + std::to_string(datagram.size()) + " bytes is over the " + std::to_string(kMaxDatagramBytes) + " allowed");
+  const unsigned char* p = datagram.data();
+  if (get_at<uint32_t>(p) != kDatagramMagic) throw DecodeError("bad magic (not a skinstream multicast datagram)");
+  const uint16_t version = get_at<uint16_t>(p);
+  if (version != kDatagramVersion) throw DecodeError("multicast datagram version " + std::to_string(version) + " (this side speaks 1)");
+  const uint16_t flags = get_at<uint16_t>(p);
+  if (flags & ~kDatagramAuthenticated) throw DecodeError("reserved header bits set");
+  DatagramHeader h;
+  h.authenticated = (flags & kDatagramAuthenticated) != 0;
+  const size_t largest = h.authenticated ? kMaxAuthenticatedFragmentBytes : kMaxFragmentBytes;
+  const size_t trailer = h.authenticated ? kDatagramTrailerBytes : 0;
+  h.stream_id = get_at<uint32_t>(p);
+  h.model_id = get_at<uint32_t>(p);
+  h.sequence = get_at<uint32_t>(p);
+  h.index = get_at<uint16_t>(p);
+  h.count = get_at<uint16_t>(p);
+  h.message_bytes = get_at<uint32_t>(p);
+  if (h.count == 0 || h.count > kMaxFragments)
+    throw DecodeError("fragment count " + std::to_string(h.count) + " (1-" + std::to_string(kMaxFragments) + ")");
+  if (h.index >= h.count) throw DecodeError("fragment " + std::to_string(h.index) + " of " + std::to_string(h.count));
+  if (h.message_bytes == 0 || stride(h.message_bytes, h.count) > largest ||
+      fragment_bytes(h.message_bytes, h.count, static_cast<uint16_t>(h.count - 1)) == 0)
+    throw DecodeError("a message of " + std::to_string(h.message_bytes) + " bytes cannot be cut into " + std::to_string(h.count) + " fragments");
+  const size_t expected = fragment_bytes(h.message_bytes, h.count, h.index);
+  if (datagram.size() - kDatagramHeaderBytes != expected + trailer)
+    throw DecodeError("fragment " + std::to_string(h.index) + " of " + std::to_string(h.count) + " holds " +
+                      std::to_string(datagram.size() - kDatagramHeaderBytes - std::min(trailer, datagram.size() - kDatagramHeaderBytes)) +
+                      " bytes, not " + std::to_string(expected));
+  return h;
+}
+
+uint32_t model_id_of(std::span<const unsigned char> model_payload) { return crc32(model_payload.data(), model_payload.size()); }
+
+}  // namespace skinstream::subscriber
