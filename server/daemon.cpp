@@ -7,7 +7,6 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
-#include <unistd.h>
 
 #include "protocol/files/file_error.h"
 #include "protocol/printable_text.h"
@@ -19,7 +18,7 @@
 #include "server/pipeline/deform_cpus.h"
 #include "server/publish/multicast_sender.h"
 #include "server/publish/subscriber_hub.h"
-#include "server/publish/tcp_subscriber.h"
+#include "server/publish/tcp_subscriber_handoff.h"
 #include "server/thread_name.h"
 
 namespace skinstream::server {
@@ -156,43 +155,13 @@ Daemon::Daemon(const DaemonConfig& config)
                  "or --natnet HOST[:PORT]): serving subscribers without frames");
   }
 
-  sub_listener_ = std::make_unique<Listener>(io_, config.bind_address, config.sub_port, "subscriber port", [this](tcp::socket socket) {
-    boost::system::error_code ec;
-    const auto endpoint = socket.remote_endpoint(ec);
-    if (ec) return;  // gone before it was taken
-    const std::string remote = endpoint.address().to_string() + ":" + std::to_string(endpoint.port());
-    // To the publish thread with the fewest subscribers: the socket moves to its io_context, and
-    // the session starts there. (Accepting straight onto that context would leave the waiting
-    // accept, and a socket of a publish context, in io_'s queue, which outlives the publish
-    // threads: see the members' order in daemon.h.) Without publish threads it stays on io_.
-    PublishThreads::Placement placed = publish_.place(io_);
-    if (&placed.io != &io_) {
-      tcp::socket own(placed.io);
-      const tcp protocol = socket.local_endpoint(ec).protocol();
-      const auto handle = ec ? tcp::socket::native_handle_type(-1) : socket.release(ec);
-      if (!ec) {
-        own.assign(protocol, handle, ec);
-        if (ec) ::close(handle);
-      }
-      if (ec) {
-        spdlog::warn("subscriber {}: cannot hand the socket to its thread: {}; closing", remote, ec.message());
-        return;
-      }
-      socket = std::move(own);
-    }
-    SubscriberHub& hub = subject(0).hub();  // until a version 2 Hello names another
-    auto subscriber = std::make_shared<TcpSubscriber>(placed.io, hub, std::move(socket), remote, std::move(placed.token));
-    // Refused or not, the subscriber is answered after its Hello, in the version it speaks. With
-    // a token it is admitted once it gave it; until then it holds a place kept for connections
-    // without it.
-    const bool token = admission_->token_required();
-    SubscriberAdmission::Decision admitted =
-        token ? admission_->admit_unauthenticated(endpoint.address()) : admission_->admit(endpoint.address());
-    const bool ask_token = admitted.ticket && token;
-    subscriber->set_admission(std::move(admitted), ask_token ? admission_ : nullptr, endpoint.address());
-    hub.add(subscriber);
-    asio::post(placed.io, [subscriber] { subscriber->start(); });
-  }, ListenerOptions{config.subscriber_tcp_congestion, &source_metrics_, &descriptor_reserve_, false, config.subscriber_unsent_kb * 1024});
+  sub_listener_ = std::make_unique<Listener>(
+      io_, config.bind_address, config.sub_port, "subscriber port",
+      [this](tcp::socket socket) {
+        hand_off_tcp_subscriber(std::move(socket), io_, publish_, subject(0).hub(), admission_);
+      },
+      ListenerOptions{config.subscriber_tcp_congestion, &source_metrics_, &descriptor_reserve_, false,
+                      config.subscriber_unsent_kb * 1024});
   HttpRoutes routes;
   routes.stream_admission = admission_;
   routes.health_json = [this] { return health_json(); };
