@@ -11,6 +11,8 @@ case "${1:-}" in
   --build-only) build_only=1 ;;
   *) echo "usage: install-deps.sh [--build-only]" >&2; exit 2 ;;
 esac
+# Checked already by the script that called this one (scripts/test.sh, for its build and fuzz steps).
+[ "${SKINSTREAM_DEPS_CHECKED:-}" = 1 ] && exit 0
 
 # What building skinstreamd, the CLI and the web page needs (--build-only installs these alone).
 packages=(

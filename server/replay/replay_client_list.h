@@ -6,9 +6,11 @@
 
 #include <algorithm>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "server/asio.h"
+#include "server/logging.h"
 #include "server/replay/replay_client.h"
 
 namespace skinstream::server {
@@ -41,5 +43,21 @@ class ReplayClientList {
   std::shared_ptr<std::vector<std::shared_ptr<Client>>> clients_ =
       std::make_shared<std::vector<std::shared_ptr<Client>>>();
 };
+
+// The rule of the TCP replay servers for a new connection: beyond `max_clients` open at once it is
+// refused (counted, said in a rate-limited line; the caller lets the socket close), else counted as
+// accepted and open. `Stats` has the atomics clients_open, clients_refused and clients_accepted.
+template <typename Stats>
+bool admit_replay_client(Stats& stats, size_t max_clients, RateLimitedLog& log, const char* server) {
+  if (static_cast<size_t>(stats.clients_open.load()) >= max_clients) {
+    ++stats.clients_refused;
+    log.warn(std::string(server) + "_too_many_clients", std::string(server) + " server: closing a connection beyond the " +
+                                                            std::to_string(max_clients) + " clients served at once");
+    return false;
+  }
+  ++stats.clients_accepted;
+  ++stats.clients_open;
+  return true;
+}
 
 }  // namespace skinstream::server

@@ -260,16 +260,9 @@ struct QtmServer::State : std::enable_shared_from_this<QtmServer::State> {
 
   void accepted(tcp::socket socket) {
     if (!running) return;
-    if (static_cast<size_t>(stats.clients_open.load()) >= options.max_clients) {
-      ++stats.clients_refused;
-      log.warn("qtm_too_many_clients", "qtm server: closing a connection beyond the " + std::to_string(options.max_clients) +
-                                           " clients served at once");
-      return;  // the socket closes as it goes
-    }
+    if (!admit_replay_client(stats, options.max_clients, log, "qtm")) return;  // the socket closes as it goes
     auto session = std::make_shared<Session>(*this, std::move(socket));
     sessions.add(session);
-    ++stats.clients_accepted;
-    ++stats.clients_open;
     session->begin();
   }
 

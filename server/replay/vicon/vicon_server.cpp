@@ -216,19 +216,12 @@ struct ViconServer::State : std::enable_shared_from_this<ViconServer::State> {
 
   void on_accept(tcp::socket socket) {
     if (!running) return;
-    if (static_cast<size_t>(stats.clients_open.load()) >= options.max_clients) {
-      ++stats.clients_refused;
-      log.warn("vicon_too_many_clients",
-               "vicon server: closing a connection beyond the " + std::to_string(options.max_clients) + " clients served at once");
-      return;  // the socket closes as it goes
-    }
+    if (!admit_replay_client(stats, options.max_clients, log, "vicon")) return;  // the socket closes as it goes
     boost::system::error_code ignored;
     if (options.socket_send_buffer_bytes > 0)
       socket.set_option(asio::socket_base::send_buffer_size(options.socket_send_buffer_bytes), ignored);
     auto session = std::make_shared<Session>(*this, std::move(socket));
     sessions.add(session);
-    ++stats.clients_accepted;
-    ++stats.clients_open;
     session->begin();
   }
 
