@@ -54,6 +54,17 @@ std::optional<int> parse_bench_options(int argc, char** argv, BenchOptions& o) {
       ->check(CLI::Range(1, 16))
       ->capture_default_str();
   app.add_option("--subject-spacing-mm", o.subject_spacing_mm, "with --subjects: how far apart the actors stand along x")->capture_default_str();
+  app.add_option(
+         "--join-wave", o.join_wave,
+         "this many more subscribers connect together --join-after-seconds into the window, while the "
+         "--subscribers watch "
+         "(the report's figures are the watchers'; the joiners' time to a first frame is under join_wave)")
+      ->check(CLI::Range(0, 256))
+      ->capture_default_str();
+  app.add_option("--join-after-seconds", o.join_after_seconds,
+                 "--join-wave: when the joiners connect, in seconds into the window")
+      ->check(CLI::Range(0.0, 3600.0))
+      ->capture_default_str();
   app.add_flag("--json", o.json, "print the report as JSON");
   app.add_flag("--hostile-waves", o.hostile_waves,
                "the soak: hostile peers (stalled, flooding, churning) connect and leave in waves while the subscribers measure "

@@ -41,6 +41,11 @@ struct BenchOptions {
   bool hostile_waves = false;
   int wave_seconds = 60, calm_seconds = 60;
   HostilePeers hostile_peers;
+  // Render nodes restarting together: this many more subscribers connect at once, join_after
+  // seconds into the window, while the first ones watch (their figures are the report's; the
+  // joiners' are apart, in "join_wave").
+  int join_wave = 0;
+  double join_after_seconds = 3.0;
   bool json = false;
 };
 

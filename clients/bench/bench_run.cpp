@@ -77,6 +77,7 @@ void subscribe(const BenchOptions& o, const std::string& host, int port, int ind
   options.decode = o.decode;
   options.evaluate = o.decode;
   options.subject = subscriber_subject(index, o.subjects);
+  const Clock::time_point connecting = Clock::now();
   client::Subscriber subscriber(options);
   tally.reserve(static_cast<size_t>(o.seconds * 130) + 16);
   const std::string who = "subscriber " + std::to_string(index);
@@ -89,6 +90,7 @@ void subscribe(const BenchOptions& o, const std::string& host, int port, int ind
     if (!subscriber.next(frame, std::chrono::milliseconds(500))) continue;
     if (!counted_ready) {
       counted_ready = true;
+      tally.first_frame_ms = std::chrono::duration<double, std::milli>(Clock::now() - connecting).count();
       window.subscribers_ready.fetch_add(1);
     }
     const int64_t start = window.start_ns.load(std::memory_order_relaxed);
@@ -124,6 +126,36 @@ void subscribe(const BenchOptions& o, const std::string& host, int port, int ind
   tally.model_bytes = subscriber.model_bytes();
 }
 
+// The joiners of --join-wave: how long each waited for its first frame (from starting to connect:
+// the MeshInfo and Model come first), and what they received once in.
+nlohmann::json join_wave_report(const BenchOptions& o, const std::vector<SubscriberTally>& joiners,
+                                int64_t window_start_ns, int64_t window_end_ns) {
+  Samples first_frame;
+  long received = 0, dropped = 0, without_frame = 0;
+  std::vector<double> rates;
+  const double joined_s = (window_end_ns - window_start_ns) * 1e-9 - o.join_after_seconds;
+  for (const SubscriberTally& t : joiners) {
+    if (t.first_frame_ms < 0)
+      ++without_frame;
+    else
+      first_frame.ms.push_back(t.first_frame_ms);
+    received += t.received;
+    dropped += t.dropped();
+    if (joined_s > 0) rates.push_back(t.received / joined_s);
+  }
+  std::sort(rates.begin(), rates.end());
+  return {{"joiners", o.join_wave},
+          {"joined_after_s", o.join_after_seconds},
+          {"first_frame_ms", first_frame.summary()},
+          {"joiners_without_a_frame", without_frame},
+          {"received", received},
+          {"dropped", dropped},
+          // Over the time since they started to connect (their wait for the Model included).
+          {"frames_per_second_since_joining",
+           rates.empty() ? nlohmann::json(nullptr)
+                         : nlohmann::json{{"slowest", rates.front()}, {"median", rates[rates.size() / 2]}}}};
+}
+
 // Sleeps until `until`, in short steps, throwing once `stop` is set.
 void sleep_until_or_stop(Clock::time_point until, const std::atomic<bool>& stop) {
   while (Clock::now() < until) {
@@ -154,6 +186,8 @@ nlohmann::json run_bench(const BenchOptions& o, const std::atomic<bool>& stop) {
   std::unique_ptr<ShapedLink> link;
   // The hostile peers play hosts 127.0.0.2-9: they reach a daemon on loopback only.
   if (o.hostile_waves && o.link_mbit > 0) throw std::runtime_error("--hostile-waves runs on loopback only, not with --link-mbit");
+  if (o.join_wave > 0 && o.join_after_seconds >= o.seconds)
+    throw std::runtime_error("--join-after-seconds must be less than --seconds, or the joiners never join");
   if (o.link_mbit > 0) link = std::make_unique<ShapedLink>(ShapedLinkOptions{.rate_mbit = o.link_mbit});
   const std::string replay_address = link ? link->host_address() : "127.0.0.1";
   const std::string daemon_address = link ? link->inner_address() : "127.0.0.1";
@@ -243,6 +277,23 @@ nlohmann::json run_bench(const BenchOptions& o, const std::atomic<bool>& stop) {
   window.start_ns = window_start_ns;
   const Clock::time_point deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(o.seconds));
 
+  // The join wave: more subscribers at once, into the running stream.
+  std::vector<SubscriberTally> joiner_tallies(static_cast<size_t>(o.join_wave));
+  std::vector<std::string> joiner_errors(static_cast<size_t>(o.join_wave));
+  std::vector<std::thread> joiners;
+  struct JoinJoiners {
+    Window& window;
+    std::vector<std::thread>& threads;
+    ~JoinJoiners() {
+      window.closed = true;
+      for (std::thread& t : threads)
+        if (t.joinable()) t.join();
+    }
+  } join_joiners{window, joiners};
+  const Clock::time_point join_at = Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                                       std::chrono::duration<double>(o.join_after_seconds));
+  bool joined = o.join_wave == 0;
+
   std::optional<HostileWaves> waves;
   if (o.hostile_waves) {
     waves.emplace(HostileWaveOptions{daemon.sub_port(), daemon.http_port(), std::chrono::seconds(o.wave_seconds),
@@ -255,6 +306,19 @@ nlohmann::json run_bench(const BenchOptions& o, const std::atomic<bool>& stop) {
   nlohmann::json rss_steps = nlohmann::json::array();
   uint64_t buffers_after_1s = 0;  // the daemon's encoded frame buffers: RSS steps when they grow
   for (auto next = Clock::now() + std::chrono::seconds(1); next < deadline; next += std::chrono::seconds(1)) {
+    if (!joined && join_at < next) {
+      sleep_until_or_stop(join_at, stop);
+      for (int j = 0; j < o.join_wave; ++j)
+        joiners.emplace_back([&, j] {
+          try {
+            subscribe(o, daemon_address, daemon.sub_port(), o.subscribers + j, send_times, window, stalls,
+                      joiner_tallies[j]);
+          } catch (const std::exception& e) {
+            joiner_errors[j] = e.what();
+          }
+        });
+      joined = true;
+    }
     sleep_until_or_stop(next, stop);
     rss_samples.push_back(server::resident_kb(daemon.pid()));
     // Every step of RSS, with its time on the stall log's clock: a leak climbs steadily, memory
@@ -277,9 +341,12 @@ nlohmann::json run_bench(const BenchOptions& o, const std::atomic<bool>& stop) {
   std::this_thread::sleep_for(std::chrono::milliseconds(500));  // the window's last frames still on their way
   window.closed = true;
   for (std::thread& t : threads) t.join();
+  for (std::thread& t : joiners) t.join();
   const int exit_status = daemon.stop();
   for (const std::string& e : errors)
     if (!e.empty()) throw std::runtime_error("subscriber: " + e);
+  for (const std::string& e : joiner_errors)
+    if (!e.empty()) throw std::runtime_error("joining subscriber: " + e);
   const std::string shaper = link ? link->shaper_stats() : "";
 
   // What the daemon warned about during the run (dropped frames say why there), first lines only.
@@ -388,6 +455,8 @@ nlohmann::json run_bench(const BenchOptions& o, const std::atomic<bool>& stop) {
       // This process: the replay server and the subscribers, sharing the machine with the daemon.
       {"load_generator", {{"cpu_seconds", own_cpu}, {"cpu_share_of_one_core", own_cpu / window_s}}}};
   if (link) report["shaped_link"] = nlohmann::json::parse(shaper);
+  if (o.join_wave > 0)
+    report["join_wave"] = join_wave_report(o, joiner_tallies, window_start_ns, window_end_ns);
   return report;
 }
 

@@ -27,6 +27,7 @@ struct SubscriberTally {
   uint64_t message_bytes = 0;                    // the Frame messages' bytes
   size_t model_bytes = 0;                        // the Model message (parameters)
   int64_t first_arrival_ns = 0, last_arrival_ns = 0;
+  double first_frame_ms = -1.0;  // from starting to connect to the first frame (-1: none came)
 
   void reserve(size_t frames) {
     for (Samples* s : {&end_to_end, &processing, &ingest, &delivery}) s->ms.reserve(frames);

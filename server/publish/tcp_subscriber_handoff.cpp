@@ -35,15 +35,16 @@ bool move_socket_to(asio::io_context& io, tcp::socket& socket, const std::string
 }  // namespace
 
 void hand_off_tcp_subscriber(tcp::socket socket, asio::io_context& accepting, PublishThreads& publish,
-                             SubscriberHub& first_hub, const std::shared_ptr<SubscriberAdmission>& admission) {
+                             SubscriberHub& first_hub,
+                             const std::shared_ptr<SubscriberAdmission>& admission) {
   boost::system::error_code ec;
   const auto endpoint = socket.remote_endpoint(ec);
   if (ec) return;  // gone before it was taken
   const std::string remote = endpoint.address().to_string() + ":" + std::to_string(endpoint.port());
   PublishThreads::Placement placed = publish.place(accepting);
   if (&placed.io != &accepting && !move_socket_to(placed.io, socket, remote)) return;
-  auto subscriber =
-      std::make_shared<TcpSubscriber>(placed.io, first_hub, std::move(socket), remote, std::move(placed.token));
+  auto subscriber = std::make_shared<TcpSubscriber>(placed.io, first_hub, std::move(socket), remote,
+                                                    std::move(placed.token));
   // Refused or not, the subscriber is answered after its Hello, in the version it speaks. With
   // a token it is admitted once it gave it; until then it holds a place kept for connections
   // without it.

@@ -51,8 +51,9 @@ template <typename Stats>
 bool admit_replay_client(Stats& stats, size_t max_clients, RateLimitedLog& log, const char* server) {
   if (static_cast<size_t>(stats.clients_open.load()) >= max_clients) {
     ++stats.clients_refused;
-    log.warn(std::string(server) + "_too_many_clients", std::string(server) + " server: closing a connection beyond the " +
-                                                            std::to_string(max_clients) + " clients served at once");
+    log.warn(std::string(server) + "_too_many_clients",
+             std::string(server) + " server: closing a connection beyond the " + std::to_string(max_clients) +
+                 " clients served at once");
     return false;
   }
   ++stats.clients_accepted;

@@ -110,6 +110,34 @@ TEST(BenchProgram, ParameterSubscribersReportTheModelAndBytesPerFrame) {
   EXPECT_GT(rates["slowest"].get<double>(), 0.0);
 }
 
+// --join-wave: the joiners connect into the running stream and are reported apart from the
+// watchers, each with the wait for its first frame; the watchers' figures stay the report's.
+TEST(BenchProgram, AJoinWaveIsReportedApartFromTheWatchers) {
+  const test::ProgramRun r =
+      test::run_program(bench("--subject " + kDemo + "/subject.sksubj --recording " + kDemo +
+                              "/live.c3d --seconds 3 --subscribers 2 --encoding parameters "
+                              "--join-wave 3 --join-after-seconds 1 --json"),
+                        /*stderr_too=*/false);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto j = nlohmann::json::parse(r.output);
+  EXPECT_EQ(j["per_subscriber"].size(), 2u);  // the watchers alone
+  const auto& wave = j["join_wave"];
+  EXPECT_EQ(wave["joiners"], 3);
+  EXPECT_EQ(wave["joiners_without_a_frame"], 0);
+  EXPECT_EQ(wave["first_frame_ms"]["count"], 3);
+  EXPECT_GT(wave["first_frame_ms"]["max_ms"].get<double>(), 0.0);
+  EXPECT_GT(wave["received"].get<long>(), 0);
+  // Joined a second into a three-second window: fewer frames than a watcher's.
+  EXPECT_LT(wave["received"].get<long>() / 3, j["per_subscriber"][0]["received"].get<long>());
+
+  const test::ProgramRun late =
+      test::run_program(bench("--subject " + kDemo + "/subject.sksubj --recording " + kDemo +
+                              "/live.c3d --seconds 2 --join-wave 3 --join-after-seconds 5"));
+  EXPECT_NE(late.exit_code, 0);
+  EXPECT_NE(late.output.find("--join-after-seconds must be less than --seconds"), std::string::npos)
+      << late.output;
+}
+
 // The other two capture systems drive the daemon too, and their frames are timed end to end
 // (the replay's send time found by frame number for every frame but the window's edges).
 TEST(BenchProgram, QtmAndNatNetSourcesAreTimedEndToEnd) {

@@ -216,7 +216,8 @@ struct ViconServer::State : std::enable_shared_from_this<ViconServer::State> {
 
   void on_accept(tcp::socket socket) {
     if (!running) return;
-    if (!admit_replay_client(stats, options.max_clients, log, "vicon")) return;  // the socket closes as it goes
+    if (!admit_replay_client(stats, options.max_clients, log, "vicon"))
+      return;  // the socket closes as it goes
     boost::system::error_code ignored;
     if (options.socket_send_buffer_bytes > 0)
       socket.set_option(asio::socket_base::send_buffer_size(options.socket_send_buffer_bytes), ignored);
