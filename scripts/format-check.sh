@@ -14,7 +14,7 @@ fi
 changes=$(git diff -U0 --no-color "$base" -- '*.cpp' '*.h' | clang-format-diff -p1 || true)
 if [ -n "$changes" ]; then
   echo "$changes"
-  echo "format-check: lines changed since ${base:0:7} are not as clang-format lays them out (above); run: git diff -U0 $base | clang-format-diff -p1 -i" >&2
+  echo "format-check: lines changed since ${base:0:7} are not as clang-format lays them out (above); run: git diff -U0 $base -- '*.cpp' '*.h' | clang-format-diff -p1 -i" >&2
   exit 1
 fi
 echo "format-check: every C++ line changed since ${base:0:7} is formatted"

@@ -85,6 +85,8 @@ struct DaemonConfig {
   int unauthenticated_hello_timeout_ms = 1000;  // ... and how long they have to say Hello
   // Bytes a subscriber's socket may hold not yet sent (TCP_NOTSENT_LOWAT); 0 = the system's (no limit).
   int subscriber_unsent_kb = 128;
+  // The joiners' MeshInfo and Model, all together, at most this fast (Mbit/s; 0 = unpaced).
+  int subscriber_join_mbit = 300;
 };
 
 // Thrown for a bad config file, a bad key or value, or conflicting flags: one line, says which.

@@ -568,6 +568,16 @@ std::vector<ConfigKey> make_config_keys() {
         "first frames took the publish threads' time from a good subscriber for 0.6 s. 0 = the\n"
         "system's (no limit)."},
             between(0, 1024 * 1024), "0-1048576 (0 = the system's)"),
+      bound(&DaemonConfig::subscriber_join_mbit,
+            {.name = "subscriber_join_mbit",
+             .doc =
+        "What joining subscribers are sent first (MeshInfo, about 1.3 MB for the demo body, and\n"
+        "the Model, about 1 MB) goes out at most this fast, all joiners together (Mbit/s), so that\n"
+        "the frames of the subscribers already watching go first on the link: 60 render nodes\n"
+        "restarting at once otherwise put 140 MB on a gigabit in one burst, and the watchers' frames\n"
+        "queue behind it. Below the stage link's rate less the frames' (64 parameter subscribers:\n"
+        "about 480 Mbit/s). 0 = unpaced."},
+            between(0, 100'000), "0-100000 (0 = unpaced)"),
       bound(&DaemonConfig::log_level,
             {.name = "log_level", .flag = "--log-level", .new_group = true,
              .flag_help = "trace, debug, info, warn, error, critical, off",

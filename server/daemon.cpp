@@ -18,6 +18,7 @@
 #include "server/pipeline/deform_cpus.h"
 #include "server/publish/multicast_sender.h"
 #include "server/publish/subscriber_hub.h"
+#include "server/publish/subscriber_session.h"
 #include "server/publish/tcp_subscriber_handoff.h"
 #include "server/thread_name.h"
 
@@ -46,6 +47,10 @@ std::vector<std::unique_ptr<SubjectStream>> load_subjects(const DaemonConfig& co
   options.hub.frame_max_wait = std::chrono::milliseconds(config.max_frame_wait_ms);
   options.hub.hello_timeout = std::chrono::milliseconds(config.hello_timeout_ms);
   options.hub.unauthenticated_hello_timeout = std::chrono::milliseconds(config.unauthenticated_hello_timeout_ms);
+  // One pacer for every subject's joiners: they share the link. Its burst: one piece of a message.
+  if (config.subscriber_join_mbit > 0)
+    options.hub.join_pacer = std::make_shared<JoinPacer>(config.subscriber_join_mbit * 1e6 / 8,
+                                                         SubscriberSession::kPacedPieceBytes);
   PipelineOptions& pipeline = options.pipeline;
   pipeline.lookahead = config.lookahead;
   pipeline.deform_threads = config.deform_threads;
@@ -365,6 +370,21 @@ void Daemon::schedule_status_log() {
   });
 }
 
+namespace {
+
+// The joiners' first messages as paced (null when unpaced): the rate, the bytes, how many pieces
+// waited and for how long in all.
+nlohmann::json join_pacing_json(const JoinPacer* pacer) {
+  if (!pacer) return nullptr;
+  const JoinPacer::Totals totals = pacer->totals();
+  return {{"mbit", pacer->bytes_per_second() * 8 / 1e6},
+          {"bytes", totals.bytes},
+          {"pieces_delayed", totals.delayed},
+          {"waited_seconds", totals.waited_seconds}};
+}
+
+}  // namespace
+
 std::string Daemon::health_json() const {
   nlohmann::json source;
   {
@@ -408,11 +428,20 @@ std::string Daemon::health_json() const {
         {"refused_limit", source_metrics_.subscribers_refused_limit.load()},
         {"refused_token", source_metrics_.subscribers_refused_token.load()},
         {"dropped_write_stall", dropped_write_stall}}},
-      {"deform", {{"threads", config_.deform_threads}, {"cpus", deform_cpus_}, {"spin_lead_us", config_.deform_spin_lead_us}}},
+      {"deform",
+       {{"threads", config_.deform_threads},
+        {"cpus", deform_cpus_},
+        {"spin_lead_us", config_.deform_spin_lead_us}}},
       {"publish_threads", publish_.count()},
+      {"join_pacing", join_pacing_json(subjects_.front()->hub().options().join_pacer.get())},
       {"subscriber_tcp_congestion", config_.subscriber_tcp_congestion},  // empty: the system's
-      {"subject", {{"name", first["name"]}, {"file", first["file"]}, {"present", first["present"]}, {"detail", first["detail"]},
-                   {"markers", first["markers"]}, {"vertices", first["vertices"]}}},
+      {"subject",
+       {{"name", first["name"]},
+        {"file", first["file"]},
+        {"present", first["present"]},
+        {"detail", first["detail"]},
+        {"markers", first["markers"]},
+        {"vertices", first["vertices"]}}},
       {"frames", first["frames"]},
       {"frame_buffers_allocated", first["frame_buffers_allocated"]},
       {"frame_buffers_allocated_by_pipeline", first["frame_buffers_allocated_by_pipeline"]},

@@ -16,6 +16,7 @@
 #include "server/asio.h"
 #include "server/metrics/metrics.h"
 #include "server/pipeline/pipeline.h"
+#include "server/publish/join_pacer.h"
 #include "server/publish/subject_directory.h"
 #include "server/publish/subscriber_queue.h"
 
@@ -30,6 +31,8 @@ struct HubOptions {
   // A connection that must give the token (or was refused as it connected) and sends no Hello
   // within this is refused and closed.
   std::chrono::milliseconds unauthenticated_hello_timeout{1000};
+  // Every subject's joiners' MeshInfo and Model, paced together (null: each written at once).
+  std::shared_ptr<JoinPacer> join_pacer;
 };
 
 class SubscriberHub : public FrameConsumer {

@@ -17,7 +17,8 @@ std::atomic<uint64_t> next_id{1};
 RateLimitedLog connection_log;
 }  // namespace
 
-SubscriberSession::SubscriberSession(asio::io_context& io, SubscriberHub& hub, std::string transport, std::string remote)
+SubscriberSession::SubscriberSession(asio::io_context& io, SubscriberHub& hub, std::string transport,
+                                     std::string remote)
     : io_(io),
       hub_(&hub),
       id_(next_id.fetch_add(1)),
@@ -25,6 +26,7 @@ SubscriberSession::SubscriberSession(asio::io_context& io, SubscriberHub& hub, s
       remote_(std::move(remote)),
       queue_(hub.options().queue_frames, hub.options().frame_max_wait),
       hello_timer_(io),
+      pace_timer_(io),
       pump_slot_(std::make_shared<HandlerSlot>()) {}
 
 void SubscriberSession::offer(const FrameRef& frame) {
@@ -223,6 +225,7 @@ void SubscriberSession::on_disconnected(const std::string& reason) {
   if (closed_) return;
   closed_ = true;
   hello_timer_.cancel();
+  pace_timer_.cancel();
   connection_log.info("subscriber_gone", fmt::format("subscriber {} ({} {}) gone: {} (sent {}, dropped {})", id_, transport_, remote_,
                                                      reason, sent_.load(), queue_.frames_dropped()));
   write_progress_ns_.store(0, std::memory_order_relaxed);
@@ -257,7 +260,8 @@ void SubscriberSession::pump() {
   writing_ = true;
   note_write_progress();
   if (in_flight_.control) {
-    start_write({asio::buffer(*in_flight_.control), asio::const_buffer()});
+    control_written_ = 0;
+    write_control();
     return;
   }
   if (paced_) ++unacked_;
@@ -271,7 +275,40 @@ void SubscriberSession::pump() {
   start_write({asio::buffer(frame_prefix_.data(), prefix), asio::buffer(message.data() + prefix, message.size() - prefix)});
 }
 
+void SubscriberSession::write_control() {
+  const std::vector<unsigned char>& message = *in_flight_.control;
+  JoinPacer* pacer = hub_->options().join_pacer.get();
+  const size_t left = message.size() - control_written_;
+  // Statuses and the like go at once: only a joiner's large messages take the link's time.
+  if (!pacer || message.size() < kPacedMessageBytes) {
+    control_written_ = message.size();
+    start_write({asio::buffer(message), asio::const_buffer()});
+    return;
+  }
+  const size_t piece = writes_in_pieces() ? std::min(left, kPacedPieceBytes) : left;
+  const std::chrono::nanoseconds wait = pacer->reserve(piece);
+  const size_t at = control_written_;
+  control_written_ += piece;
+  if (wait.count() <= 0) {
+    note_write_progress();
+    start_write({asio::buffer(message.data() + at, piece), asio::const_buffer()});
+    return;
+  }
+  // Waiting for the pacer is no stalled write (write_stalled_for: none under way).
+  write_progress_ns_.store(0, std::memory_order_relaxed);
+  pace_timer_.expires_after(wait);
+  pace_timer_.async_wait([self = shared_from_this(), this, at, piece](const boost::system::error_code& ec) {
+    if (ec || closed_) return;
+    note_write_progress();
+    start_write({asio::buffer(in_flight_.control->data() + at, piece), asio::const_buffer()});
+  });
+}
+
 void SubscriberSession::write_done(const boost::system::error_code& ec) {
+  if (!ec && in_flight_.control && control_written_ < in_flight_.control->size()) {
+    write_control();  // its next piece
+    return;
+  }
   writing_ = false;
   write_progress_ns_.store(0, std::memory_order_relaxed);
   const bool was_frame = static_cast<bool>(in_flight_.frame);

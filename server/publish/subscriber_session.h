@@ -26,6 +26,11 @@ class SubscriberHub;
 
 class SubscriberSession : public std::enable_shared_from_this<SubscriberSession> {
  public:
+  // With a JoinPacer (HubOptions): control messages of this size or more are paced, in pieces
+  // of the second size on a byte stream. A piece is 0.5 ms of a gigabit: what a watcher's frame
+  // may wait behind it in the link's queue.
+  static constexpr size_t kPacedMessageBytes = 16 * 1024;
+  static constexpr size_t kPacedPieceBytes = 64 * 1024;
   SubscriberSession(asio::io_context& io, SubscriberHub& hub, std::string transport, std::string remote);
   virtual ~SubscriberSession() = default;
 
@@ -68,6 +73,9 @@ class SubscriberSession : public std::enable_shared_from_this<SubscriberSession>
   void on_disconnected(const std::string& reason);
   // Writes the buffers as one protocol message, then calls write_done().
   virtual void start_write(const std::array<asio::const_buffer, 2>& buffers) = 0;
+  // Whether a message may be written in pieces, one start_write() each (a byte stream): the
+  // joiners' messages are then paced piece by piece; otherwise each whole.
+  virtual bool writes_in_pieces() const { return false; }
   void write_done(const boost::system::error_code& ec);
   // From the transport while a write is under way: some bytes went out.
   void note_write_progress();
@@ -78,6 +86,9 @@ class SubscriberSession : public std::enable_shared_from_this<SubscriberSession>
  private:
   void kick();
   void pump();
+  // The control message in flight, from control_written_ on: the next piece (a paced joiner's
+  // MeshInfo or Model) after the pacer's wait, or the rest at once.
+  void write_control();
   // Version 2's first Hello: into the hub of the subject it names (SubjectDirectory); false when
   // refused (no such subject).
   bool join_subject(const std::string& subject);
@@ -100,6 +111,8 @@ class SubscriberSession : public std::enable_shared_from_this<SubscriberSession>
   std::atomic<StreamKey> key_{0};
   std::atomic<uint64_t> sent_{0};
   SubscriberQueue::Item in_flight_;
+  size_t control_written_ = 0;  // of in_flight_.control, by the writes started
+  asio::steady_timer pace_timer_;
   std::chrono::steady_clock::time_point write_started_;  // of the frame in flight
   std::array<unsigned char, 64> frame_prefix_{};  // the frame's first bytes with this subscriber's drop count
   // steady_clock ns of the write's start or its last progress; 0 while no write is under way.

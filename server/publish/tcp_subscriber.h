@@ -21,6 +21,7 @@ class TcpSubscriber : public SubscriberSession {
  private:
   void read_next();
   void start_write(const std::array<asio::const_buffer, 2>& buffers) override;
+  bool writes_in_pieces() const override { return true; }
 
   tcp::socket socket_;
   std::shared_ptr<const void> placement_;

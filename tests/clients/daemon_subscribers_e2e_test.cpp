@@ -515,5 +515,59 @@ TEST(DaemonDemoSubscribers, MeshInfoIsSentAgainOnlyWhenWhatItDescribesChanges) {
   EXPECT_EQ(daemon.stop(), 0) << daemon.log();
 }
 
+// Render nodes joining together: their MeshInfo (1.3 MB each for the demo body) goes out paced
+// at subscriber_join_mbit for all of them together, while a watcher already in keeps its frames.
+TEST(DaemonDemoSubscribers, JoinersAreSentTheirMeshInfoAtTheJoinRateWhileAWatcherKeepsItsFrames) {
+  const int mbit = 40;  // 5 MB/s
+  const auto started = start_demo_daemon({{"subscriber_join_mbit", mbit}});
+  test::DaemonProcess& daemon = *started;
+  ASSERT_GT(daemon.sub_port, 0);
+  RawSubscriber watcher(daemon.sub_port);
+  ASSERT_TRUE(served(watcher, subscriber::Hello{subscriber::kWantMarkers | subscriber::kWantNoMesh}));
+  std::atomic<bool> stop{false};
+  std::atomic<int> watcher_frames{0};
+  std::thread watching([&] {
+    while (!stop.load())
+      if (const std::optional<Message> m = watcher.next(std::chrono::seconds(2));
+          m && m->header.type == subscriber::MessageType::Frame)
+        ++watcher_frames;
+  });
+  ASSERT_TRUE(eventually([&] { return watcher_frames.load() > 10; }));
+
+  constexpr int kJoiners = 4;
+  std::vector<std::unique_ptr<RawSubscriber>> joiners;
+  for (int j = 0; j < kJoiners; ++j) joiners.push_back(std::make_unique<RawSubscriber>(daemon.sub_port));
+  const auto joined = std::chrono::steady_clock::now();
+  const int frames_before = watcher_frames.load();
+  for (auto& joiner : joiners) ASSERT_TRUE(joiner->say(subscriber::Hello{0}));
+  // Each joiner reads its MeshInfo and its first frame's header, in turn: the others' bytes wait
+  // in their sockets meanwhile, which the pacer does not see.
+  size_t mesh_info_bytes = 0;
+  for (auto& joiner : joiners) {
+    const std::optional<Message> first = joiner->next();
+    ASSERT_TRUE(first && first->header.type == subscriber::MessageType::MeshInfo);
+    mesh_info_bytes += subscriber::kHeaderBytes + first->payload.size();
+    ASSERT_TRUE(joiner->read_into_a_frame());
+  }
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - joined).count();
+  const int watched = watcher_frames.load() - frames_before;
+  stop = true;
+  watching.join();
+  for (auto& joiner : joiners) joiner->hang_up();
+
+  // All but the first piece waited their turn at the rate.
+  const double rate = mbit * 1e6 / 8;
+  const double paced = static_cast<double>(mesh_info_bytes - 64 * 1024) / rate;
+  EXPECT_GT(seconds, 0.9 * paced) << mesh_info_bytes << " bytes";
+  EXPECT_LT(seconds, 3 * paced + 2) << mesh_info_bytes << " bytes";
+  const nlohmann::json pacing = health_of(daemon.http_port)["join_pacing"];
+  EXPECT_EQ(pacing["mbit"], mbit) << pacing.dump();
+  EXPECT_GE(pacing["bytes"].get<double>(), static_cast<double>(mesh_info_bytes)) << pacing.dump();
+  EXPECT_GT(pacing["pieces_delayed"].get<int>(), 0) << pacing.dump();
+  // The watcher's frames went on meanwhile (120 a second; loaded test machines are slower).
+  EXPECT_GT(watched, 60 * seconds) << watched << " frames in " << seconds << " s";
+  EXPECT_EQ(daemon.stop(), 0) << daemon.log();
+}
+
 }  // namespace
 }  // namespace skinstream

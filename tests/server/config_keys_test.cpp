@@ -66,6 +66,7 @@ const nlohmann::json kChangedValues = {
     {"max_unauthenticated_per_address", 1},
     {"unauthenticated_hello_timeout_ms", 200},
     {"subscriber_unsent_kb", 64},
+    {"subscriber_join_mbit", 500},
     {"log_level", "debug"}};
 
 // A value out of range, or not of the key's form, for every key that checks its value.
@@ -109,6 +110,7 @@ const std::pair<const char*, nlohmann::json> kBadValues[] = {{"speed", 0.0},
                                                              {"max_unauthenticated_per_address", -1},
                                                              {"unauthenticated_hello_timeout_ms", 9},
                                                              {"subscriber_unsent_kb", -1},
+                                                             {"subscriber_join_mbit", -1},
                                                              {"log_level", "loud"}};
 
 std::optional<CommandLine> parse_flags(std::vector<std::string> arguments) {
