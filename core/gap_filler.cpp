@@ -1,6 +1,5 @@
 #include "core/gap_filler.h"
 
-#include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -16,6 +15,7 @@ GapFiller::GapFiller(const SubjectModel& model, const GapFillerOptions& options)
     : model_(model),
       options_(options),
       n_(model.marker_count()),
+      single_gaps_(model),
       region_statistics_(model, RegionLearningOptions{.rate_hz = options.rate_hz}) {
   // Reverse one-rings: which markers' PCA models can predict marker i, and at which slot.
   std::vector<std::vector<std::pair<int, int>>> predictors(n_);
@@ -93,7 +93,6 @@ GapFiller::GapFiller(const SubjectModel& model, const GapFillerOptions& options)
     }
     rigid_member_variance_.push_back(leverage > 0.0 ? model.pca[i].rigid_variance / leverage : model.pca[i].rigid_variance);
   }
-  precompute_single_gaps();
   ring_recent_.assign(model.ring.size(), RecentMiss{});
   ring_calibration_.assign(model.ring.size(), 1.0);
   ring_checked_frame_.assign(n_, -1);
@@ -110,38 +109,9 @@ GapFiller::GapFiller(const SubjectModel& model, const GapFillerOptions& options)
   scratch_source_.assign(scratch, Vec3::Zero());
   scratch_target_.assign(scratch, Vec3::Zero());
   scratch_index_.assign(scratch, 0);
-  single_gap_deviation_.resize(kMaxRingDims);
   region_positions_.assign(SubjectModel::kMaxRing, Vec3::Zero());
   region_observed_.assign(SubjectModel::kMaxRing, 0);
   region_solves_.resize(model.has_regions() ? n_ : 0);
-}
-
-// For every ring member of every model, the PCA coefficients when that member alone is missing
-// are a fixed linear map of the others (the normal equations depend only on which members are
-// observed): c = A^-1 B_O^T (z_O - mean_O). Computed once; the reconstruction is mean_s + B_s c.
-void GapFiller::precompute_single_gaps() {
-  single_gap_offset_.assign(model_.ring.size(), 0);
-  single_gap_variance_.assign(model_.ring.size(), 0.0);
-  for (int j = 0; j < n_; ++j) {
-    const MarkerPcaModel& m = model_.pca[j];
-    const int d = model_.ring_size(j), components = static_cast<int>(m.variance.size());
-    for (int s = 0; s < d; ++s) {
-      const int at = model_.ring_offsets[j] + s;
-      single_gap_offset_[at] = static_cast<int>(single_gap_map_.size());
-      Eigen::MatrixXd observed(3 * (d - 1), components);
-      for (int k = 0, o = 0; k < d; ++k)
-        if (k != s) observed.middleRows<3>(3 * o++) = m.basis.middleRows<3>(3 * k);
-      Eigen::MatrixXd normal = observed.transpose() * observed;
-      for (int c = 0; c < components; ++c) normal(c, c) += m.residual_variance / m.variance(c);
-      const Eigen::LLT<Eigen::MatrixXd> llt(normal);
-      const Eigen::MatrixXd map = llt.solve(observed.transpose());
-      for (int c = 0; c < components; ++c)
-        for (int col = 0; col < map.cols(); ++col) single_gap_map_.push_back(map(c, col));
-      const Eigen::MatrixXd rows = m.basis.middleRows<3>(3 * s);
-      const double spread = components ? (rows * llt.solve(rows.transpose())).trace() / 3.0 : 0.0;
-      single_gap_variance_[at] = m.residual_variance * (1.0 + spread) * m.slot_calibration(s);
-    }
-  }
 }
 
 void GapFiller::reset() {
@@ -595,8 +565,10 @@ bool GapFiller::solve_pca(int j) {
     int missing_slot = 0;
     while (observed_[model_.ring[first + missing_slot]]) ++missing_slot;
     const int at = first + missing_slot;
-    const double miss = reconstruct_single_gap(j, missing_slot, count, pca_slot_local_[at]);
-    pca_slot_variance_[at] = single_gap_variance_[at] * ring_calibration_[at];
+    const double miss =
+        single_gaps_.reconstruct(j, missing_slot, {scratch_source_.data(), static_cast<size_t>(count)},
+                                 {scratch_index_.data(), static_cast<size_t>(count)}, pca_slot_local_[at]);
+    pca_slot_variance_[at] = single_gaps_.variance(at) * ring_calibration_[at];
     pca_novelty_[j] = novelty_factor(miss, count, m.residual_variance);
     pca_ok_[j] = 1;
     return true;
@@ -621,33 +593,11 @@ bool GapFiller::solve_pca(int j) {
     // With several members missing the exact predictive variance costs a triangular solve per
     // member; the single-gap variance, grown by the share of the ring that is missing, ranks
     // the estimates almost the same at a fraction of the cost.
-    pca_slot_variance_[first + k] = single_gap_variance_[first + k] * ring_calibration_[first + k] * (ring - 1) / count;
+    pca_slot_variance_[first + k] =
+        single_gaps_.variance(first + k) * ring_calibration_[first + k] * (ring - 1) / count;
   }
   pca_ok_[j] = 1;
   return true;
-}
-
-// Model j's reconstruction of ring member `missing_slot` from the other `count` members, already
-// in j's local frame in scratch_source_ (slots in scratch_index_): the precomputed linear map of
-// that one-member gap. Returns the observed members' squared miss (what novelty_factor reads).
-double GapFiller::reconstruct_single_gap(int j, int missing_slot, int count, Vec3& out_local) {
-  const MarkerPcaModel& m = model_.pca[j];
-  const int at = model_.ring_offsets[j] + missing_slot;
-  const double* map = single_gap_map_.data() + single_gap_offset_[at];  // empty when the model has no components
-  const int columns = 3 * count, components = static_cast<int>(m.variance.size());
-  for (int o = 0; o < count; ++o)
-    single_gap_deviation_.segment<3>(3 * o) = scratch_source_[o] - m.mean.segment<3>(3 * scratch_index_[o]);
-  single_gap_coefficients_.resize(components);
-  for (int c = 0; c < components; ++c) {
-    double sum = 0.0;
-    for (int col = 0; col < columns; ++col) sum += map[c * columns + col] * single_gap_deviation_(col);
-    single_gap_coefficients_(c) = sum;
-  }
-  double miss = 0.0;
-  for (int o = 0; o < count; ++o)
-    miss += (single_gap_deviation_.segment<3>(3 * o) - m.basis.middleRows<3>(3 * scratch_index_[o]) * single_gap_coefficients_).squaredNorm();
-  out_local = m.mean.segment<3>(3 * missing_slot) + m.basis.middleRows<3>(3 * missing_slot) * single_gap_coefficients_;
-  return miss;
 }
 
 // A few models a frame, in turn, each with its marker and whole ring measured: every member
@@ -691,10 +641,11 @@ void GapFiller::check_rings() {
       fit_rotation({scratch_source_.data(), static_cast<size_t>(count)}, {scratch_target_.data(), static_cast<size_t>(count)}, r);
       for (int o = 0; o < count; ++o) scratch_source_[o] = r * scratch_source_[o];
       Vec3 estimate;
-      reconstruct_single_gap(j, s, count, estimate);
+      single_gaps_.reconstruct(j, s, {scratch_source_.data(), static_cast<size_t>(count)},
+                               {scratch_index_.data(), static_cast<size_t>(count)}, estimate);
       const int at = first + s;
       const double miss = (estimate - r * (current_[model_.ring[at]] - current_[j])).squaredNorm() / 3.0;
-      ring_recent_[at].add(forget, seconds, miss, single_gap_variance_[at]);
+      ring_recent_[at].add(forget, seconds, miss, single_gaps_.variance(at));
       ring_calibration_[at] = std::max(1.0, ring_recent_[at].ratio());
     }
   }

@@ -57,6 +57,7 @@
 #include "core/recent_miss.h"
 #include "core/region_online_statistics.h"
 #include "core/region_pca_fit.h"
+#include "core/single_gap_reconstruction.h"
 #include "core/subject_model.h"
 
 namespace skinstream {
@@ -150,9 +151,7 @@ class GapFiller {
   void estimate_rigid();
   void fit_rigid_estimate(int i);
   void relabel();
-  void precompute_single_gaps();
   bool solve_pca(int j);
-  double reconstruct_single_gap(int j, int missing_slot, int count, Vec3& out_local);
   void check_rings();
   int pca_estimate(int i, Vec3& out, double* out_variance = nullptr, bool misfit = false);
   void remember_gap_start(int i);
@@ -260,12 +259,7 @@ class GapFiller {
   // marker's reference ring, so they change only with which members are known.
   std::vector<double> leverage_;
   std::vector<uint32_t> leverage_mask_;
-  // One ring member missing, per ring entry: the coefficients' linear map (components x 3(d-1),
-  // row-major, at single_gap_offset_) and the reconstruction's calibrated variance.
-  std::vector<double> single_gap_map_;
-  PcaVector single_gap_deviation_, single_gap_coefficients_;
-  std::vector<int> single_gap_offset_;
-  std::vector<double> single_gap_variance_;
+  SingleGapReconstruction single_gaps_;  // one ring member missing: the common case
   // The one-ring opinions' online calibration (check_rings), parallel to model.ring: how each
   // lately did against its claim, and the ratio (>= 1) that scales the claim.
   static constexpr int kRingChecksPerFrame = 2;
