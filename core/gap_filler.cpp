@@ -16,6 +16,7 @@ GapFiller::GapFiller(const SubjectModel& model, const GapFillerOptions& options)
       options_(options),
       n_(model.marker_count()),
       single_gaps_(model),
+      ring_calibration_(model, options.rate_hz),
       region_statistics_(model, RegionLearningOptions{.rate_hz = options.rate_hz}) {
   // Reverse one-rings: which markers' PCA models can predict marker i, and at which slot.
   std::vector<std::vector<std::pair<int, int>>> predictors(n_);
@@ -93,12 +94,6 @@ GapFiller::GapFiller(const SubjectModel& model, const GapFillerOptions& options)
     }
     rigid_member_variance_.push_back(leverage > 0.0 ? model.pca[i].rigid_variance / leverage : model.pca[i].rigid_variance);
   }
-  ring_recent_.assign(model.ring.size(), RecentMiss{});
-  ring_calibration_.assign(model.ring.size(), 1.0);
-  ring_checked_frame_.assign(n_, -1);
-  rigid_recent_.assign(n_, RecentMiss{});
-  rigid_calibration_.assign(n_, 1.0);
-  ring_nominal_frames_ = std::max<long>(1, (n_ + kRingChecksPerFrame - 1) / kRingChecksPerFrame);
   static_assert(SubjectModel::kMaxRing < 32, "observed slots are a 32-bit mask");
   for (int j = 0; j < n_; ++j) {
     pattern_offset_.push_back(static_cast<int>(pattern_factor_.size()));
@@ -126,12 +121,7 @@ void GapFiller::reset() {
   std::fill(carry_drift_.begin(), carry_drift_.end(), 0.0);
   std::fill(carry_checks_.begin(), carry_checks_.end(), 0);
   region_statistics_.reset();
-  std::fill(ring_recent_.begin(), ring_recent_.end(), RecentMiss{});
-  std::fill(ring_calibration_.begin(), ring_calibration_.end(), 1.0);
-  std::fill(ring_checked_frame_.begin(), ring_checked_frame_.end(), -1);
-  std::fill(rigid_recent_.begin(), rigid_recent_.end(), RecentMiss{});
-  std::fill(rigid_calibration_.begin(), rigid_calibration_.end(), 1.0);
-  ring_cursor_ = 0;
+  ring_calibration_.reset();
   for (RegionSolve& solve : region_solves_) solve.observed_mask = 0;
 }
 
@@ -206,7 +196,7 @@ FillStats GapFiller::run(const FrameInput& in, const FrameOutput& out) {
   }
   has_previous_ = true;
   if (options_.use_regions && options_.learn_regions) region_statistics_.learn(current_, status_);
-  if (options_.calibrate_rings) check_rings();
+  if (options_.calibrate_rings) ring_calibration_.check(current_, status_, single_gaps_);
   return stats_;
 }
 
@@ -409,12 +399,13 @@ void GapFiller::fit_rigid_estimate(int i) {
   double variance = 0.0, member_variances = 0.0, miss = 0.0;
   for (int k = 0; k < count; ++k) {
     const int j = scratch_index_[k];
-    const double member = rigid_member_variance_[i] * rigid_calibration_[i] + (observed_[j] ? 0.0 : rigid_estimate_variance(j, true));
+    const double member = rigid_member_variance_[i] * ring_calibration_.rigid(i) +
+                          (observed_[j] ? 0.0 : rigid_estimate_variance(j, true));
     variance += leverage[k] * member;
     member_variances += member;
     miss += (t.apply(scratch_source_[k]) - scratch_target_[k]).squaredNorm();
   }
-  rigid_variance_[i] = std::max(variance, model_.pca[i].rigid_variance * rigid_calibration_[i]);
+  rigid_variance_[i] = std::max(variance, model_.pca[i].rigid_variance * ring_calibration_.rigid(i));
   // A ring that no longer moves rigidly (a joint bent beyond training) makes the estimate worth
   // less: its members' miss against the fit, over what those variances lead one to expect of
   // it. The fit takes six of the 3n coordinates: three members leave only their three
@@ -568,7 +559,7 @@ bool GapFiller::solve_pca(int j) {
     const double miss =
         single_gaps_.reconstruct(j, missing_slot, {scratch_source_.data(), static_cast<size_t>(count)},
                                  {scratch_index_.data(), static_cast<size_t>(count)}, pca_slot_local_[at]);
-    pca_slot_variance_[at] = single_gaps_.variance(at) * ring_calibration_[at];
+    pca_slot_variance_[at] = single_gaps_.variance(at) * ring_calibration_.ring(at);
     pca_novelty_[j] = novelty_factor(miss, count, m.residual_variance);
     pca_ok_[j] = 1;
     return true;
@@ -594,61 +585,10 @@ bool GapFiller::solve_pca(int j) {
     // member; the single-gap variance, grown by the share of the ring that is missing, ranks
     // the estimates almost the same at a fraction of the cost.
     pca_slot_variance_[first + k] =
-        single_gaps_.variance(first + k) * ring_calibration_[first + k] * (ring - 1) / count;
+        single_gaps_.variance(first + k) * ring_calibration_.ring(first + k) * (ring - 1) / count;
   }
   pca_ok_[j] = 1;
   return true;
-}
-
-// A few models a frame, in turn, each with its marker and whole ring measured: every member
-// estimated from the others as in a one-member gap, and the miss against the variance that
-// estimate claims added to the member's running sums (forgetting over kRingMemorySeconds). Their
-// ratio, never below one, scales the claim from then on: a ring opinion claims no more than it
-// has lately been shown to deserve (a toe's ring that reaches across to the other foot, steady
-// while the subject stood in training and not in a walk).
-void GapFiller::check_rings() {
-  for (int scanned = 0, checked = 0; scanned < n_ && checked < kRingChecksPerFrame; ++scanned) {
-    const int j = ring_cursor_;
-    ring_cursor_ = (ring_cursor_ + 1) % n_;
-    const int first = model_.ring_offsets[j], ring = model_.ring_size(j);
-    bool whole = status_[j] == MarkerStatus::Measured && ring >= 3;
-    for (int k = 0; k < ring && whole; ++k) whole = status_[model_.ring[first + k]] == MarkerStatus::Measured;
-    if (!whole) continue;
-    ++checked;
-    const long elapsed = ring_checked_frame_[j] < 0 ? ring_nominal_frames_ : frame_ - ring_checked_frame_[j];
-    ring_checked_frame_[j] = frame_;
-    const double forget = std::exp(-static_cast<double>(elapsed) / options_.rate_hz / kRingMemorySeconds);
-    const double seconds = static_cast<double>(std::min(elapsed, ring_nominal_frames_)) / options_.rate_hz;
-    // Eq. 2 on the whole ring, against the variance it claims there.
-    for (int k = 0; k < ring; ++k) {
-      scratch_source_[k] = model_.ring_local_reference[first + k];
-      scratch_target_[k] = current_[model_.ring[first + k]];
-    }
-    RigidTransform t;
-    fit_rigid({scratch_source_.data(), static_cast<size_t>(ring)}, {scratch_target_.data(), static_cast<size_t>(ring)}, t);
-    rigid_recent_[j].add(forget, seconds, (t.translation - current_[j]).squaredNorm() / 3.0, model_.pca[j].rigid_variance);
-    rigid_calibration_[j] = std::max(1.0, rigid_recent_[j].ratio());
-    for (int s = 0; s < ring; ++s) {
-      int count = 0;
-      for (int k = 0; k < ring; ++k) {
-        if (k == s) continue;
-        scratch_source_[count] = current_[model_.ring[first + k]] - current_[j];
-        scratch_target_[count] = model_.ring_local_reference[first + k];
-        scratch_index_[count] = k;
-        ++count;
-      }
-      Eigen::Matrix3d r;
-      fit_rotation({scratch_source_.data(), static_cast<size_t>(count)}, {scratch_target_.data(), static_cast<size_t>(count)}, r);
-      for (int o = 0; o < count; ++o) scratch_source_[o] = r * scratch_source_[o];
-      Vec3 estimate;
-      single_gaps_.reconstruct(j, s, {scratch_source_.data(), static_cast<size_t>(count)},
-                               {scratch_index_.data(), static_cast<size_t>(count)}, estimate);
-      const int at = first + s;
-      const double miss = (estimate - r * (current_[model_.ring[at]] - current_[j])).squaredNorm() / 3.0;
-      ring_recent_[at].add(forget, seconds, miss, single_gaps_.variance(at));
-      ring_calibration_[at] = std::max(1.0, ring_recent_[at].ratio());
-    }
-  }
 }
 
 // Moves `previous` (where a marker was last frame) with the rigid motion of `members` from the

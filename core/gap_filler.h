@@ -31,7 +31,7 @@
 //      And each is scaled by how much it lately missed: a few models a frame, where the marker
 //      and its whole ring are measured, estimate every member (and eq. 2 the marker) from the
 //      rest, and the miss over the variance claimed (recent frames counting most), never below
-//      one, scales the claim (check_rings): a ring that spans the two feet, steady while the
+//      one, scales the claim (ring_calibration.h): a ring that spans the two feet, steady while the
 //      subject stood in training, is no judge of either foot in a walk.
 //      Without one, the rigid estimate; without that, held relative to the marker's anchors.
 //      The marker's regional PCA (region_pca_fit.h), aligned on whichever members of its region
@@ -54,9 +54,9 @@
 #include "core/absolute_orientation.h"
 #include "core/marker_status.h"
 #include "core/pca_fit.h"
-#include "core/recent_miss.h"
 #include "core/region_online_statistics.h"
 #include "core/region_pca_fit.h"
+#include "core/ring_calibration.h"
 #include "core/single_gap_reconstruction.h"
 #include "core/subject_model.h"
 
@@ -83,7 +83,7 @@ struct GapFillerOptions {
   bool learn_regions = true;
   // Each one-ring model's estimate of each member, and eq. 2's of the marker, is tried where the
   // whole ring is measured (a few models a frame), and the variance each claims is scaled by how
-  // much more it lately missed (never below its offline calibration): check_rings.
+  // much more it lately missed (never below its offline calibration): ring_calibration.h.
   bool calibrate_rings = true;
   // A new relabel stays on probation for this many frames: while it is, the fragment must pass
   // the taking test (eq. 3, unambiguous) every frame, else the relabel is revoked for all the
@@ -135,8 +135,7 @@ class GapFiller {
   void reset();  // forget the past (new take, source reconnected)
   // How much a one-ring opinion's claimed variance is scaled up by what it lately missed
   // (calibrate_rings; 1: as calibrated offline), per entry of model.ring.
-  double ring_calibration(int ring_entry) const { return ring_calibration_[ring_entry]; }
-
+  double ring_calibration(int ring_entry) const { return ring_calibration_.ring(ring_entry); }
 
  private:
   void find_suspect_labels();
@@ -152,7 +151,6 @@ class GapFiller {
   void fit_rigid_estimate(int i);
   void relabel();
   bool solve_pca(int j);
-  void check_rings();
   int pca_estimate(int i, Vec3& out, double* out_variance = nullptr, bool misfit = false);
   void remember_gap_start(int i);
   bool carried_from_gap_start(int i, Vec3& out, double& out_variance);
@@ -260,17 +258,7 @@ class GapFiller {
   std::vector<double> leverage_;
   std::vector<uint32_t> leverage_mask_;
   SingleGapReconstruction single_gaps_;  // one ring member missing: the common case
-  // The one-ring opinions' online calibration (check_rings), parallel to model.ring: how each
-  // lately did against its claim, and the ratio (>= 1) that scales the claim.
-  static constexpr int kRingChecksPerFrame = 2;
-  static constexpr double kRingMemorySeconds = 10.0;
-  int ring_cursor_ = 0;
-  long ring_nominal_frames_ = 1;  // between a model's checks when every ring is seen
-  std::vector<RecentMiss> ring_recent_;
-  std::vector<double> ring_calibration_;
-  std::vector<long> ring_checked_frame_;  // per model: the frame it was last checked
-  std::vector<RecentMiss> rigid_recent_;  // per marker: eq. 2 on its whole ring, likewise
-  std::vector<double> rigid_calibration_;
+  RingCalibration ring_calibration_;     // the one-ring and eq. 2 opinions' online calibration
   // Several ring members missing: per model, the observed slots (a bit each) its factor below
   // was made for, and that factor (PcaFit::factor_slots, components^2 at pattern_offset_).
   std::vector<uint32_t> pattern_mask_;

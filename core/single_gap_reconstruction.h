@@ -1,7 +1,7 @@
 #pragma once
 // A one-ring PCA model's reconstruction of a ring member when that member alone is missing: the
 // common case at runtime, and what the online checks of the ring opinions try
-// (GapFiller::check_rings). The coefficients are then a fixed linear map of the other members (the
+// (ring_calibration.h). The coefficients are then a fixed linear map of the other members (the
 // normal equations depend only on which members are observed), so each map and the
 // reconstruction's calibrated variance are made once, in the constructor, and a reconstruction
 // is one matrix-vector product. The same fit as PcaFit (pca_fit.h), at a fraction of the cost.
