@@ -15,6 +15,7 @@ GapFiller::GapFiller(const SubjectModel& model, const GapFillerOptions& options)
     : model_(model),
       options_(options),
       n_(model.marker_count()),
+      carry_(model, options.rate_hz),
       single_gaps_(model),
       ring_calibration_(model, options.rate_hz),
       region_statistics_(model, RegionLearningOptions{.rate_hz = options.rate_hz}) {
@@ -43,18 +44,6 @@ GapFiller::GapFiller(const SubjectModel& model, const GapFillerOptions& options)
   refused_id_.assign(n_, kNoFragment);
   revoked_.assign(n_, 0);
   gap_offset_.assign(n_, Vec3::Zero());
-  gap_start_known_.assign(n_, 0);
-  gap_start_frame_.assign(n_, 0);
-  gap_start_position_.assign(n_, Vec3::Zero());
-  gap_start_anchor_.assign(model.anchors.size(), Vec3::Zero());
-  gap_start_anchor_seen_.assign(model.anchors.size(), 0);
-  carry_check_frames_ = std::max(1, static_cast<int>(std::lround(0.5 * options_.rate_hz)));
-  snapshot_frame_.assign(n_, -1);
-  snapshot_position_.assign(n_, Vec3::Zero());
-  snapshot_anchor_.assign(model.anchors.size(), Vec3::Zero());
-  snapshot_anchor_seen_.assign(model.anchors.size(), 0);
-  carry_drift_.assign(n_, 0.0);
-  carry_checks_.assign(n_, 0);
   current_.assign(n_, Vec3::Zero());
   status_.assign(n_, MarkerStatus::Held);
   observed_.assign(n_, 0);
@@ -116,10 +105,7 @@ void GapFiller::reset() {
   std::fill(probation_start_.begin(), probation_start_.end(), -1);
   std::fill(refused_id_.begin(), refused_id_.end(), kNoFragment);
   std::fill(gap_offset_.begin(), gap_offset_.end(), Vec3::Zero());
-  std::fill(gap_start_known_.begin(), gap_start_known_.end(), 0);
-  std::fill(snapshot_frame_.begin(), snapshot_frame_.end(), -1);
-  std::fill(carry_drift_.begin(), carry_drift_.end(), 0.0);
-  std::fill(carry_checks_.begin(), carry_checks_.end(), 0);
+  carry_.reset();
   region_statistics_.reset();
   ring_calibration_.reset();
   for (RegionSolve& solve : region_solves_) solve.observed_mask = 0;
@@ -174,7 +160,7 @@ FillStats GapFiller::run(const FrameInput& in, const FrameOutput& out) {
 
   relabel();
   fill_missing();
-  if (options_.carry_from_gap_start) check_carries();
+  if (options_.carry_from_gap_start) carry_.check(frame_, current_, observed_);
 
   for (int i = 0; i < n_; ++i) {
     out.positions[i] = current_[i];
@@ -666,88 +652,6 @@ double GapFiller::rigid_estimate_variance(int i, bool misfit) const {
   return rigid_variance_[i] * (misfit ? rigid_novelty_[i] : 1.0);
 }
 
-// At the first frame of a gap: where the marker and its anchors were last frame.
-void GapFiller::remember_gap_start(int i) {
-  gap_start_known_[i] = 1;
-  gap_start_frame_[i] = frame_;
-  gap_start_position_[i] = previous_[i];
-  for (int k = model_.anchor_offsets[i]; k < model_.anchor_offsets[i + 1]; ++k) {
-    const int a = model_.anchors[k];
-    gap_start_anchor_[k] = previous_[a];
-    gap_start_anchor_seen_[k] = is_observed(previous_status_[a]);
-  }
-}
-
-// A marker's position `from_position` at an earlier frame carried by the rigid motion, from then
-// to now, of its three steadiest anchors seen both then and now (`from_anchors`, `from_seen`:
-// parallel to its anchors). Also the fit's squared residual over those three, per degree of
-// freedom (how far they moved from rigid).
-bool GapFiller::carry_rigidly(int i, const Vec3& from_position, std::span<const Vec3> from_anchors,
-                              std::span<const char> from_seen, Vec3& out, double& out_residual) {
-  const int first = model_.anchor_offsets[i];
-  int count = 0;
-  for (int k = first; k < model_.anchor_offsets[i + 1] && count < kCarryAnchors; ++k) {
-    const int a = model_.anchors[k];
-    if (!from_seen[k - first] || !observed_[a]) continue;
-    scratch_source_[count] = from_anchors[k - first];
-    scratch_target_[count] = current_[a];
-    ++count;
-  }
-  if (count < kCarryAnchors) return false;
-  RigidTransform t;
-  fit_rigid({scratch_source_.data(), static_cast<size_t>(count)}, {scratch_target_.data(), static_cast<size_t>(count)}, t);
-  double residual = 0.0;
-  for (int k = 0; k < count; ++k) residual += (t.apply(scratch_source_[k]) - scratch_target_[k]).squaredNorm();
-  out = t.apply(from_position);
-  out_residual = residual / (3 * count - 6);
-  return true;
-}
-
-// The marker's last measurement carried from the start of its gap. Over a long gap this does not
-// drift as a chain of frame-to-frame motions does, and where the marker sits on a rigid segment
-// with its anchors (a head, a pelvis, a foot) it is nearly exact, while a neighbourhood spanning a
-// joint is not. Its variance per coordinate grows with the gap's age at the rate the same carry
-// drifted for this marker while it was seen, on top of the anchors' own departure from rigid;
-// never below the marker model's residual. No estimate before that rate was measured over two
-// seconds of the marker being seen: one half-second check says little about a joint.
-bool GapFiller::carried_from_gap_start(int i, Vec3& out, double& out_variance) {
-  if (!gap_start_known_[i] || carry_checks_[i] < kCarryWarmupChecks) return false;
-  const int first = model_.anchor_offsets[i], count = model_.anchor_offsets[i + 1] - first;
-  double residual = 0.0;
-  if (!carry_rigidly(i, gap_start_position_[i], {&gap_start_anchor_[first], static_cast<size_t>(count)},
-                     {&gap_start_anchor_seen_[first], static_cast<size_t>(count)}, out, residual))
-    return false;
-  const double age = static_cast<double>(frame_ - gap_start_frame_[i]) + 1.0;
-  out_variance = std::max(residual + carry_drift_[i] * age * age / 3.0, model_.pca[i].residual_variance);
-  return true;
-}
-
-// Every carry_check_frames_, for each marker seen now: how far the carry from its snapshot missed
-// it, then a new snapshot.
-void GapFiller::check_carries() {
-  for (int i = 0; i < n_; ++i) {
-    if (!is_observed(status_[i])) continue;
-    const long age = frame_ - snapshot_frame_[i];
-    if (snapshot_frame_[i] >= 0 && age < carry_check_frames_) continue;
-    const int first = model_.anchor_offsets[i], count = model_.anchor_offsets[i + 1] - first;
-    Vec3 carried;
-    double residual = 0.0;
-    if (snapshot_frame_[i] >= 0 &&
-        carry_rigidly(i, snapshot_position_[i], {&snapshot_anchor_[first], static_cast<size_t>(count)},
-                      {&snapshot_anchor_seen_[first], static_cast<size_t>(count)}, carried, residual)) {
-      const double drift = (carried - current_[i]).squaredNorm() / (static_cast<double>(age) * age);
-      carry_drift_[i] = carry_checks_[i] == 0 ? drift : 0.5 * (carry_drift_[i] + drift);
-      ++carry_checks_[i];
-    }
-    snapshot_frame_[i] = frame_;
-    snapshot_position_[i] = current_[i];
-    for (int k = first; k < first + count; ++k) {
-      snapshot_anchor_[k] = current_[model_.anchors[k]];
-      snapshot_anchor_seen_[k] = is_observed(status_[model_.anchors[k]]);
-    }
-  }
-}
-
 // Marker i's regional PCA opinion from the observed members of its region (region_pca_fit.h).
 // Not asked for when the other opinions' variance is so much smaller than the least the region
 // can claim (its residual, calibrated) that it would weigh under 5%: the common case of a short
@@ -784,12 +688,12 @@ void GapFiller::fill_missing() {
   for (int i : missing_) {
     if (observed_[i]) continue;  // relabelled
     if (has_previous_ && is_observed(previous_status_[i])) {
-      remember_gap_start(i);
+      carry_.remember_gap_start(i, frame_, previous_, previous_status_);
       gap_offset_[i].setZero();  // set below when this frame has a neighbourhood rotation
     }
     Vec3 carried;
     double carried_variance = 0.0;
-    const bool carry = carry_on && carried_from_gap_start(i, carried, carried_variance);
+    const bool carry = carry_on && carry_.carried(i, frame_, current_, observed_, carried, carried_variance);
     // The neighbours' opinions (PCA, else eq. 2) with the carry, then the region's weighed in.
     Vec3 fused;
     double variance = 0.0;
@@ -836,7 +740,7 @@ void GapFiller::fill_missing() {
     if (is_observed(previous_status_[i]) &&
         transfer_motion(model_.ring_offsets[i], model_.ring_offsets[i + 1], model_.ring, previous_[i], expected))
       gap_offset_[i] = rotation_[i].transpose() * (expected - current_[i]);
-    const double age = static_cast<double>(frame_ - gap_start_frame_[i]);
+    const double age = static_cast<double>(frame_ - carry_.gap_start_frame(i));
     current_[i] += rotation_[i] * gap_offset_[i] * std::exp(-age / decay_frames);
   }
 }

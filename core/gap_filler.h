@@ -52,6 +52,7 @@
 #include <vector>
 
 #include "core/absolute_orientation.h"
+#include "core/gap_start_carry.h"
 #include "core/marker_status.h"
 #include "core/pca_fit.h"
 #include "core/region_online_statistics.h"
@@ -152,11 +153,6 @@ class GapFiller {
   void relabel();
   bool solve_pca(int j);
   int pca_estimate(int i, Vec3& out, double* out_variance = nullptr, bool misfit = false);
-  void remember_gap_start(int i);
-  bool carried_from_gap_start(int i, Vec3& out, double& out_variance);
-  bool carry_rigidly(int i, const Vec3& from_position, std::span<const Vec3> from_anchors,
-                     std::span<const char> from_seen, Vec3& out, double& out_residual);
-  void check_carries();
   bool expected_position(int i, Vec3& out, double* out_variance = nullptr);
   double rigid_estimate_variance(int i, bool misfit = false) const;
   void take_free_point(int marker, int point);
@@ -196,25 +192,7 @@ class GapFiller {
   std::vector<int> refused_id_;        // a fragment whose relabel was revoked, not taken again while it lasts
   std::vector<int> revoked_;           // this frame's FrameOutput::revoked
   std::vector<Vec3> gap_offset_;      // continuity offset in the local frame, made at the gap's first frame
-  // At the start of each marker's gap: its last position and its anchors' (parallel to
-  // model.anchors; usable where the anchor was measured or relabelled then).
-  static constexpr int kCarryAnchors = 3;
-  std::vector<char> gap_start_known_;
-  std::vector<long> gap_start_frame_;  // the gap's first frame (frame_ then)
-  std::vector<Vec3> gap_start_position_;
-  std::vector<Vec3> gap_start_anchor_;
-  std::vector<char> gap_start_anchor_seen_;
-  // While a marker is seen, every carry_check_frames_ (half a second) the same carry is tried on
-  // it from a snapshot of then: the squared miss per frame squared, averaged over the recent
-  // checks (mm^2 / frame^2), is how fast the carry drifts for this marker in this take.
-  static constexpr int kCarryWarmupChecks = 4;
-  int carry_check_frames_ = 1;
-  std::vector<long> snapshot_frame_;
-  std::vector<Vec3> snapshot_position_;
-  std::vector<Vec3> snapshot_anchor_;
-  std::vector<char> snapshot_anchor_seen_;
-  std::vector<double> carry_drift_;
-  std::vector<int> carry_checks_;  // how many checks carry_drift_ rests on
+  GapStartCarry carry_;               // also where each marker's gap started
 
   // Per-frame scratch.
   std::vector<Vec3> current_;
