@@ -1,6 +1,5 @@
 #include "core/gap_filler.h"
 
-#include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -16,6 +15,9 @@ GapFiller::GapFiller(const SubjectModel& model, const GapFillerOptions& options)
     : model_(model),
       options_(options),
       n_(model.marker_count()),
+      carry_(model, options.rate_hz),
+      single_gaps_(model),
+      ring_calibration_(model, options.rate_hz),
       region_statistics_(model, RegionLearningOptions{.rate_hz = options.rate_hz}) {
   // Reverse one-rings: which markers' PCA models can predict marker i, and at which slot.
   std::vector<std::vector<std::pair<int, int>>> predictors(n_);
@@ -42,18 +44,6 @@ GapFiller::GapFiller(const SubjectModel& model, const GapFillerOptions& options)
   refused_id_.assign(n_, kNoFragment);
   revoked_.assign(n_, 0);
   gap_offset_.assign(n_, Vec3::Zero());
-  gap_start_known_.assign(n_, 0);
-  gap_start_frame_.assign(n_, 0);
-  gap_start_position_.assign(n_, Vec3::Zero());
-  gap_start_anchor_.assign(model.anchors.size(), Vec3::Zero());
-  gap_start_anchor_seen_.assign(model.anchors.size(), 0);
-  carry_check_frames_ = std::max(1, static_cast<int>(std::lround(0.5 * options_.rate_hz)));
-  snapshot_frame_.assign(n_, -1);
-  snapshot_position_.assign(n_, Vec3::Zero());
-  snapshot_anchor_.assign(model.anchors.size(), Vec3::Zero());
-  snapshot_anchor_seen_.assign(model.anchors.size(), 0);
-  carry_drift_.assign(n_, 0.0);
-  carry_checks_.assign(n_, 0);
   current_.assign(n_, Vec3::Zero());
   status_.assign(n_, MarkerStatus::Held);
   observed_.assign(n_, 0);
@@ -93,13 +83,6 @@ GapFiller::GapFiller(const SubjectModel& model, const GapFillerOptions& options)
     }
     rigid_member_variance_.push_back(leverage > 0.0 ? model.pca[i].rigid_variance / leverage : model.pca[i].rigid_variance);
   }
-  precompute_single_gaps();
-  ring_recent_.assign(model.ring.size(), RecentMiss{});
-  ring_calibration_.assign(model.ring.size(), 1.0);
-  ring_checked_frame_.assign(n_, -1);
-  rigid_recent_.assign(n_, RecentMiss{});
-  rigid_calibration_.assign(n_, 1.0);
-  ring_nominal_frames_ = std::max<long>(1, (n_ + kRingChecksPerFrame - 1) / kRingChecksPerFrame);
   static_assert(SubjectModel::kMaxRing < 32, "observed slots are a 32-bit mask");
   for (int j = 0; j < n_; ++j) {
     pattern_offset_.push_back(static_cast<int>(pattern_factor_.size()));
@@ -110,38 +93,9 @@ GapFiller::GapFiller(const SubjectModel& model, const GapFillerOptions& options)
   scratch_source_.assign(scratch, Vec3::Zero());
   scratch_target_.assign(scratch, Vec3::Zero());
   scratch_index_.assign(scratch, 0);
-  single_gap_deviation_.resize(kMaxRingDims);
   region_positions_.assign(SubjectModel::kMaxRing, Vec3::Zero());
   region_observed_.assign(SubjectModel::kMaxRing, 0);
   region_solves_.resize(model.has_regions() ? n_ : 0);
-}
-
-// For every ring member of every model, the PCA coefficients when that member alone is missing
-// are a fixed linear map of the others (the normal equations depend only on which members are
-// observed): c = A^-1 B_O^T (z_O - mean_O). Computed once; the reconstruction is mean_s + B_s c.
-void GapFiller::precompute_single_gaps() {
-  single_gap_offset_.assign(model_.ring.size(), 0);
-  single_gap_variance_.assign(model_.ring.size(), 0.0);
-  for (int j = 0; j < n_; ++j) {
-    const MarkerPcaModel& m = model_.pca[j];
-    const int d = model_.ring_size(j), components = static_cast<int>(m.variance.size());
-    for (int s = 0; s < d; ++s) {
-      const int at = model_.ring_offsets[j] + s;
-      single_gap_offset_[at] = static_cast<int>(single_gap_map_.size());
-      Eigen::MatrixXd observed(3 * (d - 1), components);
-      for (int k = 0, o = 0; k < d; ++k)
-        if (k != s) observed.middleRows<3>(3 * o++) = m.basis.middleRows<3>(3 * k);
-      Eigen::MatrixXd normal = observed.transpose() * observed;
-      for (int c = 0; c < components; ++c) normal(c, c) += m.residual_variance / m.variance(c);
-      const Eigen::LLT<Eigen::MatrixXd> llt(normal);
-      const Eigen::MatrixXd map = llt.solve(observed.transpose());
-      for (int c = 0; c < components; ++c)
-        for (int col = 0; col < map.cols(); ++col) single_gap_map_.push_back(map(c, col));
-      const Eigen::MatrixXd rows = m.basis.middleRows<3>(3 * s);
-      const double spread = components ? (rows * llt.solve(rows.transpose())).trace() / 3.0 : 0.0;
-      single_gap_variance_[at] = m.residual_variance * (1.0 + spread) * m.slot_calibration(s);
-    }
-  }
 }
 
 void GapFiller::reset() {
@@ -151,17 +105,9 @@ void GapFiller::reset() {
   std::fill(probation_start_.begin(), probation_start_.end(), -1);
   std::fill(refused_id_.begin(), refused_id_.end(), kNoFragment);
   std::fill(gap_offset_.begin(), gap_offset_.end(), Vec3::Zero());
-  std::fill(gap_start_known_.begin(), gap_start_known_.end(), 0);
-  std::fill(snapshot_frame_.begin(), snapshot_frame_.end(), -1);
-  std::fill(carry_drift_.begin(), carry_drift_.end(), 0.0);
-  std::fill(carry_checks_.begin(), carry_checks_.end(), 0);
+  carry_.reset();
   region_statistics_.reset();
-  std::fill(ring_recent_.begin(), ring_recent_.end(), RecentMiss{});
-  std::fill(ring_calibration_.begin(), ring_calibration_.end(), 1.0);
-  std::fill(ring_checked_frame_.begin(), ring_checked_frame_.end(), -1);
-  std::fill(rigid_recent_.begin(), rigid_recent_.end(), RecentMiss{});
-  std::fill(rigid_calibration_.begin(), rigid_calibration_.end(), 1.0);
-  ring_cursor_ = 0;
+  ring_calibration_.reset();
   for (RegionSolve& solve : region_solves_) solve.observed_mask = 0;
 }
 
@@ -214,7 +160,7 @@ FillStats GapFiller::run(const FrameInput& in, const FrameOutput& out) {
 
   relabel();
   fill_missing();
-  if (options_.carry_from_gap_start) check_carries();
+  if (options_.carry_from_gap_start) carry_.check(frame_, current_, observed_);
 
   for (int i = 0; i < n_; ++i) {
     out.positions[i] = current_[i];
@@ -236,7 +182,7 @@ FillStats GapFiller::run(const FrameInput& in, const FrameOutput& out) {
   }
   has_previous_ = true;
   if (options_.use_regions && options_.learn_regions) region_statistics_.learn(current_, status_);
-  if (options_.calibrate_rings) check_rings();
+  if (options_.calibrate_rings) ring_calibration_.check(current_, status_, single_gaps_);
   return stats_;
 }
 
@@ -439,12 +385,13 @@ void GapFiller::fit_rigid_estimate(int i) {
   double variance = 0.0, member_variances = 0.0, miss = 0.0;
   for (int k = 0; k < count; ++k) {
     const int j = scratch_index_[k];
-    const double member = rigid_member_variance_[i] * rigid_calibration_[i] + (observed_[j] ? 0.0 : rigid_estimate_variance(j, true));
+    const double member = rigid_member_variance_[i] * ring_calibration_.rigid(i) +
+                          (observed_[j] ? 0.0 : rigid_estimate_variance(j, true));
     variance += leverage[k] * member;
     member_variances += member;
     miss += (t.apply(scratch_source_[k]) - scratch_target_[k]).squaredNorm();
   }
-  rigid_variance_[i] = std::max(variance, model_.pca[i].rigid_variance * rigid_calibration_[i]);
+  rigid_variance_[i] = std::max(variance, model_.pca[i].rigid_variance * ring_calibration_.rigid(i));
   // A ring that no longer moves rigidly (a joint bent beyond training) makes the estimate worth
   // less: its members' miss against the fit, over what those variances lead one to expect of
   // it. The fit takes six of the 3n coordinates: three members leave only their three
@@ -595,8 +542,10 @@ bool GapFiller::solve_pca(int j) {
     int missing_slot = 0;
     while (observed_[model_.ring[first + missing_slot]]) ++missing_slot;
     const int at = first + missing_slot;
-    const double miss = reconstruct_single_gap(j, missing_slot, count, pca_slot_local_[at]);
-    pca_slot_variance_[at] = single_gap_variance_[at] * ring_calibration_[at];
+    const double miss =
+        single_gaps_.reconstruct(j, missing_slot, {scratch_source_.data(), static_cast<size_t>(count)},
+                                 {scratch_index_.data(), static_cast<size_t>(count)}, pca_slot_local_[at]);
+    pca_slot_variance_[at] = single_gaps_.variance(at) * ring_calibration_.ring(at);
     pca_novelty_[j] = novelty_factor(miss, count, m.residual_variance);
     pca_ok_[j] = 1;
     return true;
@@ -621,83 +570,11 @@ bool GapFiller::solve_pca(int j) {
     // With several members missing the exact predictive variance costs a triangular solve per
     // member; the single-gap variance, grown by the share of the ring that is missing, ranks
     // the estimates almost the same at a fraction of the cost.
-    pca_slot_variance_[first + k] = single_gap_variance_[first + k] * ring_calibration_[first + k] * (ring - 1) / count;
+    pca_slot_variance_[first + k] =
+        single_gaps_.variance(first + k) * ring_calibration_.ring(first + k) * (ring - 1) / count;
   }
   pca_ok_[j] = 1;
   return true;
-}
-
-// Model j's reconstruction of ring member `missing_slot` from the other `count` members, already
-// in j's local frame in scratch_source_ (slots in scratch_index_): the precomputed linear map of
-// that one-member gap. Returns the observed members' squared miss (what novelty_factor reads).
-double GapFiller::reconstruct_single_gap(int j, int missing_slot, int count, Vec3& out_local) {
-  const MarkerPcaModel& m = model_.pca[j];
-  const int at = model_.ring_offsets[j] + missing_slot;
-  const double* map = single_gap_map_.data() + single_gap_offset_[at];  // empty when the model has no components
-  const int columns = 3 * count, components = static_cast<int>(m.variance.size());
-  for (int o = 0; o < count; ++o)
-    single_gap_deviation_.segment<3>(3 * o) = scratch_source_[o] - m.mean.segment<3>(3 * scratch_index_[o]);
-  single_gap_coefficients_.resize(components);
-  for (int c = 0; c < components; ++c) {
-    double sum = 0.0;
-    for (int col = 0; col < columns; ++col) sum += map[c * columns + col] * single_gap_deviation_(col);
-    single_gap_coefficients_(c) = sum;
-  }
-  double miss = 0.0;
-  for (int o = 0; o < count; ++o)
-    miss += (single_gap_deviation_.segment<3>(3 * o) - m.basis.middleRows<3>(3 * scratch_index_[o]) * single_gap_coefficients_).squaredNorm();
-  out_local = m.mean.segment<3>(3 * missing_slot) + m.basis.middleRows<3>(3 * missing_slot) * single_gap_coefficients_;
-  return miss;
-}
-
-// A few models a frame, in turn, each with its marker and whole ring measured: every member
-// estimated from the others as in a one-member gap, and the miss against the variance that
-// estimate claims added to the member's running sums (forgetting over kRingMemorySeconds). Their
-// ratio, never below one, scales the claim from then on: a ring opinion claims no more than it
-// has lately been shown to deserve (a toe's ring that reaches across to the other foot, steady
-// while the subject stood in training and not in a walk).
-void GapFiller::check_rings() {
-  for (int scanned = 0, checked = 0; scanned < n_ && checked < kRingChecksPerFrame; ++scanned) {
-    const int j = ring_cursor_;
-    ring_cursor_ = (ring_cursor_ + 1) % n_;
-    const int first = model_.ring_offsets[j], ring = model_.ring_size(j);
-    bool whole = status_[j] == MarkerStatus::Measured && ring >= 3;
-    for (int k = 0; k < ring && whole; ++k) whole = status_[model_.ring[first + k]] == MarkerStatus::Measured;
-    if (!whole) continue;
-    ++checked;
-    const long elapsed = ring_checked_frame_[j] < 0 ? ring_nominal_frames_ : frame_ - ring_checked_frame_[j];
-    ring_checked_frame_[j] = frame_;
-    const double forget = std::exp(-static_cast<double>(elapsed) / options_.rate_hz / kRingMemorySeconds);
-    const double seconds = static_cast<double>(std::min(elapsed, ring_nominal_frames_)) / options_.rate_hz;
-    // Eq. 2 on the whole ring, against the variance it claims there.
-    for (int k = 0; k < ring; ++k) {
-      scratch_source_[k] = model_.ring_local_reference[first + k];
-      scratch_target_[k] = current_[model_.ring[first + k]];
-    }
-    RigidTransform t;
-    fit_rigid({scratch_source_.data(), static_cast<size_t>(ring)}, {scratch_target_.data(), static_cast<size_t>(ring)}, t);
-    rigid_recent_[j].add(forget, seconds, (t.translation - current_[j]).squaredNorm() / 3.0, model_.pca[j].rigid_variance);
-    rigid_calibration_[j] = std::max(1.0, rigid_recent_[j].ratio());
-    for (int s = 0; s < ring; ++s) {
-      int count = 0;
-      for (int k = 0; k < ring; ++k) {
-        if (k == s) continue;
-        scratch_source_[count] = current_[model_.ring[first + k]] - current_[j];
-        scratch_target_[count] = model_.ring_local_reference[first + k];
-        scratch_index_[count] = k;
-        ++count;
-      }
-      Eigen::Matrix3d r;
-      fit_rotation({scratch_source_.data(), static_cast<size_t>(count)}, {scratch_target_.data(), static_cast<size_t>(count)}, r);
-      for (int o = 0; o < count; ++o) scratch_source_[o] = r * scratch_source_[o];
-      Vec3 estimate;
-      reconstruct_single_gap(j, s, count, estimate);
-      const int at = first + s;
-      const double miss = (estimate - r * (current_[model_.ring[at]] - current_[j])).squaredNorm() / 3.0;
-      ring_recent_[at].add(forget, seconds, miss, single_gap_variance_[at]);
-      ring_calibration_[at] = std::max(1.0, ring_recent_[at].ratio());
-    }
-  }
 }
 
 // Moves `previous` (where a marker was last frame) with the rigid motion of `members` from the
@@ -775,88 +652,6 @@ double GapFiller::rigid_estimate_variance(int i, bool misfit) const {
   return rigid_variance_[i] * (misfit ? rigid_novelty_[i] : 1.0);
 }
 
-// At the first frame of a gap: where the marker and its anchors were last frame.
-void GapFiller::remember_gap_start(int i) {
-  gap_start_known_[i] = 1;
-  gap_start_frame_[i] = frame_;
-  gap_start_position_[i] = previous_[i];
-  for (int k = model_.anchor_offsets[i]; k < model_.anchor_offsets[i + 1]; ++k) {
-    const int a = model_.anchors[k];
-    gap_start_anchor_[k] = previous_[a];
-    gap_start_anchor_seen_[k] = is_observed(previous_status_[a]);
-  }
-}
-
-// A marker's position `from_position` at an earlier frame carried by the rigid motion, from then
-// to now, of its three steadiest anchors seen both then and now (`from_anchors`, `from_seen`:
-// parallel to its anchors). Also the fit's squared residual over those three, per degree of
-// freedom (how far they moved from rigid).
-bool GapFiller::carry_rigidly(int i, const Vec3& from_position, std::span<const Vec3> from_anchors,
-                              std::span<const char> from_seen, Vec3& out, double& out_residual) {
-  const int first = model_.anchor_offsets[i];
-  int count = 0;
-  for (int k = first; k < model_.anchor_offsets[i + 1] && count < kCarryAnchors; ++k) {
-    const int a = model_.anchors[k];
-    if (!from_seen[k - first] || !observed_[a]) continue;
-    scratch_source_[count] = from_anchors[k - first];
-    scratch_target_[count] = current_[a];
-    ++count;
-  }
-  if (count < kCarryAnchors) return false;
-  RigidTransform t;
-  fit_rigid({scratch_source_.data(), static_cast<size_t>(count)}, {scratch_target_.data(), static_cast<size_t>(count)}, t);
-  double residual = 0.0;
-  for (int k = 0; k < count; ++k) residual += (t.apply(scratch_source_[k]) - scratch_target_[k]).squaredNorm();
-  out = t.apply(from_position);
-  out_residual = residual / (3 * count - 6);
-  return true;
-}
-
-// The marker's last measurement carried from the start of its gap. Over a long gap this does not
-// drift as a chain of frame-to-frame motions does, and where the marker sits on a rigid segment
-// with its anchors (a head, a pelvis, a foot) it is nearly exact, while a neighbourhood spanning a
-// joint is not. Its variance per coordinate grows with the gap's age at the rate the same carry
-// drifted for this marker while it was seen, on top of the anchors' own departure from rigid;
-// never below the marker model's residual. No estimate before that rate was measured over two
-// seconds of the marker being seen: one half-second check says little about a joint.
-bool GapFiller::carried_from_gap_start(int i, Vec3& out, double& out_variance) {
-  if (!gap_start_known_[i] || carry_checks_[i] < kCarryWarmupChecks) return false;
-  const int first = model_.anchor_offsets[i], count = model_.anchor_offsets[i + 1] - first;
-  double residual = 0.0;
-  if (!carry_rigidly(i, gap_start_position_[i], {&gap_start_anchor_[first], static_cast<size_t>(count)},
-                     {&gap_start_anchor_seen_[first], static_cast<size_t>(count)}, out, residual))
-    return false;
-  const double age = static_cast<double>(frame_ - gap_start_frame_[i]) + 1.0;
-  out_variance = std::max(residual + carry_drift_[i] * age * age / 3.0, model_.pca[i].residual_variance);
-  return true;
-}
-
-// Every carry_check_frames_, for each marker seen now: how far the carry from its snapshot missed
-// it, then a new snapshot.
-void GapFiller::check_carries() {
-  for (int i = 0; i < n_; ++i) {
-    if (!is_observed(status_[i])) continue;
-    const long age = frame_ - snapshot_frame_[i];
-    if (snapshot_frame_[i] >= 0 && age < carry_check_frames_) continue;
-    const int first = model_.anchor_offsets[i], count = model_.anchor_offsets[i + 1] - first;
-    Vec3 carried;
-    double residual = 0.0;
-    if (snapshot_frame_[i] >= 0 &&
-        carry_rigidly(i, snapshot_position_[i], {&snapshot_anchor_[first], static_cast<size_t>(count)},
-                      {&snapshot_anchor_seen_[first], static_cast<size_t>(count)}, carried, residual)) {
-      const double drift = (carried - current_[i]).squaredNorm() / (static_cast<double>(age) * age);
-      carry_drift_[i] = carry_checks_[i] == 0 ? drift : 0.5 * (carry_drift_[i] + drift);
-      ++carry_checks_[i];
-    }
-    snapshot_frame_[i] = frame_;
-    snapshot_position_[i] = current_[i];
-    for (int k = first; k < first + count; ++k) {
-      snapshot_anchor_[k] = current_[model_.anchors[k]];
-      snapshot_anchor_seen_[k] = is_observed(status_[model_.anchors[k]]);
-    }
-  }
-}
-
 // Marker i's regional PCA opinion from the observed members of its region (region_pca_fit.h).
 // Not asked for when the other opinions' variance is so much smaller than the least the region
 // can claim (its residual, calibrated) that it would weigh under 5%: the common case of a short
@@ -893,12 +688,12 @@ void GapFiller::fill_missing() {
   for (int i : missing_) {
     if (observed_[i]) continue;  // relabelled
     if (has_previous_ && is_observed(previous_status_[i])) {
-      remember_gap_start(i);
+      carry_.remember_gap_start(i, frame_, previous_, previous_status_);
       gap_offset_[i].setZero();  // set below when this frame has a neighbourhood rotation
     }
     Vec3 carried;
     double carried_variance = 0.0;
-    const bool carry = carry_on && carried_from_gap_start(i, carried, carried_variance);
+    const bool carry = carry_on && carry_.carried(i, frame_, current_, observed_, carried, carried_variance);
     // The neighbours' opinions (PCA, else eq. 2) with the carry, then the region's weighed in.
     Vec3 fused;
     double variance = 0.0;
@@ -945,7 +740,7 @@ void GapFiller::fill_missing() {
     if (is_observed(previous_status_[i]) &&
         transfer_motion(model_.ring_offsets[i], model_.ring_offsets[i + 1], model_.ring, previous_[i], expected))
       gap_offset_[i] = rotation_[i].transpose() * (expected - current_[i]);
-    const double age = static_cast<double>(frame_ - gap_start_frame_[i]);
+    const double age = static_cast<double>(frame_ - carry_.gap_start_frame(i));
     current_[i] += rotation_[i] * gap_offset_[i] * std::exp(-age / decay_frames);
   }
 }

@@ -31,7 +31,7 @@
 //      And each is scaled by how much it lately missed: a few models a frame, where the marker
 //      and its whole ring are measured, estimate every member (and eq. 2 the marker) from the
 //      rest, and the miss over the variance claimed (recent frames counting most), never below
-//      one, scales the claim (check_rings): a ring that spans the two feet, steady while the
+//      one, scales the claim (ring_calibration.h): a ring that spans the two feet, steady while the
 //      subject stood in training, is no judge of either foot in a walk.
 //      Without one, the rigid estimate; without that, held relative to the marker's anchors.
 //      The marker's regional PCA (region_pca_fit.h), aligned on whichever members of its region
@@ -52,11 +52,13 @@
 #include <vector>
 
 #include "core/absolute_orientation.h"
+#include "core/gap_start_carry.h"
 #include "core/marker_status.h"
 #include "core/pca_fit.h"
-#include "core/recent_miss.h"
 #include "core/region_online_statistics.h"
 #include "core/region_pca_fit.h"
+#include "core/ring_calibration.h"
+#include "core/single_gap_reconstruction.h"
 #include "core/subject_model.h"
 
 namespace skinstream {
@@ -82,7 +84,7 @@ struct GapFillerOptions {
   bool learn_regions = true;
   // Each one-ring model's estimate of each member, and eq. 2's of the marker, is tried where the
   // whole ring is measured (a few models a frame), and the variance each claims is scaled by how
-  // much more it lately missed (never below its offline calibration): check_rings.
+  // much more it lately missed (never below its offline calibration): ring_calibration.h.
   bool calibrate_rings = true;
   // A new relabel stays on probation for this many frames: while it is, the fragment must pass
   // the taking test (eq. 3, unambiguous) every frame, else the relabel is revoked for all the
@@ -134,8 +136,7 @@ class GapFiller {
   void reset();  // forget the past (new take, source reconnected)
   // How much a one-ring opinion's claimed variance is scaled up by what it lately missed
   // (calibrate_rings; 1: as calibrated offline), per entry of model.ring.
-  double ring_calibration(int ring_entry) const { return ring_calibration_[ring_entry]; }
-
+  double ring_calibration(int ring_entry) const { return ring_calibration_.ring(ring_entry); }
 
  private:
   void find_suspect_labels();
@@ -150,16 +151,8 @@ class GapFiller {
   void estimate_rigid();
   void fit_rigid_estimate(int i);
   void relabel();
-  void precompute_single_gaps();
   bool solve_pca(int j);
-  double reconstruct_single_gap(int j, int missing_slot, int count, Vec3& out_local);
-  void check_rings();
   int pca_estimate(int i, Vec3& out, double* out_variance = nullptr, bool misfit = false);
-  void remember_gap_start(int i);
-  bool carried_from_gap_start(int i, Vec3& out, double& out_variance);
-  bool carry_rigidly(int i, const Vec3& from_position, std::span<const Vec3> from_anchors,
-                     std::span<const char> from_seen, Vec3& out, double& out_residual);
-  void check_carries();
   bool expected_position(int i, Vec3& out, double* out_variance = nullptr);
   double rigid_estimate_variance(int i, bool misfit = false) const;
   void take_free_point(int marker, int point);
@@ -199,25 +192,7 @@ class GapFiller {
   std::vector<int> refused_id_;        // a fragment whose relabel was revoked, not taken again while it lasts
   std::vector<int> revoked_;           // this frame's FrameOutput::revoked
   std::vector<Vec3> gap_offset_;      // continuity offset in the local frame, made at the gap's first frame
-  // At the start of each marker's gap: its last position and its anchors' (parallel to
-  // model.anchors; usable where the anchor was measured or relabelled then).
-  static constexpr int kCarryAnchors = 3;
-  std::vector<char> gap_start_known_;
-  std::vector<long> gap_start_frame_;  // the gap's first frame (frame_ then)
-  std::vector<Vec3> gap_start_position_;
-  std::vector<Vec3> gap_start_anchor_;
-  std::vector<char> gap_start_anchor_seen_;
-  // While a marker is seen, every carry_check_frames_ (half a second) the same carry is tried on
-  // it from a snapshot of then: the squared miss per frame squared, averaged over the recent
-  // checks (mm^2 / frame^2), is how fast the carry drifts for this marker in this take.
-  static constexpr int kCarryWarmupChecks = 4;
-  int carry_check_frames_ = 1;
-  std::vector<long> snapshot_frame_;
-  std::vector<Vec3> snapshot_position_;
-  std::vector<Vec3> snapshot_anchor_;
-  std::vector<char> snapshot_anchor_seen_;
-  std::vector<double> carry_drift_;
-  std::vector<int> carry_checks_;  // how many checks carry_drift_ rests on
+  GapStartCarry carry_;               // also where each marker's gap started
 
   // Per-frame scratch.
   std::vector<Vec3> current_;
@@ -260,23 +235,8 @@ class GapFiller {
   // marker's reference ring, so they change only with which members are known.
   std::vector<double> leverage_;
   std::vector<uint32_t> leverage_mask_;
-  // One ring member missing, per ring entry: the coefficients' linear map (components x 3(d-1),
-  // row-major, at single_gap_offset_) and the reconstruction's calibrated variance.
-  std::vector<double> single_gap_map_;
-  PcaVector single_gap_deviation_, single_gap_coefficients_;
-  std::vector<int> single_gap_offset_;
-  std::vector<double> single_gap_variance_;
-  // The one-ring opinions' online calibration (check_rings), parallel to model.ring: how each
-  // lately did against its claim, and the ratio (>= 1) that scales the claim.
-  static constexpr int kRingChecksPerFrame = 2;
-  static constexpr double kRingMemorySeconds = 10.0;
-  int ring_cursor_ = 0;
-  long ring_nominal_frames_ = 1;  // between a model's checks when every ring is seen
-  std::vector<RecentMiss> ring_recent_;
-  std::vector<double> ring_calibration_;
-  std::vector<long> ring_checked_frame_;  // per model: the frame it was last checked
-  std::vector<RecentMiss> rigid_recent_;  // per marker: eq. 2 on its whole ring, likewise
-  std::vector<double> rigid_calibration_;
+  SingleGapReconstruction single_gaps_;  // one ring member missing: the common case
+  RingCalibration ring_calibration_;     // the one-ring and eq. 2 opinions' online calibration
   // Several ring members missing: per model, the observed slots (a bit each) its factor below
   // was made for, and that factor (PcaFit::factor_slots, components^2 at pattern_offset_).
   std::vector<uint32_t> pattern_mask_;

@@ -3,7 +3,7 @@
 // and of the variance it claimed (per coordinate), each check weighed by the time it stands for.
 // Their ratio is a calibration learned online: above one, the estimate claimed too much.
 // Used by the regions' prequential calibration (region_online_statistics.h) and the one-ring and
-// eq. 2 checks of the gap filler (GapFiller::check_rings).
+// eq. 2 checks of the gap filler (ring_calibration.h).
 
 namespace skinstream {
 

@@ -16,7 +16,7 @@ namespace {
 // A leg: four thigh markers, four shank markers and a foot of three (toe first), the knee at
 // 500 mm. The training take stands still (the knee straight, the whole leg turning and moving a
 // little); what follows bends the knee by up to 34 degrees, which training never showed.
-constexpr int kMarkers = 11;
+constexpr int kLegMarkers = 11;
 constexpr double kRate = 120.0;
 
 std::vector<Vec3> leg_pose(double knee, double turn, const Vec3& shift) {
@@ -26,7 +26,7 @@ std::vector<Vec3> leg_pose(double knee, double turn, const Vec3& shift) {
   const Vec3 knee_centre(0, 0, 500);
   const Eigen::Matrix3d bend = Eigen::AngleAxisd(knee, Vec3::UnitX()).toRotationMatrix();
   const Eigen::Matrix3d whole = Eigen::AngleAxisd(turn, Vec3::UnitZ()).toRotationMatrix();
-  std::vector<Vec3> pose(kMarkers);
+  std::vector<Vec3> pose(kLegMarkers);
   for (int k = 0; k < 3; ++k) pose[k] = whole * (knee_centre + bend * (below[4 + k] - knee_centre)) + shift;
   for (int k = 0; k < 4; ++k) pose[3 + k] = whole * (knee_centre + bend * (below[k] - knee_centre)) + shift;
   for (int k = 0; k < 4; ++k) pose[7 + k] = whole * thigh[k] + shift;
@@ -48,19 +48,19 @@ std::vector<Vec3> bending(int f) {
 // Every marker's region is the whole leg with the marker first; each trained on the still take.
 SubjectModel standing_leg() {
   std::vector<std::string> labels;
-  for (int m = 0; m < kMarkers; ++m) labels.push_back("M" + std::to_string(m));
+  for (int m = 0; m < kLegMarkers; ++m) labels.push_back("M" + std::to_string(m));
   Capture still(labels, 600, kRate);
   std::mt19937 rng(7);
   for (int f = 0; f < still.frame_count; ++f) {
     const std::vector<Vec3> pose = noisy(leg_pose(0.0, 0.2 * std::sin(0.01 * f), Vec3(0.2 * f, 0, 0)), rng);
-    for (int m = 0; m < kMarkers; ++m) still.at(f, m) = pose[m];
+    for (int m = 0; m < kLegMarkers; ++m) still.at(f, m) = pose[m];
   }
   SubjectModel model;
   model.marker_names = labels;
   model.region_offsets.push_back(0);
-  for (int i = 0; i < kMarkers; ++i) {
+  for (int i = 0; i < kLegMarkers; ++i) {
     std::vector<int> members = {i};
-    for (int m = 0; m < kMarkers; ++m)
+    for (int m = 0; m < kLegMarkers; ++m)
       if (m != i) members.push_back(m);
     model.region.insert(model.region.end(), members.begin(), members.end());
     model.region_offsets.push_back(static_cast<int>(model.region.size()));
@@ -86,7 +86,7 @@ Toe toe_in_a_gap(RegionPcaFit& fit, const RegionShapeGaussian& shape, double kne
 }
 
 void learn_frames(RegionOnlineStatistics& statistics, int first, int count) {
-  const std::vector<MarkerStatus> measured(kMarkers, MarkerStatus::Measured);
+  const std::vector<MarkerStatus> measured(kLegMarkers, MarkerStatus::Measured);
   for (int f = first; f < first + count; ++f) statistics.learn(bending(f), measured);
 }
 
@@ -106,13 +106,13 @@ TEST(RegionOnlineStatistics, UntilItLearnsTheBlendIsTheOfflineModel) {
 TEST(RegionOnlineStatistics, LearnsOnlyFromRegionsMeasuredWhole) {
   const SubjectModel model = standing_leg();
   RegionOnlineStatistics statistics(model);
-  std::vector<MarkerStatus> status(kMarkers, MarkerStatus::Measured);
+  std::vector<MarkerStatus> status(kLegMarkers, MarkerStatus::Measured);
   status[5] = MarkerStatus::FilledPca;
   for (int f = 0; f < 240; ++f) statistics.learn(bending(f), status);
-  for (int i = 0; i < kMarkers; ++i) EXPECT_EQ(statistics.evidence_seconds(i), 0.0) << "region " << i;
+  for (int i = 0; i < kLegMarkers; ++i) EXPECT_EQ(statistics.evidence_seconds(i), 0.0) << "region " << i;
   status[5] = MarkerStatus::Measured;
   for (int f = 0; f < 240; ++f) statistics.learn(bending(f), status);
-  for (int i = 0; i < kMarkers; ++i) EXPECT_GT(statistics.evidence_seconds(i), 1.0) << "region " << i;
+  for (int i = 0; i < kLegMarkers; ++i) EXPECT_GT(statistics.evidence_seconds(i), 1.0) << "region " << i;
 }
 
 // The offline model never saw the knee bend: with the foot hidden it puts the toe where a straight
@@ -161,7 +161,7 @@ TEST(RegionOnlineStatistics, AllocatesNothingPerFrame) {
   const SubjectModel model = standing_leg();
   RegionOnlineStatistics statistics(model);
   RegionPcaFit fit;
-  const std::vector<MarkerStatus> measured(kMarkers, MarkerStatus::Measured);
+  const std::vector<MarkerStatus> measured(kLegMarkers, MarkerStatus::Measured);
   std::vector<std::vector<Vec3>> poses;
   for (int f = 0; f < 200; ++f) poses.push_back(bending(f));
   const std::vector<char> observed = {0, 0, 0, 1, 1, 1, 1, 1, 1, 1, 1};
@@ -170,8 +170,8 @@ TEST(RegionOnlineStatistics, AllocatesNothingPerFrame) {
     statistics.learn(poses[f], measured);
     Vec3 estimate;
     double variance = 0.0;
-    fit.estimate(statistics.blended(f % kMarkers), poses[f], observed, estimate, variance);
-    statistics.calibration(f % kMarkers);
+    fit.estimate(statistics.blended(f % kLegMarkers), poses[f], observed, estimate, variance);
+    statistics.calibration(f % kLegMarkers);
   }
   EXPECT_EQ(counter.count(), 0u);
 }
