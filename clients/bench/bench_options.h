@@ -45,6 +45,7 @@ struct BenchOptions {
   // seconds into the window, while the first ones watch (their figures are the report's; the
   // joiners' are apart, in "join_wave").
   int join_wave = 0;
+  std::string daemon_config;  // skinstreamd --config (keys without a flag, e.g. subscriber_join_mbit)
   double join_after_seconds = 3.0;
   bool json = false;
 };

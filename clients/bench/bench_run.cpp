@@ -52,6 +52,7 @@ std::string daemon_arguments(const BenchOptions& o, const std::string& source_op
   if (o.deform_spin_lead_us >= 0) a += " --deform-spin-lead-us " + std::to_string(o.deform_spin_lead_us);
   if (o.publish_threads >= 0) a += " --publish-threads " + std::to_string(o.publish_threads);
   if (o.subscriber_tcp_congestion) a += " --subscriber-tcp-congestion " + server::shell_word(*o.subscriber_tcp_congestion);
+  if (!o.daemon_config.empty()) a += " --config " + server::shell_word(fs::absolute(o.daemon_config).string());
   return a;
 }
 
@@ -433,6 +434,7 @@ nlohmann::json run_bench(const BenchOptions& o, const std::atomic<bool>& stop) {
       {"per_subject", per_subject_report(o.subjects, thread_cpu_before, thread_cpu_after, health_before, health, subject_subscribers, window_s)},
       {"hostile", waves ? waves->report() : nlohmann::json(nullptr)},
       {"subscriber_limits", health.value("subscriber_limits", nlohmann::json(nullptr))},
+      {"join_pacing", health.value("join_pacing", nlohmann::json(nullptr))},  // the joiners' first messages, as paced
       // Gaps over 3 frame periods (the replay's sends, each subscriber's arrivals), drops for a
       // subscriber and drops in the pipeline, in time order: a pause of the whole machine shows
       // at one moment in all.

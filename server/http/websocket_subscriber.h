@@ -19,6 +19,7 @@ class WebSocketSubscriber : public SubscriberSession {
   void read_next();
   void refuse_text_message();
   void start_write(const std::array<asio::const_buffer, 2>& buffers) override;
+  void start_write_piece(asio::const_buffer piece, bool last) override;
 
   websocket::stream<beast::tcp_stream> ws_;
   beast::flat_buffer read_buffer_;

@@ -285,22 +285,23 @@ void SubscriberSession::write_control() {
     start_write({asio::buffer(message), asio::const_buffer()});
     return;
   }
-  const size_t piece = writes_in_pieces() ? std::min(left, kPacedPieceBytes) : left;
+  const size_t piece = std::min(left, kPacedPieceBytes);
   const std::chrono::nanoseconds wait = pacer->reserve(piece);
   const size_t at = control_written_;
   control_written_ += piece;
+  const bool last = control_written_ == message.size();
   if (wait.count() <= 0) {
     note_write_progress();
-    start_write({asio::buffer(message.data() + at, piece), asio::const_buffer()});
+    start_write_piece(asio::buffer(message.data() + at, piece), last);
     return;
   }
   // Waiting for the pacer is no stalled write (write_stalled_for: none under way).
   write_progress_ns_.store(0, std::memory_order_relaxed);
   pace_timer_.expires_after(wait);
-  pace_timer_.async_wait([self = shared_from_this(), this, at, piece](const boost::system::error_code& ec) {
+  pace_timer_.async_wait([self = shared_from_this(), this, at, piece, last](const boost::system::error_code& ec) {
     if (ec || closed_) return;
     note_write_progress();
-    start_write({asio::buffer(in_flight_.control->data() + at, piece), asio::const_buffer()});
+    start_write_piece(asio::buffer(in_flight_.control->data() + at, piece), last);
   });
 }
 

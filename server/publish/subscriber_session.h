@@ -27,8 +27,8 @@ class SubscriberHub;
 class SubscriberSession : public std::enable_shared_from_this<SubscriberSession> {
  public:
   // With a JoinPacer (HubOptions): control messages of this size or more are paced, in pieces
-  // of the second size on a byte stream. A piece is 0.5 ms of a gigabit: what a watcher's frame
-  // may wait behind it in the link's queue.
+  // of the second size. A piece is 0.5 ms of a gigabit: what a watcher's frame may wait behind
+  // it in the link's queue.
   static constexpr size_t kPacedMessageBytes = 16 * 1024;
   static constexpr size_t kPacedPieceBytes = 64 * 1024;
   SubscriberSession(asio::io_context& io, SubscriberHub& hub, std::string transport, std::string remote);
@@ -73,9 +73,9 @@ class SubscriberSession : public std::enable_shared_from_this<SubscriberSession>
   void on_disconnected(const std::string& reason);
   // Writes the buffers as one protocol message, then calls write_done().
   virtual void start_write(const std::array<asio::const_buffer, 2>& buffers) = 0;
-  // Whether a message may be written in pieces, one start_write() each (a byte stream): the
-  // joiners' messages are then paced piece by piece; otherwise each whole.
-  virtual bool writes_in_pieces() const { return false; }
+  // One piece of a message written in several (a paced joiner's MeshInfo or Model): on TCP just
+  // its bytes, on WebSocket a fragment of one message (the last one with FIN). Then write_done().
+  virtual void start_write_piece(asio::const_buffer piece, bool last) = 0;
   void write_done(const boost::system::error_code& ec);
   // From the transport while a write is under way: some bytes went out.
   void note_write_progress();

@@ -21,7 +21,7 @@ class TcpSubscriber : public SubscriberSession {
  private:
   void read_next();
   void start_write(const std::array<asio::const_buffer, 2>& buffers) override;
-  bool writes_in_pieces() const override { return true; }
+  void start_write_piece(asio::const_buffer piece, bool) override { start_write({piece, asio::const_buffer()}); }
 
   tcp::socket socket_;
   std::shared_ptr<const void> placement_;
