@@ -37,23 +37,6 @@ class ByteWriter {
   std::vector<unsigned char> bytes_;
 };
 
-// Fixed layouts whose size the caller has already checked (a header, a block of known length):
-// one value written or read at a cursor, which moves past it. Host byte order, little-endian.
-template <typename T>
-void put_at(unsigned char*& at, T value) {
-  static_assert(std::is_arithmetic_v<T>);
-  std::memcpy(at, &value, sizeof(T));
-  at += sizeof(T);
-}
-template <typename T>
-T get_at(const unsigned char*& at) {
-  static_assert(std::is_arithmetic_v<T>);
-  T value;
-  std::memcpy(&value, at, sizeof(T));
-  at += sizeof(T);
-  return value;
-}
-
 // The zero bytes that bring n bytes to a multiple of 4 (blocks of the subscriber protocol start
 // 4-aligned).
 constexpr size_t padding_to_4(size_t n) { return (4 - n % 4) % 4; }
