@@ -1,11 +1,11 @@
 #pragma once
-// Little-endian byte writing and bounds-checked reading for the project's binary formats.
-// A read past the end throws std::out_of_range; callers turn that into a FileError.
+// Little-endian byte writing into a growing buffer for the project's binary formats, and what
+// every format shares (padding, CRC-32). Reading: protocol/byte_reader.h; writing into a span of
+// known size: protocol/span_writer.h.
 
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
-#include <stdexcept>
 #include <string>
 #include <type_traits>
 #include <vector>
@@ -36,77 +36,6 @@ class ByteWriter {
  private:
   std::vector<unsigned char> bytes_;
 };
-
-class ByteReader {
- public:
-  ByteReader(const unsigned char* data, size_t size) : data_(data), size_(size) {}
-  template <typename T>
-  T get() {
-    static_assert(std::is_arithmetic_v<T>);
-    need(sizeof(T));
-    T value;
-    std::memcpy(&value, data_ + pos_, sizeof(T));
-    pos_ += sizeof(T);
-    return value;
-  }
-  std::string get_string(size_t max_length = 1 << 20) {
-    const uint32_t n = get<uint32_t>();
-    if (n > max_length) throw std::out_of_range("string of " + std::to_string(n) + " bytes is implausible");
-    need(n);
-    std::string s(reinterpret_cast<const char*>(data_ + pos_), n);
-    pos_ += n;
-    return s;
-  }
-  // A count that must fit in what is left, given the bytes each item takes at least.
-  uint32_t get_count(size_t min_item_bytes) {
-    const uint32_t n = get<uint32_t>();
-    if (min_item_bytes > 0 && n > remaining() / min_item_bytes)
-      throw std::out_of_range("count " + std::to_string(n) + " exceeds the data left");
-    return n;
-  }
-  // `count` values at once: one bounds check and one copy (the stream's byte order is the host's,
-  // little-endian, as for get()). No values may come with no storage (an empty vector's data()):
-  // memcpy must not be given a null pointer, even for 0 bytes.
-  template <typename T>
-  void get_array(T* out, size_t count) {
-    static_assert(std::is_arithmetic_v<T>);
-    if (count > (size_ - pos_) / sizeof(T)) throw std::out_of_range("truncated at byte " + std::to_string(pos_));
-    if (count == 0) return;
-    std::memcpy(out, data_ + pos_, count * sizeof(T));
-    pos_ += count * sizeof(T);
-  }
-  void skip(size_t n) {
-    need(n);
-    pos_ += n;
-  }
-  size_t remaining() const { return size_ - pos_; }
-  size_t position() const { return pos_; }
-
- private:
-  void need(size_t n) const {
-    if (n > size_ - pos_) throw std::out_of_range("truncated at byte " + std::to_string(pos_));
-  }
-  const unsigned char* data_;
-  size_t size_;
-  size_t pos_ = 0;
-};
-
-// Fixed layouts whose size the caller has already checked (a header, a block of known length):
-// one value written or read at a cursor, which moves past it. Host byte order, little-endian.
-template <typename T>
-void put_at(unsigned char*& at, T value) {
-  static_assert(std::is_arithmetic_v<T>);
-  std::memcpy(at, &value, sizeof(T));
-  at += sizeof(T);
-}
-template <typename T>
-T get_at(const unsigned char*& at) {
-  static_assert(std::is_arithmetic_v<T>);
-  T value;
-  std::memcpy(&value, at, sizeof(T));
-  at += sizeof(T);
-  return value;
-}
 
 // The zero bytes that bring n bytes to a multiple of 4 (blocks of the subscriber protocol start
 // 4-aligned).

@@ -4,9 +4,11 @@
 #include <cstring>
 #include <fstream>
 #include <iterator>
+#include <stdexcept>
 #include <unordered_set>
 
 #include "protocol/byte_buffer.h"
+#include "protocol/byte_reader.h"
 #include "protocol/files/file_error.h"
 #include "protocol/printable_text.h"
 
@@ -15,21 +17,35 @@ namespace {
 
 constexpr char kMagic[8] = {'S', 'K', 'S', 'U', 'B', 'J', '\r', '\n'};
 
+// A payload whose values do not make sense (a read past its end is the reader's ByteError);
+// thrown only while the reader is ok(), so the first problem is the one reported.
+struct SubjectPayloadError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// A u32 length + bytes of at most max_length; empty once the reader failed.
+std::string get_string(ByteReader& r, size_t max_length, const char* what) {
+  const uint32_t n = r.get<uint32_t>(what);
+  if (n > max_length) throw SubjectPayloadError("string of " + std::to_string(n) + " bytes is implausible");
+  const std::span<const unsigned char> bytes = r.take(n, what);
+  return std::string(bytes.begin(), bytes.end());
+}
+
 void put_vec3(ByteWriter& w, const Vec3& v) {
   for (int c = 0; c < 3; ++c) w.put<double>(v[c]);
 }
-Vec3 get_vec3(ByteReader& r) {
+Vec3 get_vec3(ByteReader& r, const char* what) {
   Vec3 v;
-  for (int c = 0; c < 3; ++c) v[c] = r.get<double>();
+  for (int c = 0; c < 3; ++c) v[c] = r.get<double>(what);
   return v;
 }
 void put_ints(ByteWriter& w, const std::vector<int>& v) {
   w.put<uint32_t>(static_cast<uint32_t>(v.size()));
   for (int x : v) w.put<int32_t>(x);
 }
-std::vector<int> get_ints(ByteReader& r) {
-  std::vector<int> v(r.get_count(4));
-  for (int& x : v) x = r.get<int32_t>();
+std::vector<int> get_ints(ByteReader& r, const char* what) {
+  std::vector<int> v(r.get_count(4, what));
+  for (int& x : v) x = r.get<int32_t>(what);
   return v;
 }
 
@@ -47,20 +63,20 @@ void encode(const MarkerPcaModel& p, ByteWriter& w) {
 
 MarkerPcaModel decode_pca(ByteReader& r, const std::string& what) {
   MarkerPcaModel p;
-  const uint32_t dims = r.get<uint32_t>(), components = r.get<uint32_t>();
+  const uint32_t dims = r.get<uint32_t>("PCA dimensions"), components = r.get<uint32_t>("PCA components");
   if (dims > 3 * SubjectModel::kMaxRing || dims % 3 != 0 || components > dims)
-    throw std::out_of_range(what + " has implausible shape");
-  p.training_frames = r.get<int32_t>();
-  p.residual_variance = r.get<double>();
+    throw SubjectPayloadError(what + " has implausible shape");
+  p.training_frames = r.get<int32_t>("PCA training frames");
+  p.residual_variance = r.get<double>("PCA residual variance");
   p.mean.resize(dims);
   p.variance.resize(components);
   p.basis.resize(dims, components);
-  for (uint32_t k = 0; k < dims; ++k) p.mean(k) = r.get<double>();
-  for (uint32_t k = 0; k < components; ++k) p.variance(k) = r.get<double>();
-  for (Eigen::Index k = 0; k < p.basis.size(); ++k) p.basis.data()[k] = r.get<double>();
+  for (uint32_t k = 0; k < dims; ++k) p.mean(k) = r.get<double>("PCA mean");
+  for (uint32_t k = 0; k < components; ++k) p.variance(k) = r.get<double>("PCA variance");
+  for (Eigen::Index k = 0; k < p.basis.size(); ++k) p.basis.data()[k] = r.get<double>("PCA basis");
   p.slot_calibration.resize(dims / 3);
-  for (uint32_t k = 0; k < dims / 3; ++k) p.slot_calibration(k) = r.get<double>();
-  p.rigid_variance = r.get<double>();
+  for (uint32_t k = 0; k < dims / 3; ++k) p.slot_calibration(k) = r.get<double>("PCA slot calibration");
+  p.rigid_variance = r.get<double>("PCA rigid variance");
   return p;
 }
 
@@ -74,11 +90,12 @@ void encode_regions(const SubjectModel& m, ByteWriter& w) {
 }
 
 void decode_regions(ByteReader& r, SubjectModel& m) {
-  const uint32_t count = r.get<uint32_t>();
+  const uint32_t count = r.get<uint32_t>("region count");
   if (count == 0) return;
-  if (count != static_cast<uint32_t>(m.marker_count())) throw std::out_of_range("region models for " + std::to_string(count) + " markers");
-  m.region_offsets = get_ints(r);
-  m.region = get_ints(r);
+  if (count != static_cast<uint32_t>(m.marker_count()))
+    throw SubjectPayloadError("region models for " + std::to_string(count) + " markers");
+  m.region_offsets = get_ints(r, "region offsets");
+  m.region = get_ints(r, "regions");
   for (uint32_t i = 0; i < count; ++i) m.region_pca.push_back(decode_pca(r, "region PCA model of marker " + std::to_string(i)));
 }
 
@@ -133,35 +150,35 @@ void encode(const DeformationModel* d, ByteWriter& w) {
 }
 
 std::optional<DeformationModel> decode_deformation(ByteReader& r, uint32_t version) {
-  if (r.get<uint8_t>() == 0) return std::nullopt;
+  if (r.get<uint8_t>("deformation model flag") == 0) return std::nullopt;
   DeformationModel d;
-  d.reference_vertices.resize(r.get_count(24));
-  for (Vec3& v : d.reference_vertices) v = get_vec3(r);
-  d.faces.resize(r.get_count(12));
+  d.reference_vertices.resize(r.get_count(24, "mesh vertices"));
+  for (Vec3& v : d.reference_vertices) v = get_vec3(r, "mesh vertices");
+  d.faces.resize(r.get_count(12, "mesh faces"));
   for (auto& f : d.faces)
-    for (int& v : f) v = r.get<int32_t>();
-  const uint32_t parts = r.get_count(4);
-  for (uint32_t p = 0; p < parts; ++p) d.part_names.push_back(r.get_string(256));
-  d.part_member_offsets = get_ints(r);
-  d.part_members.resize(r.get_count(12));
+    for (int& v : f) v = r.get<int32_t>("mesh faces");
+  const uint32_t parts = r.get_count(4, "part names");
+  for (uint32_t p = 0; p < parts; ++p) d.part_names.push_back(get_string(r, 256, "part names"));
+  d.part_member_offsets = get_ints(r, "part member offsets");
+  d.part_members.resize(r.get_count(12, "part members"));
   for (PartMember& m : d.part_members) {
-    m.marker = r.get<int32_t>();
-    m.weight = r.get<double>();
+    m.marker = r.get<int32_t>("part members");
+    m.weight = r.get<double>("part members");
   }
-  d.vertex_influence_offsets = get_ints(r);
-  d.vertex_influences.resize(r.get_count(12));
+  d.vertex_influence_offsets = get_ints(r, "vertex influence offsets");
+  d.vertex_influences.resize(r.get_count(12, "vertex influences"));
   for (PartInfluence& inf : d.vertex_influences) {
-    inf.part = r.get<int32_t>();
-    inf.weight = r.get<double>();
+    inf.part = r.get<int32_t>("vertex influences");
+    inf.weight = r.get<double>("vertex influences");
   }
-  d.registration_rms_mm = r.get<double>();
+  d.registration_rms_mm = r.get<double>("registration error");
   if (version >= 3) {
-    d.part_rbf_ridge.resize(r.get_count(8));
-    for (double& ridge : d.part_rbf_ridge) ridge = r.get<double>();
+    d.part_rbf_ridge.resize(r.get_count(8, "part RBF ridges"));
+    for (double& ridge : d.part_rbf_ridge) ridge = r.get<double>("part RBF ridges");
   }
   if (version >= 4) {
-    d.part_quadratic_ridge.resize(r.get_count(8));
-    for (double& ridge : d.part_quadratic_ridge) ridge = r.get<double>();
+    d.part_quadratic_ridge.resize(r.get_count(8, "part quadratic ridges"));
+    for (double& ridge : d.part_quadratic_ridge) ridge = r.get<double>("part quadratic ridges");
   }
   return d;
 }
@@ -192,53 +209,55 @@ void encode_fitted_body(const DeformationModel* d, ByteWriter& w) {
 }
 
 void decode_fitted_body(ByteReader& r, std::optional<DeformationModel>& d) {
-  if (r.get<uint8_t>() == 0) return;
-  if (!d) throw std::out_of_range("a fitted body without a deformation model");
+  if (r.get<uint8_t>("fitted body flag") == 0) return;
+  if (!d) throw SubjectPayloadError("a fitted body without a deformation model");
   SegmentSkeleton& s = d->skeleton;
-  s.segments.resize(r.get_count(4 + 4 + 24));
+  s.segments.resize(r.get_count(4 + 4 + 24, "skeleton segments"));
   for (SkeletonSegment& segment : s.segments) {
-    segment.name = r.get_string(256);
-    segment.parent = r.get<int32_t>();
-    segment.pivot = get_vec3(r);
+    segment.name = get_string(r, 256, "skeleton segment name");
+    segment.parent = r.get<int32_t>("skeleton segment parent");
+    segment.pivot = get_vec3(r, "skeleton segment joint");
   }
-  s.marker_weight_offsets = get_ints(r);
-  s.marker_weights.resize(r.get_count(12));
+  s.marker_weight_offsets = get_ints(r, "marker weight offsets");
+  s.marker_weights.resize(r.get_count(12, "marker weights"));
   for (SegmentWeight& weight : s.marker_weights) {
-    weight.segment = r.get<int32_t>();
-    weight.weight = r.get<double>();
+    weight.segment = r.get<int32_t>("marker weights");
+    weight.weight = r.get<double>("marker weights");
   }
-  s.part_segment = get_ints(r);
+  s.part_segment = get_ints(r, "part segments");
   if (s.segments.empty()) s.marker_weight_offsets = {0};  // no skeleton: written as empty
-  d->part_quadratic.resize(r.get_count(1));
-  for (uint8_t& q : d->part_quadratic) q = r.get<uint8_t>();
-  d->rest_vertices.resize(r.get_count(24));
-  for (Vec3& v : d->rest_vertices) v = get_vec3(r);
+  d->part_quadratic.resize(r.get_count(1, "part quadratic flags"));
+  for (uint8_t& q : d->part_quadratic) q = r.get<uint8_t>("part quadratic flags");
+  d->rest_vertices.resize(r.get_count(24, "rest vertices"));
+  for (Vec3& v : d->rest_vertices) v = get_vec3(r, "rest vertices");
 }
 
 SubjectModel decode(ByteReader& r) {
   SubjectModel m;
-  const uint32_t n = r.get_count(4 + 24);
+  const uint32_t n = r.get_count(4 + 24, "markers");
   for (uint32_t i = 0; i < n; ++i) {
-    m.marker_names.push_back(r.get_string(4096));
-    m.reference_positions.push_back(get_vec3(r));
+    m.marker_names.push_back(get_string(r, 4096, "marker name"));
+    m.reference_positions.push_back(get_vec3(r, "marker reference position"));
   }
-  m.triangles.resize(r.get_count(12));
+  m.triangles.resize(r.get_count(12, "triangles"));
   for (auto& t : m.triangles)
-    for (int& v : t) v = r.get<int32_t>();
-  m.ring_offsets = get_ints(r);
-  m.ring = get_ints(r);
-  if (m.ring.size() > r.remaining() / 24) throw std::out_of_range("one-ring larger than the file");
-  for (size_t k = 0; k < m.ring.size(); ++k) m.ring_local_reference.push_back(get_vec3(r));
+    for (int& v : t) v = r.get<int32_t>("triangles");
+  m.ring_offsets = get_ints(r, "one-ring offsets");
+  m.ring = get_ints(r, "one-rings");
+  if (r.ok() && m.ring.size() > r.remaining() / 24)
+    throw SubjectPayloadError("one-ring larger than the file");
+  for (size_t k = 0; k < m.ring.size(); ++k)
+    m.ring_local_reference.push_back(get_vec3(r, "one-ring local positions"));
   for (uint32_t i = 0; i < n; ++i) {
     Eigen::Matrix3d f;
-    for (int k = 0; k < 9; ++k) f.data()[k] = r.get<double>();
+    for (int k = 0; k < 9; ++k) f.data()[k] = r.get<double>("local reference frames");
     m.local_reference_frames.push_back(f);
   }
-  m.anchor_offsets = get_ints(r);
-  m.anchors = get_ints(r);
+  m.anchor_offsets = get_ints(r, "anchor offsets");
+  m.anchors = get_ints(r, "anchors");
   for (uint32_t i = 0; i < n; ++i) m.pca.push_back(decode_pca(r, "PCA model of marker " + std::to_string(i)));
-  m.parameters.alpha1 = r.get<double>();
-  m.parameters.alpha2 = r.get<double>();
+  m.parameters.alpha1 = r.get<double>("alpha1");
+  m.parameters.alpha2 = r.get<double>("alpha2");
   return m;
 }
 
@@ -367,12 +386,12 @@ SubjectFile read_subject_file(const std::string& path) {
 SubjectFile read_subject_bytes(std::span<const unsigned char> bytes, const std::string& path) {
   if (bytes.size() < 24 || std::memcmp(bytes.data(), kMagic, sizeof kMagic) != 0)
     throw FileError(path, "not a skinstream subject file (bad magic)");
-  ByteReader header(bytes.data() + 8, 12);
-  const uint32_t version = header.get<uint32_t>();
+  ByteReader header(bytes.subspan(8, 12));
+  const uint32_t version = header.get<uint32_t>("version");
   if (version < 1 || version > kSubjectFileVersion)
     throw FileError(path, "subject file version " + std::to_string(version) + ", this build reads versions 1 to " +
                               std::to_string(kSubjectFileVersion) + "; rebuild it with skinstream build-subject");
-  const uint64_t size = header.get<uint64_t>();
+  const uint64_t size = header.get<uint64_t>("payload size");
   if (size != bytes.size() - 24)
     throw FileError(path, "truncated or padded: header says " + std::to_string(size) + " payload bytes, file holds " +
                               std::to_string(bytes.size() - 24));
@@ -381,16 +400,19 @@ SubjectFile read_subject_bytes(std::span<const unsigned char> bytes, const std::
   std::memcpy(&stored_crc, bytes.data() + bytes.size() - 4, 4);
   if (crc32(payload, size) != stored_crc) throw FileError(path, "corrupt: CRC-32 mismatch");
   SubjectFile file;
+  ByteReader r(payload, size);
   try {
-    ByteReader r(payload, size);
     file.model = decode(r);
     if (version >= 2) file.deformation = decode_deformation(r, version);
     if (version >= 5) decode_regions(r, file.model);
     if (version >= 6) decode_fitted_body(r, file.deformation);
-    if (r.remaining() != 0) throw std::out_of_range(std::to_string(r.remaining()) + " unexpected bytes after the model");
-  } catch (const std::out_of_range& e) {
+  } catch (const SubjectPayloadError& e) {
     throw FileError(path, std::string("corrupt subject payload: ") + e.what());
   }
+  if (!r.ok()) throw FileError(path, "corrupt subject payload: " + r.error().message());
+  if (r.remaining() != 0)
+    throw FileError(path, "corrupt subject payload: " + std::to_string(r.remaining()) +
+                              " unexpected bytes after the model");
   const std::string problem = file.model.validate();
   if (!problem.empty()) throw FileError(path, "inconsistent subject model: " + problem);
   if (file.deformation) {

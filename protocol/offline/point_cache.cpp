@@ -6,8 +6,10 @@
 #include <fstream>
 #include <sstream>
 
+#include "protocol/byte_reader.h"
 #include "protocol/files/file_error.h"
 #include "protocol/files/whole_file.h"
+#include "protocol/span_writer.h"
 
 namespace skinstream {
 
@@ -17,20 +19,6 @@ static_assert(std::endian::native == std::endian::little, "PC2 is little-endian;
 
 // Byte offset of the sample count in the header.
 constexpr long kSampleCountOffset = 28;
-
-template <typename T>
-void put(char*& out, T value) {
-  std::memcpy(out, &value, sizeof value);
-  out += sizeof value;
-}
-
-template <typename T>
-T get(const char*& in) {
-  T value;
-  std::memcpy(&value, in, sizeof value);
-  in += sizeof value;
-  return value;
-}
 
 }  // namespace
 
@@ -42,15 +30,14 @@ PointCacheWriter::PointCacheWriter(const std::string& path, int point_count, flo
   buffer_.resize(static_cast<size_t>(point_count) * 3);
   file_ = std::fopen(path.c_str(), "wb");
   if (!file_) throw FileError(path, "cannot create");
-  char header[kPointCacheHeaderBytes];
-  char* out = header;
-  std::memcpy(out, kPointCacheSignature, sizeof kPointCacheSignature);
-  out += sizeof kPointCacheSignature;
-  put<int32_t>(out, 1);
-  put<int32_t>(out, point_count);
-  put<float>(out, start_frame);
-  put<float>(out, sample_rate);
-  put<int32_t>(out, 0);
+  unsigned char header[kPointCacheHeaderBytes];
+  SpanWriter out(header);
+  std::memcpy(out.reserve(sizeof kPointCacheSignature), kPointCacheSignature, sizeof kPointCacheSignature);
+  out.put<int32_t>(1);
+  out.put<int32_t>(point_count);
+  out.put<float>(start_frame);
+  out.put<float>(sample_rate);
+  out.put<int32_t>(0);
   if (std::fwrite(header, 1, sizeof header, file_) != sizeof header) {
     std::fclose(file_);
     file_ = nullptr;
@@ -97,14 +84,16 @@ PointCache read_point_cache(const std::string& path) {
     throw FileError(path, "truncated: " + std::to_string(bytes.size()) + " bytes, a PC2 header has 32");
   if (std::memcmp(bytes.data(), kPointCacheSignature, sizeof kPointCacheSignature) != 0)
     throw FileError(path, "not a PC2 point cache (no POINTCACHE2 signature)");
-  const char* p = bytes.data() + sizeof kPointCacheSignature;
-  const int32_t version = get<int32_t>(p);
+  // Sizes checked before each read: none can fail.
+  ByteReader r(reinterpret_cast<const unsigned char*>(bytes.data()), bytes.size());
+  r.skip(sizeof kPointCacheSignature, "signature");
+  const int32_t version = r.get<int32_t>("version");
   if (version != 1) throw FileError(path, "PC2 version " + std::to_string(version) + ", only 1 is read");
   PointCache cache;
-  cache.point_count = get<int32_t>(p);
-  cache.start_frame = get<float>(p);
-  cache.sample_rate = get<float>(p);
-  cache.sample_count = get<int32_t>(p);
+  cache.point_count = r.get<int32_t>("point count");
+  cache.start_frame = r.get<float>("start frame");
+  cache.sample_rate = r.get<float>("sample rate");
+  cache.sample_count = r.get<int32_t>("sample count");
   if (cache.point_count < 0 || cache.sample_count < 0)
     throw FileError(path, "negative point or sample count in the header");
   if (!std::isfinite(cache.start_frame) || !std::isfinite(cache.sample_rate))
@@ -119,7 +108,7 @@ PointCache read_point_cache(const std::string& path) {
     throw FileError(path, std::to_string(bytes.size() - expected) + " bytes after the last sample");
   cache.positions.resize(static_cast<size_t>(values / 3));
   for (Vec3& v : cache.positions) {
-    const float x = get<float>(p), y = get<float>(p), z = get<float>(p);
+    const float x = r.get<float>("samples"), y = r.get<float>("samples"), z = r.get<float>("samples");
     v = Vec3(x, y, z);
   }
   return cache;

@@ -4,15 +4,10 @@
 #include <cstring>
 #include <limits>
 
+#include "protocol/byte_reader.h"
+
 namespace skinstream::qtm {
 namespace {
-
-template <typename T>
-T load(const unsigned char* p) {
-  T value;
-  std::memcpy(&value, p, sizeof(T));  // the wire and the host are little-endian
-  return value;
-}
 
 bool refuse_packet(std::string& out_error, std::string reason) {
   out_error = std::move(reason);
@@ -33,7 +28,8 @@ bool decode_markers(uint32_t type, Bytes body, DataFrame& out, std::string& out_
   constexpr size_t kCountsBytes = 8;  // u32 count, u16 drop rate, u16 out-of-sync rate
   if (body.size() < kCountsBytes) return refuse_packet(out_error, "3D component of " + std::to_string(body.size()) +
                                                             " bytes is shorter than its marker count");
-  const uint32_t count = load<uint32_t>(body.data());
+  ByteReader r(body);  // sizes checked before each read: none can fail
+  const uint32_t count = r.get<uint32_t>("marker count");
   const bool unlabelled = type == component::k3dNoLabels || type == component::k3dNoLabelsResiduals;
   const bool residuals = type == component::k3dResiduals || type == component::k3dNoLabelsResiduals;
   const size_t marker_bytes = 12 + (unlabelled ? 4 : 0) + (residuals ? 4 : 0);
@@ -42,23 +38,22 @@ bool decode_markers(uint32_t type, Bytes body, DataFrame& out, std::string& out_
     return refuse_packet(out_error, "3D component says " + std::to_string(count) + " markers of " +
                                std::to_string(marker_bytes) + " bytes but holds " + std::to_string(data_bytes) +
                                " bytes");
-  out.drop_rate_2d = load<uint16_t>(body.data() + 4);
-  out.out_of_sync_rate_2d = load<uint16_t>(body.data() + 6);
-  const unsigned char* p = body.data() + kCountsBytes;
+  out.drop_rate_2d = r.get<uint16_t>("2D drop rate");
+  out.out_of_sync_rate_2d = r.get<uint16_t>("2D out-of-sync rate");
   if (unlabelled) {
     out.has_unlabelled = true;
     out.unlabelled.resize(count);
     for (UnlabelledMarker& m : out.unlabelled) {
-      std::memcpy(m.position.data(), p, 12);
-      m.id = load<uint32_t>(p + 12 + (residuals ? 4 : 0));  // the residual comes before the id
-      p += marker_bytes;
+      r.get_array(m.position.data(), 3, "marker position");
+      if (residuals) r.skip(4, "marker residual");  // the residual comes before the id
+      m.id = r.get<uint32_t>("marker id");
     }
   } else {
     out.has_labelled = true;
     out.labelled.resize(count);
     for (auto& position : out.labelled) {
-      std::memcpy(position.data(), p, 12);
-      p += marker_bytes;
+      r.get_array(position.data(), 3, "marker position");
+      if (residuals) r.skip(4, "marker residual");
     }
   }
   return true;
@@ -84,7 +79,8 @@ const char* packet_type_name(uint32_t type) {
 bool read_header(Bytes packet, uint32_t& out_type, std::string& out_error) {
   if (packet.size() < kHeaderBytes)
     return refuse_packet(out_error, "packet of " + std::to_string(packet.size()) + " bytes is shorter than its 8-byte header");
-  const uint32_t size = load<uint32_t>(packet.data());
+  ByteReader r(packet);
+  const uint32_t size = r.get<uint32_t>("packet size");
   if (size < kHeaderBytes) return refuse_packet(out_error, "packet size " + std::to_string(size) + " is less than its header");
   if (size > kMaxPacketBytes)
     return refuse_packet(out_error, "packet size " + std::to_string(size) + " exceeds the limit of " +
@@ -92,7 +88,7 @@ bool read_header(Bytes packet, uint32_t& out_type, std::string& out_error) {
   if (size != packet.size())
     return refuse_packet(out_error, "packet size field says " + std::to_string(size) + " bytes but " +
                                std::to_string(packet.size()) + " were given");
-  out_type = load<uint32_t>(packet.data() + 4);
+  out_type = r.get<uint32_t>("packet type");
   return true;
 }
 
@@ -121,28 +117,27 @@ bool decode_data(Bytes packet, DataFrame& out, std::string& out_error) {
   constexpr size_t kFrameHeaderBytes = 16;  // i64 timestamp, u32 frame number, u32 component count
   if (packet.size() < kHeaderBytes + kFrameHeaderBytes)
     return refuse_packet(out_error, "data packet of " + std::to_string(packet.size()) + " bytes is shorter than its header");
-  const unsigned char* p = packet.data() + kHeaderBytes;
-  out.timestamp_us = load<int64_t>(p);
-  out.frame_number = load<uint32_t>(p + 8);
-  const uint32_t components = load<uint32_t>(p + 12);
+  ByteReader r(packet.subspan(kHeaderBytes));  // sizes checked before each read: none can fail
+  out.timestamp_us = r.get<int64_t>("timestamp");
+  out.frame_number = r.get<uint32_t>("frame number");
+  const uint32_t components = r.get<uint32_t>("component count");
   out.has_labelled = out.has_unlabelled = false;
   out.drop_rate_2d = out.out_of_sync_rate_2d = 0;
   out.labelled.clear();
   out.unlabelled.clear();
   out.skipped_components = 0;
 
-  size_t offset = kHeaderBytes + kFrameHeaderBytes;
   for (uint32_t i = 0; i < components; ++i) {
-    const size_t left = packet.size() - offset;
+    const size_t left = r.remaining();
     if (left < 8)
       return refuse_packet(out_error, "data packet ends inside the header of component " + std::to_string(i + 1) + " of " +
                                  std::to_string(components));
-    const uint32_t size = load<uint32_t>(packet.data() + offset);
-    const uint32_t type = load<uint32_t>(packet.data() + offset + 4);
+    const uint32_t size = r.get<uint32_t>("component size");
+    const uint32_t type = r.get<uint32_t>("component type");
     if (size < 8 || size > left)
       return refuse_packet(out_error, "component " + std::to_string(i + 1) + " (type " + std::to_string(type) + ") says " +
                                  std::to_string(size) + " bytes with " + std::to_string(left) + " left");
-    const Bytes body = packet.subspan(offset + 8, size - 8);
+    const Bytes body = r.take(size - 8, "component");
     switch (type) {
       case component::k3d:
       case component::k3dResiduals:
@@ -158,11 +153,10 @@ bool decode_data(Bytes packet, DataFrame& out, std::string& out_error) {
         ++out.skipped_components;
         break;
     }
-    offset += size;
   }
-  if (offset != packet.size())
-    return refuse_packet(out_error, "data packet has " + std::to_string(packet.size() - offset) + " bytes after its " +
-                               std::to_string(components) + " components");
+  if (r.remaining() != 0)
+    return refuse_packet(out_error, "data packet has " + std::to_string(r.remaining()) + " bytes after its " +
+                                        std::to_string(components) + " components");
   return true;
 }
 

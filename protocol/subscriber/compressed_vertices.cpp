@@ -10,6 +10,8 @@
 #include <string>
 
 #include "protocol/byte_buffer.h"
+#include "protocol/byte_reader.h"
+#include "protocol/span_writer.h"
 #include "protocol/subscriber/subscriber_stream.h"
 
 namespace skinstream::subscriber {
@@ -124,17 +126,17 @@ size_t CompressedVertexEncoder::encode_positions(uint32_t frame_number, std::spa
   } else {
     ++since_key_;
   }
-  unsigned char* at = out;
-  put_at<uint32_t>(at, key_frame_number_);
-  for (float o : origin_) put_at<float>(at, o);
-  for (float s : step_) put_at<float>(at, s);
-  unsigned char* count_at = at;
-  at += 4;
-  const size_t coded = meshopt_encodeVertexBuffer(at, meshopt_encodeVertexBufferBound(v, kPositionVertexBytes), vertices_.data(), v,
+  const size_t bound = meshopt_encodeVertexBufferBound(v, kPositionVertexBytes);
+  SpanWriter w(std::span(out, kPositionHeaderBytes + bound + 3));
+  w.put<uint32_t>(key_frame_number_);
+  w.put_array<float>(origin_);
+  w.put_array<float>(step_);
+  unsigned char* count_at = w.reserve(4);
+  const size_t coded = meshopt_encodeVertexBuffer(out + kPositionHeaderBytes, bound, vertices_.data(), v,
                                                   kPositionVertexBytes);
   if (coded == 0 && v > 0) throw std::runtime_error("meshopt_encodeVertexBuffer failed");
-  put_at<uint32_t>(count_at, static_cast<uint32_t>(coded));
-  std::memset(at + coded, 0, padding_to_4(coded));
+  SpanWriter(std::span(count_at, 4)).put<uint32_t>(static_cast<uint32_t>(coded));
+  std::memset(out + kPositionHeaderBytes + coded, 0, padding_to_4(coded));
   return kPositionHeaderBytes + coded + padding_to_4(coded);
 }
 
@@ -151,8 +153,7 @@ size_t CompressedVertexEncoder::encode_normals(std::span<const float> normals, u
   const size_t coded = meshopt_encodeVertexBuffer(out + 4, meshopt_encodeVertexBufferBound(v, kNormalVertexBytes), octahedral_.data(), v,
                                                   kNormalVertexBytes);
   if (coded == 0 && v > 0) throw std::runtime_error("meshopt_encodeVertexBuffer failed");
-  unsigned char* at = out;
-  put_at<uint32_t>(at, static_cast<uint32_t>(coded));
+  SpanWriter(std::span(out, 4)).put<uint32_t>(static_cast<uint32_t>(coded));
   std::memset(out + 4 + coded, 0, padding_to_4(coded));
   return 4 + coded + padding_to_4(coded);
 }
@@ -172,12 +173,12 @@ CompressedVertexDecoder::Result CompressedVertexDecoder::decode(std::span<const 
   if (positions.size() < 3 * v || (!normals.empty() && normals.size() < 3 * v))
     throw std::invalid_argument("CompressedVertexDecoder::decode: output smaller than the mesh");
   if (positions_block.size() < kPositionHeaderBytes) throw DecodeError("compressed positions: block truncated");
-  const unsigned char* at = positions_block.data();
-  const uint32_t key_frame_number = get_at<uint32_t>(at);
+  ByteReader r(positions_block);  // its size checked: the header's reads cannot fail
+  const uint32_t key_frame_number = r.get<uint32_t>("key frame number");
   float origin[3], step[3];
-  for (float& o : origin) o = get_at<float>(at);
-  for (float& s : step) s = get_at<float>(at);
-  const uint32_t coded = get_at<uint32_t>(at);
+  r.get_array(origin, 3, "grid origin");
+  r.get_array(step, 3, "grid step");
+  const uint32_t coded = r.get<uint32_t>("coded bytes");
   if (kPositionHeaderBytes + coded + padding_to_4(coded) != positions_block.size())
     throw DecodeError("compressed positions: " + std::to_string(coded) + " coded bytes in a block of " + std::to_string(positions_block.size()));
   for (int a = 0; a < 3; ++a) {
@@ -189,7 +190,7 @@ CompressedVertexDecoder::Result CompressedVertexDecoder::decode(std::span<const 
       throw DecodeError("compressed positions: the grid reaches beyond the range of a float");
   }
   if (!key && (!has_key_ || key_frame_number != key_frame_number_)) return Result::NeedsKey;
-  if (meshopt_decodeVertexBuffer(vertices_.data(), v, kPositionVertexBytes, at, coded) != 0)
+  if (meshopt_decodeVertexBuffer(vertices_.data(), v, kPositionVertexBytes, r.here(), coded) != 0)
     throw DecodeError("compressed positions: the vertex codec refused the data");
   if (key) {
     key_q_ = vertices_;  // same size: copies, never allocates
@@ -205,11 +206,11 @@ CompressedVertexDecoder::Result CompressedVertexDecoder::decode(std::span<const 
     }
   if (!normals.empty() && !normals_block.empty()) {
     if (normals_block.size() < 4) throw DecodeError("compressed normals: block truncated");
-    const unsigned char* n = normals_block.data();
-    const uint32_t normal_bytes = get_at<uint32_t>(n);
+    ByteReader n(normals_block);
+    const uint32_t normal_bytes = n.get<uint32_t>("coded bytes");
     if (4 + normal_bytes + padding_to_4(normal_bytes) != normals_block.size())
       throw DecodeError("compressed normals: " + std::to_string(normal_bytes) + " coded bytes in a block of " + std::to_string(normals_block.size()));
-    if (meshopt_decodeVertexBuffer(octahedral_.data(), v, kNormalVertexBytes, n, normal_bytes) != 0)
+    if (meshopt_decodeVertexBuffer(octahedral_.data(), v, kNormalVertexBytes, n.here(), normal_bytes) != 0)
       throw DecodeError("compressed normals: the vertex codec refused the data");
     meshopt_decodeFilterOct(octahedral_.data(), v, kNormalVertexBytes);
     // The filter leaves unit vectors rounded to 8 bits a component: unit again here.

@@ -5,6 +5,8 @@
 #include <string>
 
 #include "protocol/byte_buffer.h"
+#include "protocol/byte_reader.h"
+#include "protocol/span_writer.h"
 
 namespace skinstream::subscriber {
 namespace {
@@ -27,16 +29,16 @@ size_t fragment_bytes(size_t message_bytes, uint16_t count, uint16_t index) {
 }
 
 void encode_datagram_header(const DatagramHeader& h, std::span<unsigned char, kDatagramHeaderBytes> out) {
-  unsigned char* p = out.data();
-  put_at<uint32_t>(p, kDatagramMagic);
-  put_at<uint16_t>(p, kDatagramVersion);
-  put_at<uint16_t>(p, h.authenticated ? kDatagramAuthenticated : 0);  // flags; the other bits reserved
-  put_at<uint32_t>(p, h.stream_id);
-  put_at<uint32_t>(p, h.model_id);
-  put_at<uint32_t>(p, h.sequence);
-  put_at<uint16_t>(p, h.index);
-  put_at<uint16_t>(p, h.count);
-  put_at<uint32_t>(p, h.message_bytes);
+  SpanWriter w(out);
+  w.put<uint32_t>(kDatagramMagic);
+  w.put<uint16_t>(kDatagramVersion);
+  w.put<uint16_t>(h.authenticated ? kDatagramAuthenticated : 0);  // flags; the other bits reserved
+  w.put<uint32_t>(h.stream_id);
+  w.put<uint32_t>(h.model_id);
+  w.put<uint32_t>(h.sequence);
+  w.put<uint16_t>(h.index);
+  w.put<uint16_t>(h.count);
+  w.put<uint32_t>(h.message_bytes);
 }
 
 DatagramHeader decode_datagram_header(std::span<const unsigned char> datagram) {
@@ -45,22 +47,23 @@ DatagramHeader decode_datagram_header(std::span<const unsigned char> datagram) {
                       std::to_string(kDatagramHeaderBytes) + "-byte header");
   if (datagram.size() > kMaxDatagramBytes)
     throw DecodeError("datagram of " + std::to_string(datagram.size()) + " bytes is over the " + std::to_string(kMaxDatagramBytes) + " allowed");
-  const unsigned char* p = datagram.data();
-  if (get_at<uint32_t>(p) != kDatagramMagic) throw DecodeError("bad magic (not a skinstream multicast datagram)");
-  const uint16_t version = get_at<uint16_t>(p);
+  ByteReader r(datagram);  // its size checked: no read below can fail
+  if (r.get<uint32_t>("magic") != kDatagramMagic)
+    throw DecodeError("bad magic (not a skinstream multicast datagram)");
+  const uint16_t version = r.get<uint16_t>("version");
   if (version != kDatagramVersion) throw DecodeError("multicast datagram version " + std::to_string(version) + " (this side speaks 1)");
-  const uint16_t flags = get_at<uint16_t>(p);
+  const uint16_t flags = r.get<uint16_t>("flags");
   if (flags & ~kDatagramAuthenticated) throw DecodeError("reserved header bits set");
   DatagramHeader h;
   h.authenticated = (flags & kDatagramAuthenticated) != 0;
   const size_t largest = h.authenticated ? kMaxAuthenticatedFragmentBytes : kMaxFragmentBytes;
   const size_t trailer = h.authenticated ? kDatagramTrailerBytes : 0;
-  h.stream_id = get_at<uint32_t>(p);
-  h.model_id = get_at<uint32_t>(p);
-  h.sequence = get_at<uint32_t>(p);
-  h.index = get_at<uint16_t>(p);
-  h.count = get_at<uint16_t>(p);
-  h.message_bytes = get_at<uint32_t>(p);
+  h.stream_id = r.get<uint32_t>("stream id");
+  h.model_id = r.get<uint32_t>("model id");
+  h.sequence = r.get<uint32_t>("sequence");
+  h.index = r.get<uint16_t>("fragment index");
+  h.count = r.get<uint16_t>("fragment count");
+  h.message_bytes = r.get<uint32_t>("message bytes");
   if (h.count == 0 || h.count > kMaxFragments)
     throw DecodeError("fragment count " + std::to_string(h.count) + " (1-" + std::to_string(kMaxFragments) + ")");
   if (h.index >= h.count) throw DecodeError("fragment " + std::to_string(h.index) + " of " + std::to_string(h.count));

@@ -7,47 +7,14 @@
 #include <limits>
 
 #include "protocol/byte_buffer.h"
+#include "protocol/byte_reader.h"
+#include "protocol/span_writer.h"
 #include "protocol/subscriber/frame_quantisation.h"
 
 namespace skinstream::subscriber {
 namespace {
 
-// Writes little-endian values at a cursor in a caller's span (the frame path, no allocation).
-// The host's byte order is the protocol's, so values are copied as they are.
-static_assert(std::endian::native == std::endian::little, "the protocol is little-endian; a big-endian host must swap");
-class SpanWriter {
- public:
-  explicit SpanWriter(std::span<unsigned char> out) : out_(out) {}
-  template <typename T>
-  void put(T value) {
-    std::memcpy(out_.data() + pos_, &value, sizeof(T));
-    pos_ += sizeof(T);
-  }
-  // A whole array in one copy: value by value, the compiler must assume each byte written may
-  // be the cursor itself and reload it, which made the 640 kB of a mesh's positions a scalar loop.
-  void put_floats(std::span<const float> values) {
-    if (values.empty()) return;  // its data() may be null, which memcpy must not be given
-    std::memcpy(out_.data() + pos_, values.data(), values.size_bytes());
-    pos_ += values.size_bytes();
-  }
-  // The next n bytes, for the caller to fill; the cursor moves past them.
-  unsigned char* reserve(size_t n) {
-    unsigned char* at = out_.data() + pos_;
-    pos_ += n;
-    return at;
-  }
-  void zeros(size_t n) {
-    std::memset(out_.data() + pos_, 0, n);
-    pos_ += n;
-  }
-  size_t position() const { return pos_; }
-
- private:
-  std::span<unsigned char> out_;
-  size_t pos_ = 0;
-};
-
-void put_header(ByteWriter& w, MessageType type, size_t payload, uint16_t version) {
+void put_header(SpanWriter& w, MessageType type, size_t payload, uint16_t version) {
   w.put<uint32_t>(kMagic);
   w.put<uint16_t>(version);
   w.put<uint16_t>(static_cast<uint16_t>(type));
@@ -56,10 +23,11 @@ void put_header(ByteWriter& w, MessageType type, size_t payload, uint16_t versio
 
 // Messages other than Frame: payload built first, then the header in front.
 std::vector<unsigned char> with_header(MessageType type, const ByteWriter& payload, uint16_t version) {
-  ByteWriter w;
+  std::vector<unsigned char> message(kHeaderBytes + payload.bytes().size());
+  SpanWriter w(message);
   put_header(w, type, payload.bytes().size(), version);
-  w.put_bytes(payload.bytes().data(), payload.bytes().size());
-  return std::move(w.bytes());
+  std::copy(payload.bytes().begin(), payload.bytes().end(), w.reserve(payload.bytes().size()));
+  return message;
 }
 
 // A string as u16 length + bytes, cut at `limit` bytes.
@@ -69,13 +37,12 @@ void put_short_string(ByteWriter& w, const std::string& s, size_t limit = std::n
   w.put_bytes(s.data(), n);
 }
 
+// Empty once the reader failed.
 std::string get_short_string(ByteReader& r, const char* what, size_t limit = std::numeric_limits<uint16_t>::max()) {
-  const uint16_t n = r.get<uint16_t>();
+  const uint16_t n = r.get<uint16_t>(what);
   if (n > limit) throw DecodeError(std::string(what) + " of " + std::to_string(n) + " bytes exceeds " + std::to_string(limit));
-  if (n > r.remaining()) throw std::out_of_range(std::string(what) + " truncated");
-  std::string s(n, '\0');
-  r.get_array(s.data(), n);
-  return s;
+  const std::span<const unsigned char> bytes = r.take(n, what);
+  return std::string(bytes.begin(), bytes.end());
 }
 
 Encoding encoding_of(uint32_t value, const char* what) {
@@ -87,25 +54,24 @@ void check_version(uint16_t version) {
   if (version != kVersion1 && version != kVersion2) throw std::invalid_argument("subscriber protocol version " + std::to_string(version));
 }
 
-// Runs a payload decoder, turning a read past the end into a DecodeError naming the message.
+// Runs a payload decoder, turning a read past the end into a DecodeError naming the message and
+// the field. The decoder checks r.ok() before judging values read after a failure (zeros).
 template <typename F>
 auto decode_payload(const char* what, std::span<const unsigned char> payload, F&& body) {
-  ByteReader r(payload.data(), payload.size());
-  try {
-    auto result = body(r);
-    if (r.remaining() != 0)
-      throw DecodeError(std::string(what) + ": " + std::to_string(r.remaining()) + " bytes left over after the message");
-    return result;
-  } catch (const std::out_of_range& e) {
-    throw DecodeError(std::string(what) + ": " + e.what());
-  }
+  ByteReader r(payload);
+  auto result = body(r);
+  if (!r.ok()) throw DecodeError(std::string(what) + ": " + r.error().message());
+  if (r.remaining() != 0)
+    throw DecodeError(std::string(what) + ": " + std::to_string(r.remaining()) +
+                      " bytes left over after the message");
+  return result;
 }
 
 // Only after the frame's sizes were checked against the payload (read_frame_info), so `count`
 // never allocates more than the payload holds.
-void get_floats(ByteReader& r, std::vector<float>& out, size_t count) {
+void get_floats(ByteReader& r, std::vector<float>& out, size_t count, const char* what) {
   out.resize(count);
-  r.get_array(out.data(), count);
+  r.get_array(out.data(), count, what);
 }
 
 }  // namespace
@@ -175,9 +141,8 @@ std::vector<unsigned char> encode_ack(const Ack& ack, uint16_t version) {
 
 void write_header(MessageType type, uint16_t version, size_t payload_bytes, std::span<unsigned char, kHeaderBytes> out) {
   check_version(version);
-  ByteWriter w;
+  SpanWriter w(out);
   put_header(w, type, payload_bytes, version);
-  std::memcpy(out.data(), w.bytes().data(), kHeaderBytes);
 }
 
 std::vector<unsigned char> encode_mesh_info(const MeshInfo& info, uint16_t version) {
@@ -238,10 +203,7 @@ namespace {
 
 // The header, the fixed part and (version 2) the timecode.
 void write_frame_start(SpanWriter& w, const FrameInfo& info, size_t total, uint16_t version) {
-  w.put<uint32_t>(kMagic);
-  w.put<uint16_t>(version);
-  w.put<uint16_t>(static_cast<uint16_t>(MessageType::Frame));
-  w.put<uint32_t>(static_cast<uint32_t>(total - kHeaderBytes));
+  put_header(w, MessageType::Frame, total - kHeaderBytes, version);
   w.put<uint32_t>(info.frame_number);
   w.put<uint32_t>(info.flags);
   w.put<int64_t>(info.source_time_ns);
@@ -266,7 +228,7 @@ void write_frame_start(SpanWriter& w, const FrameInfo& info, size_t total, uint1
 }
 
 void write_markers(SpanWriter& w, const FrameInfo& info, std::span<const float> markers, std::span<const uint8_t> marker_status) {
-  w.put_floats(markers.first(3 * size_t{info.marker_count}));
+  w.put_array<float>(markers.first(3 * size_t{info.marker_count}));
   std::memcpy(w.reserve(info.marker_count), marker_status.data(), info.marker_count);
   w.zeros(padding_to_4(info.marker_count));
 }
@@ -299,7 +261,7 @@ void encode_frame(const FrameInfo& in, std::span<const float> positions, std::sp
   write_frame_start(w, info, total, version);
 
   if (has_positions && !quantised) {
-    w.put_floats(positions.first(v3));
+    w.put_array<float>(positions.first(v3));
   } else if (has_positions) {
     const QuantisationBox box = quantisation_box(positions.first(v3));
     for (int a = 0; a < 3; ++a) w.put<float>(box.lo[a]);
@@ -308,7 +270,7 @@ void encode_frame(const FrameInfo& in, std::span<const float> positions, std::sp
     w.zeros(padding_to_4(2 * v3));
   }
   if (has_normals && !quantised) {
-    w.put_floats(normals.first(v3));
+    w.put_array<float>(normals.first(v3));
   } else if (has_normals) {
     quantise_normals(normals.first(v3), w.reserve(2 * v3));
     w.zeros(padding_to_4(2 * v3));
@@ -354,11 +316,11 @@ void patch_publish_time(std::span<unsigned char> frame_message, int64_t publish_
 MessageHeader decode_header(std::span<const unsigned char> bytes, uint32_t max_payload) {
   if (bytes.size() < kHeaderBytes)
     throw DecodeError("message header truncated: " + std::to_string(bytes.size()) + " of 12 bytes");
-  ByteReader r(bytes.data(), kHeaderBytes);
-  const uint32_t magic = r.get<uint32_t>();
-  const uint16_t version = r.get<uint16_t>();
-  const uint16_t type = r.get<uint16_t>();
-  const uint32_t payload = r.get<uint32_t>();
+  ByteReader r(bytes.first(kHeaderBytes));
+  const uint32_t magic = r.get<uint32_t>("magic");
+  const uint16_t version = r.get<uint16_t>("version");
+  const uint16_t type = r.get<uint16_t>("message type");
+  const uint32_t payload = r.get<uint32_t>("payload size");
   if (magic != kMagic) throw DecodeError("bad magic (not a skinstream subscriber stream)");
   if (version != kVersion1 && version != kVersion2)
     throw DecodeError("unsupported protocol version " + std::to_string(version) + " (this side speaks 1 and 2)");
@@ -374,11 +336,11 @@ Hello decode_hello(std::span<const unsigned char> payload, uint16_t version) {
   return decode_payload("Hello", payload, [version](ByteReader& r) {
     Hello hello;
     hello.version = version;
-    hello.wants = r.get<uint32_t>();
+    hello.wants = r.get<uint32_t>("wants");
     const uint32_t allowed = version >= kVersion2 ? kWantAllVersion2 : kWantAll;
     if (hello.wants & ~allowed) throw DecodeError("Hello: reserved wants bits set (" + std::to_string(hello.wants) + ")");
     if (version >= kVersion2) {
-      hello.encoding = r.get<uint32_t>();  // an unknown one is the daemon's to answer, not an error
+      hello.encoding = r.get<uint32_t>("encoding");  // an unknown one is the daemon's to answer, not an error
       hello.subject = get_short_string(r, "Hello: subject name", kMaxHelloString);
       hello.token = get_short_string(r, "Hello: token", kMaxHelloString);
     }
@@ -387,17 +349,18 @@ Hello decode_hello(std::span<const unsigned char> payload, uint16_t version) {
 }
 
 Ack decode_ack(std::span<const unsigned char> payload) {
-  return decode_payload("Ack", payload, [](ByteReader& r) { return Ack{r.get<uint32_t>()}; });
+  return decode_payload("Ack", payload, [](ByteReader& r) { return Ack{r.get<uint32_t>("frame number")}; });
 }
 
 MeshInfo decode_mesh_info(std::span<const unsigned char> payload, uint16_t version, const MeshInfoLimits& limits) {
   return decode_payload("MeshInfo", payload, [version, &limits](ByteReader& r) {
     MeshInfo info;
-    info.vertex_count = r.get<uint32_t>();
-    const uint32_t face_count = r.get<uint32_t>();
-    info.marker_count = r.get<uint32_t>();
-    info.part_count = r.get<uint32_t>();
-    info.source_rate_hz = r.get<float>();
+    info.vertex_count = r.get<uint32_t>("vertex count");
+    const uint32_t face_count = r.get<uint32_t>("face count");
+    info.marker_count = r.get<uint32_t>("marker count");
+    info.part_count = r.get<uint32_t>("part count");
+    info.source_rate_hz = r.get<float>("source rate");
+    if (!r.ok()) return info;
     if (info.vertex_count > limits.max_vertices)
       throw DecodeError("MeshInfo: " + std::to_string(info.vertex_count) + " vertices, more than this subscriber takes (" +
                         std::to_string(limits.max_vertices) + ", its max_vertices)");
@@ -405,33 +368,40 @@ MeshInfo decode_mesh_info(std::span<const unsigned char> payload, uint16_t versi
       throw DecodeError("MeshInfo: " + std::to_string(info.marker_count) + " markers, more than this subscriber takes (" +
                         std::to_string(limits.max_markers) + ", its max_markers)");
     if (face_count > r.remaining() / 12 || info.vertex_count > r.remaining())
-      throw std::out_of_range("vertex or face count exceeds the data left");
+      throw DecodeError("MeshInfo: vertex or face count exceeds the data left");
     info.faces.resize(face_count);
     for (auto& f : info.faces)
       for (uint32_t& v : f) {
-        v = r.get<uint32_t>();
-        if (v >= info.vertex_count) throw DecodeError("MeshInfo: face index " + std::to_string(v) + " out of range");
+        v = r.get<uint32_t>("face");
+        if (r.ok() && v >= info.vertex_count)
+          throw DecodeError("MeshInfo: face index " + std::to_string(v) + " out of range");
       }
     info.dominant_part.resize(info.vertex_count);
-    for (uint8_t& p : info.dominant_part) p = r.get<uint8_t>();
-    info.marker_triangles.resize(r.get_count(12));
+    r.get_array(info.dominant_part.data(), info.dominant_part.size(), "dominant parts");
+    info.marker_triangles.resize(r.get_count(12, "marker triangles"));
     for (auto& t : info.marker_triangles)
       for (uint32_t& m : t) {
-        m = r.get<uint32_t>();
-        if (m >= info.marker_count) throw DecodeError("MeshInfo: marker triangle index " + std::to_string(m) + " out of range");
+        m = r.get<uint32_t>("marker triangle");
+        if (r.ok() && m >= info.marker_count)
+          throw DecodeError("MeshInfo: marker triangle index " + std::to_string(m) + " out of range");
       }
-    if (info.marker_count > r.remaining() / 2) throw std::out_of_range("marker count exceeds the data left");
+    if (!r.ok()) return info;
+    if (info.marker_count > r.remaining() / 2)
+      throw DecodeError("MeshInfo: marker count exceeds the data left");
     info.marker_names.resize(info.marker_count);
     for (std::string& name : info.marker_names) name = get_short_string(r, "marker name");
     if (version >= kVersion2) {
       info.subject = get_short_string(r, "MeshInfo: subject name");
-      info.encoding = encoding_of(r.get<uint32_t>(), "MeshInfo");
-      const uint32_t order = r.get<uint32_t>();
+      info.encoding = encoding_of(r.get<uint32_t>("encoding"), "MeshInfo");
+      const uint32_t order = r.get<uint32_t>("compressed vertex order");
       if (order != 0 && order != info.vertex_count)
         throw DecodeError("MeshInfo: a compressed vertex order of " + std::to_string(order) + " for " + std::to_string(info.vertex_count) + " vertices");
-      if (order > r.remaining() / 4) throw std::out_of_range("compressed vertex order truncated");
+      if (order > r.remaining() / 4) {
+        r.fail("compressed vertex order", 4 * size_t{order});
+        return info;
+      }
       info.compressed_order.resize(order);
-      r.get_array(info.compressed_order.data(), order);
+      r.get_array(info.compressed_order.data(), order, "compressed vertex order");
       for (uint32_t v : info.compressed_order)
         if (v >= info.vertex_count) throw DecodeError("MeshInfo: compressed vertex order names vertex " + std::to_string(v));
     }
@@ -441,32 +411,33 @@ MeshInfo decode_mesh_info(std::span<const unsigned char> payload, uint16_t versi
 
 namespace {
 
-// The fixed part of a Frame payload (and the version 2 timecode), its flags checked; the reader
-// is left at the first block.
+// The fixed part of a Frame payload (and the version 2 timecode), its flags checked once read
+// whole; the reader is left at the first block.
 FrameInfo read_frame_info(ByteReader& r, uint16_t version) {
   FrameInfo info;
-  info.frame_number = r.get<uint32_t>();
-  info.flags = r.get<uint32_t>();
-  info.source_time_ns = r.get<int64_t>();
-  info.receive_time_ns = r.get<int64_t>();
-  info.publish_time_ns = r.get<int64_t>();
-  info.vertex_count = r.get<uint32_t>();
-  info.marker_count = r.get<uint32_t>();
-  info.markers_filled = r.get<uint16_t>();
-  info.markers_relabelled = r.get<uint16_t>();
-  info.pipeline_dropped = r.get<uint32_t>();
-  info.subscriber_dropped = r.get<uint32_t>();
+  info.frame_number = r.get<uint32_t>("frame number");
+  info.flags = r.get<uint32_t>("flags");
+  info.source_time_ns = r.get<int64_t>("source time");
+  info.receive_time_ns = r.get<int64_t>("receive time");
+  info.publish_time_ns = r.get<int64_t>("publish time");
+  info.vertex_count = r.get<uint32_t>("vertex count");
+  info.marker_count = r.get<uint32_t>("marker count");
+  info.markers_filled = r.get<uint16_t>("markers filled");
+  info.markers_relabelled = r.get<uint16_t>("markers relabelled");
+  info.pipeline_dropped = r.get<uint32_t>("pipeline dropped");
+  info.subscriber_dropped = r.get<uint32_t>("subscriber dropped");
   if (version >= kVersion2) {
     FrameTimecode& t = info.timecode;
-    t.hours = r.get<uint8_t>();
-    t.minutes = r.get<uint8_t>();
-    t.seconds = r.get<uint8_t>();
-    t.frames = r.get<uint8_t>();
-    t.subframe = r.get<uint16_t>();
-    t.subframes_per_frame = r.get<uint16_t>();
-    t.rate_hz = r.get<float>();
-    t.flags = r.get<uint32_t>();
+    t.hours = r.get<uint8_t>("timecode hours");
+    t.minutes = r.get<uint8_t>("timecode minutes");
+    t.seconds = r.get<uint8_t>("timecode seconds");
+    t.frames = r.get<uint8_t>("timecode frames");
+    t.subframe = r.get<uint16_t>("timecode subframe");
+    t.subframes_per_frame = r.get<uint16_t>("timecode subframes per frame");
+    t.rate_hz = r.get<float>("timecode rate");
+    t.flags = r.get<uint32_t>("timecode flags");
   }
+  if (!r.ok()) return info;
   const uint32_t allowed = version >= kVersion2 ? kFrameFlagsVersion2 : kFrameFlagsVersion1;
   if (info.flags & ~allowed) throw DecodeError("Frame: reserved flag bits set (" + std::to_string(info.flags) + ")");
   const bool has_positions = !(info.flags & kFrameNoPositions);
@@ -482,41 +453,41 @@ FrameInfo read_frame_info(ByteReader& r, uint16_t version) {
 }
 
 // The next `bytes` of the payload as a block, or a DecodeError naming it.
-std::span<const unsigned char> take_block(std::span<const unsigned char> payload, ByteReader& r, size_t bytes, const char* what) {
+std::span<const unsigned char> take_block(ByteReader& r, size_t bytes, const char* what) {
   if (bytes > r.remaining())
     throw DecodeError(std::string("Frame: ") + what + " of " + std::to_string(bytes) + " bytes, the payload holds " +
                       std::to_string(r.remaining()));
-  const std::span<const unsigned char> block = payload.subspan(r.position(), bytes);
-  r.skip(bytes);
-  return block;
+  return r.take(bytes, what);
 }
 
 // A block whose first u32 (at `offset`) counts the coded bytes that follow: its whole size.
-size_t counted_block_bytes(ByteReader& r, size_t offset, const char* what) {
+size_t counted_block_bytes(const ByteReader& r, size_t offset, const char* what) {
   if (r.remaining() < offset + 4) throw DecodeError(std::string("Frame: ") + what + " truncated");
-  uint32_t coded = 0;
   ByteReader peek = r;
-  peek.skip(offset);
-  coded = peek.get<uint32_t>();
+  peek.skip(offset, what);
+  const uint32_t coded = peek.get<uint32_t>(what);
   if (coded > r.remaining()) throw DecodeError(std::string("Frame: ") + what + " says " + std::to_string(coded) + " bytes, more than the payload holds");
   return offset + 4 + coded + padding_to_4(coded);
 }
 
-FrameView view_payload(std::span<const unsigned char> payload, ByteReader& r, uint16_t version) {
+FrameView view_payload(ByteReader& r, uint16_t version) {
   FrameView view;
   view.info = read_frame_info(r, version);
+  if (!r.ok()) return view;
   const FrameInfo& info = view.info;
   const size_t v3 = 3 * size_t{info.vertex_count};
   const bool has_positions = !(info.flags & kFrameNoPositions);
   if (info.flags & kFrameParameters) {
     if (r.remaining() < 8) throw DecodeError("Frame: parameters truncated");
     ByteReader peek = r;
-    const uint64_t parts = peek.get<uint32_t>(), members = peek.get<uint32_t>();
-    view.positions = take_block(payload, r, 8 + 160 * parts + 12 * members, "parameters");
+    const uint64_t parts = peek.get<uint32_t>("parameter parts"),
+                   members = peek.get<uint32_t>("parameter members");
+    view.positions = take_block(r, 8 + 160 * parts + 12 * members, "parameters");
   } else if (info.flags & kFrameCompressed) {
-    view.positions = take_block(payload, r, counted_block_bytes(r, 28, "compressed positions"), "compressed positions");
+    view.positions =
+        take_block(r, counted_block_bytes(r, 28, "compressed positions"), "compressed positions");
     if (info.flags & kFrameNormals)
-      view.normals = take_block(payload, r, counted_block_bytes(r, 0, "compressed normals"), "compressed normals");
+      view.normals = take_block(r, counted_block_bytes(r, 0, "compressed normals"), "compressed normals");
   } else if (has_positions) {
     const bool quantised = info.flags & kFrameQuantised;
     // Checked against the payload before anything is cut, so a corrupt count is named as such.
@@ -525,28 +496,29 @@ FrameView view_payload(std::span<const unsigned char> payload, ByteReader& r, ui
     if (expected != r.remaining())
       throw DecodeError("Frame: counts say " + std::to_string(expected) + " bytes of data, the payload holds " +
                         std::to_string(r.remaining()));
-    view.positions = take_block(payload, r, quantised ? 24 + 2 * v3 + padding_to_4(2 * v3) : 4 * v3, "positions");
+    view.positions = take_block(r, quantised ? 24 + 2 * v3 + padding_to_4(2 * v3) : 4 * v3, "positions");
     if (info.flags & kFrameNormals)
-      view.normals = take_block(payload, r, quantised ? 2 * v3 + padding_to_4(2 * v3) : 4 * v3, "normals");
+      view.normals = take_block(r, quantised ? 2 * v3 + padding_to_4(2 * v3) : 4 * v3, "normals");
   }
   if (info.flags & kFrameMarkers) {
     const size_t m = info.marker_count;
     if (marker_block_bytes(info.marker_count) != r.remaining())
       throw DecodeError("Frame: counts say " + std::to_string(marker_block_bytes(info.marker_count)) +
                         " bytes of markers, the payload holds " + std::to_string(r.remaining()));
-    view.markers = take_block(payload, r, 12 * m, "markers");
-    view.marker_status = take_block(payload, r, m, "marker status");
-    r.skip(padding_to_4(m));
+    view.markers = take_block(r, 12 * m, "markers");
+    view.marker_status = take_block(r, m, "marker status");
+    r.skip(padding_to_4(m), "marker padding");
   }
   if (r.remaining() != 0)
-    throw DecodeError("Frame: counts say " + std::to_string(r.position()) + " bytes, the payload holds " + std::to_string(payload.size()));
+    throw DecodeError("Frame: counts say " + std::to_string(r.position()) + " bytes, the payload holds " +
+                      std::to_string(r.size()));
   return view;
 }
 
 }  // namespace
 
 FrameView view_frame(std::span<const unsigned char> payload, uint16_t version) {
-  return decode_payload("Frame", payload, [&](ByteReader& r) { return view_payload(payload, r, version); });
+  return decode_payload("Frame", payload, [&](ByteReader& r) { return view_payload(r, version); });
 }
 
 FrameInfo decode_frame_info(std::span<const unsigned char> payload, uint16_t version) { return view_frame(payload, version).info; }
@@ -558,30 +530,32 @@ Frame decode_frame(std::span<const unsigned char> payload, uint16_t version) {
   const FrameInfo& info = frame.info;
   const size_t v3 = 3 * size_t{info.vertex_count};
   const bool quantised = info.flags & kFrameQuantised;
+  // The blocks' sizes were checked by view_frame: the reads below cannot fail.
   if ((info.flags & kFrameCompressed) || (info.flags & kFrameParameters)) {
     frame.coded_positions.assign(view.positions.begin(), view.positions.end());
     frame.coded_normals.assign(view.normals.begin(), view.normals.end());
   } else if (quantised) {
-    ByteReader r(view.positions.data(), view.positions.size());
-    for (float& o : frame.origin) o = r.get<float>();
-    for (float& s : frame.step) s = r.get<float>();
+    ByteReader r(view.positions);
+    r.get_array(frame.origin.data(), 3, "quantisation origin");
+    r.get_array(frame.step.data(), 3, "quantisation step");
     frame.positions.resize(v3);
-    for (size_t i = 0; i < v3; ++i) frame.positions[i] = frame.origin[i % 3] + r.get<uint16_t>() * frame.step[i % 3];
+    for (size_t i = 0; i < v3; ++i)
+      frame.positions[i] = frame.origin[i % 3] + r.get<uint16_t>("positions") * frame.step[i % 3];
     if (!view.normals.empty()) {
-      ByteReader n(view.normals.data(), view.normals.size());
+      ByteReader n(view.normals);
       frame.normals.resize(v3);
-      for (float& c : frame.normals) c = n.get<int16_t>() / 32767.0f;
+      for (float& c : frame.normals) c = n.get<int16_t>("normals") / 32767.0f;
     }
   } else {
-    ByteReader p(view.positions.data(), view.positions.size());
-    get_floats(p, frame.positions, view.positions.size() / 4);
-    ByteReader n(view.normals.data(), view.normals.size());
-    get_floats(n, frame.normals, view.normals.size() / 4);
+    ByteReader p(view.positions);
+    get_floats(p, frame.positions, view.positions.size() / 4, "positions");
+    ByteReader n(view.normals);
+    get_floats(n, frame.normals, view.normals.size() / 4, "normals");
     if (frame.positions.size() != v3 || (!frame.normals.empty() && frame.normals.size() != v3))
       throw DecodeError("Frame: block sizes do not match the vertex count");
   }
-  ByteReader m(view.markers.data(), view.markers.size());
-  get_floats(m, frame.markers, view.markers.size() / 4);
+  ByteReader m(view.markers);
+  get_floats(m, frame.markers, view.markers.size() / 4, "markers");
   frame.marker_status.assign(view.marker_status.begin(), view.marker_status.end());
   for (uint8_t s : frame.marker_status)
     if (s > 4) throw DecodeError("Frame: marker status " + std::to_string(s) + " is not one of 0-4");
@@ -591,19 +565,19 @@ Frame decode_frame(std::span<const unsigned char> payload, uint16_t version) {
 Status decode_status(std::span<const unsigned char> payload, uint16_t version) {
   return decode_payload("Status", payload, [version](ByteReader& r) {
     Status status;
-    const uint32_t state = r.get<uint32_t>();
+    const uint32_t state = r.get<uint32_t>("source state");
     if (state > (version >= kVersion2 ? 4u : 3u)) throw DecodeError("Status: unknown source state " + std::to_string(state));
     status.state = static_cast<SourceStateCode>(state);
-    status.source_rate_hz = r.get<float>();
-    status.frames_received = r.get<uint64_t>();
-    status.frames_published = r.get<uint64_t>();
+    status.source_rate_hz = r.get<float>("source rate");
+    status.frames_received = r.get<uint64_t>("frames received");
+    status.frames_published = r.get<uint64_t>("frames published");
     status.detail = get_short_string(r, "Status: detail");
     if (version >= kVersion2) {
       status.subject = get_short_string(r, "Status: subject name");
-      const uint32_t present = r.get<uint32_t>();
+      const uint32_t present = r.get<uint32_t>("subject presence");
       if (present > 1) throw DecodeError("Status: subject presence " + std::to_string(present) + " is not 0 or 1");
       status.subject_present = present == 1;
-      status.encoding = encoding_of(r.get<uint32_t>(), "Status");
+      status.encoding = encoding_of(r.get<uint32_t>("encoding"), "Status");
     }
     return status;
   });
