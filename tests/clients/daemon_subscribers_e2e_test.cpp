@@ -406,18 +406,22 @@ TEST(DaemonDemoSubscribers, BuffersOfFormatsNobodyWantsAnyMoreAreFreed) {
   // Every frame the pool keeps (at least kept_free) held a buffer of each format; a frame the
   // 1 Hz trim frees takes its buffers with it, uncounted.
   const int kept = with["frame_pool"]["kept_free"].get<int>();
+  // What the formats cost depends on how many pooled frames held their buffers (8-10 here: 13-37
+  // MB): at least half of it must come back, to within the same of where RSS was before them.
+  ASSERT_GT(rss_with - rss_before, 8 * 1024) << "the formats' buffers cost too little to tell their return";
+  auto came_back = [&](long rss) { return rss < rss_before + (rss_with - rss_before) / 2; };
   nlohmann::json after;
   auto released = [&] {
     for (int i = 0; i < 10; ++i) good.next(std::chrono::seconds(1));  // keep reading
     after = health_of(daemon.http_port);
-    return after["frame_buffers_released"].get<int>() >= 4 * kept && resident_kb(daemon.pid()) < rss_with - 16 * 1024;
+    return after["frame_buffers_released"].get<int>() >= 4 * kept && came_back(resident_kb(daemon.pid()));
   };
   EXPECT_TRUE(eventually(released, std::chrono::seconds(40))) << after.dump();
   EXPECT_EQ(after["frame_buffers_allocated_by_pipeline"], 0) << after.dump();
   const long rss_after = resident_kb(daemon.pid());
   std::printf("RSS %ld kB before, %ld kB with 4 more formats, %ld kB once nobody wanted them (%d pooled frames)\n", rss_before,
               rss_with, rss_after, pool_frames);
-  EXPECT_LT(rss_after, rss_with - 16 * 1024) << "the formats' buffers did not come back";
+  EXPECT_TRUE(came_back(rss_after)) << "the formats' buffers did not come back";
   EXPECT_EQ(daemon.stop(), 0) << daemon.log();
 }
 
