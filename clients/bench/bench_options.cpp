@@ -57,10 +57,11 @@ std::optional<int> parse_bench_options(int argc, char** argv, BenchOptions& o) {
   app.add_option("--daemon-config", o.daemon_config,
                  "skinstreamd --config FILE: daemon keys that have no flag of their own")
       ->check(CLI::ExistingFile);
-  app.add_option("--join-wave", o.join_wave,
-                 "this many more subscribers connect together --join-after-seconds into the window, while the "
-                 "--subscribers watch (the report's figures are the watchers'; the joiners' wait for a first "
-                 "frame is under join_wave)")
+  app.add_option(
+         "--join-wave", o.join_wave,
+         "this many more subscribers connect together --join-after-seconds into the window, while the "
+         "--subscribers watch (the report's figures are the watchers'; the joiners' wait for a first "
+         "frame is under join_wave)")
       ->check(CLI::Range(0, 256))
       ->capture_default_str();
   app.add_option("--join-after-seconds", o.join_after_seconds,

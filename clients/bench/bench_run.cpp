@@ -52,7 +52,8 @@ std::string daemon_arguments(const BenchOptions& o, const std::string& source_op
   if (o.deform_spin_lead_us >= 0) a += " --deform-spin-lead-us " + std::to_string(o.deform_spin_lead_us);
   if (o.publish_threads >= 0) a += " --publish-threads " + std::to_string(o.publish_threads);
   if (o.subscriber_tcp_congestion) a += " --subscriber-tcp-congestion " + server::shell_word(*o.subscriber_tcp_congestion);
-  if (!o.daemon_config.empty()) a += " --config " + server::shell_word(fs::absolute(o.daemon_config).string());
+  if (!o.daemon_config.empty())
+    a += " --config " + server::shell_word(fs::absolute(o.daemon_config).string());
   return a;
 }
 
@@ -385,16 +386,22 @@ nlohmann::json run_bench(const BenchOptions& o, const std::atomic<bool>& stop) {
   const double bytes_per_frame = all.received > 0 ? static_cast<double>(all.message_bytes) / all.received : 0.0;
   nlohmann::json report = {
       {"mode", std::string(to_string(o.protocol)) + " replay (in-process) -> skinstreamd -> subscribers, " +
-                   (link ? "over a " + std::to_string(o.link_mbit) + " Mbit/s shaped link" : std::string("on loopback"))},
+                   (link ? "over a " + std::to_string(o.link_mbit) + " Mbit/s shaped link"
+                         : std::string("on loopback"))},
       {"seconds", o.seconds},
       {"window_seconds", window_s},
       {"subscribers", o.subscribers},
       {"subjects", o.subjects},
       {"encoding", client::to_string(o.encoding)},
       {"protocol", to_string(o.protocol)},
-      {"natnet_clock", {{"timestamp_jitter_us", o.natnet_timestamp_jitter_us}, {"clock_hz", o.natnet_clock_hz}}},
+      {"natnet_clock",
+       {{"timestamp_jitter_us", o.natnet_timestamp_jitter_us}, {"clock_hz", o.natnet_clock_hz}}},
       {"link_mbit", o.link_mbit},
-      {"subscribers_want", {{"normals", o.normals}, {"quantised", o.encoding == client::Encoding::Quantised}, {"decode", o.decode}, {"paced", o.paced}}},
+      {"subscribers_want",
+       {{"normals", o.normals},
+        {"quantised", o.encoding == client::Encoding::Quantised},
+        {"decode", o.decode},
+        {"paced", o.paced}}},
       {"seconds_until_every_subscriber_had_a_frame", seconds_to_first_frames},
       {"deform_threads", o.deform_threads},
       {"deform", health["deform"]},  // as the daemon applied it: threads, CPUs pinned to, spin lead
@@ -408,52 +415,60 @@ nlohmann::json run_bench(const BenchOptions& o, const std::atomic<bool>& stop) {
       {"markers", health["subject"]["markers"]},
       {"bytes_per_frame", bytes_per_frame},
       {"model_bytes", tallies.empty() ? 0 : tallies.front().model_bytes},
-      {"subscriber_frames_per_second", {{"slowest", rates.front()}, {"median", rates[rates.size() / 2]}, {"fastest", rates.back()}}},
+      {"subscriber_frames_per_second",
+       {{"slowest", rates.front()}, {"median", rates[rates.size() / 2]}, {"fastest", rates.back()}}},
       {"end_to_end", all.end_to_end.summary()},
       {"daemon_processing", all.processing.summary()},
-      {"ingest", all.ingest.summary()},      // replay send -> daemon receive
-      {"delivery", all.delivery.summary()},  // daemon publish -> subscriber arrival
+      {"ingest", all.ingest.summary()},           // replay send -> daemon receive
+      {"delivery", all.delivery.summary()},       // daemon publish -> subscriber arrival
       {"replay_sends", send_times.regularity()},  // gaps between the replay's consecutive sends
       // The daemon's own stage histograms (/health's latency_ms) over its whole life, warm-up
       // included: quantiles as bucket upper bounds. Delivery splits into subscriber_queue_wait
       // (published -> the write starts) and subscriber_write (-> the socket took the frame).
       {"daemon_stages_ms", health["latency_ms"]},
-      {"frames", {{"sent_by_replay", sent},
-                  {"dropped_by_replay", replay_dropped},
-                  {"received_by_daemon", delta("received")},
-                  {"processed", delta("processed")},
-                  {"published", delta("published")},
-                  {"dropped_in_pipeline", delta("dropped")},
-                  {"dropped_in_pipeline_mailbox_full", delta("dropped_mailbox_full")},
-                  {"received_by_subscribers", all.received},
-                  {"dropped_for_subscribers", total_dropped},
-                  {"out_of_order", all.out_of_order},
-                  {"without_send_time", all.unmatched}}},
+      {"frames",
+       {{"sent_by_replay", sent},
+        {"dropped_by_replay", replay_dropped},
+        {"received_by_daemon", delta("received")},
+        {"processed", delta("processed")},
+        {"published", delta("published")},
+        {"dropped_in_pipeline", delta("dropped")},
+        {"dropped_in_pipeline_mailbox_full", delta("dropped_mailbox_full")},
+        {"received_by_subscribers", all.received},
+        {"dropped_for_subscribers", total_dropped},
+        {"out_of_order", all.out_of_order},
+        {"without_send_time", all.unmatched}}},
       {"per_subscriber", per_subscriber},
       // Each actor's own threads' CPU and the daemon's figures for it; the threads they share.
-      {"per_subject", per_subject_report(o.subjects, thread_cpu_before, thread_cpu_after, health_before, health, subject_subscribers, window_s)},
+      {"per_subject", per_subject_report(o.subjects, thread_cpu_before, thread_cpu_after, health_before,
+                                         health, subject_subscribers, window_s)},
       {"hostile", waves ? waves->report() : nlohmann::json(nullptr)},
       {"subscriber_limits", health.value("subscriber_limits", nlohmann::json(nullptr))},
-      {"join_pacing", health.value("join_pacing", nlohmann::json(nullptr))},  // the joiners' first messages, as paced
+      {"join_pacing",
+       health.value("join_pacing", nlohmann::json(nullptr))},  // the joiners' first messages, as paced
       // Gaps over 3 frame periods (the replay's sends, each subscriber's arrivals), drops for a
       // subscriber and drops in the pipeline, in time order: a pause of the whole machine shows
       // at one moment in all.
       {"stalls", stalls.to_json()},
-      {"daemon", {{"cpu_seconds", cpu}, {"cpu_share_of_one_core", cpu / window_s}, {"peak_rss_kb", peak_rss_kb},
-                  {"rss_kb_after_1s", rss_samples.empty() ? 0 : rss_samples.front()},
-                  {"rss_kb_at_end", rss_samples.empty() ? 0 : rss_samples.back()},
-                  {"rss_kb_max_sampled", rss_samples.empty() ? 0 : *std::max_element(rss_samples.begin(), rss_samples.end())},
-                  {"rss_kb_every_60s", every_minute},
-                  {"rss_steps", rss_steps},  // each change between two 1 s samples: at_s, kb
-                  {"frame_buffers_after_1s", buffers_after_1s},
-                  {"frame_buffers_at_end", health.value("frame_buffers_allocated", 0)},
-                  // Of those, made on the 120 Hz thread because no prepared one was ready: 0 when
-                  // every subscriber's encoding was prepared on its Hello.
-                  {"frame_buffers_made_by_pipeline", health.value("frame_buffers_allocated_by_pipeline", 0)},
-                  // Gap filler rebuilds for a new source rate over the daemon's life (1: the rate became known).
-                  {"source_rate_changes", health["subjects"][0].value("source_rate_changes", uint64_t{0})},
-                  {"exit_status", exit_status},
-                  {"warnings", daemon_warnings}}},
+      {"daemon",
+       {{"cpu_seconds", cpu},
+        {"cpu_share_of_one_core", cpu / window_s},
+        {"peak_rss_kb", peak_rss_kb},
+        {"rss_kb_after_1s", rss_samples.empty() ? 0 : rss_samples.front()},
+        {"rss_kb_at_end", rss_samples.empty() ? 0 : rss_samples.back()},
+        {"rss_kb_max_sampled",
+         rss_samples.empty() ? 0 : *std::max_element(rss_samples.begin(), rss_samples.end())},
+        {"rss_kb_every_60s", every_minute},
+        {"rss_steps", rss_steps},  // each change between two 1 s samples: at_s, kb
+        {"frame_buffers_after_1s", buffers_after_1s},
+        {"frame_buffers_at_end", health.value("frame_buffers_allocated", 0)},
+        // Of those, made on the 120 Hz thread because no prepared one was ready: 0 when
+        // every subscriber's encoding was prepared on its Hello.
+        {"frame_buffers_made_by_pipeline", health.value("frame_buffers_allocated_by_pipeline", 0)},
+        // Gap filler rebuilds for a new source rate over the daemon's life (1: the rate became known).
+        {"source_rate_changes", health["subjects"][0].value("source_rate_changes", uint64_t{0})},
+        {"exit_status", exit_status},
+        {"warnings", daemon_warnings}}},
       // This process: the replay server and the subscribers, sharing the machine with the daemon.
       {"load_generator", {{"cpu_seconds", own_cpu}, {"cpu_share_of_one_core", own_cpu / window_s}}}};
   if (link) report["shaped_link"] = nlohmann::json::parse(shaper);

@@ -71,8 +71,9 @@ void WebSocketSubscriber::start_write(const std::array<asio::const_buffer, 2>& b
 }
 
 void WebSocketSubscriber::start_write_piece(asio::const_buffer piece, bool last) {
-  ws_.async_write_some(last, piece,
-                       [self = shared_from_this(), this](const boost::system::error_code& ec, size_t) { write_done(ec); });
+  ws_.async_write_some(
+      last, piece,
+      [self = shared_from_this(), this](const boost::system::error_code& ec, size_t) { write_done(ec); });
 }
 
 }  // namespace skinstream::server

@@ -298,11 +298,12 @@ void SubscriberSession::write_control() {
   // Waiting for the pacer is no stalled write (write_stalled_for: none under way).
   write_progress_ns_.store(0, std::memory_order_relaxed);
   pace_timer_.expires_after(wait);
-  pace_timer_.async_wait([self = shared_from_this(), this, at, piece, last](const boost::system::error_code& ec) {
-    if (ec || closed_) return;
-    note_write_progress();
-    start_write_piece(asio::buffer(in_flight_.control->data() + at, piece), last);
-  });
+  pace_timer_.async_wait(
+      [self = shared_from_this(), this, at, piece, last](const boost::system::error_code& ec) {
+        if (ec || closed_) return;
+        note_write_progress();
+        start_write_piece(asio::buffer(in_flight_.control->data() + at, piece), last);
+      });
 }
 
 void SubscriberSession::write_done(const boost::system::error_code& ec) {

@@ -21,7 +21,9 @@ class TcpSubscriber : public SubscriberSession {
  private:
   void read_next();
   void start_write(const std::array<asio::const_buffer, 2>& buffers) override;
-  void start_write_piece(asio::const_buffer piece, bool) override { start_write({piece, asio::const_buffer()}); }
+  void start_write_piece(asio::const_buffer piece, bool) override {
+    start_write({piece, asio::const_buffer()});
+  }
 
   tcp::socket socket_;
   std::shared_ptr<const void> placement_;
