@@ -283,15 +283,7 @@ nlohmann::json run_bench(const BenchOptions& o, const std::atomic<bool>& stop) {
   std::vector<SubscriberTally> joiner_tallies(static_cast<size_t>(o.join_wave));
   std::vector<std::string> joiner_errors(static_cast<size_t>(o.join_wave));
   std::vector<std::thread> joiners;
-  struct JoinJoiners {
-    Window& window;
-    std::vector<std::thread>& threads;
-    ~JoinJoiners() {
-      window.closed = true;
-      for (std::thread& t : threads)
-        if (t.joinable()) t.join();
-    }
-  } join_joiners{window, joiners};
+  JoinSubscribers join_joiners{window, joiners};  // the same guard: joined first, being declared later
   const Clock::time_point join_at = Clock::now() + std::chrono::duration_cast<Clock::duration>(
                                                        std::chrono::duration<double>(o.join_after_seconds));
   bool joined = o.join_wave == 0;
