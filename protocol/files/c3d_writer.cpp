@@ -11,6 +11,7 @@
 
 #include "protocol/files/c3d.h"
 #include "protocol/files/c3d_format.h"
+#include "protocol/files/c3d_preamble.h"
 #include "protocol/files/capture_checks.h"
 #include "protocol/files/file_error.h"
 
@@ -177,31 +178,30 @@ struct FrameRange {
   uint64_t last() const { return first + std::max<uint64_t>(count, 1) - 1; }
 };
 
-std::vector<uint8_t> parameter_section(const Capture& capture, const WordEncoder& encode,
+std::vector<uint8_t> parameter_section(const C3dPointLayout& layout, const WordEncoder& encode,
                                        const C3dWriteOptions& options, float scale, uint16_t data_start) {
   enum : int8_t { kPoint = 1, kAnalog = 2, kTrial = 3 };
-  const FrameRange frames{static_cast<uint64_t>(capture.first_frame),
-                          static_cast<uint64_t>(capture.frame_count)};
+  const std::vector<std::string>& labels = layout.labels;
+  const FrameRange frames{static_cast<uint64_t>(layout.first_frame), layout.frame_count};
   ParameterSectionWriter p(encode);
   p.group(kPoint, "POINT", "3-D point parameters");
-  p.int16(kPoint, "USED", static_cast<uint16_t>(capture.point_count()));
+  p.int16(kPoint, "USED", static_cast<uint16_t>(labels.size()));
   // 16 bits read unsigned by readers; longer captures are described by the TRIAL fields.
   p.int16(kPoint, "FRAMES", static_cast<uint16_t>(std::min<uint64_t>(frames.count, 65535)));
   p.int16(kPoint, "DATA_START", data_start);
   p.float32(kPoint, "SCALE", scale);
-  p.float32(kPoint, "RATE", static_cast<float>(capture.rate_hz));
+  p.float32(kPoint, "RATE", static_cast<float>(layout.rate_hz));
   p.string(kPoint, "UNITS", "mm");
 
   int width = 1;
-  for (const std::string& label : capture.labels) width = std::max(width, static_cast<int>(label.size()));
+  for (const std::string& label : labels) width = std::max(width, static_cast<int>(label.size()));
   // Dimensions are bytes: more than 255 labels continue in LABELS2, LABELS3...
   const size_t per_array = std::min<size_t>(kMaxArrayDimension, kMaxRecordBytes / width);
-  const std::vector<std::string> no_descriptions(capture.labels.size(), "");
-  for (size_t first = 0, part = 1; first < capture.labels.size() || part == 1; first += per_array, ++part) {
-    const size_t end = std::min(capture.labels.size(), first + per_array);
+  const std::vector<std::string> no_descriptions(labels.size(), "");
+  for (size_t first = 0, part = 1; first < labels.size() || part == 1; first += per_array, ++part) {
+    const size_t end = std::min(labels.size(), first + per_array);
     const std::string suffix = part == 1 ? "" : std::to_string(part);
-    p.strings(kPoint, "LABELS" + suffix, {capture.labels.begin() + first, capture.labels.begin() + end},
-              width);
+    p.strings(kPoint, "LABELS" + suffix, {labels.begin() + first, labels.begin() + end}, width);
     p.strings(kPoint, "DESCRIPTIONS" + suffix,
               {no_descriptions.begin() + first, no_descriptions.begin() + end}, 1);
   }
@@ -217,19 +217,18 @@ std::vector<uint8_t> parameter_section(const Capture& capture, const WordEncoder
   p.group(kTrial, "TRIAL", "Trial parameters");
   p.int16s(kTrial, "ACTUAL_START_FIELD", {2}, field(frames.first));
   p.int16s(kTrial, "ACTUAL_END_FIELD", {2}, field(frames.last()));
-  p.float32(kTrial, "CAMERA_RATE", static_cast<float>(capture.rate_hz));
+  p.float32(kTrial, "CAMERA_RATE", static_cast<float>(layout.rate_hz));
   return p.finish(options.processor);
 }
 
-std::vector<uint8_t> header_block(const Capture& capture, const WordEncoder& encode, float scale,
+std::vector<uint8_t> header_block(const C3dPointLayout& layout, const WordEncoder& encode, float scale,
                                   uint16_t data_start) {
   std::vector<uint8_t> header(kBlockBytes, 0);
   header[0] = kParameterBlock;
   header[1] = kHeaderKey;
   const auto clip16 = [](uint64_t value) { return static_cast<uint16_t>(std::min<uint64_t>(value, 65535)); };
-  const FrameRange frames{static_cast<uint64_t>(capture.first_frame),
-                          static_cast<uint64_t>(capture.frame_count)};
-  encode.u16(&header[2], static_cast<uint16_t>(capture.point_count()));
+  const FrameRange frames{static_cast<uint64_t>(layout.first_frame), layout.frame_count};
+  encode.u16(&header[2], static_cast<uint16_t>(layout.labels.size()));
   encode.u16(&header[4], 0);  // analog words per frame
   encode.u16(&header[6], clip16(frames.first));
   encode.u16(&header[8], clip16(frames.last()));
@@ -237,7 +236,7 @@ std::vector<uint8_t> header_block(const Capture& capture, const WordEncoder& enc
   encode.f32(&header[12], scale);
   encode.u16(&header[16], data_start);
   encode.u16(&header[18], 0);  // analog samples per frame
-  encode.f32(&header[20], static_cast<float>(capture.rate_hz));
+  encode.f32(&header[20], static_cast<float>(layout.rate_hz));
   return header;
 }
 
@@ -276,40 +275,49 @@ void encode_sample(uint8_t* out, const Vec3& p, float scale, const WordEncoder& 
   encode.i16(out + 6, 0);
 }
 
-void check_c3d_writable(const Capture& capture, const std::string& path) {
-  check_capture_shape(capture, path);
-  if (capture.point_count() > 65535)
-    throw FileError(path,
-                    "C3D holds at most 65535 points, capture has " + std::to_string(capture.point_count()));
-  if (capture.first_frame < 0)
-    throw FileError(path, "C3D cannot store negative first frame " + std::to_string(capture.first_frame));
-  for (const std::string& label : capture.labels)
+void check_c3d_layout(const C3dPointLayout& layout, const std::string& path) {
+  if (layout.labels.size() > 65535)
+    throw FileError(path, "C3D holds at most 65535 points, capture has " + std::to_string(layout.labels.size()));
+  if (layout.first_frame < 0)
+    throw FileError(path, "C3D cannot store negative first frame " + std::to_string(layout.first_frame));
+  for (const std::string& label : layout.labels)
     if (label.size() > kMaxArrayDimension)
       throw FileError(path, "label longer than 255 characters: " + label.substr(0, 40) + "...");
 }
 
 }  // namespace
 
-void write_c3d(const Capture& capture, const std::string& path, const C3dWriteOptions& options) {
-  check_c3d_writable(capture, path);
+std::vector<uint8_t> c3d_preamble(const C3dPointLayout& layout, const std::string& path,
+                                  const C3dWriteOptions& options, float scale) {
+  check_c3d_layout(layout, path);
   const WordEncoder encode(path, options.processor);
-  // A negative scale selects float storage; -1 leaves residuals unscaled.
-  const float scale = options.float_storage ? -1.0f : integer_scale(capture);
-
   // The section's size does not depend on DATA_START's value: build once to learn it.
-  const size_t parameter_blocks = parameter_section(capture, encode, options, scale, 0).size() / kBlockBytes;
+  const size_t parameter_blocks = parameter_section(layout, encode, options, scale, 0).size() / kBlockBytes;
   if (parameter_blocks > kMaxParameterBlocks)
     throw FileError(path,
                     "labels need " + std::to_string(parameter_blocks) + " parameter blocks, C3D allows 255");
   const auto data_start = static_cast<uint16_t>(kParameterBlock + parameter_blocks);
+  std::vector<uint8_t> bytes = header_block(layout, encode, scale, data_start);
+  const std::vector<uint8_t> parameters = parameter_section(layout, encode, options, scale, data_start);
+  bytes.insert(bytes.end(), parameters.begin(), parameters.end());
+  return bytes;
+}
+
+void write_c3d(const Capture& capture, const std::string& path, const C3dWriteOptions& options) {
+  check_capture_shape(capture, path);
+  // A negative scale selects float storage; -1 leaves residuals unscaled.
+  const float scale = options.float_storage ? -1.0f : integer_scale(capture);
+  const C3dPointLayout layout{capture.labels, capture.rate_hz, capture.first_frame,
+                              static_cast<uint64_t>(std::max(capture.frame_count, 0))};
+  const std::vector<uint8_t> preamble = c3d_preamble(layout, path, options, scale);
+  const WordEncoder encode(path, options.processor);
 
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
   if (!out) throw FileError(path, "cannot open for writing");
   const auto put = [&](const std::vector<uint8_t>& bytes) {
     out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
   };
-  put(header_block(capture, encode, scale, data_start));
-  put(parameter_section(capture, encode, options, scale, data_start));
+  put(preamble);
 
   const size_t sample_bytes = options.float_storage ? 16 : 8;
   const size_t frame_bytes = sample_bytes * capture.labels.size();
