@@ -578,6 +578,28 @@ std::vector<ConfigKey> make_config_keys() {
         "queue behind it. Below the stage link's rate less the frames' (64 parameter subscribers:\n"
         "about 480 Mbit/s). 0 = unpaced."},
             between(0, 100'000), "0-100000 (0 = unpaced)"),
+      bound(&DaemonConfig::record_dir,
+            {.name = "record_dir", .flag = "--record-dir", .new_group = true,
+             .flag_help = "folder of the takes the daemon records (\"\" = no recording)",
+             .doc =
+        "Folder of the takes the daemon records (flag --record-dir; created when missing; \"\" =\n"
+        "no recording). A take is, per subject, what was received (C3D and a per-frame table of\n"
+        "source frame numbers, times and timecode) and what was published (the filled markers and\n"
+        "each sample's status), with a take.json; started and stopped through the control API\n"
+        "(docs/control-api.md) or record_always. Readable up to the last second after a crash or a\n"
+        "full disk; the daemon closes interrupted takes when it starts (docs/takes.md)."}),
+      bound(&DaemonConfig::record_always,
+            {.name = "record_always", .flag = "--record-always",
+             .flag_help = "record a take from start to stop (needs --record-dir)",
+             .doc =
+        "Record one take from the daemon's start to its stop, named by the UTC time (flag\n"
+        "--record-always; needs record_dir)."}),
+      bound(&DaemonConfig::record_unlabelled,
+            {.name = "record_unlabelled",
+             .doc =
+        "Unlabelled points kept per received frame in a take (0-1024): channels \"*1\"..\"*N\" after\n"
+        "the subject's markers; a frame's points beyond them are counted in the table, not kept."},
+            between(0, 1024), "0-1024"),
       bound(&DaemonConfig::log_level,
             {.name = "log_level", .flag = "--log-level", .new_group = true,
              .flag_help = "trace, debug, info, warn, error, critical, off",

@@ -141,6 +141,9 @@ Daemon::Daemon(const DaemonConfig& config)
     s->hub().set_directory(&directory_);
   }
   admission_ = std::make_shared<SubscriberAdmission>(admission_options_of(config), source_metrics_);
+  if (config.record_always && config.record_dir.empty())
+    throw ConfigError("record_always needs record_dir (--record-dir)");
+  if (!config.record_dir.empty()) start_recorder();
   const SourceSpec source = source_spec_of(config);
   source_ = make_source(io_, source, config, static_cast<SourceSink&>(*this));
   if (source.kind == SourceSpec::Kind::Replay) {
@@ -199,6 +202,19 @@ void Daemon::start_source() {
   if (source_) asio::post(io_, [this] { if (!stopping_.load()) source_->start(); });
 }
 
+void Daemon::start_recorder() {
+  TakeRecorderOptions options;
+  options.dir = config_.record_dir;
+  options.unlabelled_slots = config_.record_unlabelled;
+  options.default_rate_hz = config_.default_rate_hz;
+  options.config = printable(config_);
+  recorder_ = std::make_unique<TakeRecorder>(std::move(options));
+  for (auto& s : subjects_)
+    s->set_take_tap(&recorder_->add_subject(s->name(), s->config().file, s->model().marker_names));
+  for (const std::string& line : recorder_->recover_interrupted()) spdlog::warn("skinstreamd: {}", line);
+  recorder_->start_thread();
+}
+
 void Daemon::start_serving() {
   if (started_.exchange(true)) return;
   for (auto& s : subjects_) s->start();
@@ -207,6 +223,10 @@ void Daemon::start_serving() {
   http_->start();
   schedule_status();
   if (config_.status_log_seconds > 0) schedule_status_log();
+  if (recorder_ && config_.record_always) {
+    const TakeAnswer answer = recorder_->start("", "record_always");
+    if (answer.status >= 300) spdlog::error("skinstreamd: record_always: {}", answer.body.value("error", ""));
+  }
   write_ports_file();
   for (const auto& s : subjects_)
     spdlog::info("skinstreamd: subject {} ({}, {} markers, {} vertices)", s->name(), s->config().file, s->model().marker_count(),
@@ -242,6 +262,7 @@ void Daemon::wait() {
   if (!stopped_) {
     stopped_ = true;
     for (auto& s : subjects_) s->stop();
+    recorder_.reset();  // closes a take in progress: after the last frame was published
   }
 }
 
@@ -410,6 +431,7 @@ std::string Daemon::health_json() const {
       {"status", "ok"},
       {"source", source},
       {"subjects", subjects},
+      {"recording", recorder_ ? recorder_->health() : nlohmann::json{{"state", "off"}}},
       {"subscribers", subscribers},
       {"frame_pool", first["frame_pool"]},
       {"subscriber_limits",

@@ -27,6 +27,7 @@
 #include "server/publish/publish_threads.h"
 #include "server/publish/subject_directory.h"
 #include "server/publish/subscriber_admission.h"
+#include "server/record/take_recorder.h"
 #include "server/subject_stream.h"
 
 namespace skinstream::server {
@@ -75,6 +76,7 @@ class Daemon : private SourceSink, private SubjectRouter::Observer {
   void schedule_status();
   void schedule_status_log();
   void write_ports_file() const;
+  void start_recorder();
 
   DaemonConfig config_;
   std::vector<int> deform_cpus_;  // deform_threads per subject, subject after subject, or none (not pinned)
@@ -82,6 +84,8 @@ class Daemon : private SourceSink, private SubjectRouter::Observer {
   RateLimitedLog bad_input_log_;
   RateLimitedLog state_log_;  // the source's changes of state
   SubjectDirectory directory_;  // the subjects' hubs by name; outlives them
+  // Takes (when record_dir is set): its taps are the subjects' and outlive them.
+  std::unique_ptr<TakeRecorder> recorder_;
   // Before io_: the io_context is destroyed first, and with it the handlers still holding
   // sessions whose queues hold frames of the subjects' pipelines' pools.
   std::vector<std::unique_ptr<SubjectStream>> subjects_;

@@ -129,6 +129,11 @@ void SubjectStream::start() { pipeline_->start(); }
 
 void SubjectStream::stop() { pipeline_->stop(); }
 
+void SubjectStream::set_take_tap(TakeTap* tap) {
+  take_tap_ = tap;
+  pipeline_->set_filled_observer(tap);
+}
+
 void SubjectStream::post() {
   metrics_.frames_received.fetch_add(1, std::memory_order_relaxed);
   const MarkerFrame& frame = mailbox_.writable();
@@ -144,6 +149,7 @@ void SubjectStream::post() {
                                                  std::to_string(frame.implausible_points) +
                                                  " points taken as missing (outside the capture volume, source_max_coordinate_m)");
   }
+  if (take_tap_) take_tap_->record_received(frame);
   if (frame.source_rate_hz > 0 && frame.source_rate_hz != source_rate_hz_) {
     source_rate_hz_ = frame.source_rate_hz;
     hub_->set_source_rate(static_cast<float>(frame.source_rate_hz));

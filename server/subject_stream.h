@@ -27,6 +27,7 @@
 #include "server/pipeline/pipeline.h"
 #include "server/publish/multicast_sender.h"
 #include "server/publish/subscriber_hub.h"
+#include "server/record/take_tap.h"
 
 namespace skinstream::server {
 
@@ -57,6 +58,8 @@ class SubjectStream {
   Metrics& metrics() { return metrics_; }
   const Metrics& metrics() const { return metrics_; }
 
+  // Before start(): the take recorder's tap for this subject (received and published frames).
+  void set_take_tap(TakeTap* tap);
   void start();  // the pipeline thread
   void stop();   // no frame is published after it returns; safe to call twice
 
@@ -94,6 +97,7 @@ class SubjectStream {
   std::unique_ptr<Pipeline> pipeline_;
   std::vector<int> deform_cpus_;
   int deform_threads_ = 0;
+  TakeTap* take_tap_ = nullptr;
   uint64_t generation_ = 0;  // io thread only
   double source_rate_hz_ = 0.0;  // io thread only
 

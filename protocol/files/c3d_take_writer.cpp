@@ -16,14 +16,16 @@
 namespace skinstream {
 namespace {
 
-static_assert(std::endian::native == std::endian::little, "the take writer stores Intel floats as they are in memory");
+static_assert(std::endian::native == std::endian::little,
+              "the take writer stores Intel floats as they are in memory");
 
 constexpr size_t kTakeSampleBytes = 16;  // x, y, z, residual: float storage
 constexpr float kFloatStorageScale = -1.0f;
 
 std::vector<uint8_t> take_preamble(const std::vector<std::string>& labels, double rate_hz, uint64_t frames,
                                    const std::string& path) {
-  return c3d_preamble(C3dPointLayout{labels, rate_hz, 1, frames}, path, C3dWriteOptions{}, kFloatStorageScale);
+  return c3d_preamble(C3dPointLayout{labels, rate_hz, 1, frames}, path, C3dWriteOptions{},
+                      kFloatStorageScale);
 }
 
 std::string system_reason(int error) { return std::strerror(error); }
@@ -54,7 +56,8 @@ void C3dTakeWriter::append(std::span<const Vec3> points) {
   uint8_t* out = pending_.data() + at;
   for (size_t i = 0; i < labels_.size(); ++i, out += kTakeSampleBytes) {
     const bool present = i < points.size() && is_present(points[i]);
-    for (int axis = 0; axis < 3; ++axis) put_float(out + 4 * axis, present ? static_cast<float>(points[i][axis]) : 0.0f);
+    for (int axis = 0; axis < 3; ++axis)
+      put_float(out + 4 * axis, present ? static_cast<float>(points[i][axis]) : 0.0f);
     put_float(out + 12, present ? 0.0f : -1.0f);  // a negative residual marks a missing sample
   }
   ++queued_;
@@ -75,7 +78,8 @@ void C3dTakeWriter::close() {
   if (fd_ < 0) return;
   commit();
   const uint64_t end = data_offset_ + committed_ * kTakeSampleBytes * labels_.size();
-  const uint64_t padded = (end + c3d_format::kBlockBytes - 1) / c3d_format::kBlockBytes * c3d_format::kBlockBytes;
+  const uint64_t padded =
+      (end + c3d_format::kBlockBytes - 1) / c3d_format::kBlockBytes * c3d_format::kBlockBytes;
   if (::ftruncate(fd_, static_cast<off_t>(padded)) != 0 || ::fsync(fd_) != 0)
     throw FileError(path_, "cannot finish: " + system_reason(errno));
   ::close(fd_);
@@ -84,7 +88,8 @@ void C3dTakeWriter::close() {
 
 void C3dTakeWriter::write_preamble(uint64_t frames) {
   const std::vector<uint8_t> preamble = take_preamble(labels_, rate_hz_, frames, path_);
-  if (preamble.size() != preamble_bytes_) throw FileError(path_, "preamble changed size");  // cannot happen: values only
+  if (preamble.size() != preamble_bytes_)
+    throw FileError(path_, "preamble changed size");  // cannot happen: values only
   write_all(preamble.data(), preamble.size(), 0, "preamble");
   if (::fsync(fd_) != 0) throw FileError(path_, "cannot sync the frame count: " + system_reason(errno));
 }
@@ -93,7 +98,9 @@ void C3dTakeWriter::write_all(const uint8_t* data, size_t size, uint64_t offset,
   while (size > 0) {
     const ssize_t written = ::pwrite(fd_, data, size, static_cast<off_t>(offset));
     if (written < 0 && errno == EINTR) continue;
-    if (written <= 0) throw FileError(path_, std::string("cannot write ") + what + ": " + system_reason(written < 0 ? errno : ENOSPC));
+    if (written <= 0)
+      throw FileError(
+          path_, std::string("cannot write ") + what + ": " + system_reason(written < 0 ? errno : ENOSPC));
     data += written;
     offset += static_cast<uint64_t>(written);
     size -= static_cast<size_t>(written);
@@ -130,7 +137,8 @@ uint64_t recover_c3d_take(const std::string& path, const std::vector<std::string
   }
   const std::vector<uint8_t> preamble = take_preamble(labels, rate_hz, frames, path);
   const uint64_t end = empty.size() + frames * frame_bytes;
-  const uint64_t padded = (end + c3d_format::kBlockBytes - 1) / c3d_format::kBlockBytes * c3d_format::kBlockBytes;
+  const uint64_t padded =
+      (end + c3d_format::kBlockBytes - 1) / c3d_format::kBlockBytes * c3d_format::kBlockBytes;
   if (::pwrite(fd, preamble.data(), preamble.size(), 0) != static_cast<ssize_t>(preamble.size()) ||
       ::ftruncate(fd, static_cast<off_t>(end)) != 0 || ::ftruncate(fd, static_cast<off_t>(padded)) != 0 ||
       ::fsync(fd) != 0)

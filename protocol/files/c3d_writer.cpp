@@ -277,7 +277,8 @@ void encode_sample(uint8_t* out, const Vec3& p, float scale, const WordEncoder& 
 
 void check_c3d_layout(const C3dPointLayout& layout, const std::string& path) {
   if (layout.labels.size() > 65535)
-    throw FileError(path, "C3D holds at most 65535 points, capture has " + std::to_string(layout.labels.size()));
+    throw FileError(path,
+                    "C3D holds at most 65535 points, capture has " + std::to_string(layout.labels.size()));
   if (layout.first_frame < 0)
     throw FileError(path, "C3D cannot store negative first frame " + std::to_string(layout.first_frame));
   for (const std::string& label : layout.labels)

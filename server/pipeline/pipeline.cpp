@@ -310,6 +310,9 @@ void Pipeline::publish(const Released& meta, std::span<const Vec3> positions, st
                                                  " are not all finite");
     return;
   }
+  if (filled_observer_)
+    filled_observer_->on_filled(
+        {meta.frame_number, meta.source_time_ns, meta.receive_time_ns, positions, status});
   subscriber::FrameInfo info;
   info.frame_number = meta.frame_number;
   info.source_time_ns = meta.source_time_ns;

@@ -28,6 +28,7 @@
 #include "server/metrics/metrics.h"
 #include "server/pipeline/deform_workers.h"
 #include "server/pipeline/encoded_frame.h"
+#include "server/pipeline/filled_frame_observer.h"
 #include "server/pipeline/frame_mailbox.h"
 #include "server/pipeline/on_demand_thread.h"
 #include "server/pipeline/stream_key.h"
@@ -67,6 +68,8 @@ class Pipeline {
 
   void start();
   void stop();  // joins the thread; safe to call twice
+  // Before start(): who also sees each published frame's filled markers (the take recorder).
+  void set_filled_observer(FilledFrameObserver* observer) { filled_observer_ = observer; }
 
   bool has_mesh() const { return deformer_ != nullptr; }
   uint32_t vertex_count() const { return deformer_ ? static_cast<uint32_t>(deformer_->vertex_count()) : 0; }
@@ -188,6 +191,7 @@ class Pipeline {
   std::vector<unsigned char> compressed_blocks_;
 
   RateLimitedLog non_finite_log_;
+  FilledFrameObserver* filled_observer_ = nullptr;
 
   std::atomic<bool> running_{false};
   std::atomic<uint64_t> published_{0};

@@ -26,8 +26,8 @@ SubscriberSession::SubscriberSession(asio::io_context& io, SubscriberHub& hub, s
       remote_(std::move(remote)),
       queue_(hub.options().queue_frames, hub.options().frame_max_wait),
       hello_timer_(io),
-      pace_timer_(io),
-      pump_slot_(std::make_shared<HandlerSlot>()) {}
+      pump_slot_(std::make_shared<HandlerSlot>()),
+      pace_timer_(io) {}
 
 void SubscriberSession::offer(const FrameRef& frame) {
   if (!frame->has(key_.load())) return;  // encoding not ready in this frame (wants just changed)

@@ -67,6 +67,9 @@ const nlohmann::json kChangedValues = {
     {"unauthenticated_hello_timeout_ms", 200},
     {"subscriber_unsent_kb", 64},
     {"subscriber_join_mbit", 500},
+    {"record_dir", "takes"},
+    {"record_always", true},
+    {"record_unlabelled", 16},
     {"log_level", "debug"}};
 
 // A value out of range, or not of the key's form, for every key that checks its value.
@@ -106,6 +109,7 @@ const std::pair<const char*, nlohmann::json> kBadValues[] = {{"speed", 0.0},
                                                              {"subscriber_write_stall_ms", -5},
                                                              {"allow_subscribers", {"10.0.0.0/40"}},
                                                              {"subscriber_token", std::string(300, 't')},
+                                                             {"record_unlabelled", 1025},
                                                              {"max_unauthenticated_subscribers", -1},
                                                              {"max_unauthenticated_per_address", -1},
                                                              {"unauthenticated_hello_timeout_ms", 9},

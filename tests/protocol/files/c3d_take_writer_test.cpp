@@ -43,7 +43,8 @@ void expect_frames(const Capture& capture, int count) {
 
 // What the writer leaves on disk when it dies after syncing frames but before the count.
 void say_count(const std::string& path, uint64_t frames) {
-  const std::vector<uint8_t> preamble = c3d_preamble(C3dPointLayout{kLabels, 120.0, 1, frames}, path, {}, -1.0f);
+  const std::vector<uint8_t> preamble =
+      c3d_preamble(C3dPointLayout{kLabels, 120.0, 1, frames}, path, {}, -1.0f);
   std::string bytes = test::read_bytes(path);
   std::copy(preamble.begin(), preamble.end(), bytes.begin());
   test::write_bytes(path, bytes);
@@ -52,7 +53,8 @@ void say_count(const std::string& path, uint64_t frames) {
 TEST(C3dTakeWriter, RefusesAFileThatExists) {
   const std::string path = test::scratch_path("take_exists.c3d");
   test::write_bytes(path, "keep me");
-  EXPECT_TRUE(test::throws_file_error([&] { C3dTakeWriter writer(path, kLabels, 120.0); }, path, "cannot create"));
+  EXPECT_TRUE(
+      test::throws_file_error([&] { C3dTakeWriter writer(path, kLabels, 120.0); }, path, "cannot create"));
   EXPECT_EQ(test::read_bytes(path), "keep me");
 }
 
@@ -85,7 +87,7 @@ TEST(C3dTakeWriter, RecoveryCountsTheFramesWrittenBeforeACrashAndDropsAPartialOn
     C3dTakeWriter writer(path, kLabels, 120.0);
     for (int f = 0; f < 7; ++f) writer.append(frame_of(f));
     writer.commit();
-  }  // not closed: as after kill -9
+  }                    // not closed: as after kill -9
   say_count(path, 4);  // the frames reached the disk, the count did not
   test::write_bytes(path, test::read_bytes(path) + std::string(20, '\x7f'));  // half a frame
   expect_frames(read_c3d(path), 4);
@@ -101,7 +103,8 @@ TEST(C3dTakeWriter, RecoveryRefusesAFileOfOtherPoints) {
   const std::string path = test::scratch_path("take_other.c3d");
   { C3dTakeWriter writer(path, kLabels, 120.0); }
   const std::vector<std::string> other{"A", "B"};
-  EXPECT_TRUE(test::throws_file_error([&] { recover_c3d_take(path, other, 120.0); }, path, "not a take file"));
+  EXPECT_TRUE(
+      test::throws_file_error([&] { recover_c3d_take(path, other, 120.0); }, path, "not a take file"));
   expect_frames(read_c3d(path), 0);
 }
 
