@@ -21,20 +21,24 @@ struct RecordedFrame {
   int64_t source_time_ns = 0;
   int64_t receive_time_ns = 0;
   SourceTimecode timecode;
-  std::vector<Vec3>
-      points;  // received: the labelled markers, then the unlabelled slots; published: the markers
-  std::vector<uint8_t> status;  // published: MarkerStatus per marker
-  int unlabelled = 0;      // received: unlabelled points of the frame (those beyond the slots are not kept)
+  // Received: the labelled markers, then the frame's first unlabelled points; published: the markers.
+  std::vector<Vec3> points;
+  std::vector<uint8_t> status;      // published: MarkerStatus per marker
+  std::vector<int> unlabelled_ids;  // received: the source's trajectory id of each unlabelled point copied
+  int unlabelled_copied = 0;        // received: unlabelled points copied
+  int unlabelled = 0;      // received: unlabelled points of the frame (those not copied are not kept)
   int unknown_labels = 0;  // received: labels the subject does not have
 };
 
 class RecordedFrameRing {
  public:
-  // `slots` frames of `points` points (and as many status bytes). Allocates.
-  RecordedFrameRing(size_t slots, size_t points) : slots_(slots) {
+  // `slots` frames of `points` points (and as many status bytes), `unlabelled` of them
+  // unlabelled points with their ids. Allocates.
+  RecordedFrameRing(size_t slots, size_t points, size_t unlabelled = 0) : slots_(slots) {
     for (RecordedFrame& slot : slots_) {
       slot.points.assign(points, missing_point());
       slot.status.assign(points, 0);
+      slot.unlabelled_ids.assign(unlabelled, -1);
     }
   }
   RecordedFrameRing(const RecordedFrameRing&) = delete;

@@ -18,6 +18,7 @@
 #include "protocol/files/file_error.h"
 #include "protocol/files/whole_file.h"
 #include "server/record/frame_table.h"
+#include "server/record/unlabelled_slots.h"
 #include "server/thread_name.h"
 
 namespace skinstream::server {
@@ -134,6 +135,9 @@ struct TakeRecorder::ActiveTake {
     std::string subject_sha256;
     std::unique_ptr<C3dTakeWriter> raw_c3d, filled_c3d;
     std::unique_ptr<FrameTable> raw_table, filled_table;
+    std::unique_ptr<UnlabelledSlots> unlabelled;
+    std::vector<Vec3> raw_points;  // a received frame with its unlabelled points in their channels
+    std::vector<int> slot_of_point;
     uint64_t raw_frames = 0, filled_frames = 0;
     uint64_t raw_dropped_before = 0, filled_dropped_before = 0;  // the tap's counts when the take began
   };
@@ -293,6 +297,10 @@ void TakeRecorder::begin_take(ActiveTake& take) {
     files.rate_hz = rate > 0 ? rate : options_.default_rate_hz;
     files.subject_sha256 = sha256_of_file(subject.subject_file);
     files.raw_dropped_before = subject.tap->received_dropped();
+    files.unlabelled = std::make_unique<UnlabelledSlots>(subject.tap->unlabelled_slots());
+    files.raw_points.resize(subject.tap->marker_names().size() +
+                            static_cast<size_t>(subject.tap->unlabelled_slots()));
+    files.slot_of_point.resize(static_cast<size_t>(subject.tap->unlabelled_slots()));
     files.filled_dropped_before = subject.tap->published_dropped();
     take.files.push_back(std::move(files));
   }
@@ -315,13 +323,23 @@ void TakeRecorder::drain(ActiveTake& take) {
     RecordedFrameRing& received = files.subject->tap->received();
     while (const RecordedFrame* frame = received.front()) {
       if (frame->take == take.id) {
-        files.raw_c3d->append(frame->points);
+        const size_t markers = files.subject->tap->marker_names().size();
+        const auto copied = static_cast<size_t>(frame->unlabelled_copied);
+        const int kept = files.unlabelled->assign(std::span<const int>(frame->unlabelled_ids).first(copied),
+                                                  std::span<int>(files.slot_of_point).first(copied));
+        std::copy_n(frame->points.begin(), markers, files.raw_points.begin());
+        std::fill(files.raw_points.begin() + static_cast<long>(markers), files.raw_points.end(),
+                  missing_point());
+        for (size_t j = 0; j < copied; ++j)
+          if (files.slot_of_point[j] >= 0)
+            files.raw_points[markers + static_cast<size_t>(files.slot_of_point[j])] =
+                frame->points[markers + j];
+        files.raw_c3d->append(files.raw_points);
         std::string& line = files.raw_table->line();
         fmt::format_to(std::back_inserter(line), "{}\t{}\t{}\t{}\t", ++files.raw_frames, frame->frame_number,
                        frame->source_time_ns, frame->receive_time_ns);
         append_timecode(line, frame->timecode);
-        fmt::format_to(std::back_inserter(line), "\t{}\t{}\t{}\n", frame->unlabelled,
-                       std::min(frame->unlabelled, files.subject->tap->unlabelled_slots()),
+        fmt::format_to(std::back_inserter(line), "\t{}\t{}\t{}\n", frame->unlabelled, kept,
                        frame->unknown_labels);
       }
       received.pop();

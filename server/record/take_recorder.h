@@ -35,8 +35,8 @@
 namespace skinstream::server {
 
 struct TakeRecorderOptions {
-  std::filesystem::path dir;                       // where takes go (created when missing)
-  int unlabelled_slots = 64;                       // unlabelled points kept per received frame
+  std::filesystem::path dir;   // where takes go (created when missing)
+  int unlabelled_slots = 256;  // unlabelled channels of a received take (server/record/unlabelled_slots.h)
   std::chrono::milliseconds commit_interval{500};  // a crash loses at most about this much
   size_t ring_frames = 480;        // frames a subject's rings hold for the writer (4 s at 120 Hz)
   double default_rate_hz = 120.0;  // the C3D rate when the source has not said yet

@@ -9,7 +9,8 @@ TakeTap::TakeTap(std::string subject, std::vector<std::string> marker_names, int
     : subject_(std::move(subject)),
       marker_names_(std::move(marker_names)),
       unlabelled_slots_(std::max(unlabelled_slots, 0)),
-      received_(ring_frames, marker_names_.size() + static_cast<size_t>(unlabelled_slots_)),
+      received_(ring_frames, marker_names_.size() + static_cast<size_t>(unlabelled_slots_),
+                static_cast<size_t>(unlabelled_slots_)),
       published_(ring_frames, marker_names_.size()) {}
 
 std::vector<std::string> TakeTap::received_labels() const {
@@ -40,6 +41,8 @@ void TakeTap::record_received(const MarkerFrame& frame) {
   const auto unlabelled = slot->points.begin() + static_cast<long>(marker_names_.size());
   std::copy_n(frame.unlabelled.begin(), kept, unlabelled);
   std::fill(unlabelled + kept, slot->points.end(), missing_point());
+  std::copy_n(frame.unlabelled_ids.begin(), kept, slot->unlabelled_ids.begin());
+  slot->unlabelled_copied = kept;
   slot->unlabelled = frame.unlabelled_count;
   slot->unknown_labels = frame.unknown_labels;
   received_.publish();

@@ -18,7 +18,8 @@ namespace skinstream::server {
 
 class TakeTap : public FilledFrameObserver {
  public:
-  // `unlabelled_slots`: unlabelled points kept per received frame (after the labelled markers).
+  // `unlabelled_slots`: unlabelled points kept per received frame (after the labelled markers;
+  // the take writer puts each in a channel by its trajectory: server/record/unlabelled_slots.h).
   TakeTap(std::string subject, std::vector<std::string> marker_names, int unlabelled_slots,
           size_t ring_frames);
 

@@ -4,7 +4,7 @@
 # the demo subject's vertex buffers against `skinstream fill` + `deform`; bad paths fail clearly.
 if(TARGET skinstreamd AND TARGET skinstream-sub AND TARGET skinstream-replay)
   add_executable(daemon_tests ${CMAKE_CURRENT_LIST_DIR}/daemon_e2e_test.cpp ${CMAKE_CURRENT_LIST_DIR}/daemon_subjects_e2e_test.cpp
-    ${CMAKE_CURRENT_LIST_DIR}/daemon_subscribers_e2e_test.cpp
+    ${CMAKE_CURRENT_LIST_DIR}/daemon_subscribers_e2e_test.cpp ${CMAKE_CURRENT_LIST_DIR}/daemon_takes_e2e_test.cpp
     ${PROJECT_SOURCE_DIR}/tests/support/test_data.cpp ${PROJECT_SOURCE_DIR}/tests/support/program_run.cpp
     ${PROJECT_SOURCE_DIR}/tests/support/loopback_peer.cpp ${PROJECT_SOURCE_DIR}/tests/support/daemon_process.cpp
     ${PROJECT_SOURCE_DIR}/tests/support/subscriber_client.cpp)

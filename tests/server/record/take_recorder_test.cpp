@@ -48,6 +48,7 @@ void feed(TakeTap& tap, uint32_t first, int count) {
     frame.frame_number = n;
     frame.labelled = {Vec3(n, 1, 2), missing_point(), Vec3(-1.5, n, 0.25)};
     frame.unlabelled[0] = Vec3(7, 7, n);
+    frame.unlabelled_ids[0] = 5;  // one trajectory: one channel
     frame.unlabelled_count = 1;
     tap.record_received(frame);
     filled = {Vec3(n, 1, 2), Vec3(0.5, 0.5, n), Vec3(-1.5, n, 0.25)};
