@@ -1,9 +1,9 @@
 // Takes recorded by the real skinstreamd replaying the demo capture: what it received equals the
-// capture, what it published equals what a subscriber got and `skinstream fill` of the received
-// take; kill -9 at random moments leaves every take readable (by our reader and by an independent
-// one written from the C3D specification) up to at most a second before the kill, and the next
-// start closes it; a full disk (a small tmpfs) or a folder that cannot be made stops the
-// recording, says why, and the stream goes on.
+// capture, what it published equals what a subscriber got, `skinstream fill` of the received take
+// and what a daemon replaying the received take publishes; kill -9 at random moments leaves every take
+// readable (by our reader and by an independent one written from the C3D specification) up to at most a
+// second before the kill, and the next start closes it; a full disk (a small tmpfs) or a folder that cannot
+// be made stops the recording, says why, and the stream goes on.
 #include <gtest/gtest.h>
 #include <sys/mount.h>
 
@@ -191,6 +191,32 @@ TEST(DaemonDemoTakes, ATakeHoldsWhatWasReceivedAndWhatWasPublished) {
       ASSERT_GE(o, 0) << filled.labels[m];
       for (int f = 0; f < filled.frame_count; ++f)
         ASSERT_EQ(offline.at(f, o), filled.at(f, m)) << filled.labels[m] << " frame " << f;
+    }
+
+    // The received take replayed into a daemon with the same subject: it publishes what the live
+    // session published, frame by frame, bit for bit.
+    const std::string again = fresh_folder("takes_replayed");
+    {
+      DaemonProcess replay("--subject " + kSubject + " --replay " + (take / "subject.raw.c3d").string() +
+                           " --speed 0.5 --record-dir " + again + " --record-always");
+      ASSERT_TRUE(eventually([&] { return health_of(replay)["source"].value("state", "") == "finished"; }));
+      ASSERT_EQ(replay.stop(), 0) << replay.log();
+    }
+    const std::filesystem::path replayed_take = only_take(again);
+    const Capture replayed = read_c3d((replayed_take / "subject.filled.c3d").string());
+    if (replayed.frame_count != filled.frame_count) {
+      std::printf("attempt %d: the replay's pipeline published %d of %d frames\n", attempt + 1,
+                  replayed.frame_count, filled.frame_count);
+      continue;
+    }
+    EXPECT_EQ(test::read_bytes((replayed_take / "subject.filled.c3d").string()),
+              test::read_bytes((take / "subject.filled.c3d").string()))
+        << "the replay published other markers than the live session";
+    const auto replayed_rows = table_rows(replayed_take / "subject.filled.tsv");
+    ASSERT_EQ(replayed_rows.size(), filled_rows.size());
+    for (size_t r = 0; r < filled_rows.size(); ++r) {
+      EXPECT_EQ(replayed_rows[r][1], filled_rows[r][1]) << "frame number, row " << r;
+      EXPECT_EQ(replayed_rows[r][4], filled_rows[r][4]) << "statuses, row " << r;
     }
     return;
   }
