@@ -88,9 +88,10 @@ struct DaemonConfig {
   // The joiners' MeshInfo and Model, all together, at most this fast (Mbit/s; 0 = unpaced).
   int subscriber_join_mbit = 300;
   // Takes (server/record/take_recorder.h).
-  std::string record_dir;       // empty = no recording
-  bool record_always = false;   // one take from start to stop
-  int record_unlabelled = 256;  // unlabelled channels of a received take
+  std::string record_dir;           // empty = no recording
+  bool record_always = false;       // one take from start to stop
+  bool record_with_source = false;  // a take while the capture system records one (NatNet, QTM)
+  int record_unlabelled = 256;      // unlabelled channels of a received take
 };
 
 // Thrown for a bad config file, a bad key or value, or conflicting flags: one line, says which.

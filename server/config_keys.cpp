@@ -594,6 +594,14 @@ std::vector<ConfigKey> make_config_keys() {
              .doc =
         "Record one take from the daemon's start to its stop, named by the UTC time (flag\n"
         "--record-always; needs record_dir)."}),
+      bound(&DaemonConfig::record_with_source,
+            {.name = "record_with_source", .flag = "--record-with-source",
+             .flag_help = "record a take while the capture system records one (NatNet, QTM RT)",
+             .doc =
+        "Record a take while the capture system records one of its own (flag --record-with-source;\n"
+        "needs record_dir): NatNet's frame flag (Motive recording), QTM RT's capture started and\n"
+        "stopped events. Vicon DataStream does not say. A take started through the control API is\n"
+        "left to the operator."}),
       bound(&DaemonConfig::record_unlabelled,
             {.name = "record_unlabelled",
              .doc =

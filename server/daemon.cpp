@@ -143,6 +143,8 @@ Daemon::Daemon(const DaemonConfig& config)
   admission_ = std::make_shared<SubscriberAdmission>(admission_options_of(config), source_metrics_);
   if (config.record_always && config.record_dir.empty())
     throw ConfigError("record_always needs record_dir (--record-dir)");
+  if (config.record_with_source && config.record_dir.empty())
+    throw ConfigError("record_with_source needs record_dir (--record-dir)");
   if (!config.record_dir.empty()) start_recorder();
   const SourceSpec source = source_spec_of(config);
   source_ = make_source(io_, source, config, static_cast<SourceSink&>(*this));
@@ -215,6 +217,22 @@ void Daemon::start_recorder() {
   recorder_->start_thread();
 }
 
+void Daemon::follow_capture_recording(CaptureRecording recording) {
+  if (recording == CaptureRecording::Unknown || recording == capture_recording_) return;
+  capture_recording_ = recording;
+  const std::string who = "the capture system";
+  if (recording == CaptureRecording::Recording) {
+    const TakeAnswer answer = recorder_->start("", who);
+    take_from_capture_ = answer.status == 201;
+    if (!take_from_capture_)
+      spdlog::warn("skinstreamd: the capture system records, no take started: {}",
+                   answer.body.value("error", ""));
+  } else if (take_from_capture_) {
+    recorder_->stop(who);
+    take_from_capture_ = false;
+  }
+}
+
 void Daemon::start_serving() {
   if (started_.exchange(true)) return;
   for (auto& s : subjects_) s->start();
@@ -277,6 +295,7 @@ void Daemon::on_frame(const SourceFrame& frame) {
     std::lock_guard lock(state_mutex_);
     source_rate_hz_ = frame.rate_hz;
   }
+  if (recorder_ && config_.record_with_source) follow_capture_recording(frame.capture_recording);
   const FrameNumbering::Step step = numbering_.next(frame.frame_number, frame.rate_hz);
   if (step.skipped > 0) {
     source_metrics_.source_frames_skipped.fetch_add(step.skipped, std::memory_order_relaxed);

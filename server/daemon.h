@@ -77,6 +77,8 @@ class Daemon : private SourceSink, private SubjectRouter::Observer {
   void schedule_status_log();
   void write_ports_file() const;
   void start_recorder();
+  // The io thread, each frame (record_with_source): a take while the capture system records.
+  void follow_capture_recording(CaptureRecording recording);
 
   DaemonConfig config_;
   std::vector<int> deform_cpus_;  // deform_threads per subject, subject after subject, or none (not pinned)
@@ -86,6 +88,8 @@ class Daemon : private SourceSink, private SubjectRouter::Observer {
   SubjectDirectory directory_;  // the subjects' hubs by name; outlives them
   // Takes (when record_dir is set): its taps are the subjects' and outlive them.
   std::unique_ptr<TakeRecorder> recorder_;
+  CaptureRecording capture_recording_ = CaptureRecording::Unknown;  // io thread
+  bool take_from_capture_ = false;  // the take recording was started by the capture system
   // Before io_: the io_context is destroyed first, and with it the handlers still holding
   // sessions whose queues hold frames of the subjects' pipelines' pools.
   std::vector<std::unique_ptr<SubjectStream>> subjects_;

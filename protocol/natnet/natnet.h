@@ -72,6 +72,7 @@ constexpr int16_t kMarkerModelSolved = 0x04;
 constexpr int16_t kMarkerHasModel = 0x08;
 constexpr int16_t kMarkerUnlabelled = 0x10;
 // Frame params bits.
+constexpr int16_t kFrameRecording = 0x01;  // Motive is recording a take
 constexpr int16_t kFrameTrackedModelsChanged = 0x02;
 
 struct Version {

@@ -94,7 +94,7 @@ const FrameOfData& CaptureEncoder::frame(uint64_t stream_index) {
   frame_.stamp_mid_exposure = frame_.stamp_data_received = frame_.stamp_transmit = ticks;
   frame_.precise_seconds = static_cast<uint32_t>(frame_.timestamp_s);
   frame_.precise_fraction = static_cast<uint32_t>((frame_.timestamp_s - std::floor(frame_.timestamp_s)) * 4294967296.0);
-  frame_.params = 0;
+  frame_.params = stream_index >= recording_first_ && stream_index < recording_end_ ? kFrameRecording : 0;
   return frame_;
 }
 

@@ -47,6 +47,12 @@ class CaptureEncoder {
   // The frame of stream index k, then its bytes in `version`'s layout (no allocation once warm).
   const FrameOfData& frame(uint64_t stream_index);
   void encode(uint64_t stream_index, Version version, ByteVector& out);
+  // Frames of stream indices [first, end) say that Motive records (frame params bit 0), as a
+  // take recorded on the capture system during the stream would.
+  void set_recording_frames(uint64_t first, uint64_t end) {
+    recording_first_ = first;
+    recording_end_ = end;
+  }
 
  private:
   std::vector<ReplaySubject> subjects_;
@@ -57,6 +63,7 @@ class CaptureEncoder {
   FrameOfData frame_;
   Clock clock_;
   std::mt19937 random_{1};
+  uint64_t recording_first_ = 0, recording_end_ = 0;
 };
 
 }  // namespace skinstream::natnet

@@ -269,6 +269,8 @@ struct NatNetSource::State : std::enable_shared_from_this<NatNetSource::State> {
     frame.rate_hz = rate.add(data.frame_number, data.timestamp_s);
 
     frame.frame_number = static_cast<uint32_t>(data.frame_number);
+    frame.capture_recording = (data.params & natnet::kFrameRecording) ? CaptureRecording::Recording
+                                                                      : CaptureRecording::NotRecording;
     frame.source_time_ns = static_cast<int64_t>(std::llround(data.timestamp_s * 1e9));
     const natnet::TimecodeFields tc = natnet::split_timecode(data.timecode);
     frame.timecode.valid = data.timecode != 0 || data.timecode_subframe != 0;

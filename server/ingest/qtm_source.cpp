@@ -167,6 +167,10 @@ struct QtmSource::State : std::enable_shared_from_this<QtmSource::State> {
         qtm::Event event{};
         if (!qtm::decode_event(packet, event, error)) return false;
         if (phase == Phase::Streaming && may_change_labels(event)) ask_parameters(gen);
+        // A capture in QTM is a take it records; "capture saved" ends one too.
+        if (event == qtm::Event::CaptureStarted) frame.capture_recording = CaptureRecording::Recording;
+        if (event == qtm::Event::CaptureStopped || event == qtm::Event::CaptureSaved)
+          frame.capture_recording = CaptureRecording::NotRecording;
         return true;
       }
       case qtm::PacketType::NoMoreData:

@@ -38,12 +38,17 @@ struct SourceSubject {
   std::vector<std::string> labels;
 };
 
+// Whether the capture system says it is recording a take of its own (NatNet's frame flag, QTM's
+// capture events); Vicon DataStream does not say.
+enum class CaptureRecording : uint8_t { Unknown, Recording, NotRecording };
+
 struct SourceFrame {
   uint32_t frame_number = 0;   // as the capture system's SDK reports it
   int64_t source_time_ns = 0;  // capture time (timecode, or frame x period)
   int64_t receive_time_ns = 0;  // wall clock (system_clock, ns since the epoch) when complete
   double rate_hz = 0.0;         // the source's frame rate; 0 when not known yet
   SourceTimecode timecode;
+  CaptureRecording capture_recording = CaptureRecording::Unknown;
 
   uint64_t structure_version = 0;  // changes whenever `subjects` changed
   std::vector<SourceSubject> subjects;

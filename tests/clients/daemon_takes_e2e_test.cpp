@@ -25,6 +25,9 @@
 
 #include "protocol/files/c3d.h"
 #include "server/client/health_probe.h"
+#include "server/replay/natnet/natnet_server.h"
+#include "server/replay/qtm/qtm_server.h"
+#include "support/io_thread.h"
 #include "support/program_processes.h"
 #include "support/program_run.h"
 #include "support/test_data.h"
@@ -347,6 +350,71 @@ TEST(DaemonDemoTakes, ATakesFolderThatCannotBeMadeIsReportedAndTheStreamGoesOn) 
   ASSERT_TRUE(eventually([&] { return subscriber.frames() >= 60; }));
   EXPECT_EQ(daemon.stop(), 0);
 }
+
+// With record_with_source, a take while the capture system records one: NatNet's frame flag
+// (Motive) and QTM RT's capture events, from the replay servers flagging frames [60, 180) of 240.
+void expect_take_follows_capture_system(bool natnet) {
+  const Capture capture = read_c3d(kCapture);
+  test::IoThread server_io;
+  std::unique_ptr<server::QtmServer> qtm;
+  std::unique_ptr<server::NatNetServer> natnet_server;
+  std::string source;
+  if (natnet) {
+    server::NatNetServerOptions options;
+    options.bind_address = "127.0.0.1";
+    options.command_port = 0;
+    options.multicast = false;
+    options.recording_first = 60;
+    options.recording_end = 180;
+    natnet_server = std::make_unique<server::NatNetServer>(
+        server_io.io, std::vector<ReplaySubject>{{"demo", &capture}}, options);
+    source = "--natnet 127.0.0.1:" + std::to_string(server_io.call([&] {
+               natnet_server->start();
+               return natnet_server->command_port();
+             }));
+  } else {
+    server::QtmServerOptions options;
+    options.bind_address = "127.0.0.1";
+    options.port = 0;
+    options.capture_first = 60;
+    options.capture_end = 180;
+    qtm = std::make_unique<server::QtmServer>(server_io.io, std::vector<ReplaySubject>{{"demo", &capture}},
+                                              options);
+    source = "--qtm 127.0.0.1:" + std::to_string(server_io.call([&] {
+               qtm->start();
+               return qtm->port();
+             }));
+  }
+  const std::string dir = fresh_folder(natnet ? "takes_natnet" : "takes_qtm");
+  DaemonProcess daemon("--subject " + kSubject + " " + source + " --record-dir " + dir +
+                       " --record-with-source");
+  const bool closed =
+      eventually([&] { return health_of(daemon)["recording"].value("takes_closed", 0) == 1; });
+  const nlohmann::json health = health_of(daemon);
+  EXPECT_EQ(daemon.stop(), 0) << daemon.log();
+  server_io.call([&] {
+    if (qtm) qtm->stop();
+    if (natnet_server) natnet_server->stop();
+  });
+  ASSERT_TRUE(closed) << health["recording"];
+
+  const std::filesystem::path take = only_take(dir);
+  const nlohmann::json sidecar = read_json(take / "take.json");
+  EXPECT_EQ(sidecar["state"], "closed");
+  EXPECT_EQ(sidecar["started_by"], "the capture system");
+  // The frames the capture system recorded, give or take the frame or two an event and the
+  // frames cross on their way (QTM's events and frames are queued apart).
+  const auto rows = table_rows(take / "subject.raw.tsv");
+  ASSERT_FALSE(rows.empty());
+  const int first = std::stoi(rows.front()[1]) - capture.first_frame,
+            last = std::stoi(rows.back()[1]) - capture.first_frame;
+  EXPECT_NEAR(first, 60, 2) << "first frame of the take";
+  EXPECT_NEAR(last, 179, 2) << "last frame of the take";
+  EXPECT_GE(rows.size(), 116u);
+}
+
+TEST(DaemonDemoTakes, ATakeFollowsMotivesRecordingOverNatNet) { expect_take_follows_capture_system(true); }
+TEST(DaemonDemoTakes, ATakeFollowsQtmsCaptureEvents) { expect_take_follows_capture_system(false); }
 
 TEST(DaemonDemoTakes, RecordAlwaysWithoutAFolderIsRefusedAtStart) {
   const test::ProgramRun run = test::run_program(std::string(SKINSTREAMD) + " --subject " + kSubject +

@@ -69,6 +69,7 @@ const nlohmann::json kChangedValues = {
     {"subscriber_join_mbit", 500},
     {"record_dir", "takes"},
     {"record_always", true},
+    {"record_with_source", true},
     {"record_unlabelled", 16},
     {"log_level", "debug"}};
 

@@ -286,7 +286,12 @@ struct QtmServer::State : std::enable_shared_from_this<QtmServer::State> {
     if (frame_hook)
       frame_hook(encoder.frame_number(k),
                  std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch()).count());
+    const bool capture = options.capture_end > options.capture_first;
     for (auto& session : sessions.snapshot()) {
+      if (capture && session->open() && session->streaming &&
+          (k == options.capture_first || k == options.capture_end))
+        session->send(qtm::encode_event(k == options.capture_first ? qtm::Event::CaptureStarted
+                                                                   : qtm::Event::CaptureStopped));
       if (!session->open() || !session->streaming || k % session->divisor != 0) continue;
       Packet p = packet(session->labelled, session->unlabelled);
       if (session->udp_destination)

@@ -52,6 +52,9 @@ struct QtmServerOptions {
   size_t max_queued_frames = 4;  // per client, frames waiting behind the one being written
   size_t max_queued_replies = 64;  // per client, command replies waiting; then its commands wait
   size_t max_clients = 64;         // served at once
+  // Stream indices [first, end) recorded as a QTM capture: the events "capture started" before
+  // frame `first` and "capture stopped" before frame `end`, as QTM sends them; none by default.
+  uint64_t capture_first = 0, capture_end = 0;
 };
 
 struct QtmServerStats {
