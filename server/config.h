@@ -87,6 +87,9 @@ struct DaemonConfig {
   int subscriber_unsent_kb = 128;
   // The joiners' MeshInfo and Model, all together, at most this fast (Mbit/s; 0 = unpaced).
   int subscriber_join_mbit = 300;
+  // The operator's control API (docs/control-api.md): a file holding its token; empty = off (unless
+  // SKINSTREAM_CONTROL_TOKEN is set). Read by load_control_token (server/control/control_token.h).
+  std::string control_token_file;
 };
 
 // Thrown for a bad config file, a bad key or value, or conflicting flags: one line, says which.
