@@ -1,7 +1,12 @@
 // The control API through a real HttpServer on loopback, with a ControlActions double that
 // records its calls: who may call what, what is answered, what is counted.
 #include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <mutex>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -10,6 +15,7 @@
 #include "server/beast.h"
 #include "server/http/http_server.h"
 #include "support/io_thread.h"
+#include "support/test_data.h"
 
 namespace skinstream::server {
 namespace {
@@ -216,6 +222,65 @@ TEST_F(HttpServerControl, AControlApiWithoutATokenIsRefusedAtConstruction) {
   HttpRoutes routes;
   routes.control = actions;
   EXPECT_THROW(HttpServer(io_thread.io, "127.0.0.1", 0, hub, std::move(routes)), std::invalid_argument);
+}
+
+// skinstream-ctl, the real program, beside this test's program in the build's bin/.
+std::string ctl_program() {
+  return (std::filesystem::read_symlink("/proc/self/exe").parent_path() / "skinstream-ctl").string();
+}
+
+struct ProgramRun {
+  int exit_code = -1;
+  std::string out, err;
+};
+
+// Runs skinstream-ctl with `arguments` (shell words) and SKINSTREAM_CONTROL_TOKEN unset.
+ProgramRun run_ctl(const std::string& arguments) {
+  const std::string out = test::scratch_path("ctl.out"), err = test::scratch_path("ctl.err");
+  const std::string command =
+      "env -u SKINSTREAM_CONTROL_TOKEN " + ctl_program() + " " + arguments + " > " + out + " 2> " + err;
+  const int status = std::system(command.c_str());
+  auto read = [](const std::string& path) {
+    std::ifstream in(path);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  };
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, read(out), read(err)};
+}
+
+TEST_F(HttpServerControl, SkinstreamCtlStartsStopsAndListsTakesAndExitsOneOnRefusals) {
+  ASSERT_TRUE(std::filesystem::exists(ctl_program())) << ctl_program() << ": build skinstream-ctl";
+  start(true);
+  const std::string token_file = test::scratch_path("ctl-token");
+  std::ofstream(token_file) << kControlToken << "\n";
+  const std::string common =
+      "--port " + std::to_string(port) + " --token-file " + token_file + " --operator anna";
+
+  const ProgramRun started = run_ctl(common + " take start 'take 7'");
+  EXPECT_EQ(started.exit_code, 0) << started.err;
+  EXPECT_EQ(nlohmann::json::parse(started.out).at("take"), "take 7");
+  const ProgramRun stopped = run_ctl(common + " take stop");
+  EXPECT_EQ(stopped.exit_code, 1);  // the double answers 409
+  EXPECT_NE(stopped.err.find("409 no take is being recorded"), std::string::npos) << stopped.err;
+  const ProgramRun listed = run_ctl(common + " takes");
+  EXPECT_EQ(listed.exit_code, 0) << listed.err;
+  EXPECT_EQ(nlohmann::json::parse(listed.out).at("takes").size(), 2u);
+
+  const std::vector<RecordingControlActions::Call> calls = actions->calls();
+  ASSERT_EQ(calls.size(), 3u);
+  EXPECT_EQ(calls[0].action, "start_take");
+  EXPECT_EQ(calls[0].caller.operator_name, "anna");
+  EXPECT_EQ(calls[0].request.at("name"), "take 7");
+  EXPECT_EQ(calls[1].action, "stop_take");
+
+  const std::string wrong_file = test::scratch_path("ctl-wrong-token");
+  std::ofstream(wrong_file) << "not-the-token-0123456789\n";
+  const ProgramRun refused =
+      run_ctl("--port " + std::to_string(port) + " --token-file " + wrong_file + " takes");
+  EXPECT_EQ(refused.exit_code, 1);
+  EXPECT_NE(refused.err.find("403 wrong token"), std::string::npos) << refused.err;
+  EXPECT_EQ(refused.err.find('\n'), refused.err.size() - 1) << "one line: " << refused.err;
+  EXPECT_EQ(actions->calls().size(), 3u);
+  EXPECT_EQ(run_ctl("--port " + std::to_string(port) + " take").exit_code, 2);
 }
 
 }  // namespace
