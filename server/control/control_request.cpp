@@ -92,6 +92,9 @@ ControlDecision decide_control_request(const ControlRequest& request, std::strin
     body = nlohmann::json::parse(request.body, depth_check);
   } catch (const nlohmann::json::parse_error& e) {
     return refused_request(400, "body is not valid JSON (byte " + std::to_string(e.byte) + ")");
+  } catch (const nlohmann::json::exception&) {
+    // A number beyond a double (1e400) is out_of_range, not a parse_error.
+    return refused_request(400, "body is not valid JSON (a number out of range)");
   }
   if (too_deep)
     return refused_request(400, "body nests deeper than " + std::to_string(kMaxControlBodyDepth) + " levels");

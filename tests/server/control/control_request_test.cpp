@@ -101,6 +101,14 @@ TEST(ControlRequest, BadJsonIs400WithOneLine) {
   }
 }
 
+TEST(ControlRequest, ANumberBeyondADoubleIs400NotAnException) {
+  // Found by the fuzz target (tests/fuzz/seeds/control_request/number_out_of_range.txt).
+  const ControlDecision decision = decide("POST", "/takes", kBearer, "12.4567801234e339");
+  EXPECT_EQ(decision.status, 400);
+  EXPECT_EQ(decide("POST", "/takes", kBearer, R"({"name": 1e400})").status, 400);
+  expect_one_printable_line(decision.reason);
+}
+
 TEST(ControlRequest, ABodyMustBeAJsonObject) {
   for (const char* body : {"[]", "\"take1\"", "3", "null", "true"}) {
     const ControlDecision decision = decide("POST", "/takes", kBearer, body);
