@@ -92,6 +92,9 @@ struct DaemonConfig {
   bool record_always = false;       // one take from start to stop
   bool record_with_source = false;  // a take while the capture system records one (NatNet, QTM)
   int record_unlabelled = 256;      // unlabelled channels of a received take
+  // The operator's control API (docs/control-api.md): a file holding its token; empty = off (unless
+  // SKINSTREAM_CONTROL_TOKEN is set). Read by load_control_token (server/control/control_token.h).
+  std::string control_token_file;
 };
 
 // Thrown for a bad config file, a bad key or value, or conflicting flags: one line, says which.

@@ -612,6 +612,26 @@ std::vector<ConfigKey> make_config_keys() {
         "(unlabelled against unlabelled_kept), not kept. A channel costs 16 bytes a frame (1.9 kB/s\n"
         "at 120 Hz); the demo capture has up to 129 unlabelled points at once."},
             between(0, 1024), "0-1024"),
+      bound(&DaemonConfig::control_token_file,
+            {.name = "control_token_file", .flag = "--control-token-file", .new_group = true,
+             .flag_help = "turn the control API on (POST /takes ...): the file whose first line is its token "
+                          "(16-256 visible characters; not readable by every user)",
+             .problem = [](const DaemonConfig& c) -> std::string {
+               const std::string& path = c.control_token_file;
+               const auto is_path_byte = [](unsigned char ch) { return ch >= 0x20 && ch != 0x7f; };
+               if (std::all_of(path.begin(), path.end(), is_path_byte) &&
+                   path.size() <= 4096)
+                 return "";
+               return "control_token_file must be a file's path (no line breaks nor control characters)";
+             },
+             .doc =
+        "The operator's control API (docs/control-api.md: start and stop takes with skinstream-ctl or\n"
+        "curl): a file whose first line is the token every control request must carry as\n"
+        "\"Authorization: Bearer TOKEN\" (16-256 visible ASCII characters). The file must not be\n"
+        "readable by every user (chmod 600): the daemon refuses to start otherwise. Instead of a file\n"
+        "the token may be in the environment variable SKINSTREAM_CONTROL_TOKEN (not both); never on the\n"
+        "command line, where ps shows it. Neither = the control API is off (its paths answer 404).\n"
+        "Wrong tokens are counted and rate-limited per address; the token is never logged nor printed."}),
       bound(&DaemonConfig::log_level,
             {.name = "log_level", .flag = "--log-level", .new_group = true,
              .flag_help = "trace, debug, info, warn, error, critical, off",

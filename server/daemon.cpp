@@ -11,6 +11,7 @@
 #include "protocol/files/file_error.h"
 #include "protocol/printable_text.h"
 #include "protocol/subscriber/datagram_authentication.h"
+#include "server/control/control_token.h"
 #include "server/http/http_server.h"
 #include "server/ingest/file_replay_source.h"
 #include "server/ingest/source_spec.h"
@@ -20,6 +21,7 @@
 #include "server/publish/subscriber_hub.h"
 #include "server/publish/subscriber_session.h"
 #include "server/publish/tcp_subscriber_handoff.h"
+#include "server/record/take_control.h"
 #include "server/thread_name.h"
 
 namespace skinstream::server {
@@ -177,6 +179,13 @@ Daemon::Daemon(const DaemonConfig& config)
   routes.health_json = [this] { return health_json(); };
   routes.metrics_text = [this] { return metrics_text(); };
   routes.web_root = config.web_root;
+  // The operator's control API, on only with a token (docs/control-api.md).
+  if (const std::optional<std::string> token = load_control_token(config)) {
+    routes.control = std::make_shared<TakeControl>(recorder_.get());
+    routes.control_token = *token;
+    control_counters_ = std::make_shared<ControlCounters>();
+    routes.control_counters = control_counters_;
+  }
   if (!config.web_root.empty() && !std::filesystem::is_directory(config.web_root))
     throw FileError(config.web_root, "web root is not a directory");
   // Out of descriptors, the HTTP port spends the reserve: /health answers while subscribers hold the rest.
@@ -451,6 +460,7 @@ std::string Daemon::health_json() const {
       {"source", source},
       {"subjects", subjects},
       {"recording", recorder_ ? recorder_->health() : nlohmann::json{{"state", "off"}}},
+      {"control", control_counters_ ? control_counters_->to_json() : nlohmann::json{{"state", "off"}}},
       {"subscribers", subscribers},
       {"frame_pool", first["frame_pool"]},
       {"subscriber_limits",
@@ -504,6 +514,7 @@ std::string Daemon::metrics_text() const {
   std::string text = render_prometheus(source_metrics_, views);
   // The sender's series carry no subject label: with several subjects they are in /health only.
   if (subjects_.size() == 1) subjects_.front()->render_multicast_metrics(text);
+  if (control_counters_) control_counters_->render_metrics(text);
   return text;
 }
 

@@ -18,6 +18,7 @@
 
 #include "server/asio.h"
 #include "server/config.h"
+#include "server/control/control_counters.h"
 #include "server/descriptor_reserve.h"
 #include "server/ingest/frame_numbering.h"
 #include "server/ingest/frame_source.h"
@@ -89,7 +90,8 @@ class Daemon : private SourceSink, private SubjectRouter::Observer {
   // Takes (when record_dir is set): its taps are the subjects' and outlive them.
   std::unique_ptr<TakeRecorder> recorder_;
   CaptureRecording capture_recording_ = CaptureRecording::Unknown;  // io thread
-  bool take_from_capture_ = false;  // the take recording was started by the capture system
+  bool take_from_capture_ = false;                     // the take recording was started by the capture system
+  std::shared_ptr<ControlCounters> control_counters_;  // the control API's requests; null when it is off
   // Before io_: the io_context is destroyed first, and with it the handlers still holding
   // sessions whose queues hold frames of the subjects' pipelines' pools.
   std::vector<std::unique_ptr<SubjectStream>> subjects_;

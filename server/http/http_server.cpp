@@ -1,9 +1,14 @@
 #include "server/http/http_server.h"
 
+#include <spdlog/spdlog.h>
+
 #include <fstream>
 #include <sstream>
 
+#include "protocol/printable_text.h"
 #include "server/beast.h"
+#include "server/control/control_dispatch.h"
+#include "server/control/control_request.h"
 #include "server/http/query_parameter.h"
 #include "server/http/static_files.h"
 #include "server/http/websocket_subscriber.h"
@@ -13,6 +18,8 @@ namespace {
 
 // Refused WebSocket subscribers, all connections together: a flood logs once a second.
 RateLimitedLog websocket_refusals;
+// Refused control requests, all connections together: a flood of wrong tokens logs once a second.
+RateLimitedLog control_refusals;
 
 std::string remote_of(const tcp::socket& socket) {
   boost::system::error_code ec;
@@ -23,8 +30,13 @@ std::string remote_of(const tcp::socket& socket) {
 // One HTTP connection: requests one after another (keep-alive) until it upgrades or closes.
 class HttpSession : public std::enable_shared_from_this<HttpSession> {
  public:
-  HttpSession(asio::io_context& io, tcp::socket socket, SubscriberHub& hub, std::shared_ptr<const HttpRoutes> routes)
-      : io_(io), stream_(std::move(socket)), hub_(hub), routes_(std::move(routes)) {}
+  HttpSession(asio::io_context& io, tcp::socket socket, SubscriberHub& hub,
+              std::shared_ptr<const HttpRoutes> routes, std::shared_ptr<ControlRateLimit> control_rate_limit)
+      : io_(io),
+        stream_(std::move(socket)),
+        hub_(hub),
+        routes_(std::move(routes)),
+        control_rate_limit_(std::move(control_rate_limit)) {}
 
   void read_next() {
     request_ = {};
@@ -42,6 +54,10 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
     if (websocket::is_upgrade(request_)) {
       if (path != "/stream") return respond(error(http::status::not_found, "WebSocket subscribers connect to /stream\n"));
       return upgrade();
+    }
+    if (is_control_path(path)) {
+      if (!routes_->control) return respond(error(http::status::not_found, "not found\n"));
+      return control();
     }
     if (request_.method() != http::verb::get && request_.method() != http::verb::head)
       return respond(error(http::status::method_not_allowed, "only GET and HEAD\n"));
@@ -90,6 +106,78 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
     subscriber->accept(std::move(request_));
   }
 
+  // A control request (docs/control-api.md): refused while its address is rate-limited, then
+  // decided (route, token, body) and, when right, its action called. One log line each, naming the
+  // peer and the operator, never the token.
+  void control() {
+    const ControlCaller caller{peer_address(), std::string(request_[operator_header()])};
+    const std::string what =
+        std::string(request_.method_string()) + " " +
+        printable_text(std::string_view(request_.target().data(), request_.target().size()), 80);
+    const std::string who = caller.address + " (operator " + quoted_text(caller.operator_name) + ")";
+    ControlCounters& counters = *routes_->control_counters;
+    const auto now = ControlRateLimit::Clock::now();
+    if (const auto blocked = control_rate_limit_->blocked_for(caller.address, now); blocked.count() > 0) {
+      counters.rate_limited.fetch_add(1, std::memory_order_relaxed);
+      const auto seconds = std::chrono::ceil<std::chrono::seconds>(blocked).count();
+      const std::string reason = "too many wrong tokens from " + caller.address + ": refused for " +
+                                 std::to_string(seconds) + " s more";
+      control_refusals.warn("control_refused", "control: " + what + " from " + who + ": 429 " + reason);
+      auto res = json_answer(http::status::too_many_requests, {{"error", reason}});
+      res.set(http::field::retry_after, std::to_string(seconds));
+      return respond(std::move(res));
+    }
+    const ControlDecision decision =
+        decide_control_request({.method = sv(request_.method_string()),
+                                .target = sv(request_.target()),
+                                .authorization = sv(request_[http::field::authorization]),
+                                .operator_name = sv(request_[operator_header()]),
+                                .body = request_.body()},
+                               routes_->control_token);
+    counters.count(decision.status);
+    if (decision.status != 200) {
+      std::string reason = decision.reason;
+      if (decision.status == 403 && control_rate_limit_->count_refusal(caller.address, now))
+        reason += "; too many from " + caller.address + ": refused for " +
+                  std::to_string(
+                      std::chrono::ceil<std::chrono::seconds>(routes_->control_rate_limit.block).count()) +
+                  " s";
+      control_refusals.warn("control_refused", "control: " + what + " from " + who + ": " +
+                                                   std::to_string(decision.status) + " " + reason);
+      auto res = json_answer(static_cast<http::status>(decision.status), {{"error", reason}});
+      if (decision.status == 401) res.set(http::field::www_authenticate, "Bearer");
+      if (decision.status == 405) res.set(http::field::allow, decision.allow);
+      return respond(std::move(res));
+    }
+    ControlAnswer answer;
+    try {
+      answer = run_control_action(*routes_->control, decision, caller);
+    } catch (const std::exception& e) {
+      answer = {500, {{"error", printable_text(e.what())}}};
+    }
+    if (answer.status < 200 || answer.status > 599)
+      answer = {500, {{"error", "the action answered no status"}}};
+    spdlog::info("control: {} from {}: {}", what, who, answer.status);
+    respond(json_answer(static_cast<http::status>(answer.status), answer.body));
+  }
+
+  static std::string_view sv(beast::string_view text) { return {text.data(), text.size()}; }
+  static beast::string_view operator_header() { return "X-Skinstream-Operator"; }
+
+  std::string peer_address() const {
+    boost::system::error_code ec;
+    const auto endpoint = stream_.socket().remote_endpoint(ec);
+    return ec ? "?" : endpoint.address().to_string();
+  }
+
+  http::response<http::string_body> json_answer(http::status status, const nlohmann::json& body) {
+    http::response<http::string_body> res{status, request_.version()};
+    res.set(http::field::content_type, "application/json");
+    res.set(http::field::cache_control, "no-store");
+    res.body() = body.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
+    return res;
+  }
+
   void refuse(http::status status, const std::string& reason) {
     websocket_refusals.warn("websocket_refused", "WebSocket subscriber " + remote_of(stream_.socket()) + " refused: " + reason);
     auto res = error(status, reason + "\n");
@@ -136,17 +224,31 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
   std::shared_ptr<http::response<http::string_body>> response_;
   SubscriberHub& hub_;
   std::shared_ptr<const HttpRoutes> routes_;
+  std::shared_ptr<ControlRateLimit> control_rate_limit_;
 };
+
+// The routes as the sessions read them: the control API's counters made when the daemon gave none.
+std::shared_ptr<const HttpRoutes> checked_routes(HttpRoutes routes) {
+  if (routes.control && routes.control_token.empty())
+    throw std::invalid_argument("the control API needs a token (control_token_file)");
+  if (!routes.control_counters) routes.control_counters = std::make_shared<ControlCounters>();
+  return std::make_shared<const HttpRoutes>(std::move(routes));
+}
 
 }  // namespace
 
-HttpServer::HttpServer(asio::io_context& io, const std::string& address, int port, SubscriberHub& hub, HttpRoutes routes,
-                       ListenerOptions listening)
+HttpServer::HttpServer(asio::io_context& io, const std::string& address, int port, SubscriberHub& hub,
+                       HttpRoutes routes, ListenerOptions listening)
     : io_(io),
       hub_(hub),
-      routes_(std::make_shared<const HttpRoutes>(std::move(routes))),
-      listener_(io, address, port, "HTTP port", [this](tcp::socket socket) {
-        std::make_shared<HttpSession>(io_, std::move(socket), hub_, routes_)->read_next();
-      }, std::move(listening)) {}
+      routes_(checked_routes(std::move(routes))),
+      control_rate_limit_(std::make_shared<ControlRateLimit>(routes_->control_rate_limit)),
+      listener_(
+          io, address, port, "HTTP port",
+          [this](tcp::socket socket) {
+            std::make_shared<HttpSession>(io_, std::move(socket), hub_, routes_, control_rate_limit_)
+                ->read_next();
+          },
+          std::move(listening)) {}
 
 }  // namespace skinstream::server

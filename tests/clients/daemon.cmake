@@ -16,6 +16,7 @@ if(TARGET skinstreamd AND TARGET skinstream-sub AND TARGET skinstream-replay)
     SKINSTREAM_SUB="$<TARGET_FILE:skinstream-sub>"
     SKINSTREAM_REPLAY="$<TARGET_FILE:skinstream-replay>"
     SKINSTREAM_CLI="$<TARGET_FILE:skinstream>"
+    SKINSTREAM_CTL="$<TARGET_FILE:skinstream-ctl>"
     SKINSTREAM_DEMO_DIR="${CMAKE_BINARY_DIR}/demo"
     SKINSTREAM_SHARED_DIR="${SKINSTREAM_SHARED_DIR}"
     SKINSTREAM_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
@@ -23,7 +24,7 @@ if(TARGET skinstreamd AND TARGET skinstream-sub AND TARGET skinstream-replay)
   if(SKINSTREAM_SANITIZE MATCHES undefined)
     target_compile_definitions(daemon_tests PRIVATE SKINSTREAM_UBSAN_VPTR)  # its vptr check, on with undefined
   endif()
-  add_dependencies(daemon_tests skinstreamd skinstream-sub skinstream-replay skinstream)
+  add_dependencies(daemon_tests skinstreamd skinstream-sub skinstream-replay skinstream skinstream-ctl)
   gtest_discover_tests(daemon_tests TEST_FILTER "-DaemonDemo*" DISCOVERY_TIMEOUT 60 PROPERTIES LABELS clients TIMEOUT ${time_limit_120})
   # The demo subject's tests need the demo_subject fixture (tests/clients/CMakeLists.txt).
   gtest_discover_tests(daemon_tests TEST_FILTER "DaemonDemo*" DISCOVERY_TIMEOUT 60

@@ -6,6 +6,7 @@
 // be made stops the recording, says why, and the stream goes on.
 #include <gtest/gtest.h>
 #include <sys/mount.h>
+#include <sys/stat.h>
 
 #include <algorithm>
 #include <array>
@@ -28,6 +29,7 @@
 #include "server/replay/natnet/natnet_server.h"
 #include "server/replay/qtm/qtm_server.h"
 #include "support/io_thread.h"
+#include "support/loopback_peer.h"
 #include "support/program_processes.h"
 #include "support/program_run.h"
 #include "support/test_data.h"
@@ -415,6 +417,62 @@ void expect_take_follows_capture_system(bool natnet) {
 
 TEST(DaemonDemoTakes, ATakeFollowsMotivesRecordingOverNatNet) { expect_take_follows_capture_system(true); }
 TEST(DaemonDemoTakes, ATakeFollowsQtmsCaptureEvents) { expect_take_follows_capture_system(false); }
+
+// The operator's control API on the real daemon: skinstream-ctl with the token starts, stops and
+// lists a take; without it, or with a wrong one, nothing happens, it is counted, and the token
+// never reaches the log.
+TEST(DaemonDemoTakes, TheOperatorRecordsATakeWithSkinstreamCtlAndNobodyElseCan) {
+  const std::string dir = fresh_folder("takes_ctl");
+  const std::string token = "stage-control-token-4711";
+  const std::string token_file = test::scratch_path("control_token_" + std::to_string(getpid()));
+  test::write_bytes(token_file, token + "\n");
+  ASSERT_EQ(chmod(token_file.c_str(), 0600), 0);
+  DaemonProcess daemon("--subject " + kSubject + " --replay " + kCapture + " --loop --record-dir " + dir +
+                       " --control-token-file " + token_file);
+  const std::string ctl = std::string(SKINSTREAM_CTL) + " --port " + std::to_string(daemon.http_port);
+  const auto ctl_run = [&](const std::string& arguments) {
+    return test::run_program("SKINSTREAM_CONTROL_TOKEN= " + ctl + " " + arguments, false);
+  };
+
+  // Nobody else: no token, a wrong one, raw requests without one.
+  const std::string wrong_file = token_file + ".wrong";
+  test::write_bytes(wrong_file, "not-the-stage-token-0000\n");
+  ASSERT_EQ(chmod(wrong_file.c_str(), 0600), 0);
+  EXPECT_EQ(ctl_run("--token-file " + wrong_file + " take start stolen").exit_code, 1);
+  const std::string unauthorised = test::http_exchange_within(
+      daemon.http_port, "POST /takes HTTP/1.1\r\nHost: x\r\nContent-Length: 0\r\nConnection: close\r\n\r\n",
+      std::chrono::seconds(10));
+  EXPECT_NE(unauthorised.find("401"), std::string::npos) << unauthorised;
+  EXPECT_TRUE(std::filesystem::is_empty(dir)) << "a refused request started a take";
+  const nlohmann::json refused = health_of(daemon)["control"];
+  EXPECT_EQ(refused["refused_403"], 1) << refused;
+  EXPECT_EQ(refused["refused_401"], 1) << refused;
+
+  // The operator.
+  const test::ProgramRun started = ctl_run("--token-file " + token_file + " --operator anna take start walk");
+  ASSERT_EQ(started.exit_code, 0) << started.output;
+  EXPECT_EQ(nlohmann::json::parse(started.output)["take"], "walk");
+  ASSERT_TRUE(eventually([&] {
+    const nlohmann::json subjects = health_of(daemon)["recording"]["subjects"];
+    return subjects.contains("subject") && subjects["subject"].value("received_frames", 0) >= 60;
+  }));
+  const test::ProgramRun again = ctl_run("--token-file " + token_file + " take start other");
+  EXPECT_EQ(again.exit_code, 1) << again.output;  // one take at a time: 409, said in one line
+  ASSERT_EQ(ctl_run("--token-file " + token_file + " take stop").exit_code, 0);
+  ASSERT_TRUE(eventually([&] { return health_of(daemon)["recording"].value("state", "") == "idle"; }));
+  const test::ProgramRun listed = ctl_run("--token-file " + token_file + " takes");
+  ASSERT_EQ(listed.exit_code, 0) << listed.output;
+  const nlohmann::json takes = nlohmann::json::parse(listed.output)["takes"];
+  ASSERT_EQ(takes.size(), 1u) << listed.output;
+  EXPECT_EQ(takes[0]["take"], "walk");
+  EXPECT_EQ(takes[0]["state"], "closed");
+  EXPECT_EQ(takes[0]["started_by"], "control from 127.0.0.1 (anna)");
+  EXPECT_GE(takes[0]["subjects"][0]["received_frames"].get<int>(), 60);
+  EXPECT_EQ(daemon.stop(), 0);
+  EXPECT_EQ(daemon.log().find(token), std::string::npos) << "the token reached the log";
+  EXPECT_NE(daemon.log().find("take walk started by control from 127.0.0.1 (anna)"), std::string::npos)
+      << daemon.log();
+}
 
 TEST(DaemonDemoTakes, RecordAlwaysWithoutAFolderIsRefusedAtStart) {
   const test::ProgramRun run = test::run_program(std::string(SKINSTREAMD) + " --subject " + kSubject +

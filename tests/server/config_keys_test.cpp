@@ -71,6 +71,7 @@ const nlohmann::json kChangedValues = {
     {"record_always", true},
     {"record_with_source", true},
     {"record_unlabelled", 16},
+    {"control_token_file", "control-token.txt"},
     {"log_level", "debug"}};
 
 // A value out of range, or not of the key's form, for every key that checks its value.
@@ -116,6 +117,7 @@ const std::pair<const char*, nlohmann::json> kBadValues[] = {{"speed", 0.0},
                                                              {"unauthenticated_hello_timeout_ms", 9},
                                                              {"subscriber_unsent_kb", -1},
                                                              {"subscriber_join_mbit", -1},
+                                                             {"control_token_file", "token\n.txt"},
                                                              {"log_level", "loud"}};
 
 std::optional<CommandLine> parse_flags(std::vector<std::string> arguments) {

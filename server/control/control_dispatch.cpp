@@ -1,0 +1,18 @@
+#include "server/control/control_dispatch.h"
+
+namespace skinstream::server {
+
+ControlAnswer run_control_action(ControlActions& actions, const ControlDecision& decision,
+                                 const ControlCaller& caller) {
+  switch (decision.route->action) {
+    case ControlAction::StartTake:
+      return actions.start_take(caller, decision.body);
+    case ControlAction::StopTake:
+      return actions.stop_take(caller);
+    case ControlAction::ListTakes:
+      return actions.list_takes();
+  }
+  return {500, {{"error", "no action for this route"}}};
+}
+
+}  // namespace skinstream::server
