@@ -17,7 +17,12 @@ runs=()
 if [ -n "${FUZZ_RUNS:-}" ]; then runs=(-runs="$FUZZ_RUNS"); fi
 bash scripts/install-deps.sh >&2
 launcher=()
-if command -v ccache >/dev/null 2>&1; then launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache); fi
+# As scripts/build.sh: paths hashed relative to the checkout, so a fresh clone (CI) reuses what
+# another checkout's fuzz build compiled instead of compiling the whole fuzz build again.
+if command -v ccache >/dev/null 2>&1; then
+  launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
+  export CCACHE_BASEDIR="$PWD" CCACHE_NOHASHDIR=1
+fi
 # -O2 as RelWithDebInfo, with line tables only for the sanitizers' stack traces: full debug
 # information roughly doubles what the compiler writes and is not read here.
 # File by file, not in unity groups: a group pulls a whole group of runtime files into a fuzz

@@ -9,10 +9,18 @@
 #   OUT/live.c3d          the 2 s capture the end-to-end tests replay: replay_data/synthetic/jumprope_2s_seed1.c3d
 #   OUT/medley.c3d        the 25 s capture the run command replays: punch, golf, jump rope, flex and
 #                         breathing in turn (seed 1, made here rather than bundled: 2.3 MB saved)
-# Usage: scripts/make-demo.sh SKINSTREAM_BINARY OUT_DIR   (skips work already done)
+# Usage: scripts/make-demo.sh SKINSTREAM_BINARY OUT_DIR [--no-medley]   (skips work already done)
+# --no-medley: the subject and live.c3d only (the tests' fixture: no test replays the medley, and
+# its synthesis is a sixth of the fixture's time, spent while the end-to-end tests wait).
 set -euo pipefail
-cli=${1:?usage: make-demo.sh SKINSTREAM_BINARY OUT_DIR}
-out=${2:?usage: make-demo.sh SKINSTREAM_BINARY OUT_DIR}
+cli=${1:?usage: make-demo.sh SKINSTREAM_BINARY OUT_DIR [--no-medley]}
+out=${2:?usage: make-demo.sh SKINSTREAM_BINARY OUT_DIR [--no-medley]}
+medley=1
+case "${3:-}" in
+  "") ;;
+  --no-medley) medley=0 ;;
+  *) echo "usage: make-demo.sh SKINSTREAM_BINARY OUT_DIR [--no-medley]" >&2; exit 2 ;;
+esac
 root="$(cd "$(dirname "$0")/.." && pwd)"
 mkdir -p "$out"
 if [ ! -s "$out/rom_truth.c3d" ]; then
@@ -29,6 +37,10 @@ if [ ! -s "$out/subject.sksubj" ] || [ "$out/subject.sksubj" -ot "$cli" ]; then
   mv "$out/subject.sksubj.tmp" "$out/subject.sksubj"
 fi
 cp "$root/replay_data/synthetic/jumprope_2s_seed1.c3d" "$out/live.c3d"
+if [ "$medley" -eq 0 ]; then
+  echo "make-demo: $out/subject.sksubj and $out/live.c3d ready (build report: $out/subject.json)"
+  exit 0
+fi
 if [ ! -s "$out/medley.c3d" ] || [ "$out/medley.c3d" -ot "$cli" ]; then
   "$cli" synth --motion medley --seconds 25 --seed 1 --body "$root/replay_data/makehuman" --out "$out/medley.c3d.tmp.c3d" > /dev/null
   mv "$out/medley.c3d.tmp.c3d" "$out/medley.c3d"
