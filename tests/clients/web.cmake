@@ -2,7 +2,8 @@
 # installs the npm packages pinned in clients/web/package-lock.json), then
 # - web.units: the page's decoders and tables in node (node's test runner);
 # - web.bad_input: the page in the system Chromium against a scripted server sending bad input;
-# - web.viewer: the page in Chromium against the real daemon (tests/clients/web/viewer_test.mjs).
+# - web.viewer: the page in Chromium against the real daemon (tests/clients/web/viewer_test.mjs);
+# - web.takes_panel: the page's take controls against the real daemon (takes_panel_test.mjs).
 # Needs node and npm (Debian: nodejs npm) and chromium (software WebGL).
 find_program(SKINSTREAM_NODE NAMES node nodejs)
 if(NOT TARGET skinstreamd)
@@ -28,6 +29,15 @@ else()
     --recording ${CMAKE_BINARY_DIR}/demo/live.c3d
     --web-root ${CMAKE_BINARY_DIR}/web
     --out ${CMAKE_BINARY_DIR}/test_tmp/web)
+  # The page's take controls against the real daemon with a record_dir and a control token.
+  add_test(NAME web.takes_panel COMMAND ${SKINSTREAM_NODE} ${web_tests}/takes_panel_test.mjs
+    --daemon $<TARGET_FILE:skinstreamd>
+    --subject ${CMAKE_BINARY_DIR}/demo/subject.sksubj
+    --recording ${CMAKE_BINARY_DIR}/demo/live.c3d
+    --web-root ${CMAKE_BINARY_DIR}/web
+    --out ${CMAKE_BINARY_DIR}/test_tmp/web)
+  set_tests_properties(web.takes_panel PROPERTIES FIXTURES_REQUIRED "web_bundle;demo_subject"
+    LABELS browser TIMEOUT ${time_limit_300})
   # Chromium with SwiftShader keeps both cores busy: let ctest -j count it as two.
   set_tests_properties(web.viewer PROPERTIES FIXTURES_REQUIRED "web_bundle;demo_subject"
     LABELS browser TIMEOUT ${time_limit_600} PROCESSORS 2)

@@ -13,6 +13,7 @@ import { StatusBar } from './status_bar.js';
 import { installToggles } from './toggles.js';
 import { installEncodingPicker, requestedEncoding } from './encoding_picker.js';
 import { installSubjectPicker } from './subject_picker.js';
+import { installTakeControls } from './take_controls.js';
 
 const SAMPLED_POINTS = 8;
 const STATUS_INTERVAL_MS = 250;
@@ -292,6 +293,7 @@ function updateStatus() {
 }
 
 installToggles(shown, applyToggles);
+installTakeControls();
 installEncodingPicker(document.getElementById('encoding'), requested.encoding);
 if (viewerScene) viewerScene.controls.addEventListener('change', () => { sceneDirty = true; });
 window.addEventListener('resize', () => { sceneDirty = true; });

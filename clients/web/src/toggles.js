@@ -18,6 +18,7 @@ export function installToggles(shown, onChange) {
   }
   window.addEventListener('keydown', (event) => {
     if (event.ctrlKey || event.metaKey || event.altKey) return;
+    if (event.target instanceof HTMLInputElement) return;  // typing a token or a take's name
     const t = TOGGLES.find((x) => x.hotkey === event.key.toLowerCase());
     if (!t) return;
     const box = document.getElementById(t.id);
