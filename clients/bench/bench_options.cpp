@@ -68,6 +68,12 @@ std::optional<int> parse_bench_options(int argc, char** argv, BenchOptions& o) {
                  "--join-wave: when the joiners connect, in seconds into the window")
       ->check(CLI::Range(0.0, 3600.0))
       ->capture_default_str();
+  app.add_option(
+         "--record-ab", o.record_ab_seconds,
+         "recording A/B in one run: the daemon records a take for this many seconds, then none for as long, "
+         "in turn (through its control API); the report's record_ab splits the figures by recording on and "
+         "off")
+      ->check(CLI::Range(0.0, 3600.0));
   app.add_flag("--json", o.json, "print the report as JSON");
   app.add_flag("--hostile-waves", o.hostile_waves,
                "the soak: hostile peers (stalled, flooding, churning) connect and leave in waves while the subscribers measure "

@@ -47,6 +47,9 @@ struct BenchOptions {
   int join_wave = 0;
   std::string daemon_config;  // skinstreamd --config (keys without a flag, e.g. subscriber_join_mbit)
   double join_after_seconds = 3.0;
+  // Recording A/B in one run: a take starts and stops every this many seconds through the control
+  // API (0: off); the report splits the subscribers' figures by whether a take was recording.
+  double record_ab_seconds = 0.0;
   bool json = false;
 };
 

@@ -29,6 +29,7 @@
 #include "clients/bench/subjects.h"
 #include "protocol/files/capture_file.h"
 #include "protocol/files/file_error.h"
+#include "server/client/control_client.h"
 #include "server/client/daemon_process.h"
 #include "server/client/process_usage.h"
 #include "server/tcp_congestion.h"
@@ -66,6 +67,7 @@ struct Window {
   std::atomic<int64_t> start_ns{0};  // 0: not open yet
   std::atomic<int64_t> end_ns{INT64_MAX};
   std::atomic<bool> closed{false};
+  std::atomic<bool> recording{false};  // --record-ab: a take is recording
 };
 
 void subscribe(const BenchOptions& o, const std::string& host, int port, int index, const SendTimes& send_times, Window& window,
@@ -99,13 +101,18 @@ void subscribe(const BenchOptions& o, const std::string& host, int port, int ind
     if (start == 0 || frame.publish_time_ns < start || frame.publish_time_ns >= window.end_ns.load(std::memory_order_relaxed)) continue;
     const int64_t now = frame.ready_time_ns;
     const int64_t sent = send_times.find(frame.frame_number);
+    const int recording = window.recording.load(std::memory_order_relaxed) ? 1 : 0;
     if (sent > 0) {
       tally.end_to_end.ms.push_back((now - sent) * 1e-6);
       tally.ingest.ms.push_back((frame.receive_time_ns - sent) * 1e-6);
+      if (o.record_ab_seconds > 0) tally.end_to_end_by_recording[recording].ms.push_back((now - sent) * 1e-6);
     } else {
       ++tally.unmatched;
     }
     tally.processing.ms.push_back((frame.publish_time_ns - frame.receive_time_ns) * 1e-6);
+    if (o.record_ab_seconds > 0)
+      tally.processing_by_recording[recording].ms.push_back((frame.publish_time_ns - frame.receive_time_ns) *
+                                                            1e-6);
     tally.delivery.ms.push_back((frame.arrival_time_ns - frame.publish_time_ns) * 1e-6);
     tally.message_bytes += frame.message_bytes;
     if (static_cast<int64_t>(frame.frame_number) <= last_frame) ++tally.out_of_order;
@@ -226,6 +233,19 @@ nlohmann::json run_bench(const BenchOptions& o, const std::atomic<bool>& stop) {
   server::DaemonLaunch launch;
   launch.program = daemon_path.string();
   launch.arguments = daemon_arguments(o, replay.daemon_source_option());
+  // --record-ab: takes into the work folder, started and stopped with a token of this run's own.
+  const std::string control_token =
+      "bench-" + std::to_string(getpid()) + "-" + std::to_string(wall_clock_ns());
+  if (o.record_ab_seconds > 0) {
+    const fs::path token_file = work / "control-token";
+    {
+      std::ofstream out(token_file);
+      out << control_token << "\n";
+    }
+    fs::permissions(token_file, fs::perms::owner_read | fs::perms::owner_write);
+    launch.arguments += " --record-dir " + server::shell_word((work / "takes").string()) +
+                        " --control-token-file " + server::shell_word(token_file.string());
+  }
   launch.bind = daemon_address;
   launch.files_stem = (work / "skinstreamd").string();
   if (link)
@@ -299,7 +319,31 @@ nlohmann::json run_bench(const BenchOptions& o, const std::atomic<bool>& stop) {
   std::vector<long> rss_samples;
   nlohmann::json rss_steps = nlohmann::json::array();
   uint64_t buffers_after_1s = 0;  // the daemon's encoded frame buffers: RSS steps when they grow
+  // --record-ab: a take on, then off, in turn, through the control API.
+  int takes_recorded = 0;
+  const auto toggle_recording = [&](bool on) {
+    const server::ControlReply reply = server::post_control(daemon_address, daemon.http_port(),
+                                                            on ? "/takes" : "/takes/stop", control_token);
+    if (reply.status != (on ? 201 : 200))
+      throw std::runtime_error("--record-ab: the daemon answered " + std::to_string(reply.status) + " " +
+                               reply.body.dump());
+    window.recording = on;
+    if (on) ++takes_recorded;
+  };
+  Clock::time_point next_toggle = Clock::now();
   for (auto next = Clock::now() + std::chrono::seconds(1); next < deadline; next += std::chrono::seconds(1)) {
+    // (The loop ticks once a second: a toggle due within the next 50 ms is taken now.)
+    if (o.record_ab_seconds > 0 && Clock::now() + std::chrono::milliseconds(50) >= next_toggle) {
+      // A take must have closed before the next starts: a stop answered 200 closes within a moment.
+      if (!window.recording) {
+        const nlohmann::json recording = daemon.health()["recording"];
+        if (recording.value("state", "") == "idle") toggle_recording(true);
+      } else {
+        toggle_recording(false);
+      }
+      next_toggle = Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                       std::chrono::duration<double>(o.record_ab_seconds));
+    }
     if (!joined && join_at < next) {
       sleep_until_or_stop(join_at, stop);
       for (int j = 0; j < o.join_wave; ++j)
@@ -323,6 +367,9 @@ nlohmann::json run_bench(const BenchOptions& o, const std::atomic<bool>& stop) {
   }
   sleep_until_or_stop(deadline, stop);
   if (waves) waves->stop();
+  const nlohmann::json recording_health =
+      o.record_ab_seconds > 0 ? daemon.health()["recording"] : nlohmann::json();
+  if (o.record_ab_seconds > 0 && window.recording) toggle_recording(false);
   const int64_t window_end_ns = wall_clock_ns();
   window.end_ns = window_end_ns;
   const nlohmann::json health = daemon.health();
@@ -466,6 +513,24 @@ nlohmann::json run_bench(const BenchOptions& o, const std::atomic<bool>& stop) {
   if (link) report["shaped_link"] = nlohmann::json::parse(shaper);
   if (o.join_wave > 0)
     report["join_wave"] = join_wave_report(o, joiner_tallies, window_start_ns, window_end_ns);
+  if (o.record_ab_seconds > 0) {
+    nlohmann::json halves;
+    for (int r = 0; r < 2; ++r)
+      halves[r ? "on" : "off"] = {{"end_to_end", all.end_to_end_by_recording[r].summary()},
+                                  {"daemon_processing", all.processing_by_recording[r].summary()}};
+    const auto ratio = [&](const char* what) {
+      const double off = halves["off"][what]["p99_ms"].get<double>(),
+                   on = halves["on"][what]["p99_ms"].get<double>();
+      return off > 0 ? on / off : 0.0;
+    };
+    report["record_ab"] = {{"seconds", o.record_ab_seconds},
+                           {"takes", takes_recorded},
+                           {"off", halves["off"]},
+                           {"on", halves["on"]},
+                           {"daemon_processing_p99_on_over_off", ratio("daemon_processing")},
+                           {"end_to_end_p99_on_over_off", ratio("end_to_end")},
+                           {"recording_at_the_end", recording_health}};
+  }
   return report;
 }
 

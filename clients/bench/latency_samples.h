@@ -28,6 +28,9 @@ struct SubscriberTally {
   size_t model_bytes = 0;                        // the Model message (parameters)
   int64_t first_arrival_ns = 0, last_arrival_ns = 0;
   double first_frame_ms = -1.0;  // from starting to connect to the first frame (-1: none came)
+  // --record-ab: the same samples split by whether a take was recording when the frame arrived
+  // (index 1: recording).
+  Samples end_to_end_by_recording[2], processing_by_recording[2];
 
   void reserve(size_t frames) {
     for (Samples* s : {&end_to_end, &processing, &ingest, &delivery}) s->ms.reserve(frames);
@@ -40,6 +43,10 @@ struct SubscriberTally {
     append(processing, other.processing);
     append(ingest, other.ingest);
     append(delivery, other.delivery);
+    for (int r = 0; r < 2; ++r) {
+      append(end_to_end_by_recording[r], other.end_to_end_by_recording[r]);
+      append(processing_by_recording[r], other.processing_by_recording[r]);
+    }
     received += other.received;
     unmatched += other.unmatched;
     out_of_order += other.out_of_order;

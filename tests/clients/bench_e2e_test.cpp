@@ -138,6 +138,28 @@ TEST(BenchProgram, AJoinWaveIsReportedApartFromTheWatchers) {
       << late.output;
 }
 
+// Recording A/B in one run: takes start and stop through the control API, and the figures are
+// split by whether one was recording; every frame counted falls in one half.
+TEST(BenchProgram, RecordAbSplitsTheFiguresByRecordingOnAndOff) {
+  const test::ProgramRun r =
+      test::run_program(bench("--subject " + kDemo + "/subject.sksubj --recording " + kDemo +
+                              "/live.c3d --seconds 5 --subscribers 2 --record-ab 1 --json"),
+                        /*stderr_too=*/false);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto j = nlohmann::json::parse(r.output);
+  const auto& ab = j["record_ab"];
+  EXPECT_GE(ab["takes"].get<int>(), 1);
+  const long on = ab["on"]["daemon_processing"]["count"].get<long>(),
+             off = ab["off"]["daemon_processing"]["count"].get<long>();
+  EXPECT_GT(on, 0);
+  EXPECT_GT(off, 0);
+  EXPECT_EQ(on + off, j["daemon_processing"]["count"].get<long>());
+  EXPECT_GT(ab["daemon_processing_p99_on_over_off"].get<double>(), 0.0);
+  EXPECT_GE(ab["recording_at_the_end"]["takes_closed"].get<int>() +
+                (ab["recording_at_the_end"]["state"] == "recording"),
+            ab["takes"].get<int>());
+}
+
 // The other two capture systems drive the daemon too, and their frames are timed end to end
 // (the replay's send time found by frame number for every frame but the window's edges).
 TEST(BenchProgram, QtmAndNatNetSourcesAreTimedEndToEnd) {

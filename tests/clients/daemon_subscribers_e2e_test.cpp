@@ -372,10 +372,20 @@ TEST(DaemonDemoSubscribers, ThePoolShrinksBackToItsHighWaterMarkAfterStalledSubs
   };
   EXPECT_TRUE(eventually(pool_back)) << after["frame_pool"].dump();
   EXPECT_EQ(after["frame_buffers_allocated_by_pipeline"], 0) << after.dump();
-  const long rss_after = resident_kb(daemon.pid());
+  // Within 10% (the soak's bound): 60 held frames are 38 MB, about 70% of the daemon's RSS. The
+  // pool counts its frames gone before its thread has freed them (deleted outside its lock, then
+  // handed back to the system): measured, RSS sampled once right after /health said 9 frames was
+  // 69-94 MB in 8 of 26 runs (the test failed on it), and 58 MB 250 ms later in each run sampled
+  // again. So RSS gets a moment to follow; the bound is the same.
+  long rss_after = 0;
+  EXPECT_TRUE(eventually(
+      [&] {
+        rss_after = resident_kb(daemon.pid());
+        return rss_after < rss_before + rss_before / 10;
+      },
+      std::chrono::seconds(5)))
+      << "the stalled subscribers' memory did not come back: RSS " << rss_after << " kB";
   std::printf("pool after they left %s; RSS %ld kB\n", after["frame_pool"].dump().c_str(), rss_after);
-  // Within 10% (the soak's bound): 60 held frames are 38 MB, about 70% of the daemon's RSS.
-  EXPECT_LT(rss_after, rss_before + rss_before / 10) << "the stalled subscribers' memory did not come back";
   EXPECT_EQ(daemon.stop(), 0) << daemon.log();
 }
 
