@@ -14,6 +14,7 @@ struct ControlReply {
 
 // POST `path` with the Bearer `token` and no body. Throws boost::system::system_error when the
 // daemon cannot be reached.
-ControlReply post_control(const std::string& host, int http_port, const std::string& path, const std::string& token);
+ControlReply post_control(const std::string& host, int http_port, const std::string& path,
+                          const std::string& token);
 
 }  // namespace skinstream::server
