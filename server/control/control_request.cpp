@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cctype>
 
-#include "server/control/constant_time_equal.h"
+#include "server/constant_time_equal.h"
 
 namespace skinstream::server {
 namespace {

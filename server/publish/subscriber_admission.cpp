@@ -1,6 +1,6 @@
 #include "server/publish/subscriber_admission.h"
 
-#include <algorithm>
+#include "server/constant_time_equal.h"
 
 namespace skinstream::server {
 namespace {
@@ -85,16 +85,7 @@ void SubscriberAdmission::release(Places& places, const asio::ip::address& peer)
 }
 
 bool SubscriberAdmission::token_matches(std::string_view given) const {
-  const std::string& expected = options_.token;
-  // Every byte of the longer string is looked at whatever the others hold.
-  const size_t n = std::max(expected.size(), given.size());
-  unsigned char difference = expected.size() == given.size() ? 0 : 1;
-  for (size_t i = 0; i < n; ++i) {
-    const unsigned char a = i < expected.size() ? static_cast<unsigned char>(expected[i]) : 0;
-    const unsigned char b = i < given.size() ? static_cast<unsigned char>(given[i]) : 0;
-    difference |= static_cast<unsigned char>(a ^ b);
-  }
-  const bool matches = difference == 0 && !expected.empty();
+  const bool matches = constant_time_equal(given, options_.token) && !options_.token.empty();
   if (!matches) metrics_.subscribers_refused_token.fetch_add(1, std::memory_order_relaxed);
   return matches;
 }

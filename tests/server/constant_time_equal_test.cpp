@@ -1,4 +1,4 @@
-#include "server/control/constant_time_equal.h"
+#include "server/constant_time_equal.h"
 
 #include <gtest/gtest.h>
 
