@@ -19,19 +19,27 @@ std::vector<std::string> TakeTap::received_labels() const {
   return labels;
 }
 
-void TakeTap::record_received(const MarkerFrame& frame) {
-  if (frame.source_rate_hz > 0) source_rate_hz_.store(frame.source_rate_hz, std::memory_order_relaxed);
+RecordedFrame* TakeTap::claim(RecordedFrameRing& ring, std::atomic<uint64_t>& dropped, uint32_t frame_number,
+                              int64_t source_time_ns, int64_t receive_time_ns) {
   const uint64_t take = take_.load(std::memory_order_acquire);
-  if (take == 0) return;
-  RecordedFrame* slot = received_.claim();
+  if (take == 0) return nullptr;
+  RecordedFrame* slot = ring.claim();
   if (!slot) {
-    received_dropped_.fetch_add(1, std::memory_order_relaxed);
-    return;
+    dropped.fetch_add(1, std::memory_order_relaxed);
+    return nullptr;
   }
   slot->take = take;
-  slot->frame_number = frame.frame_number;
-  slot->source_time_ns = frame.source_time_ns;
-  slot->receive_time_ns = frame.receive_time_ns;
+  slot->frame_number = frame_number;
+  slot->source_time_ns = source_time_ns;
+  slot->receive_time_ns = receive_time_ns;
+  return slot;
+}
+
+void TakeTap::record_received(const MarkerFrame& frame) {
+  if (frame.source_rate_hz > 0) source_rate_hz_.store(frame.source_rate_hz, std::memory_order_relaxed);
+  RecordedFrame* slot =
+      claim(received_, received_dropped_, frame.frame_number, frame.source_time_ns, frame.receive_time_ns);
+  if (!slot) return;
   slot->timecode = frame.timecode;
   const size_t markers = std::min(marker_names_.size(), frame.labelled.size());
   std::copy_n(frame.labelled.begin(), markers, slot->points.begin());
@@ -49,17 +57,9 @@ void TakeTap::record_received(const MarkerFrame& frame) {
 }
 
 void TakeTap::on_filled(const FilledFrameView& frame) {
-  const uint64_t take = take_.load(std::memory_order_acquire);
-  if (take == 0) return;
-  RecordedFrame* slot = published_.claim();
-  if (!slot) {
-    published_dropped_.fetch_add(1, std::memory_order_relaxed);
-    return;
-  }
-  slot->take = take;
-  slot->frame_number = frame.frame_number;
-  slot->source_time_ns = frame.source_time_ns;
-  slot->receive_time_ns = frame.receive_time_ns;
+  RecordedFrame* slot =
+      claim(published_, published_dropped_, frame.frame_number, frame.source_time_ns, frame.receive_time_ns);
+  if (!slot) return;
   slot->timecode = SourceTimecode{};
   const size_t markers = std::min(marker_names_.size(), frame.positions.size());
   std::copy_n(frame.positions.begin(), markers, slot->points.begin());

@@ -44,6 +44,11 @@ class TakeTap : public FilledFrameObserver {
   double source_rate_hz() const { return source_rate_hz_.load(std::memory_order_relaxed); }
 
  private:
+  // The ring's next slot stamped with the take and the frame's numbers, or null: no take records,
+  // or the ring is full (counted in `dropped`).
+  RecordedFrame* claim(RecordedFrameRing& ring, std::atomic<uint64_t>& dropped, uint32_t frame_number,
+                       int64_t source_time_ns, int64_t receive_time_ns);
+
   std::string subject_;
   std::vector<std::string> marker_names_;
   int unlabelled_slots_ = 0;
