@@ -103,7 +103,8 @@ const char* const kRawTableHeader =
     "labels";
 const char* const kFilledTableHeader = "frame\tsource_frame\tsource_time_ns\treceive_time_ns\tstatus";
 
-// take.json written whole beside, synced, then renamed over: a reader sees the old or the new.
+// take.json written whole beside, then renamed over: a reader sees the old or the new (not synced:
+// a kill leaves it whole; after a power loss the C3D files and tables are what was synced).
 void write_json_atomically(const std::filesystem::path& path, const nlohmann::json& json) {
   const std::filesystem::path temporary = path.string() + ".tmp";
   {
