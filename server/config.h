@@ -95,6 +95,10 @@ struct DaemonConfig {
   // The operator's control API (docs/control-api.md): a file holding its token; empty = off (unless
   // SKINSTREAM_CONTROL_TOKEN is set). Read by load_control_token (server/control/control_token.h).
   std::string control_token_file;
+  // Subjects changed at run time (server/subjects/subject_changes.h).
+  std::string calibration_dir;   // empty = record_dir's "calibrations", else the system's temporary folder's
+  std::string calibration_mesh;  // a live calibration's body mesh when its request names none
+  std::string subject_builder;   // empty = the skinstream program beside skinstreamd
 };
 
 // Thrown for a bad config file, a bad key or value, or conflicting flags: one line, says which.

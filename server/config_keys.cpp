@@ -632,6 +632,24 @@ std::vector<ConfigKey> make_config_keys() {
         "the token may be in the environment variable SKINSTREAM_CONTROL_TOKEN (not both); never on the\n"
         "command line, where ps shows it. Neither = the control API is off (its paths answer 404).\n"
         "Wrong tokens are counted and rate-limited per address; the token is never logged nor printed."}),
+      bound(&DaemonConfig::calibration_dir,
+            {.name = "calibration_dir", .new_group = true,
+             .doc =
+        "Folder of the live calibrations (POST /subjects/NAME/calibration): each one's range of motion\n"
+        "(C3D), the subject file built from it, the builder's report and log. \"\" = \"calibrations\" in\n"
+        "record_dir, or without one skinstream-calibrations in the system's temporary folder."}),
+      bound(&DaemonConfig::calibration_mesh,
+            {.name = "calibration_mesh",
+             .doc =
+        "The body a live calibration fits to the actor when its request names none: the template (a\n"
+        "MakeHuman body OBJ with its skeleton and weights beside it) or a scan of the actor, as\n"
+        "`skinstream build-subject --mesh` takes it. \"\" = the request must name one for a subject\n"
+        "served with a mesh."}),
+      bound(&DaemonConfig::subject_builder,
+            {.name = "subject_builder",
+             .doc =
+        "The program that builds a live calibration's subject (`PROGRAM build-subject ...`, run as a\n"
+        "separate process at the lowest priority). \"\" = the skinstream program beside skinstreamd."}),
       bound(&DaemonConfig::log_level,
             {.name = "log_level", .flag = "--log-level", .new_group = true,
              .flag_help = "trace, debug, info, warn, error, critical, off",

@@ -6,12 +6,14 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <future>
 #include <nlohmann/json.hpp>
 
 #include "protocol/files/file_error.h"
 #include "protocol/printable_text.h"
 #include "protocol/subscriber/datagram_authentication.h"
 #include "server/control/control_token.h"
+#include "server/daemon_control.h"
 #include "server/http/http_server.h"
 #include "server/ingest/file_replay_source.h"
 #include "server/ingest/source_spec.h"
@@ -21,7 +23,7 @@
 #include "server/publish/subscriber_hub.h"
 #include "server/publish/subscriber_session.h"
 #include "server/publish/tcp_subscriber_handoff.h"
-#include "server/record/take_control.h"
+#include "server/subjects/subject_builder.h"
 #include "server/thread_name.h"
 
 namespace skinstream::server {
@@ -112,6 +114,20 @@ MulticastSenderOptions multicast_options_of(const DaemonConfig& config, uint32_t
   return options;
 }
 
+SubjectChangesOptions changes_options_of(const DaemonConfig& config) {
+  SubjectChangesOptions options;
+  if (!config.calibration_dir.empty())
+    options.dir = config.calibration_dir;
+  else if (!config.record_dir.empty())
+    options.dir = std::filesystem::path(config.record_dir) / "calibrations";
+  else
+    options.dir = std::filesystem::temp_directory_path() / "skinstream-calibrations";
+  options.builder = config.subject_builder.empty() ? default_subject_builder() : config.subject_builder;
+  options.mesh = config.calibration_mesh;
+  options.default_rate_hz = config.default_rate_hz;
+  return options;
+}
+
 AdmissionOptions admission_options_of(const DaemonConfig& config) {
   AdmissionOptions options;
   for (const std::string& text : config.allow_subscribers) {
@@ -148,6 +164,10 @@ Daemon::Daemon(const DaemonConfig& config)
   if (config.record_with_source && config.record_dir.empty())
     throw ConfigError("record_with_source needs record_dir (--record-dir)");
   if (!config.record_dir.empty()) start_recorder();
+  std::vector<SubjectStream*> streams;
+  for (auto& stream : subjects_) streams.push_back(stream.get());
+  changes_ = std::make_unique<SubjectChanges>(changes_options_of(config), std::move(streams),
+                                              static_cast<SubjectChanges::Host&>(*this), recorder_.get());
   const SourceSpec source = source_spec_of(config);
   source_ = make_source(io_, source, config, static_cast<SourceSink&>(*this));
   if (source.kind == SourceSpec::Kind::Replay) {
@@ -181,7 +201,7 @@ Daemon::Daemon(const DaemonConfig& config)
   routes.web_root = config.web_root;
   // The operator's control API, on only with a token (docs/control-api.md).
   if (const std::optional<std::string> token = load_control_token(config)) {
-    routes.control = std::make_shared<TakeControl>(recorder_.get());
+    routes.control = std::make_shared<DaemonControl>(recorder_.get(), *changes_);
     routes.control_token = *token;
     control_counters_ = std::make_shared<ControlCounters>();
     routes.control_counters = control_counters_;
@@ -288,6 +308,7 @@ void Daemon::wait() {
   publish_.join();
   if (!stopped_) {
     stopped_ = true;
+    changes_.reset();  // a build under way killed, a swap under way finished or abandoned
     for (auto& s : subjects_) s->stop();
     recorder_.reset();  // closes a take in progress: after the last frame was published
   }
@@ -327,7 +348,31 @@ void Daemon::on_frame(const SourceFrame& frame) {
                                                  fmt::format("{:g}", config_.source_max_coordinate_m) + " m of the origin)");
   }
   for (size_t k = 0; k < subjects_.size(); ++k)
-    if (router_.present(static_cast<int>(k))) subjects_[k]->post();
+    if (router_.present(static_cast<int>(k))) {
+      changes_->on_routed(static_cast<int>(k), *routed_[k]);
+      subjects_[k]->post();
+    }
+}
+
+bool Daemon::run_on_io_thread(const std::function<void()>& job) {
+  auto done = std::make_shared<std::promise<bool>>();
+  std::future<bool> ran = done->get_future();
+  asio::post(io_, [this, job, done] {
+    if (stopping_.load()) return done->set_value(false);
+    job();
+    done->set_value(true);
+  });
+  // Once the io thread has stopped, the job will never run: its copy goes with the io_context.
+  while (ran.wait_for(std::chrono::milliseconds(50)) != std::future_status::ready)
+    if (io_.stopped()) return false;
+  return ran.get();
+}
+
+void Daemon::retarget(int index) { router_.replace_target(index, subject(index).target()); }
+
+double Daemon::source_rate_hz() const {
+  std::lock_guard lock(state_mutex_);
+  return source_rate_hz_;
 }
 
 void Daemon::on_source_state(SourceState state, std::string_view detail) {
@@ -446,8 +491,10 @@ std::string Daemon::health_json() const {
   nlohmann::json subjects = nlohmann::json::array();
   size_t subscribers = 0;
   uint64_t dropped_write_stall = 0;
-  for (const auto& s : subjects_) {
+  for (size_t k = 0; k < subjects_.size(); ++k) {
+    const auto& s = subjects_[k];
     subjects.push_back(s->health());
+    subjects.back()["change"] = changes_ ? changes_->health(static_cast<int>(k)) : nlohmann::json();
     subscribers += subjects.back()["subscribers"].get<size_t>();
     dropped_write_stall += s->metrics().subscribers_dropped_write_stall.load();
   }

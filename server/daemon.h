@@ -30,6 +30,7 @@
 #include "server/publish/subscriber_admission.h"
 #include "server/record/take_recorder.h"
 #include "server/subject_stream.h"
+#include "server/subjects/subject_changes.h"
 
 namespace skinstream::server {
 
@@ -38,7 +39,7 @@ class MulticastSender;
 class HttpServer;
 class Listener;
 
-class Daemon : private SourceSink, private SubjectRouter::Observer {
+class Daemon : private SourceSink, private SubjectRouter::Observer, private SubjectChanges::Host {
  public:
   // Loads the subjects, opens the source file, binds both ports. Throws with a one-line message
   // (FileError, ConfigError, std::runtime_error) when any of it fails.
@@ -72,6 +73,11 @@ class Daemon : private SourceSink, private SubjectRouter::Observer {
   void on_match(int target, bool present, std::string_view detail) override;
   void on_unknown_subjects(std::span<const std::string> names, size_t not_listed) override;
   void on_unknown_labels(int target, std::span<const std::string> names, size_t not_listed) override;
+
+  // SubjectChanges::Host (a subject swapped at run time).
+  bool run_on_io_thread(const std::function<void()>& job) override;
+  void retarget(int index) override;
+  double source_rate_hz() const override;
 
   void broadcast_status();
   void schedule_status();
@@ -109,6 +115,7 @@ class Daemon : private SourceSink, private SubjectRouter::Observer {
   std::unique_ptr<FrameSource> source_;
   asio::steady_timer status_timer_;
   asio::steady_timer status_log_timer_;
+  std::unique_ptr<SubjectChanges> changes_;  // its thread swaps subjects through the io thread: stopped first
 
   mutable std::mutex state_mutex_;
   SourceState state_ = SourceState::Connecting;

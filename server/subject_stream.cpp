@@ -70,54 +70,164 @@ nlohmann::json latency_summaries(const Metrics& metrics) {
 
 }  // namespace
 
+// A subject file and what is made from it; replaced whole by a swap.
+struct SubjectStream::Replacement {
+  Replacement(std::string path, SubjectFile s, std::chrono::nanoseconds max_frame_wait)
+      : file(std::move(path)), subject(std::move(s)), mailbox(subject.model.marker_count(), max_frame_wait) {}
+  std::string file;
+  SubjectFile subject;
+  FrameMailbox mailbox;
+  std::unique_ptr<Pipeline> pipeline;
+  subscriber::MeshInfo mesh_info;
+  ControlMessage model_message;  // null without a mesh
+  uint32_t epoch = 0;
+  std::chrono::steady_clock::time_point retired;
+};
+
+namespace {
+
+// The subject file read and checked as the daemon serves it: a body it would refuse (folded,
+// crumpled, not a body) is refused here too.
+SubjectFile read_served_subject(const std::string& file, const std::string& name) {
+  SubjectFile subject = read_subject_file(file);
+  if (subject.deformation)
+    if (const std::string problem = implausible_body(subject.model, *subject.deformation); !problem.empty())
+      throw FileError(file, "refused: " + problem);
+  if (!subject.deformation)
+    spdlog::warn(
+        "subject {}: {}: no deformation model (built without --mesh): publishing markers only (MeshInfo with "
+        "V = 0)",
+        name, file);
+  return subject;
+}
+
+}  // namespace
+
 SubjectStream::SubjectStream(SubjectConfig config, const SubjectStreamOptions& options)
     : config_(std::move(config)),
       name_(config_.name.empty() ? std::filesystem::path(config_.file).stem().string() : config_.name),
-      subject_(read_subject_file(config_.file)),
-      mailbox_(subject_.model.marker_count(), options.max_frame_wait),
+      options_(options),
       deform_cpus_(options.pipeline.deform_cpus),
       deform_threads_(options.pipeline.deform_threads) {
-  if (subject_.deformation)
-    if (const std::string problem = implausible_body(subject_.model, *subject_.deformation); !problem.empty())
-      throw FileError(config_.file, "refused: " + problem);
-  if (!subject_.deformation)
-    spdlog::warn("subject {}: {}: no deformation model (built without --mesh): publishing markers only (MeshInfo with V = 0)",
-                 name_, config_.file);
-  subscriber::MeshInfo mesh_info = mesh_info_of(subject_);
+  auto body = std::make_shared<Replacement>(config_.file, read_served_subject(config_.file, name_),
+                                            options.max_frame_wait);
+  subscriber::MeshInfo mesh_info = mesh_info_of(body->subject);
   mesh_info.subject = name_;
-  hub_ = std::make_unique<SubscriberHub>(metrics_, options.hub, std::move(mesh_info), subject_.deformation.has_value());
-  FrameConsumer* consumer = hub_.get();
+  const bool has_mesh = body->subject.deformation.has_value();
+  hub_ = std::make_unique<SubscriberHub>(metrics_, options.hub, std::move(mesh_info), has_mesh);
+  consumer_ = hub_.get();
   if (options.multicast) {
-    if (!subject_.deformation)
+    if (!has_mesh)
       throw ConfigError("multicast sends the parameters of the mesh: subject " + name_ + " (" + config_.file + ") has none (built without --mesh)");
     multicast_ = std::make_unique<MulticastSender>(*hub_, *options.multicast);
-    consumer = multicast_.get();
+    consumer_ = multicast_.get();
   }
-  try {
-    pipeline_ = std::make_unique<Pipeline>(subject_.model, subject_.deformation ? &*subject_.deformation : nullptr, options.pipeline,
-                                           mailbox_, *consumer, metrics_);
-  } catch (const std::invalid_argument& e) {
-    throw FileError(config_.file, std::string("deformation model unusable: ") + e.what());
-  }
-  Pipeline* pipeline = pipeline_.get();
+  make_pipeline(*body, 0);
+  Pipeline* pipeline = body->pipeline.get();
   hub_->set_encoding_preparer({.ready = [pipeline](StreamKey key) { return pipeline->encoding_ready(key); },
                                .request = [pipeline](StreamKey key) { pipeline->request_encoding(key); },
                                .activated = [pipeline](StreamKey key) { pipeline->encoding_activated(key); }});
-  pipeline_->set_encoding_ready_callback([hub = hub_.get()](StreamKey key) { hub->encoding_prepared(key); });
-  hub_->set_compressed_order(pipeline_->compressed_order());
-  if (const EvaluationModel* evaluation = pipeline_->evaluation_model()) {
-    hub_->set_model_message(std::make_shared<const std::vector<unsigned char>>(subscriber::encode_model(*evaluation)));
-    spdlog::info("subject {}: parameter encoding: Model message of {} bytes ({} parts, {} RBF centres, {} influences)", name_,
-                 hub_->model_message()->size(), evaluation->part_count(), evaluation->member_count(), evaluation->influence_count());
+  hub_->set_compressed_order(pipeline->compressed_order());
+  if (body->model_message) {
+    hub_->set_model_message(body->model_message);
+    const EvaluationModel& evaluation = *pipeline->evaluation_model();
+    spdlog::info(
+        "subject {}: parameter encoding: Model message of {} bytes ({} parts, {} RBF centres, {} influences)",
+        name_, body->model_message->size(), evaluation.part_count(), evaluation.member_count(),
+        evaluation.influence_count());
     if (multicast_) {
-      multicast_->set_model(std::span<const unsigned char>(*hub_->model_message()).subspan(subscriber::kHeaderBytes));
-      pipeline_->prepare_encoding(MulticastSender::sent_key());
+      multicast_->set_model(
+          std::span<const unsigned char>(*body->model_message).subspan(subscriber::kHeaderBytes));
+      pipeline->prepare_encoding(MulticastSender::sent_key());
       spdlog::info("subject {}: multicast: every frame's parameters to {}:{} from {} (TTL {}), stream {}, model id {:08x}", name_,
                    options.multicast->group, options.multicast->port, options.multicast->interface_address, options.multicast->ttl,
                    options.multicast->stream_id, multicast_->model_id());
     }
   }
+  input_ = body.get();
+  body_ = std::move(body);
 }
+
+void SubjectStream::make_pipeline(Replacement& body, uint32_t epoch) {
+  PipelineOptions options = options_.pipeline;
+  options.model_epoch = epoch;
+  body.epoch = epoch;
+  const SubjectFile& subject = body.subject;
+  try {
+    body.pipeline =
+        std::make_unique<Pipeline>(subject.model, subject.deformation ? &*subject.deformation : nullptr,
+                                   options, body.mailbox, *consumer_, metrics_);
+  } catch (const std::invalid_argument& e) {
+    throw FileError(body.file, std::string("deformation model unusable: ") + e.what());
+  }
+  Pipeline* pipeline = body.pipeline.get();
+  pipeline->set_encoding_ready_callback([hub = hub_.get()](StreamKey key) { hub->encoding_prepared(key); });
+  body.mesh_info = mesh_info_of(subject);
+  if (const EvaluationModel* evaluation = pipeline->evaluation_model())
+    body.model_message =
+        std::make_shared<const std::vector<unsigned char>>(subscriber::encode_model(*evaluation));
+}
+
+std::shared_ptr<SubjectStream::Replacement> SubjectStream::prepare_replacement(const std::string& file) {
+  auto body = std::make_shared<Replacement>(file, read_served_subject(file, name_), options_.max_frame_wait);
+  if (body->subject.deformation.has_value() != has_mesh())
+    throw FileError(file, has_mesh()
+                              ? "refused: it has no deformation model (built without --mesh), and subject " +
+                                    name_ + "'s subscribers receive a mesh"
+                              : "refused: it has a deformation model, and subject " + name_ +
+                                    " is served as markers only (restart the daemon to serve a mesh)");
+  make_pipeline(*body, last_epoch_.fetch_add(1) + 1);
+  // The buffers of every encoding its subscribers receive, made here: its first frames would
+  // otherwise make them on its thread.
+  hub_->wanted_encodings().for_each([&](StreamKey key) { body->pipeline->prepare_encoding(key); });
+  if (multicast_) body->pipeline->prepare_encoding(MulticastSender::sent_key());
+  return body;
+}
+
+const SubjectModel& SubjectStream::model() const { return input_->subject.model; }
+
+MarkerFrame& SubjectStream::writable() { return input_->mailbox.writable(); }
+
+const SubjectModel& SubjectStream::model_of(const Replacement& replacement) {
+  return replacement.subject.model;
+}
+
+void SubjectStream::switch_input(Replacement& replacement) { input_ = &replacement; }
+
+void SubjectStream::complete_replacement(std::shared_ptr<Replacement> next) {
+  const std::shared_ptr<Replacement> old = served();
+  old->pipeline->stop();  // its last frame published; nothing publishes until the new one starts
+  Pipeline* pipeline = next->pipeline.get();
+  if (multicast_ && next->model_message)
+    multicast_->set_model(
+        std::span<const unsigned char>(*next->model_message).subspan(subscriber::kHeaderBytes));
+  hub_->replace_model({next->mesh_info,
+                       next->model_message,
+                       pipeline->compressed_order(),
+                       {.ready = [pipeline](StreamKey key) { return pipeline->encoding_ready(key); },
+                        .request = [pipeline](StreamKey key) { pipeline->request_encoding(key); },
+                        .activated = [pipeline](StreamKey key) { pipeline->encoding_activated(key); }},
+                       next->epoch});
+  pipeline->set_filled_observer(take_tap_);
+  pipeline->start();
+  old->retired = std::chrono::steady_clock::now();
+  std::lock_guard lock(mutex_);
+  config_.file = next->file;
+  retired_.push_back(old);
+  body_ = std::move(next);
+}
+
+std::shared_ptr<SubjectStream::Replacement> SubjectStream::served() const {
+  std::lock_guard lock(mutex_);
+  return body_;
+}
+
+SubjectConfig SubjectStream::config() const {
+  std::lock_guard lock(mutex_);
+  return config_;
+}
+
+uint32_t SubjectStream::vertex_count() const { return served()->pipeline->vertex_count(); }
 
 void SubjectStream::render_multicast_metrics(std::string& out) const {
   if (multicast_) multicast_->render_prometheus(out);
@@ -125,18 +235,19 @@ void SubjectStream::render_multicast_metrics(std::string& out) const {
 
 SubjectStream::~SubjectStream() { stop(); }
 
-void SubjectStream::start() { pipeline_->start(); }
+void SubjectStream::start() { served()->pipeline->start(); }
 
-void SubjectStream::stop() { pipeline_->stop(); }
+void SubjectStream::stop() { served()->pipeline->stop(); }
 
 void SubjectStream::set_take_tap(TakeTap* tap) {
   take_tap_ = tap;
-  pipeline_->set_filled_observer(tap);
+  served()->pipeline->set_filled_observer(tap);
 }
 
 void SubjectStream::post() {
   metrics_.frames_received.fetch_add(1, std::memory_order_relaxed);
-  const MarkerFrame& frame = mailbox_.writable();
+  FrameMailbox& mailbox = input_->mailbox;
+  const MarkerFrame& frame = mailbox.writable();
   if (frame.rejected_points > 0) {
     metrics_.count_bad_input("rejected_point");
     bad_input_log_.warn("rejected_point", "subject " + name_ + ", frame " + std::to_string(frame.frame_number) + ": " +
@@ -154,18 +265,20 @@ void SubjectStream::post() {
     source_rate_hz_ = frame.source_rate_hz;
     hub_->set_source_rate(static_cast<float>(frame.source_rate_hz));
   }
-  if (const std::optional<FrameMailbox::Drop> drop = mailbox_.post(generation_)) {
+  if (const std::optional<FrameMailbox::Drop> drop = mailbox.post(generation_)) {
     // Says which side fell behind: the pipeline (it took nothing for a while), or the source,
     // whose frames came in a burst longer than the mailbox holds.
     using Ms = std::chrono::duration<double, std::milli>;
     const bool full = drop->reason == FrameMailbox::DropReason::kMailboxFull;
-    drop_log_.warn("frame_gave_way",
-                   fmt::format("subject {}: frame {} gave way to newer ones after waiting {:.1f} ms: {}; the pipeline last took a "
-                               "frame {:.1f} ms before ({} dropped in all)",
-                               name_, drop->frame_number, Ms(drop->waited).count(),
-                               full ? "more frames arrived together than the mailbox holds (a burst from the source)"
-                                    : "the pipeline is behind (longer than max_frame_wait_ms)",
-                               Ms(drop->since_last_take).count(), mailbox_.dropped()));
+    drop_log_.warn(
+        "frame_gave_way",
+        fmt::format("subject {}: frame {} gave way to newer ones after waiting {:.1f} ms: {}; the pipeline "
+                    "last took a "
+                    "frame {:.1f} ms before ({} dropped in all)",
+                    name_, drop->frame_number, Ms(drop->waited).count(),
+                    full ? "more frames arrived together than the mailbox holds (a burst from the source)"
+                         : "the pipeline is behind (longer than max_frame_wait_ms)",
+                    Ms(drop->since_last_take).count(), mailbox.dropped()));
   }
 }
 
@@ -206,7 +319,14 @@ void SubjectStream::broadcast_status(SourceState state, std::string_view source_
 
 void SubjectStream::tend_subscribers(std::chrono::milliseconds write_stall) {
   if (write_stall.count() > 0) hub_->drop_stalled_writers(write_stall);
-  pipeline_->trim_pool();
+  served()->pipeline->trim_pool();
+  // A replaced model's frames may still be queued for a subscriber, its pool's buffers in use;
+  // its encoding preparer may still be called by a subscriber's thread for a moment.
+  std::lock_guard lock(mutex_);
+  const auto now = std::chrono::steady_clock::now();
+  std::erase_if(retired_, [&](const std::shared_ptr<Replacement>& r) {
+    return r->pipeline->pool_frames_in_use() == 0 && now - r->retired > std::chrono::seconds(10);
+  });
 }
 
 std::string SubjectStream::status_line(StatusLine::Clock::time_point now) {
@@ -222,8 +342,11 @@ nlohmann::json SubjectStream::health() const {
     // present: in the source's latest frames (the daemon waits for an absent one).
     out = {{"name", name_}, {"file", config_.file}, {"present", present_}, {"detail", presence_detail_}, {"fps", published_fps_}};
   }
-  out["markers"] = subject_.model.marker_count();
-  out["vertices"] = pipeline_->vertex_count();
+  const std::shared_ptr<Replacement> body = served();
+  const Pipeline& pipeline = *body->pipeline;
+  out["markers"] = body->subject.model.marker_count();
+  out["vertices"] = pipeline.vertex_count();
+  out["model_epoch"] = body->epoch;
   out["frames"] = {{"received", metrics_.frames_received.load()},
                    {"processed", metrics_.frames_processed.load()},
                    {"published", metrics_.frames_published.load()},
@@ -242,9 +365,9 @@ nlohmann::json SubjectStream::health() const {
   // Frames in the pool and held by subscribers now, and the most held at once since the last
   // Status tick: within two ticks of stalled subscribers leaving, the pool is back to that high
   // water mark plus the frames kept free.
-  out["frame_pool"] = {{"frames", pipeline_->pool_frames()},
-                       {"in_use", pipeline_->pool_frames_in_use()},
-                       {"in_use_high_water", pipeline_->pool_frames_in_use_high_water()},
+  out["frame_pool"] = {{"frames", pipeline.pool_frames()},
+                       {"in_use", pipeline.pool_frames_in_use()},
+                       {"in_use_high_water", pipeline.pool_frames_in_use_high_water()},
                        {"kept_free", Pipeline::pool_frames_kept_free()},
                        {"unwanted_encoding_hold_off_s", Pipeline::unwanted_encoding_hold_off().count()}};
   if (multicast_) out["multicast"] = multicast_->health();

@@ -6,6 +6,7 @@
 // present in it; a stream's work never waits for another's (each has its own threads: see
 // SubjectStreamOptions::pipeline for how the CPUs are shared).
 
+#include <atomic>
 #include <chrono>
 #include <memory>
 #include <mutex>
@@ -50,10 +51,13 @@ class SubjectStream {
   // What subscribers, the log, /health and /metrics call it: the source subject it follows,
   // else its file's stem.
   const std::string& name() const { return name_; }
-  const SubjectConfig& config() const { return config_; }
-  const SubjectModel& model() const { return subject_.model; }
-  SubjectTarget target() const { return {config_.name, subject_.model.marker_names}; }
-  uint32_t vertex_count() const { return pipeline_->vertex_count(); }
+  // The subject file served now (a swap changes it).
+  SubjectConfig config() const;
+  // The io thread: the model whose frames it routes.
+  const SubjectModel& model() const;
+  SubjectTarget target() const { return {config_.name, model().marker_names}; }
+  uint32_t vertex_count() const;
+  bool has_mesh() const { return hub_->has_mesh(); }
   SubscriberHub& hub() { return *hub_; }
   Metrics& metrics() { return metrics_; }
   const Metrics& metrics() const { return metrics_; }
@@ -63,8 +67,24 @@ class SubjectStream {
   void start();  // the pipeline thread
   void stop();   // no frame is published after it returns; safe to call twice
 
+  // A swap of the subject (a live calibration, another file), in three steps, so that the
+  // subscribers carry on across it and the io thread never waits for a file or a thread.
+  // 1. Any thread but the io thread (slow: reads the file, builds the deformer): `file` read and
+  //    checked as at start-up and made into a pipeline that is not started. Throws FileError with
+  //    the reason; nothing served changes.
+  struct Replacement;
+  std::shared_ptr<Replacement> prepare_replacement(const std::string& file);
+  static const SubjectModel& model_of(const Replacement& replacement);
+  // 2. The io thread, between two frames: the replacement's mailbox takes this subject's frames
+  //    from the next one on (the router is told the new target by the caller).
+  void switch_input(Replacement& replacement);
+  // 3. Off the io thread, after 2: the old pipeline publishes its last frame and stops, the
+  //    subscribers are sent the new MeshInfo and Model, the new pipeline starts. The old model
+  //    is freed once no subscriber holds its frames.
+  void complete_replacement(std::shared_ptr<Replacement> replacement);
+
   // The io thread, for each frame the router gives this subject: fill writable(), then post().
-  MarkerFrame& writable() { return mailbox_.writable(); }
+  MarkerFrame& writable();
   void post();
   // The io thread: the source (re)started streaming, a new take for the filler.
   void new_take() { ++generation_; }
@@ -78,23 +98,32 @@ class SubjectStream {
   nlohmann::json health() const;  // /health's entry for this subject
   void render_multicast_metrics(std::string& out) const;  // appended to /metrics when multicast is on
   // The io thread, every Status tick: drops subscribers whose write made no progress for
-  // `write_stall` (0: never), and gives the frame pool back down to what the active ones need.
+  // `write_stall` (0: never), gives the frame pool back down to what the active ones need, and
+  // frees replaced models no subscriber holds a frame of.
   void tend_subscribers(std::chrono::milliseconds write_stall);
   // The io thread: the log's status line for the interval since the previous one.
   std::string status_line(StatusLine::Clock::time_point now);
 
  private:
-  SubjectConfig config_;
+  // The pipeline for `subject` (its models in `body`), publishing to consumer_.
+  void make_pipeline(Replacement& body, uint32_t epoch);
+  std::shared_ptr<Replacement> served() const;
+
+  SubjectConfig config_;  // its file: under mutex_ (a swap changes it)
   std::string name_;
-  SubjectFile subject_;
+  SubjectStreamOptions options_;
   Metrics metrics_;
   RateLimitedLog bad_input_log_;
   RateLimitedLog drop_log_;  // frames that gave way in the mailbox, with the reason
   StatusLine status_line_;
-  FrameMailbox mailbox_;
   std::unique_ptr<SubscriberHub> hub_;
   std::unique_ptr<MulticastSender> multicast_;  // the pipeline's consumer in front of the hub, when on
-  std::unique_ptr<Pipeline> pipeline_;
+  FrameConsumer* consumer_ = nullptr;           // multicast_ or hub_
+  std::shared_ptr<Replacement> body_;  // the subject file, mailbox and pipeline served (under mutex_)
+  Replacement* input_ = nullptr;       // whose mailbox the io thread fills: body_'s, or the next one's
+  std::vector<std::shared_ptr<Replacement>>
+      retired_;                          // replaced, until no subscriber holds their frames (under mutex_)
+  std::atomic<uint32_t> last_epoch_{0};  // of the newest model made
   std::vector<int> deform_cpus_;
   int deform_threads_ = 0;
   TakeTap* take_tap_ = nullptr;

@@ -1,8 +1,9 @@
 // skinstream-ctl: the operator's control API of a skinstreamd (docs/control-api.md) from a
-// script: start and stop takes, list them. Prints the daemon's JSON answer; exits 0 when it
-// accepted, 1 when it refused (the one-line reason on stderr) or could not be reached, 2 on a
-// usage error. The token comes from a file or SKINSTREAM_CONTROL_TOKEN, never from the command
-// line, where ps shows it to every user.
+// script: start and stop takes, list them; calibrate a subject live or load another subject
+// file into it, and wait for the swap. Prints the daemon's JSON answer; exits 0 when it
+// accepted (and a subject change succeeded), 1 when it refused or the change failed (the
+// one-line reason on stderr) or it could not be reached, 2 on a usage error. The token comes from a file or
+// SKINSTREAM_CONTROL_TOKEN, never from the command line, where ps shows it to every user.
 #include <CLI/CLI.hpp>
 #include <chrono>
 #include <cstdio>
@@ -12,6 +13,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
+#include <thread>
 
 #include "protocol/printable_text.h"
 #include "server/beast.h"
@@ -91,18 +93,79 @@ std::string reason_of(const http::response<http::string_body>& response) {
   return skinstream::printable_text(first_line.empty() ? std::string(response.reason()) : first_line);
 }
 
+struct Control {
+  std::string host;
+  int port = 0;
+  std::string token, operator_name;
+
+  // One request; its status and JSON body (null when the body is not JSON). Throws
+  // std::runtime_error when the daemon cannot be reached.
+  std::pair<unsigned, nlohmann::json> call(http::verb method, const std::string& target,
+                                           const nlohmann::json* body, std::string* reason) const {
+    http::request<http::string_body> request;
+    request.version(11);
+    request.method(method);
+    request.target(target);
+    if (body) {
+      request.body() = body->dump();
+      request.set(http::field::content_type, "application/json");
+    }
+    request.set(http::field::authorization, "Bearer " + token);
+    request.set(http::field::host, host);
+    if (!operator_name.empty()) request.set("X-Skinstream-Operator", operator_name);
+    request.keep_alive(false);
+    request.prepare_payload();
+    const http::response<http::string_body> response = exchange(host, port, std::move(request));
+    if (reason) *reason = reason_of(response);
+    const nlohmann::json json = nlohmann::json::parse(response.body(), nullptr, false);
+    return {response.result_int(), json.is_discarded() ? nlohmann::json() : json};
+  }
+};
+
+// A subject change asked for: polls GET /subjects/NAME until it is done or failed (or `limit`
+// passes), prints its last state; 0 when done.
+int wait_for_change(const Control& control, const std::string& name, std::chrono::seconds limit) {
+  const auto until = std::chrono::steady_clock::now() + limit;
+  nlohmann::json change;
+  for (;;) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(250));
+    std::string reason;
+    const auto [status, json] = control.call(http::verb::get, "/subjects/" + name, nullptr, &reason);
+    if (status != 200) {
+      std::fprintf(stderr, "skinstream-ctl: %u %s\n", status, reason.c_str());
+      return kExitRefused;
+    }
+    change = json.value("change", nlohmann::json());
+    const std::string state = change.is_object() ? change.value("state", "") : "";
+    if (state == "done" || state == "failed") break;
+    if (std::chrono::steady_clock::now() > until) {
+      std::fprintf(stderr, "skinstream-ctl: subject %s: still %s after %lld s; not waiting longer\n",
+                   name.c_str(), state.c_str(), static_cast<long long>(limit.count()));
+      return kExitRefused;
+    }
+  }
+  std::cout << change.dump(2) << "\n";
+  if (change.value("state", "") == "done") return 0;
+  std::fprintf(stderr, "skinstream-ctl: subject %s: %s failed: %s\n", name.c_str(),
+               change.value("kind", "change").c_str(),
+               skinstream::printable_text(change.value("reason", "")).c_str());
+  return kExitRefused;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"skinstream-ctl: control a skinstreamd's takes (docs/control-api.md)"};
-  std::string host = "127.0.0.1", token_file, operator_name, take_name;
-  int port = 8480;
-  if (const char* user = std::getenv("USER")) operator_name = user;
-  app.add_option("--host", host, "the daemon's host (default 127.0.0.1)");
-  app.add_option("--port", port, "its HTTP port (default 8480)")->check(CLI::Range(1, 65535));
+  CLI::App app{"skinstream-ctl: control a skinstreamd's takes and subjects (docs/control-api.md)"};
+  Control control{"127.0.0.1", 8480, "", ""};
+  std::string token_file, take_name, subject_name, subject_file, mesh;
+  double seconds = 30.0;
+  bool no_wait = false;
+  if (const char* user = std::getenv("USER")) control.operator_name = user;
+  app.add_option("--host", control.host, "the daemon's host (default 127.0.0.1)");
+  app.add_option("--port", control.port, "its HTTP port (default 8480)")->check(CLI::Range(1, 65535));
   app.add_option("--token-file", token_file,
                  "a file whose first line is the control token (default: $SKINSTREAM_CONTROL_TOKEN)");
-  app.add_option("--operator", operator_name, "who asks, for the daemon's log (default: $USER)");
+  app.add_option("--operator", control.operator_name, "who asks, for the daemon's log (default: $USER)");
   app.require_subcommand(1);
   CLI::App* take = app.add_subcommand("take", "start or stop a take");
   take->require_subcommand(1);
@@ -110,6 +173,23 @@ int main(int argc, char** argv) {
   start->add_option("name", take_name, "the take's name (default: the daemon's)");
   CLI::App* stop = take->add_subcommand("stop", "stop the take being recorded");
   CLI::App* takes = app.add_subcommand("takes", "list the takes");
+  CLI::App* subject =
+      app.add_subcommand("subject", "calibrate a subject live, or give it another subject file");
+  subject->require_subcommand(1);
+  CLI::App* calibrate = subject->add_subcommand(
+      "calibrate",
+      "record the subject's range of motion from the stream, build it, check it, swap it in: calibrate NAME");
+  calibrate->add_option("name", subject_name, "the subject")->required();
+  calibrate->add_option("--seconds", seconds, "seconds of range of motion to record (default 30)")
+      ->check(CLI::Range(1.0, 120.0));
+  calibrate->add_option("--mesh", mesh, "the body to fit (default: the daemon's calibration_mesh)");
+  CLI::App* load =
+      subject->add_subcommand("load", "serve the subject from another subject file: load NAME FILE");
+  load->add_option("name", subject_name, "the subject")->required();
+  load->add_option("file", subject_file, "the subject file (a path on the daemon's machine)")->required();
+  for (CLI::App* change : {calibrate, load})
+    change->add_flag("--no-wait", no_wait, "return once the daemon accepted, without waiting for the swap");
+  CLI::App* subjects = app.add_subcommand("subjects", "list the subjects and their last change");
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -118,45 +198,51 @@ int main(int argc, char** argv) {
     app.exit(e);
     return kExitUsage;
   }
-
-  http::request<http::string_body> request;
-  request.version(11);
-  if (start->parsed()) {
-    request.method(http::verb::post);
-    request.target("/takes");
-    nlohmann::json body = nlohmann::json::object();
-    if (!take_name.empty()) body["name"] = take_name;
-    request.body() = body.dump();
-    request.set(http::field::content_type, "application/json");
-  } else if (stop->parsed()) {
-    request.method(http::verb::post);
-    request.target("/takes/stop");
-  } else if (takes->parsed()) {
-    request.method(http::verb::get);
-    request.target("/takes");
-  }
   try {
-    request.set(http::field::authorization, "Bearer " + control_token(token_file));
+    control.token = control_token(token_file);
   } catch (const UsageError& e) {
     std::fprintf(stderr, "skinstream-ctl: %s\n", e.what());
     return kExitUsage;
   }
-  request.set(http::field::host, host);
-  if (!operator_name.empty()) request.set("X-Skinstream-Operator", operator_name);
-  request.keep_alive(false);
-  request.prepare_payload();
 
-  http::response<http::string_body> response;
+  http::verb method = http::verb::get;
+  std::string target;
+  nlohmann::json body = nlohmann::json::object();
+  bool has_body = false;
+  if (start->parsed()) {
+    method = http::verb::post, target = "/takes", has_body = true;
+    if (!take_name.empty()) body["name"] = take_name;
+  } else if (stop->parsed()) {
+    method = http::verb::post, target = "/takes/stop";
+  } else if (takes->parsed()) {
+    target = "/takes";
+  } else if (calibrate->parsed()) {
+    method = http::verb::post, target = "/subjects/" + subject_name + "/calibration", has_body = true;
+    body["seconds"] = seconds;
+    if (!mesh.empty()) body["mesh"] = mesh;
+  } else if (load->parsed()) {
+    method = http::verb::post, target = "/subjects/" + subject_name + "/file", has_body = true;
+    body["file"] = subject_file;
+  } else if (subjects->parsed()) {
+    target = "/subjects";
+  }
   try {
-    response = exchange(host, port, std::move(request));
+    std::string reason;
+    const auto [status, json] = control.call(method, target, has_body ? &body : nullptr, &reason);
+    if (status < 200 || status >= 300) {
+      if (!json.is_null()) std::cout << json.dump(2) << "\n";
+      std::fprintf(stderr, "skinstream-ctl: %u %s\n", status, reason.c_str());
+      return kExitRefused;
+    }
+    const bool change = calibrate->parsed() || load->parsed();
+    if (!change || no_wait) {
+      if (!json.is_null()) std::cout << json.dump(2) << "\n";
+      return 0;
+    }
+    // Recording, then the build (real actors: under a minute), then the swap.
+    return wait_for_change(control, subject_name, std::chrono::seconds(static_cast<long>(seconds) + 900));
   } catch (const std::exception& e) {
     std::fprintf(stderr, "skinstream-ctl: %s\n", e.what());
     return kExitRefused;
   }
-  const unsigned status = response.result_int();
-  const nlohmann::json json = nlohmann::json::parse(response.body(), nullptr, false);
-  if (!json.is_discarded()) std::cout << json.dump(2) << "\n";
-  if (status >= 200 && status < 300) return 0;
-  std::fprintf(stderr, "skinstream-ctl: %u %s\n", status, reason_of(response).c_str());
-  return kExitRefused;
 }

@@ -261,23 +261,25 @@ int main(int argc, char** argv) {
     }
     if (recording) recording->close();
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    nlohmann::json summary = {{"frames", frames},
-                              {"out_of_order", out_of_order},
-                              {"seconds", seconds},
-                              {"frames_per_second", seconds > 0 ? frames / seconds : 0.0},
-                              {"megabytes", sub.bytes_received() / 1e6},
-                              {"encoding", sub.has_mesh() ? client::to_string(sub.mesh().encoding) : "none"},
-                              {"bytes_per_frame", frames > 0 ? static_cast<double>(frame_bytes) / frames : 0.0},
-                              {"model_bytes", sub.model_bytes()},
-                              {"frames_skipped", sub.frames_skipped()},
-                              {"frames_rejected", sub.frames_rejected()},
-                              {"pipeline_dropped", pipeline_dropped},
-                              {"subscriber_dropped", subscriber_dropped},
-                              {"saved", saved},
-                              {"recorded", recording ? recording->sample_count() : 0},
-                              {"decode", decode.summary()},
-                              {"latency_since_publish", since_publish.summary()},
-                              {"latency_since_receive", since_receive.summary()}};
+    nlohmann::json summary = {
+        {"frames", frames},
+        {"out_of_order", out_of_order},
+        {"seconds", seconds},
+        {"frames_per_second", seconds > 0 ? frames / seconds : 0.0},
+        {"megabytes", sub.bytes_received() / 1e6},
+        {"encoding", sub.has_mesh() ? client::to_string(sub.mesh().encoding) : "none"},
+        {"bytes_per_frame", frames > 0 ? static_cast<double>(frame_bytes) / frames : 0.0},
+        {"model_bytes", sub.model_bytes()},
+        {"meshes_received", sub.meshes_received()},
+        {"frames_skipped", sub.frames_skipped()},
+        {"frames_rejected", sub.frames_rejected()},
+        {"pipeline_dropped", pipeline_dropped},
+        {"subscriber_dropped", subscriber_dropped},
+        {"saved", saved},
+        {"recorded", recording ? recording->sample_count() : 0},
+        {"decode", decode.summary()},
+        {"latency_since_publish", since_publish.summary()},
+        {"latency_since_receive", since_receive.summary()}};
     if (!end_to_end.values.empty()) summary["latency_end_to_end"] = end_to_end.summary();
     if (!multicast.empty()) {
       const client::MulticastStats m = sub.multicast_stats();

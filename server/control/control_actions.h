@@ -26,6 +26,14 @@ class ControlActions {
                                    const nlohmann::json& request) = 0;  // POST /takes
   virtual ControlAnswer stop_take(const ControlCaller& caller) = 0;     // POST /takes/stop
   virtual ControlAnswer list_takes() = 0;                               // GET /takes
+  // POST /subjects/NAME/calibration: record the subject's range of motion, build, check, swap in.
+  virtual ControlAnswer calibrate_subject(const ControlCaller& caller, const std::string& name,
+                                          const nlohmann::json& request) = 0;
+  // POST /subjects/NAME/file: another subject file for subject NAME, checked, swapped in.
+  virtual ControlAnswer load_subject_file(const ControlCaller& caller, const std::string& name,
+                                          const nlohmann::json& request) = 0;
+  virtual ControlAnswer subject_state(const std::string& name) = 0;  // GET /subjects/NAME
+  virtual ControlAnswer list_subjects() = 0;                         // GET /subjects
 };
 
 }  // namespace skinstream::server

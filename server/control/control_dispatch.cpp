@@ -11,6 +11,14 @@ ControlAnswer run_control_action(ControlActions& actions, const ControlDecision&
       return actions.stop_take(caller);
     case ControlAction::ListTakes:
       return actions.list_takes();
+    case ControlAction::CalibrateSubject:
+      return actions.calibrate_subject(caller, decision.parameters.at(0).second, decision.body);
+    case ControlAction::LoadSubjectFile:
+      return actions.load_subject_file(caller, decision.parameters.at(0).second, decision.body);
+    case ControlAction::SubjectState:
+      return actions.subject_state(decision.parameters.at(0).second);
+    case ControlAction::ListSubjects:
+      return actions.list_subjects();
   }
   return {500, {{"error", "no action for this route"}}};
 }

@@ -9,6 +9,10 @@ constexpr ControlRoute kControlRoutes[] = {
     {"GET", "/takes", ControlAction::ListTakes},
     {"POST", "/takes", ControlAction::StartTake, /*takes_body=*/true},
     {"POST", "/takes/stop", ControlAction::StopTake},
+    {"GET", "/subjects", ControlAction::ListSubjects},
+    {"GET", "/subjects/{name}", ControlAction::SubjectState},
+    {"POST", "/subjects/{name}/calibration", ControlAction::CalibrateSubject, /*takes_body=*/true},
+    {"POST", "/subjects/{name}/file", ControlAction::LoadSubjectFile, /*takes_body=*/true},
 };
 
 // The next segment of `path` after position `at` (which is at a '/'), advancing `at` past it.

@@ -12,7 +12,15 @@
 
 namespace skinstream::server {
 
-enum class ControlAction { StartTake, StopTake, ListTakes };
+enum class ControlAction {
+  StartTake,
+  StopTake,
+  ListTakes,
+  CalibrateSubject,
+  LoadSubjectFile,
+  SubjectState,
+  ListSubjects
+};
 
 struct ControlRoute {
   std::string_view method;   // "GET", "POST", "DELETE"

@@ -55,6 +55,11 @@ SubjectRouter::SubjectRouter(std::vector<SubjectTarget> targets, Observer& obser
   candidates_.reserve(targets_.size());
 }
 
+void SubjectRouter::replace_target(int t, SubjectTarget target) {
+  targets_[static_cast<size_t>(t)] = Target(std::move(target));
+  matched_ = false;
+}
+
 int SubjectRouter::markers_labelled_by(int t, const SourceSubject& subject) const {
   const Target& target = targets_[static_cast<size_t>(t)];
   std::vector<char> labelled(target.config.marker_names.size(), 0);

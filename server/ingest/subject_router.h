@@ -89,6 +89,10 @@ class SubjectRouter {
   Stats route(const SourceFrame& frame, std::span<MarkerFrame* const> out);
   bool present(int t) const { return targets_[static_cast<size_t>(t)].present; }
 
+  // The routing thread, between two frames: target t is another subject model (a swap: its
+  // markers may differ). Matched afresh at the next frame, which says so to the Observer.
+  void replace_target(int t, SubjectTarget target);
+
   // How many of target t's markers `subject` labels (a check before a replay starts).
   int markers_labelled_by(int t, const SourceSubject& subject) const;
 

@@ -33,6 +33,9 @@ struct EncodedFrame {
   static constexpr int kEncodings = kStreamKeys;  // one per stream key (version and frame flags)
 
   uint32_t frame_number = 0;
+  // The subject model that made it (SubscriberHub::model_epoch()): a subscriber is sent frames of
+  // the model whose MeshInfo it was sent last, so none crosses a swap of the subject.
+  uint32_t model_epoch = 0;
   int64_t publish_time_ns = 0;                     // wall clock, as sent
   std::chrono::steady_clock::time_point published;  // for the subscriber queues' wait limit
   StreamKeySet encoded;  // key k: messages[k] holds the frame for stream key k

@@ -349,6 +349,7 @@ FrameRef Pipeline::encode(const StreamKeySet& keys, subscriber::FrameInfo info, 
   if (pool_.free_count() < kFreeFrames) pool_keeper_.wake();  // more made off this thread
   EncodedFrame& out = *ref.mutable_frame();
   out.frame_number = info.frame_number;
+  out.model_epoch = options_.model_epoch;
   keys.for_each([&](StreamKey key) {
     const uint16_t version = stream_version(key);
     info.flags = stream_flags(key);

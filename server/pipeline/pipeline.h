@@ -54,6 +54,7 @@ struct PipelineOptions {
   GapFillerOptions filler;
   int compressed_key_interval =
       10;  // frames; the compressed encoding's key frames (protocol/subscriber/compressed_vertices.h)
+  uint32_t model_epoch = 0;              // stamped on every frame (EncodedFrame::model_epoch)
   std::string thread_name = "pipeline";  // its deform workers: DeformWorkerOptions::thread_name
   std::string deform_thread_name = "deform";
 };

@@ -91,7 +91,13 @@ void MulticastSender::publish(const FrameRef& frame) {
                                      " 64 datagrams carry; not sent");
     return;
   }
-  wire::DatagramHeader header{options_.stream_id, model_id_, sequence_++, 0, count, static_cast<uint32_t>(message.size()), signed_datagrams};
+  wire::DatagramHeader header{options_.stream_id,
+                              model_id_.load(std::memory_order_relaxed),
+                              sequence_++,
+                              0,
+                              count,
+                              static_cast<uint32_t>(message.size()),
+                              signed_datagrams};
   for (uint16_t i = 0; i < count; ++i) {
     header.index = i;
     wire::encode_datagram_header(header, headers_[i]);
@@ -137,14 +143,18 @@ nlohmann::json MulticastSender::health() const {
           {"ttl", options_.ttl},
           {"stream_id", options_.stream_id},
           {"authenticated", authenticator_ != nullptr},
-          {"model_id", model_id_},
+          {"model_id", model_id_.load()},
           {"frames_sent", frames_sent_.load()},
           {"datagrams_sent", datagrams_sent_.load()},
           {"bytes_sent", bytes_sent_.load()},
           {"datagrams_dropped", datagrams_dropped_.load()},
           {"send_errors", send_errors_.load()},
           {"frames_too_large", frames_too_large_.load()},
-          {"send_ms", {{"count", send.count}, {"p50_le", send.p50_le_ms}, {"p99_le", send.p99_le_ms}, {"max", send.max_ms}}}};
+          {"send_ms",
+           {{"count", send.count},
+            {"p50_le", send.p50_le_ms},
+            {"p99_le", send.p99_le_ms},
+            {"max", send.max_ms}}}};
 }
 
 void MulticastSender::render_prometheus(std::string& out) const {

@@ -57,14 +57,14 @@ class MulticastSender : public FrameConsumer {
   // Before the pipeline starts: the Model message's payload, whose CRC-32 every datagram carries
   // (the pipeline makes the Model, and needs its consumer first).
   void set_model(std::span<const unsigned char> model_payload);
-  uint32_t model_id() const { return model_id_; }
+  uint32_t model_id() const { return model_id_.load(std::memory_order_relaxed); }
   nlohmann::json health() const;           // /health's "multicast"
   void render_prometheus(std::string& out) const;  // appended to /metrics
 
  private:
   FrameConsumer& next_;
   MulticastSenderOptions options_;
-  uint32_t model_id_ = 0;
+  std::atomic<uint32_t> model_id_{0};  // read by /health while a swap sets it
   bool has_model_ = false;
   int fd_ = -1;
   uint32_t sequence_ = 0;  // pipeline thread only

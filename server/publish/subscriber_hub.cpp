@@ -28,9 +28,14 @@ ControlMessage encode_status_for(subscriber::Status status, StreamKey key) {
 
 }  // namespace
 
-SubscriberHub::SubscriberHub(Metrics& metrics, const HubOptions& options, subscriber::MeshInfo mesh_info, bool has_mesh)
-    : metrics_(metrics), options_(options), has_mesh_(has_mesh), mesh_info_(std::move(mesh_info)) {
-  status_.subject = mesh_info_.subject;
+SubscriberHub::SubscriberHub(Metrics& metrics, const HubOptions& options, subscriber::MeshInfo mesh_info,
+                             bool has_mesh)
+    : metrics_(metrics),
+      options_(options),
+      has_mesh_(has_mesh),
+      subject_(mesh_info.subject),
+      mesh_info_(std::move(mesh_info)) {
+  status_.subject = subject_;
   broadcast_status(status_);
 }
 
@@ -42,11 +47,13 @@ void SubscriberHub::add(const std::shared_ptr<SubscriberSession>& session, bool 
 
 void SubscriberHub::activate(SubscriberSession& session, StreamKey key) {
   bool ready = true;
+  EncodingPreparer preparer;  // a copy: replace_model() may change it once the lock is released
   {
     std::lock_guard lock(mutex_);
+    preparer = preparer_;
     std::erase_if(waiting_, [&](const Waiting& w) { return w.session == &session; });
     const auto active = std::find(active_.begin(), active_.end(), &session);
-    ready = !preparer_.ready || preparer_.ready(key);
+    ready = !preparer.ready || preparer.ready(key);
     if (ready && active == active_.end()) active_.push_back(&session);
     if (!ready) {
       if (active != active_.end()) active_.erase(active);  // a new Hello asked for another key
@@ -54,14 +61,18 @@ void SubscriberHub::activate(SubscriberSession& session, StreamKey key) {
     }
     update_wanted_locked();
   }
-  if (!ready) preparer_.request(key);
-  else if (preparer_.activated) preparer_.activated(key);
+  if (!ready)
+    preparer.request(key);
+  else if (preparer.activated)
+    preparer.activated(key);
 }
 
 void SubscriberHub::encoding_prepared(StreamKey key) {
   bool started = false;
+  EncodingPreparer preparer;
   {
     std::lock_guard lock(mutex_);
+    preparer = preparer_;
     std::erase_if(waiting_, [&](const Waiting& w) {
       if (w.key != key) return false;
       active_.push_back(w.session);
@@ -70,7 +81,33 @@ void SubscriberHub::encoding_prepared(StreamKey key) {
     });
     if (started) update_wanted_locked();
   }
-  if (started && preparer_.activated) preparer_.activated(key);
+  if (started && preparer.activated) preparer.activated(key);
+}
+
+void SubscriberHub::replace_model(ModelReplacement replacement) {
+  {
+    std::lock_guard lock(mesh_info_mutex_);
+    replacement.mesh_info.subject = subject_;
+    replacement.mesh_info.source_rate_hz = mesh_info_.source_rate_hz;
+    mesh_info_ = std::move(replacement.mesh_info);
+    for (ControlMessage& m : mesh_info_messages_) m.reset();
+    model_message_ = std::move(replacement.model);
+    compressed_order_ = std::move(replacement.compressed_order);
+    model_epoch_ = replacement.epoch;
+  }
+  std::vector<std::shared_ptr<SubscriberSession>> sessions;
+  std::vector<StreamKey> waiting_keys;
+  EncodingPreparer preparer;
+  {
+    std::lock_guard lock(mutex_);
+    preparer_ = std::move(replacement.preparer);
+    preparer = preparer_;
+    sessions = sessions_;
+    for (const Waiting& w : waiting_) waiting_keys.push_back(w.key);
+  }
+  if (preparer.request)
+    for (StreamKey key : waiting_keys) preparer.request(key);
+  for (const auto& s : sessions) s->model_changed();
 }
 
 void SubscriberHub::remove(SubscriberSession& session) {
@@ -113,7 +150,22 @@ void SubscriberHub::update_wanted_locked() {
   wanted_[1].store(set.bits[1]);
 }
 
-ControlMessage SubscriberHub::mesh_info_message(StreamKey key) {
+void SubscriberHub::set_compressed_order(std::vector<uint32_t> order) {
+  std::lock_guard lock(mesh_info_mutex_);
+  compressed_order_ = std::move(order);
+}
+
+void SubscriberHub::set_model_message(ControlMessage model) {
+  std::lock_guard lock(mesh_info_mutex_);
+  model_message_ = std::move(model);
+}
+
+ControlMessage SubscriberHub::model_message() const {
+  std::lock_guard lock(mesh_info_mutex_);
+  return model_message_;
+}
+
+ControlMessage SubscriberHub::mesh_info_message(StreamKey key, uint32_t* epoch) {
   // What MeshInfo describes: whether positions come, and in version 2 their encoding; not
   // normals, markers or pacing. Keys that differ only in those share one message, so a
   // subscriber whose new Hello changes only them is not sent the 1.35 MB again.
@@ -121,6 +173,7 @@ ControlMessage SubscriberHub::mesh_info_message(StreamKey key) {
   const uint32_t described_flags = subscriber::kFrameNoPositions | (stream_version(key) >= subscriber::kVersion2 ? encoding_flags : 0u);
   const StreamKey described = stream_key(stream_flags(key) & described_flags, stream_version(key));
   std::lock_guard lock(mesh_info_mutex_);
+  if (epoch) *epoch = model_epoch_;
   ControlMessage& cached = mesh_info_messages_[described % kStreamKeys];
   if (!cached) {
     subscriber::MeshInfo info = mesh_info_;
@@ -161,7 +214,7 @@ ControlMessage SubscriberHub::status_message(StreamKey key, const std::string& d
 
 void SubscriberHub::broadcast_status(const subscriber::Status& in) {
   subscriber::Status status = in;
-  if (status.subject.empty()) status.subject = mesh_info_.subject;
+  if (status.subject.empty()) status.subject = subject_;
   std::array<ControlMessage, 1 + subscriber::kEncodingCount> messages;
   messages[0] = encode_status_for(status, stream_key(0, subscriber::kVersion1));
   const uint32_t encoding_flags[subscriber::kEncodingCount] = {0, subscriber::kFrameQuantised, subscriber::kFrameCompressed,

@@ -44,7 +44,7 @@ class SubscriberHub : public FrameConsumer {
   const HubOptions& options() const { return options_; }
   Metrics& metrics() { return metrics_; }
   bool has_mesh() const { return has_mesh_; }
-  const std::string& subject_name() const { return mesh_info_.subject; }
+  const std::string& subject_name() const { return subject_; }
   // Every subject's hub, for a Hello naming one (a new subscriber starts in the first subject's
   // hub and moves to the one it names); null: this hub serves alone. Set before any subscriber.
   void set_directory(const SubjectDirectory* directory) { directory_ = directory; }
@@ -76,13 +76,29 @@ class SubscriberHub : public FrameConsumer {
   // socket, its queue and the frames in it for as long as it stays connected.
   void drop_stalled_writers(std::chrono::nanoseconds limit);
 
-  ControlMessage mesh_info_message(StreamKey key);
+  // The MeshInfo for `key`, and in `epoch` the model it describes (EncodedFrame::model_epoch).
+  ControlMessage mesh_info_message(StreamKey key, uint32_t* epoch = nullptr);
   // The compressed encoding's vertex order, sent in its MeshInfo. Set before any subscriber connects.
-  void set_compressed_order(std::vector<uint32_t> order) { compressed_order_ = std::move(order); }
+  void set_compressed_order(std::vector<uint32_t> order);
   // The Model message of the parameter encoding (null without a mesh). Set before any
   // subscriber connects.
-  void set_model_message(ControlMessage model) { model_message_ = std::move(model); }
-  const ControlMessage& model_message() const { return model_message_; }
+  void set_model_message(ControlMessage model);
+  ControlMessage model_message() const;
+
+  // A new subject model in place of the one served (a live calibration, another subject file),
+  // called between the old model's last frame and the new one's first: its MeshInfo, Model,
+  // compressed order, the new pipeline's encoding preparer and the epoch its frames carry. Every
+  // subscriber is sent the new MeshInfo (and Model) on its own thread, then frames of the new
+  // model only; subscribers waiting for an encoding's buffers ask the new pipeline for them.
+  // The subject's name and whether it has a mesh stay as they were.
+  struct ModelReplacement {
+    subscriber::MeshInfo mesh_info;
+    ControlMessage model;
+    std::vector<uint32_t> compressed_order;
+    EncodingPreparer preparer;
+    uint32_t epoch = 0;
+  };
+  void replace_model(ModelReplacement replacement);
   // The latest Status, in the key's version (and with the encoding it serves).
   ControlMessage status_message(StreamKey key) const;
   // The latest Status with another detail (a notice to one subscriber, e.g. an encoding it
@@ -110,13 +126,15 @@ class SubscriberHub : public FrameConsumer {
   Metrics& metrics_;
   HubOptions options_;
   bool has_mesh_;
+  const std::string subject_;  // mesh_info_.subject, which never changes (read without a lock)
   // The MeshInfo cache has its own lock: encoding one (1.3 MB for the 53,500-vertex body, on a
   // subscriber's Hello) under mutex_ held the pipeline's publish() for 14 ms at start-up.
-  std::mutex mesh_info_mutex_;
+  mutable std::mutex mesh_info_mutex_;
   subscriber::MeshInfo mesh_info_;
   std::array<ControlMessage, kStreamKeys> mesh_info_messages_;
   ControlMessage model_message_;
   std::vector<uint32_t> compressed_order_;
+  uint32_t model_epoch_ = 0;
   mutable std::mutex mutex_;  // the sessions and the status
   std::vector<std::shared_ptr<SubscriberSession>> sessions_;
   std::vector<SubscriberSession*> active_;
@@ -129,7 +147,7 @@ class SubscriberHub : public FrameConsumer {
   // The status encoded: version 1, then version 2 per encoding served.
   std::array<ControlMessage, 1 + subscriber::kEncodingCount> status_messages_;
   std::array<std::atomic<uint64_t>, 2> wanted_{};  // StreamKeySet::bits
-  EncodingPreparer preparer_;
+  EncodingPreparer preparer_;                      // under mutex_: replaced with the model
   const SubjectDirectory* directory_ = nullptr;
 };
 

@@ -161,16 +161,7 @@ void SubscriberSession::on_hello(const subscriber::Hello& hello) {
   hello_timer_.cancel();
   if (!changed) return;
   key_.store(key);
-  // Sent again only when what it describes changed (MeshInfo is 1.35 MB for the 53,500-vertex
-  // body; a Hello that changes normals or markers must not cost that), the Model only once.
-  if (ControlMessage mesh_info = hub_->mesh_info_message(key); mesh_info != mesh_info_sent_) {
-    offer_control(mesh_info);
-    mesh_info_sent_ = std::move(mesh_info);
-  }
-  if ((flags & subscriber::kFrameParameters) && hub_->model_message() && !model_sent_) {
-    offer_control(hub_->model_message());
-    model_sent_ = true;
-  }
+  send_model(key);
   offer_control(hub_->status_message(key));
   if (!notice.empty()) {
     offer_control(hub_->status_message(key, notice, subscriber::SourceStateCode::Streaming));
@@ -179,6 +170,35 @@ void SubscriberSession::on_hello(const subscriber::Hello& hello) {
   hub_->activate(*this, key);
   connection_log.info("subscriber_hello", fmt::format("subscriber {} ({} {}): protocol {}, wants {:#x}, frame flags {:#x}", id_,
                                                       transport_, remote_, hello.version, hello.wants, flags));
+}
+
+void SubscriberSession::send_model(StreamKey key) {
+  // Sent again only when what it describes changed (MeshInfo is 1.35 MB for the 53,500-vertex
+  // body; a Hello that changes normals or markers must not cost that), the Model once a model.
+  uint32_t epoch = 0;
+  if (ControlMessage mesh_info = hub_->mesh_info_message(key, &epoch); mesh_info != mesh_info_sent_) {
+    offer_control(mesh_info);
+    mesh_info_sent_ = std::move(mesh_info);
+  }
+  if (epoch != model_epoch_) model_sent_ = false;
+  model_epoch_ = epoch;
+  if (stream_flags(key) & subscriber::kFrameParameters)
+    if (ControlMessage model = hub_->model_message(); model && !model_sent_) {
+      offer_control(std::move(model));
+      model_sent_ = true;
+    }
+}
+
+void SubscriberSession::model_changed() {
+  asio::post(io_, [self = shared_from_this()] {
+    if (!self->greeted_ || self->closed_ || self->close_after_write_)
+      return;  // a Hello to come gets the new one
+    uint32_t epoch = 0;
+    self->hub_->mesh_info_message(self->key_.load(), &epoch);
+    if (epoch == self->model_epoch_) return;
+    self->send_model(self->key_.load());
+    self->offer_control(self->hub_->status_message(self->key_.load()));
+  });
 }
 
 bool SubscriberSession::join_subject(const std::string& subject) {
@@ -254,8 +274,11 @@ void SubscriberSession::pump() {
     const auto take = window_full ? SubscriberQueue::Take::ControlOnly
                                   : (paced_ ? SubscriberQueue::Take::NewestFrame : SubscriberQueue::Take::OldestFrame);
     if (!queue_.pop(in_flight_, take)) return;
-    if (in_flight_.control || in_flight_.frame->has(key_.load())) break;
-    in_flight_.frame.reset();  // encoded for this subscriber's previous wants
+    if (in_flight_.control ||
+        (in_flight_.frame->has(key_.load()) && in_flight_.frame->model_epoch == model_epoch_))
+      break;
+    in_flight_.frame
+        .reset();  // encoded for this subscriber's previous wants, or of another model than its MeshInfo's
   }
   writing_ = true;
   note_write_progress();

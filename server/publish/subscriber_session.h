@@ -38,6 +38,10 @@ class SubscriberSession : public std::enable_shared_from_this<SubscriberSession>
   void offer(const FrameRef& frame);
   void offer_control(ControlMessage message);
 
+  // Any thread (SubscriberHub::replace_model): the subject's model changed; on the session's io
+  // thread a greeted subscriber is sent the new MeshInfo (and Model), then the new model's frames.
+  void model_changed();
+
   StreamKey stream_key() const { return key_.load(); }
   SubscriberMetrics stats() const;
   uint64_t id() const { return id_; }
@@ -92,6 +96,9 @@ class SubscriberSession : public std::enable_shared_from_this<SubscriberSession>
   // Version 2's first Hello: into the hub of the subject it names (SubjectDirectory); false when
   // refused (no such subject).
   bool join_subject(const std::string& subject);
+  // The MeshInfo of the hub's model for `key` (and its Model for the parameter encoding) when
+  // not sent yet, then frames of that model only.
+  void send_model(StreamKey key);
 
   uint64_t id_;
   std::string transport_, remote_;
@@ -105,6 +112,7 @@ class SubscriberSession : public std::enable_shared_from_this<SubscriberSession>
   uint16_t version_ = 0;  // of the first Hello; 0 before it
   ControlMessage mesh_info_sent_;  // the last MeshInfo queued for it
   bool model_sent_ = false;
+  uint32_t model_epoch_ = 0;  // of that MeshInfo: only frames of this model are sent
   int unacked_ = 0;     // Frames sent (or being sent) and not acknowledged yet
   std::atomic<bool> pump_scheduled_{false};
   std::shared_ptr<HandlerSlot> pump_slot_;  // the posted pump's memory: the pipeline thread posts it

@@ -133,7 +133,7 @@ struct TakeRecorder::ActiveTake {
   struct Files {
     SubjectEntry* subject = nullptr;
     double rate_hz = 0.0;
-    std::string subject_sha256;
+    std::string subject_file, subject_sha256;  // as the take began
     std::unique_ptr<C3dTakeWriter> raw_c3d, filled_c3d;
     std::unique_ptr<FrameTable> raw_table, filled_table;
     std::unique_ptr<UnlabelledSlots> unlabelled;
@@ -193,6 +193,18 @@ TakeTap& TakeRecorder::add_subject(const std::string& name, const std::string& s
   entry.file_stem = stem;
   subjects_.push_back(std::move(entry));
   return *subjects_.back().tap;
+}
+
+void TakeRecorder::set_subject_file(const std::string& name, const std::string& subject_file) {
+  std::lock_guard lock(mutex_);
+  for (SubjectEntry& subject : subjects_)
+    if (subject.tap->subject() == name) subject.subject_file = subject_file;
+}
+
+std::vector<std::string> TakeRecorder::recorded_marker_names(const std::string& name) const {
+  for (const SubjectEntry& subject : subjects_)
+    if (subject.tap->subject() == name) return subject.tap->marker_names();
+  return {};
 }
 
 void TakeRecorder::start_thread() {
@@ -296,7 +308,11 @@ void TakeRecorder::begin_take(ActiveTake& take) {
     files.subject = &subject;
     const double rate = subject.tap->source_rate_hz();
     files.rate_hz = rate > 0 ? rate : options_.default_rate_hz;
-    files.subject_sha256 = sha256_of_file(subject.subject_file);
+    {
+      std::lock_guard lock(mutex_);
+      files.subject_file = subject.subject_file;
+    }
+    files.subject_sha256 = sha256_of_file(files.subject_file);
     files.raw_dropped_before = subject.tap->received_dropped();
     files.unlabelled = std::make_unique<UnlabelledSlots>(subject.tap->unlabelled_slots());
     files.raw_points.resize(subject.tap->marker_names().size() +
@@ -431,7 +447,7 @@ void TakeRecorder::write_sidecar(const ActiveTake& take, const std::string& stat
     const TakeTap& tap = *files.subject->tap;
     const std::string& stem = files.subject->file_stem;
     subjects.push_back({{"name", tap.subject()},
-                        {"subject_file", files.subject->subject_file},
+                        {"subject_file", files.subject_file},
                         {"subject_sha256", files.subject_sha256},
                         {"rate_hz", files.rate_hz},
                         {"raw",

@@ -64,6 +64,12 @@ class TakeRecorder {
   std::vector<std::string> recover_interrupted();
   void start_thread();
 
+  // Any thread: the subject file of subject `name` from the next take on (a swap); a take in
+  // progress keeps the one it began with. The markers stay those add_subject() was given.
+  void set_subject_file(const std::string& name, const std::string& subject_file);
+  // The marker names subject `name` is recorded with (empty when it is not recorded).
+  std::vector<std::string> recorded_marker_names(const std::string& name) const;
+
   // Any thread, quick (creates the take's folder; the files are made on the recorder's thread).
   // `name` empty: named by the UTC time. 201, or 409 when a take is recording or the name is
   // taken, 400 for a bad name, 500 when the folder cannot be made.
@@ -80,8 +86,8 @@ class TakeRecorder {
  private:
   struct SubjectEntry {
     std::unique_ptr<TakeTap> tap;
-    std::string subject_file;
-    std::string file_stem;  // the subject's name made safe for a file name, unique in the take
+    std::string subject_file;  // under mutex_ once the thread runs
+    std::string file_stem;     // the subject's name made safe for a file name, unique in the take
   };
   struct ActiveTake;
   enum class State { Idle, Recording, Stopping, Failed };

@@ -4,6 +4,10 @@
 // subjects, each a separate client of the same Vicon stream.
 #include <gtest/gtest.h>
 
+#include <sys/stat.h>
+
+#include <filesystem>
+#include <sstream>
 #include <thread>
 
 #include "protocol/files/capture_file.h"
@@ -111,6 +115,183 @@ TEST_F(DaemonSubjects, OneDaemonServesBothActorsToSubscribersNamingThem) {
       << nobody.output;
   ASSERT_EQ(health["subjects"].size(), 2u);
   for (const auto& subject : health["subjects"]) EXPECT_TRUE(subject["present"].get<bool>()) << subject.dump();
+}
+
+// The summary line of skinstream-sub --json output.
+nlohmann::json summary_of(const std::string& sub_output) {
+  std::istringstream lines(sub_output);
+  nlohmann::json summary;
+  for (std::string line; std::getline(lines, line);)
+    if (const nlohmann::json j = nlohmann::json::parse(line, nullptr, false);
+        j.is_object() && j.contains("summary"))
+      summary = j["summary"];
+  return summary;
+}
+
+// Frame numbers that do not follow the one before (a frame missed), in a subscriber's frames.
+int frames_missed(const std::vector<nlohmann::json>& frames) {
+  int missed = 0;
+  for (size_t i = 1; i < frames.size(); ++i)
+    if (frames[i]["frame"].get<int64_t>() != frames[i - 1]["frame"].get<int64_t>() + 1) ++missed;
+  return missed;
+}
+
+// A stage with two actors and the control API on: skinstream-replay streams both, the daemon
+// serves each with a subject fitted to the body template, and the operator's skinstream-ctl
+// changes Actor2 while both have a subscriber.
+class DaemonSubjectChanges : public DaemonSubjects {
+ protected:
+  static void SetUpTestSuite() {
+    DaemonSubjects::SetUpTestSuite();
+    const std::string own = std::to_string(getpid());
+    meshed_ = test::scratch_path("changes_meshed_" + own + ".sks");
+    const ProgramRun built = test::run_program(std::string(SKINSTREAM_CLI) + " build-subject --capture " +
+                                               test::source_path("replay_data/cmu/85_02.c3d") + " --mesh " +
+                                               mesh() + " --out " + meshed_);
+    ASSERT_EQ(built.exit_code, 0) << built.output;
+  }
+  static std::string mesh() {
+    return test::source_path("replay_data/makehuman/makehuman_hm08_body_only.obj");
+  }
+
+  void SetUp() override {
+    const std::string own = std::to_string(getpid());
+    token_file_ = test::scratch_path("changes_token_" + own);
+    test::write_bytes(token_file_, "changes-token-0123456789\n");
+    ASSERT_EQ(chmod(token_file_.c_str(), 0600), 0);
+    calibrations_ = test::scratch_path("changes_calibrations_" + own);
+    config_ = test::scratch_path("changes_config_" + own + ".json");
+    test::write_bytes(config_,
+                      nlohmann::json{{"calibration_dir", calibrations_}, {"deform_threads", 1}}.dump());
+  }
+  std::string daemon_arguments(int replay_port) const {
+    return "--config " + config_ + " --subject Actor1=" + meshed_ + " --subject Actor2=" + meshed_ +
+           " --vicon 127.0.0.1:" + std::to_string(replay_port) + " --control-token-file " + token_file_;
+  }
+  std::string ctl(const DaemonProcess& daemon) const {
+    return "SKINSTREAM_CONTROL_TOKEN= " + std::string(SKINSTREAM_CTL) + " --port " +
+           std::to_string(daemon.http_port) + " --token-file " + token_file_ + " --operator anna ";
+  }
+  static std::string sub(const DaemonProcess& daemon) {
+    return std::string(SKINSTREAM_SUB) + " 127.0.0.1:" + std::to_string(daemon.sub_port) + " --json ";
+  }
+
+  static inline std::string meshed_;
+  std::string token_file_, calibrations_, config_;
+};
+
+// Actor2 calibrated live: 3 s of its range of motion recorded from the stream, built by
+// build-subject in its own process, checked and swapped in between two frames. Its parameter
+// subscriber is sent the new MeshInfo and Model and carries on; Actor1's subscriber misses no
+// frame.
+TEST_F(DaemonSubjectChanges, AnActorCalibratedLiveIsSwappedInWhileTheOtherMissesNoFrame) {
+  ReplayProcess replay(replay_arguments(), 0, "--subject Actor1 --subject Actor2");
+  DaemonProcess daemon(daemon_arguments(replay.port));
+  // Both subscribers run until the daemon stops.
+  ProgramRun actor1, actor2;
+  std::thread watcher([&] { actor1 = test::run_program(sub(daemon) + "--subject Actor1 --no-mesh", false); });
+  std::thread changed(
+      [&] { actor2 = test::run_program(sub(daemon) + "--subject Actor2 --encoding parameters", false); });
+  std::this_thread::sleep_for(std::chrono::seconds(2));
+  const ProgramRun calibrated =
+      test::run_program(ctl(daemon) + "subject calibrate Actor2 --seconds 3 --mesh " + mesh(), false);
+  const int64_t swapped_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                 std::chrono::system_clock::now().time_since_epoch())
+                                 .count();
+  std::this_thread::sleep_for(std::chrono::seconds(2));
+  const nlohmann::json health = server::fetch_health(daemon.http_port);
+  EXPECT_EQ(daemon.stop(), 0) << daemon.log();
+  watcher.join();
+  changed.join();
+
+  ASSERT_EQ(calibrated.exit_code, 0) << calibrated.output << daemon.log();
+  const nlohmann::json change = nlohmann::json::parse(calibrated.output);
+  EXPECT_EQ(change["state"], "done");
+  EXPECT_EQ(change["kind"], "calibration");
+  EXPECT_EQ(change["frames_recorded"], 360);
+  EXPECT_EQ(change["markers"], 41);
+  EXPECT_NE(change["who"].get<std::string>().find("anna"), std::string::npos);
+  const std::string built = change["subject_file"];
+  EXPECT_TRUE(std::filesystem::exists(built)) << built;
+  EXPECT_TRUE(std::filesystem::exists(change["capture"].get<std::string>()));
+  std::printf("calibration: build %.2f s, load %.2f s, swap %.1f ms, in all %.2f s\n",
+              change["build_seconds"].get<double>(), change["load_seconds"].get<double>(),
+              change["swap_ms"].get<double>(), change["seconds_in_all"].get<double>());
+
+  ASSERT_EQ(actor2.exit_code, 0) << actor2.output.substr(0, 2000) << daemon.log();
+  const nlohmann::json summary2 = summary_of(actor2.output);
+  EXPECT_EQ(summary2["meshes_received"], 2)
+      << summary2.dump();  // the first subject's, then the calibrated one's
+  EXPECT_EQ(summary2["frames_rejected"], 0) << summary2.dump();
+  int after_swap = 0;  // frames of the calibrated subject, taken by the same subscriber
+  for (const nlohmann::json& frame : test::frames_of(actor2.output))
+    after_swap += frame["arrival_time_ns"].get<int64_t>() > swapped_ns;
+  EXPECT_GE(after_swap, 120);
+
+  ASSERT_EQ(actor1.exit_code, 0) << actor1.output.substr(0, 2000) << daemon.log();
+  const std::vector<nlohmann::json> frames1 = test::frames_of(actor1.output);
+  EXPECT_GE(frames1.size(), 120u * 10);  // 2 s, 3 s recorded, the build, 2 s
+  EXPECT_EQ(frames_missed(frames1), 0);
+  EXPECT_EQ(summary_of(actor1.output)["pipeline_dropped"], 0);
+  EXPECT_EQ(summary_of(actor1.output)["subscriber_dropped"], 0);
+
+  ASSERT_EQ(health["subjects"].size(), 2u);
+  EXPECT_EQ(health["subjects"][0]["file"], meshed_);
+  EXPECT_EQ(health["subjects"][0]["frames"]["dropped"], 0);
+  EXPECT_EQ(health["subjects"][1]["file"], built);
+  EXPECT_EQ(health["subjects"][1]["change"]["state"], "done");
+  EXPECT_EQ(health["subjects"][1]["model_epoch"], 1);
+}
+
+// What fails leaves the subject served as it was and says why: a calibration fitting a mesh that
+// is not a body (build-subject refuses it), a subject file without a mesh for a subject served
+// with one, a file that is not a subject file; the control API refuses unknown subjects and bad
+// requests at once. The subscriber never gets another MeshInfo.
+TEST_F(DaemonSubjectChanges, AChangeThatFailsLeavesTheServedSubjectAndSaysWhy) {
+  ReplayProcess replay(replay_arguments(), 0, "--subject Actor1 --subject Actor2");
+  DaemonProcess daemon(daemon_arguments(replay.port));
+  ProgramRun actor2;
+  std::thread watcher(
+      [&] { actor2 = test::run_program(sub(daemon) + "--subject Actor2 --encoding parameters", false); });
+  const std::string cube = test::scratch_path("changes_cube.obj");
+  test::write_bytes(cube, "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\nf 1 2 4\nf 1 3 4\nf 2 3 4\n");
+  const ProgramRun not_a_body =
+      test::run_program(ctl(daemon) + "subject calibrate Actor2 --seconds 1 --mesh " + cube);
+  const ProgramRun markers_only = test::run_program(ctl(daemon) + "subject load Actor2 " + subject_);
+  const std::string garbage = test::scratch_path("changes_garbage.sks");
+  test::write_bytes(garbage, "not a subject file");
+  const ProgramRun not_a_subject = test::run_program(ctl(daemon) + "subject load Actor2 " + garbage);
+  const ProgramRun nobody = test::run_program(ctl(daemon) + "subject load Nobody " + meshed_);
+  const ProgramRun no_mesh =
+      test::run_program(ctl(daemon) + "subject calibrate Actor2 --seconds 1 --mesh /no/such/body.obj");
+  const ProgramRun no_token = test::run_program(
+      "SKINSTREAM_CONTROL_TOKEN= " + std::string(SKINSTREAM_CTL) + " --port " +
+      std::to_string(daemon.http_port) + " --token-file " + garbage + " subject load Actor2 " + meshed_);
+  const nlohmann::json health = server::fetch_health(daemon.http_port);
+  EXPECT_EQ(daemon.stop(), 0) << daemon.log();
+  watcher.join();
+
+  EXPECT_EQ(not_a_body.exit_code, 1) << not_a_body.output;
+  EXPECT_NE(not_a_body.output.find("calibration failed: build-subject exited with"), std::string::npos)
+      << not_a_body.output;
+  EXPECT_EQ(markers_only.exit_code, 1) << markers_only.output;
+  EXPECT_NE(markers_only.output.find("has no deformation model"), std::string::npos) << markers_only.output;
+  EXPECT_EQ(not_a_subject.exit_code, 1) << not_a_subject.output;
+  EXPECT_NE(not_a_subject.output.find(garbage), std::string::npos) << not_a_subject.output;
+  EXPECT_EQ(nobody.exit_code, 1);
+  EXPECT_NE(nobody.output.find("404 no subject 'Nobody' here"), std::string::npos) << nobody.output;
+  EXPECT_EQ(no_mesh.exit_code, 1);
+  EXPECT_NE(no_mesh.output.find("no such file"), std::string::npos) << no_mesh.output;
+  EXPECT_EQ(no_token.exit_code, 1);
+  EXPECT_NE(no_token.output.find("403"), std::string::npos) << no_token.output;
+
+  ASSERT_EQ(actor2.exit_code, 0) << actor2.output.substr(0, 2000) << daemon.log();
+  EXPECT_EQ(summary_of(actor2.output)["meshes_received"], 1);
+  EXPECT_EQ(summary_of(actor2.output)["frames_rejected"], 0);
+  EXPECT_EQ(health["subjects"][1]["file"], meshed_);
+  EXPECT_EQ(health["subjects"][1]["model_epoch"], 0);
+  EXPECT_EQ(health["subjects"][1]["change"]["state"], "failed");
+  EXPECT_EQ(health["control"]["refused_403"], 1);
 }
 
 }  // namespace

@@ -72,6 +72,9 @@ const nlohmann::json kChangedValues = {
     {"record_with_source", true},
     {"record_unlabelled", 16},
     {"control_token_file", "control-token.txt"},
+    {"calibration_dir", "calibrations"},
+    {"calibration_mesh", "body.obj"},
+    {"subject_builder", "/opt/skinstream/bin/skinstream"},
     {"log_level", "debug"}};
 
 // A value out of range, or not of the key's form, for every key that checks its value.

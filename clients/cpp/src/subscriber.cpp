@@ -54,6 +54,7 @@ struct Subscriber::State {
   bool has_mesh = false;
   SourceStatus status;
   uint64_t skipped = 0;
+  uint64_t meshes_received = 0;  // MeshInfo messages taken
   uint64_t rejected = 0;  // Frame messages that broke the protocol on their own
   std::string last_rejection;
   uint64_t bytes = 0;
@@ -324,6 +325,7 @@ void Subscriber::State::on_mesh_info(std::span<const unsigned char> payload) {
   for (const auto& t : info.marker_triangles) mesh.marker_triangles.insert(mesh.marker_triangles.end(), t.begin(), t.end());
   mesh.source_rate_hz = info.source_rate_hz;
   has_mesh = true;
+  ++meshes_received;
   const size_t v3 = 3 * static_cast<size_t>(mesh.vertex_count);
   positions.assign(v3, 0.0f);
   normals.assign(v3, 0.0f);
@@ -460,6 +462,7 @@ const Mesh& Subscriber::mesh() const { return state_->mesh; }
 const SourceStatus& Subscriber::status() const { return state_->status; }
 const Options& Subscriber::options() const { return state_->options; }
 uint64_t Subscriber::frames_skipped() const { return state_->skipped; }
+uint64_t Subscriber::meshes_received() const { return state_->meshes_received; }
 uint64_t Subscriber::frames_rejected() const { return state_->rejected; }
 std::string Subscriber::last_rejection() const { return state_->last_rejection; }
 uint64_t Subscriber::bytes_received() const { return state_->bytes; }

@@ -22,7 +22,7 @@ void expect_one_printable_line(const std::string& reason) {
 }
 
 TEST(ControlRequest, UnknownPathsAre404) {
-  for (const char* target : {"/takes/start", "/takes/stop/now", "/takes//stop", "/subjects"}) {
+  for (const char* target : {"/takes/start", "/takes/stop/now", "/takes//stop", "/subjects/Actor1/other"}) {
     const ControlDecision decision = decide("POST", target);
     EXPECT_EQ(decision.status, 404) << target;
     EXPECT_EQ(decision.route, nullptr);

@@ -42,6 +42,24 @@ class RecordingControlActions : public ControlActions {
     record({"list_takes", {}, {}});
     return {200, {{"takes", nlohmann::json::array({"a", "b"})}}};
   }
+  ControlAnswer calibrate_subject(const ControlCaller& caller, const std::string& name,
+                                  const nlohmann::json& request) override {
+    record({"calibrate_subject:" + name, caller, request});
+    return {202, {{"state", "recording"}}};
+  }
+  ControlAnswer load_subject_file(const ControlCaller& caller, const std::string& name,
+                                  const nlohmann::json& request) override {
+    record({"load_subject_file:" + name, caller, request});
+    return {202, {{"state", "loading"}}};
+  }
+  ControlAnswer subject_state(const std::string& name) override {
+    record({"subject_state:" + name, {}, {}});
+    return {200, {{"name", name}}};
+  }
+  ControlAnswer list_subjects() override {
+    record({"list_subjects", {}, {}});
+    return {200, {{"subjects", nlohmann::json::array()}}};
+  }
   std::vector<Call> calls() {
     std::lock_guard lock(mutex_);
     return calls_;
@@ -186,6 +204,27 @@ TEST_F(HttpServerControl, TheRightTokenCallsTheActionWithTheCallerAndAnswersItsJ
   EXPECT_EQ(calls[1].caller.operator_name, "bob");
   EXPECT_EQ(calls[2].action, "list_takes");
   EXPECT_EQ(counters->accepted.load(), 3u);
+}
+
+TEST_F(HttpServerControl, TheSubjectRoutesCallTheirActionWithTheSubjectNamedInThePath) {
+  start(true);
+  const std::string bearer = "Bearer " + kControlToken;
+  EXPECT_EQ(send(port, http::verb::post, "/subjects/Actor2/calibration", bearer, R"({"seconds":30})").status,
+            202);
+  EXPECT_EQ(send(port, http::verb::post, "/subjects/Actor1/file", bearer, R"({"file":"a.sksubj"})").status,
+            202);
+  EXPECT_EQ(send(port, http::verb::get, "/subjects/Actor1", bearer).json().at("name"), "Actor1");
+  EXPECT_EQ(send(port, http::verb::get, "/subjects", bearer).status, 200);
+  EXPECT_EQ(send(port, http::verb::get, "/subjects/Actor1/calibration", bearer).status, 405);
+  EXPECT_EQ(send(port, http::verb::post, "/subjects/Actor1/other", bearer).status, 404);
+  const std::vector<RecordingControlActions::Call> calls = actions->calls();
+  ASSERT_EQ(calls.size(), 4u);
+  EXPECT_EQ(calls[0].action, "calibrate_subject:Actor2");
+  EXPECT_EQ(calls[0].request.at("seconds"), 30);
+  EXPECT_EQ(calls[1].action, "load_subject_file:Actor1");
+  EXPECT_EQ(calls[1].request.at("file"), "a.sksubj");
+  EXPECT_EQ(calls[2].action, "subject_state:Actor1");
+  EXPECT_EQ(calls[3].action, "list_subjects");
 }
 
 TEST_F(HttpServerControl, BadRequestsAreRefusedBeforeTheAction) {

@@ -178,6 +178,9 @@ class Subscriber {
   const SourceStatus& status() const;
   const Options& options() const;
   uint64_t frames_skipped() const;  // compressed deltas without their key
+  // MeshInfo messages taken: more than one when the daemon swapped the subject's model (a live
+  // calibration: mesh() and the Model are then the new ones) or a new Hello changed the encoding.
+  uint64_t meshes_received() const;
   uint64_t frames_rejected() const;  // Frame messages that broke the protocol, skipped
   std::string last_rejection() const;  // one line: why the last of them was skipped
   uint64_t bytes_received() const;
