@@ -3,7 +3,8 @@
 # - web.units: the page's decoders and tables in node (node's test runner);
 # - web.bad_input: the page in the system Chromium against a scripted server sending bad input;
 # - web.viewer: the page in Chromium against the real daemon (tests/clients/web/viewer_test.mjs);
-# - web.takes_panel: the page's take controls against the real daemon (takes_panel_test.mjs).
+# - web.takes_panel: the page's take controls against the real daemon (takes_panel_test.mjs);
+# - web.calibration_panel: the page's live calibration against the real daemon.
 # Needs node and npm (Debian: nodejs npm) and chromium (software WebGL).
 find_program(SKINSTREAM_NODE NAMES node nodejs)
 if(NOT TARGET skinstreamd)
@@ -38,6 +39,16 @@ else()
     --out ${CMAKE_BINARY_DIR}/test_tmp/web)
   set_tests_properties(web.takes_panel PROPERTIES FIXTURES_REQUIRED "web_bundle;demo_subject"
     LABELS browser TIMEOUT ${time_limit_300})
+  # The page's live calibration: a CMU capture's subject recorded, built, checked and swapped in.
+  add_test(NAME web.calibration_panel COMMAND ${SKINSTREAM_NODE} ${web_tests}/calibration_panel_test.mjs
+    --daemon $<TARGET_FILE:skinstreamd>
+    --cli $<TARGET_FILE:skinstream>
+    --capture ${PROJECT_SOURCE_DIR}/replay_data/cmu/85_02.c3d
+    --mesh ${PROJECT_SOURCE_DIR}/replay_data/makehuman/makehuman_hm08_body_only.obj
+    --web-root ${CMAKE_BINARY_DIR}/web
+    --out ${CMAKE_BINARY_DIR}/test_tmp/web)
+  # Two processors: the builder runs at the lowest priority, and beside Chromium it waited minutes.
+  set_tests_properties(web.calibration_panel PROPERTIES FIXTURES_REQUIRED web_bundle LABELS browser TIMEOUT ${time_limit_300} PROCESSORS 2)
   # Chromium with SwiftShader keeps both cores busy: let ctest -j count it as two.
   set_tests_properties(web.viewer PROPERTIES FIXTURES_REQUIRED "web_bundle;demo_subject"
     LABELS browser TIMEOUT ${time_limit_600} PROCESSORS 2)

@@ -13,6 +13,7 @@ import { StatusBar } from './status_bar.js';
 import { installToggles } from './toggles.js';
 import { installEncodingPicker, requestedEncoding } from './encoding_picker.js';
 import { installSubjectPicker } from './subject_picker.js';
+import { installSubjectControls } from './subject_controls.js';
 import { installTakeControls } from './take_controls.js';
 
 const SAMPLED_POINTS = 8;
@@ -294,6 +295,7 @@ function updateStatus() {
 
 installToggles(shown, applyToggles);
 installTakeControls();
+installSubjectControls(() => (meshInfo ? meshInfo.subject : ''));
 installEncodingPicker(document.getElementById('encoding'), requested.encoding);
 if (viewerScene) viewerScene.controls.addEventListener('change', () => { sceneDirty = true; });
 window.addEventListener('resize', () => { sceneDirty = true; });

@@ -1,10 +1,9 @@
 // The operator's take controls (docs/control-api.md, docs/takes.md): start and stop a take
-// through the daemon's control API with its token, and the recording's state as /health says it.
-// The token stays in this tab's sessionStorage (a reload keeps it, closing the tab forgets it) and
-// goes only to the daemon that served the page.
-const TOKEN_KEY = 'skinstream.controlToken';
+// through the daemon's control API with its token (control_call.js), and the recording's state as
+// /health says it.
+import { postControl, refusal, restoreControlToken } from './control_call.js';
+
 const HEALTH_INTERVAL_MS = 1000;
-const OPERATOR = 'web page';
 
 function describeRecording(recording) {
   switch (recording.state) {
@@ -24,25 +23,15 @@ function describeRecording(recording) {
 }
 
 export function installTakeControls() {
-  const token = document.getElementById('control-token');
   const name = document.getElementById('take-name');
   const answer = document.getElementById('take-answer');
   const recording = document.getElementById('take-recording');
-  token.value = sessionStorage.getItem(TOKEN_KEY) || '';
+  restoreControlToken();
 
   const call = async (path, body) => {
-    sessionStorage.setItem(TOKEN_KEY, token.value);
-    const headers = { Authorization: `Bearer ${token.value}`, 'X-Skinstream-Operator': OPERATOR };
-    if (body) headers['Content-Type'] = 'application/json';
-    try {
-      const response = await fetch(path, { method: 'POST', headers, body: body ? JSON.stringify(body) : undefined, cache: 'no-store' });
-      const reply = await response.json().catch(() => ({}));
-      answer.textContent = response.ok ? `${reply.take}: ${reply.state}` : `${response.status}: ${reply.error || response.statusText}`;
-      answer.className = response.ok ? '' : 'error';
-    } catch (error) {
-      answer.textContent = `the control API did not answer: ${error.message}`;
-      answer.className = 'error';
-    }
+    const result = await postControl(path, body);
+    answer.textContent = result.ok ? `${result.reply.take}: ${result.reply.state}` : refusal(result);
+    answer.className = result.ok ? '' : 'error';
   };
   document.getElementById('take-start').addEventListener('click', () => call('/takes', name.value ? { name: name.value } : null));
   document.getElementById('take-stop').addEventListener('click', () => call('/takes/stop', null));
