@@ -44,7 +44,8 @@ std::vector<int> deform_cpus_of(const DaemonConfig& config) {
 
 MulticastSenderOptions multicast_options_of(const DaemonConfig& config, uint32_t stream_id);
 
-std::vector<std::unique_ptr<SubjectStream>> load_subjects(const DaemonConfig& config, const std::vector<int>& cpus) {
+// How every subject is served (each then gets its own thread names, CPUs and multicast stream id).
+SubjectStreamOptions stream_options_of(const DaemonConfig& config) {
   SubjectStreamOptions options;
   options.max_frame_wait = std::chrono::milliseconds(config.max_frame_wait_ms);
   options.hub.queue_frames = config.subscriber_queue_frames;
@@ -63,6 +64,14 @@ std::vector<std::unique_ptr<SubjectStream>> load_subjects(const DaemonConfig& co
   pipeline.filler.continuity_seconds = config.continuity_seconds;
   pipeline.filler.use_pca = config.use_pca;
   pipeline.compressed_key_interval = config.compressed_key_interval;
+  return options;
+}
+
+std::vector<std::unique_ptr<SubjectStream>> load_subjects(const DaemonConfig& config,
+                                                          const std::vector<int>& cpus,
+                                                          const SubjectStreamOptions& shared) {
+  SubjectStreamOptions options = shared;
+  PipelineOptions& pipeline = options.pipeline;
   const bool several = config.subjects.size() > 1;
   std::vector<std::unique_ptr<SubjectStream>> subjects;
   for (size_t k = 0; k < config.subjects.size(); ++k) {
@@ -148,8 +157,11 @@ AdmissionOptions admission_options_of(const DaemonConfig& config) {
 Daemon::Daemon(const DaemonConfig& config)
     : config_(config),
       deform_cpus_(deform_cpus_of(config)),
-      subjects_(load_subjects(config, deform_cpus_)),
-      router_(targets_of(subjects_), static_cast<SubjectRouter::Observer&>(*this), 1000.0 * config.source_max_coordinate_m),
+      stream_options_(stream_options_of(config)),
+      subjects_(load_subjects(config, deform_cpus_, stream_options_)),
+      next_stream_id_(static_cast<uint32_t>(config.subjects.size())),
+      router_(targets_of(subjects_), static_cast<SubjectRouter::Observer&>(*this),
+              1000.0 * config.source_max_coordinate_m),
       routed_(subjects_.size(), nullptr),
       publish_(config.publish_threads),
       status_timer_(io_),
@@ -166,7 +178,7 @@ Daemon::Daemon(const DaemonConfig& config)
   if (!config.record_dir.empty()) start_recorder();
   std::vector<SubjectStream*> streams;
   for (auto& stream : subjects_) streams.push_back(stream.get());
-  changes_ = std::make_unique<SubjectChanges>(changes_options_of(config), std::move(streams),
+  changes_ = std::make_unique<SubjectChanges>(changes_options_of(config), streams,
                                               static_cast<SubjectChanges::Host&>(*this), recorder_.get());
   const SourceSpec source = source_spec_of(config);
   source_ = make_source(io_, source, config, static_cast<SourceSink&>(*this));
@@ -349,7 +361,7 @@ void Daemon::on_frame(const SourceFrame& frame) {
   }
   for (size_t k = 0; k < subjects_.size(); ++k)
     if (router_.present(static_cast<int>(k))) {
-      changes_->on_routed(static_cast<int>(k), *routed_[k]);
+      changes_->on_routed(*subjects_[k], *routed_[k]);
       subjects_[k]->post();
     }
 }
@@ -368,7 +380,59 @@ bool Daemon::run_on_io_thread(const std::function<void()>& job) {
   return ran.get();
 }
 
-void Daemon::retarget(int index) { router_.replace_target(index, subject(index).target()); }
+void Daemon::retarget(SubjectStream& changed) {
+  for (size_t k = 0; k < subjects_.size(); ++k)
+    if (subjects_[k].get() == &changed) router_.replace_target(static_cast<int>(k), changed.target());
+}
+
+std::unique_ptr<SubjectStream> Daemon::make_subject(const std::string& name, const std::string& file) {
+  SubjectStreamOptions options = stream_options_;
+  // Its own thread names; its deform threads not pinned (the CPUs were shared out at start).
+  const std::string tag = std::to_string(next_stream_id_);
+  options.pipeline.thread_name = "pipeline-" + tag;
+  options.pipeline.deform_thread_name = "deform-" + tag;
+  if (!config_.multicast.empty()) options.multicast = multicast_options_of(config_, next_stream_id_);
+  ++next_stream_id_;
+  return std::make_unique<SubjectStream>(SubjectConfig{name, file}, options);
+}
+
+void Daemon::insert_subject(std::unique_ptr<SubjectStream> added) {
+  SubjectStream& s = *added;
+  subjects_.push_back(std::move(added));
+  routed_.push_back(nullptr);
+  router_.add_target(s.target());
+  directory_.add(s.name(), s.hub());
+  s.hub().set_directory(&directory_);
+  s.start();
+  broadcast_status();
+}
+
+ControlAnswer Daemon::remove_subject(const std::string& name, const std::string& who) {
+  const auto it =
+      std::find_if(subjects_.begin(), subjects_.end(), [&](const auto& s) { return s->name() == name; });
+  if (it == subjects_.end()) return {404, {{"error", "no subject " + quoted_text(name) + " here"}}};
+  if (subjects_.size() == 1)
+    return {409, {{"error", "subject " + name + " is the only one served: add another first"}}};
+  const int k = static_cast<int>(it - subjects_.begin());
+  router_.remove_target(k);
+  routed_.erase(routed_.begin() + k);
+  directory_.remove(name);
+  std::unique_ptr<SubjectStream> removed = std::move(*it);
+  subjects_.erase(it);
+  removed->hub().retire("subject " + name + " was removed from this daemon");
+  removed->stop();
+  spdlog::info("subject {}: removed by {}; its {} subscribers were told", name, who,
+               removed->hub().subscriber_count());
+  removed_subjects_.push_back({std::move(removed), std::chrono::steady_clock::now()});
+  return {200, {{"removed", name}}};
+}
+
+void Daemon::free_removed_subjects() {
+  const auto now = std::chrono::steady_clock::now();
+  std::erase_if(removed_subjects_, [&](const RemovedSubject& r) {
+    return now - r.removed > std::chrono::seconds(10) && r.stream->holds_nothing();
+  });
+}
 
 double Daemon::source_rate_hz() const {
   std::lock_guard lock(state_mutex_);
@@ -449,6 +513,7 @@ void Daemon::schedule_status() {
     if (ec || stopping_.load()) return;
     broadcast_status();
     for (auto& s : subjects_) s->tend_subscribers(std::chrono::milliseconds(config_.subscriber_write_stall_ms));
+    free_removed_subjects();
     schedule_status();
   });
 }
@@ -494,7 +559,7 @@ std::string Daemon::health_json() const {
   for (size_t k = 0; k < subjects_.size(); ++k) {
     const auto& s = subjects_[k];
     subjects.push_back(s->health());
-    subjects.back()["change"] = changes_ ? changes_->health(static_cast<int>(k)) : nlohmann::json();
+    subjects.back()["change"] = changes_ ? changes_->health(s->name()) : nlohmann::json();
     subscribers += subjects.back()["subscribers"].get<size_t>();
     dropped_write_stall += s->metrics().subscribers_dropped_write_stall.load();
   }

@@ -58,6 +58,7 @@ class Daemon : private SourceSink, private SubjectRouter::Observer, private Subj
   asio::io_context& io() { return io_; }
   // The source's own counters: its frames, its bad input (each subject has its own metrics).
   Metrics& source_metrics() { return source_metrics_; }
+  // The io thread (or before start): subjects are added and removed at run time on it.
   int subject_count() const { return static_cast<int>(subjects_.size()); }
   SubjectStream& subject(int index) { return *subjects_[static_cast<size_t>(index)]; }
   SourceState source_state() const;
@@ -76,8 +77,13 @@ class Daemon : private SourceSink, private SubjectRouter::Observer, private Subj
 
   // SubjectChanges::Host (a subject swapped at run time).
   bool run_on_io_thread(const std::function<void()>& job) override;
-  void retarget(int index) override;
+  void retarget(SubjectStream& subject) override;
   double source_rate_hz() const override;
+  std::unique_ptr<SubjectStream> make_subject(const std::string& name, const std::string& file) override;
+  void insert_subject(std::unique_ptr<SubjectStream> subject) override;
+  ControlAnswer remove_subject(const std::string& name, const std::string& who) override;
+  // The io thread, every Status tick: frees removed subjects once no subscriber holds their frames.
+  void free_removed_subjects();
 
   void broadcast_status();
   void schedule_status();
@@ -100,7 +106,14 @@ class Daemon : private SourceSink, private SubjectRouter::Observer, private Subj
   std::shared_ptr<ControlCounters> control_counters_;  // the control API's requests; null when it is off
   // Before io_: the io_context is destroyed first, and with it the handlers still holding
   // sessions whose queues hold frames of the subjects' pipelines' pools.
-  std::vector<std::unique_ptr<SubjectStream>> subjects_;
+  SubjectStreamOptions stream_options_;  // how every subject is made (one join pacer for all)
+  std::vector<std::unique_ptr<SubjectStream>> subjects_;  // the io thread's: subjects come and go at run time
+  struct RemovedSubject {
+    std::unique_ptr<SubjectStream> stream;
+    std::chrono::steady_clock::time_point removed;
+  };
+  std::vector<RemovedSubject> removed_subjects_;  // until no subscriber holds their frames
+  uint32_t next_stream_id_ = 0;                   // its multicast stream id
   SubjectRouter router_;
   std::vector<MarkerFrame*> routed_;  // per subject, its mailbox slot being filled (one frame)
   FrameNumbering numbering_;  // the source's frame numbers (io thread only)

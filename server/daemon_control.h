@@ -25,6 +25,12 @@ class DaemonControl final : public ControlActions {
                                   const nlohmann::json& request) override {
     return subjects_.load_file(name, request, TakeControl::who(caller));
   }
+  ControlAnswer add_subject(const ControlCaller& caller, const nlohmann::json& request) override {
+    return subjects_.add(request, TakeControl::who(caller));
+  }
+  ControlAnswer remove_subject(const ControlCaller& caller, const std::string& name) override {
+    return subjects_.remove(name, TakeControl::who(caller));
+  }
   ControlAnswer subject_state(const std::string& name) override { return subjects_.state(name); }
   ControlAnswer list_subjects() override { return subjects_.list(); }
 

@@ -3,6 +3,7 @@
 #include <spdlog/fmt/ranges.h>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
@@ -327,6 +328,14 @@ void SubjectStream::tend_subscribers(std::chrono::milliseconds write_stall) {
   std::erase_if(retired_, [&](const std::shared_ptr<Replacement>& r) {
     return r->pipeline->pool_frames_in_use() == 0 && now - r->retired > std::chrono::seconds(10);
   });
+}
+
+bool SubjectStream::holds_nothing() const {
+  if (hub_->subscriber_count() > 0) return false;
+  std::lock_guard lock(mutex_);
+  if (body_->pipeline->pool_frames_in_use() > 0) return false;
+  return std::all_of(retired_.begin(), retired_.end(),
+                     [](const auto& r) { return r->pipeline->pool_frames_in_use() == 0; });
 }
 
 std::string SubjectStream::status_line(StatusLine::Clock::time_point now) {

@@ -101,6 +101,8 @@ class SubjectStream {
   // `write_stall` (0: never), gives the frame pool back down to what the active ones need, and
   // frees replaced models no subscriber holds a frame of.
   void tend_subscribers(std::chrono::milliseconds write_stall);
+  // Whether no subscriber is left and no frame of its pools is held (a removed subject may go).
+  bool holds_nothing() const;
   // The io thread: the log's status line for the interval since the previous one.
   std::string status_line(StatusLine::Clock::time_point now);
 

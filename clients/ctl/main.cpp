@@ -187,7 +187,13 @@ int main(int argc, char** argv) {
       subject->add_subcommand("load", "serve the subject from another subject file: load NAME FILE");
   load->add_option("name", subject_name, "the subject")->required();
   load->add_option("file", subject_file, "the subject file (a path on the daemon's machine)")->required();
-  for (CLI::App* change : {calibrate, load})
+  CLI::App* add = subject->add_subcommand("add", "serve another subject from a subject file: add NAME FILE");
+  add->add_option("name", subject_name, "the source's name of the subject")->required();
+  add->add_option("file", subject_file, "the subject file (a path on the daemon's machine)")->required();
+  CLI::App* remove =
+      subject->add_subcommand("remove", "stop serving a subject (its subscribers are told): remove NAME");
+  remove->add_option("name", subject_name, "the subject")->required();
+  for (CLI::App* change : {calibrate, load, add})
     change->add_flag("--no-wait", no_wait, "return once the daemon accepted, without waiting for the swap");
   CLI::App* subjects = app.add_subcommand("subjects", "list the subjects and their last change");
   try {
@@ -223,6 +229,12 @@ int main(int argc, char** argv) {
   } else if (load->parsed()) {
     method = http::verb::post, target = "/subjects/" + subject_name + "/file", has_body = true;
     body["file"] = subject_file;
+  } else if (add->parsed()) {
+    method = http::verb::post, target = "/subjects", has_body = true;
+    body["name"] = subject_name;
+    body["file"] = subject_file;
+  } else if (remove->parsed()) {
+    method = http::verb::delete_, target = "/subjects/" + subject_name;
   } else if (subjects->parsed()) {
     target = "/subjects";
   }
@@ -234,7 +246,7 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "skinstream-ctl: %u %s\n", status, reason.c_str());
       return kExitRefused;
     }
-    const bool change = calibrate->parsed() || load->parsed();
+    const bool change = calibrate->parsed() || load->parsed() || add->parsed();
     if (!change || no_wait) {
       if (!json.is_null()) std::cout << json.dump(2) << "\n";
       return 0;

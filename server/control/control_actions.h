@@ -32,6 +32,10 @@ class ControlActions {
   // POST /subjects/NAME/file: another subject file for subject NAME, checked, swapped in.
   virtual ControlAnswer load_subject_file(const ControlCaller& caller, const std::string& name,
                                           const nlohmann::json& request) = 0;
+  // POST /subjects {"name", "file"}: another subject served from now on.
+  virtual ControlAnswer add_subject(const ControlCaller& caller, const nlohmann::json& request) = 0;
+  // DELETE /subjects/NAME: subject NAME no longer served; its subscribers told and closed.
+  virtual ControlAnswer remove_subject(const ControlCaller& caller, const std::string& name) = 0;
   virtual ControlAnswer subject_state(const std::string& name) = 0;  // GET /subjects/NAME
   virtual ControlAnswer list_subjects() = 0;                         // GET /subjects
 };

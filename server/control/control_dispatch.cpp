@@ -15,6 +15,10 @@ ControlAnswer run_control_action(ControlActions& actions, const ControlDecision&
       return actions.calibrate_subject(caller, decision.parameters.at(0).second, decision.body);
     case ControlAction::LoadSubjectFile:
       return actions.load_subject_file(caller, decision.parameters.at(0).second, decision.body);
+    case ControlAction::AddSubject:
+      return actions.add_subject(caller, decision.body);
+    case ControlAction::RemoveSubject:
+      return actions.remove_subject(caller, decision.parameters.at(0).second);
     case ControlAction::SubjectState:
       return actions.subject_state(decision.parameters.at(0).second);
     case ControlAction::ListSubjects:

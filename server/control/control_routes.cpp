@@ -10,7 +10,9 @@ constexpr ControlRoute kControlRoutes[] = {
     {"POST", "/takes", ControlAction::StartTake, /*takes_body=*/true},
     {"POST", "/takes/stop", ControlAction::StopTake},
     {"GET", "/subjects", ControlAction::ListSubjects},
+    {"POST", "/subjects", ControlAction::AddSubject, /*takes_body=*/true},
     {"GET", "/subjects/{name}", ControlAction::SubjectState},
+    {"DELETE", "/subjects/{name}", ControlAction::RemoveSubject},
     {"POST", "/subjects/{name}/calibration", ControlAction::CalibrateSubject, /*takes_body=*/true},
     {"POST", "/subjects/{name}/file", ControlAction::LoadSubjectFile, /*takes_body=*/true},
 };

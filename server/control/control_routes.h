@@ -18,6 +18,8 @@ enum class ControlAction {
   ListTakes,
   CalibrateSubject,
   LoadSubjectFile,
+  AddSubject,
+  RemoveSubject,
   SubjectState,
   ListSubjects
 };

@@ -60,6 +60,17 @@ void SubjectRouter::replace_target(int t, SubjectTarget target) {
   matched_ = false;
 }
 
+void SubjectRouter::add_target(SubjectTarget target) {
+  targets_.emplace_back(std::move(target));
+  candidates_.reserve(targets_.size());
+  matched_ = false;
+}
+
+void SubjectRouter::remove_target(int t) {
+  targets_.erase(targets_.begin() + t);
+  matched_ = false;
+}
+
 int SubjectRouter::markers_labelled_by(int t, const SourceSubject& subject) const {
   const Target& target = targets_[static_cast<size_t>(t)];
   std::vector<char> labelled(target.config.marker_names.size(), 0);

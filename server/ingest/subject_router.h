@@ -92,6 +92,10 @@ class SubjectRouter {
   // The routing thread, between two frames: target t is another subject model (a swap: its
   // markers may differ). Matched afresh at the next frame, which says so to the Observer.
   void replace_target(int t, SubjectTarget target);
+  // The routing thread, between two frames: a subject added at the end (index target_count()),
+  // or target t removed (the later ones move down one). Matched afresh at the next frame.
+  void add_target(SubjectTarget target);
+  void remove_target(int t);
 
   // How many of target t's markers `subject` labels (a check before a replay starts).
   int markers_labelled_by(int t, const SourceSubject& subject) const;

@@ -40,9 +40,24 @@ SubscriberHub::SubscriberHub(Metrics& metrics, const HubOptions& options, subscr
 }
 
 void SubscriberHub::add(const std::shared_ptr<SubscriberSession>& session, bool accepted) {
-  std::lock_guard lock(mutex_);
-  sessions_.push_back(session);
-  if (accepted) metrics_.subscribers_connected.fetch_add(1, std::memory_order_relaxed);
+  std::string retired;
+  {
+    std::lock_guard lock(mutex_);
+    sessions_.push_back(session);
+    if (accepted) metrics_.subscribers_connected.fetch_add(1, std::memory_order_relaxed);
+    retired = retired_;
+  }
+  if (!retired.empty()) session->end_with(retired);
+}
+
+void SubscriberHub::retire(const std::string& reason) {
+  std::vector<std::shared_ptr<SubscriberSession>> sessions;
+  {
+    std::lock_guard lock(mutex_);
+    retired_ = reason;
+    sessions = sessions_;
+  }
+  for (const auto& s : sessions) s->end_with(reason);
 }
 
 void SubscriberHub::activate(SubscriberSession& session, StreamKey key) {

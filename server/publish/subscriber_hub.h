@@ -71,6 +71,9 @@ class SubscriberHub : public FrameConsumer {
   void encoding_prepared(StreamKey key);
   void remove(SubscriberSession& session);
   void close_all();
+  // Any thread: the subject is no longer served (removed at run time). Every subscriber, and any
+  // that still joins, is sent a Status "refused" with `reason` and closed.
+  void retire(const std::string& reason);
   // Any thread (the daemon's 1 Hz timer): closes and counts each subscriber whose write has made
   // no progress for `limit`; a subscriber that stopped reading would otherwise hold its
   // socket, its queue and the frames in it for as long as it stays connected.
@@ -143,6 +146,7 @@ class SubscriberHub : public FrameConsumer {
     StreamKey key;
   };
   std::vector<Waiting> waiting_;  // activated, their key's buffers not made yet
+  std::string retired_;           // why the subject is no longer served; empty while it is
   subscriber::Status status_;
   // The status encoded: version 1, then version 2 per encoding served.
   std::array<ControlMessage, 1 + subscriber::kEncodingCount> status_messages_;

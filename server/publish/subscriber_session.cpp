@@ -201,6 +201,15 @@ void SubscriberSession::model_changed() {
   });
 }
 
+void SubscriberSession::end_with(std::string reason) {
+  asio::post(io_, [self = shared_from_this(), reason = std::move(reason)] {
+    if (self->closed_ || self->close_after_write_) return;
+    if (self->version_ == 0)
+      self->version_ = subscriber::kVersion1;  // no Hello yet: the version every subscriber reads
+    self->refuse(reason);
+  });
+}
+
 bool SubscriberSession::join_subject(const std::string& subject) {
   const SubjectDirectory* directory = hub_->directory();
   SubscriberHub* chosen =

@@ -41,6 +41,9 @@ class SubscriberSession : public std::enable_shared_from_this<SubscriberSession>
   // Any thread (SubscriberHub::replace_model): the subject's model changed; on the session's io
   // thread a greeted subscriber is sent the new MeshInfo (and Model), then the new model's frames.
   void model_changed();
+  // Any thread: sends a Status "refused" with `reason` (a subscriber that has not said Hello yet
+  // gets it in version 1), then closes, on the session's io thread.
+  void end_with(std::string reason);
 
   StreamKey stream_key() const { return key_.load(); }
   SubscriberMetrics stats() const;

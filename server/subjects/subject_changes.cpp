@@ -4,6 +4,7 @@
 #include <sys/resource.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <ctime>
 
@@ -37,6 +38,13 @@ std::string file_stem_of(const std::string& name) {
   return out.empty() ? "subject" : out;
 }
 
+// A source subject's name as a route's segment carries it.
+bool valid_subject_name(const std::string& name) {
+  if (name.empty() || name.size() > 64) return false;
+  return std::all_of(name.begin(), name.end(),
+                     [](unsigned char c) { return c >= 0x21 && c < 0x7f && c != '/'; });
+}
+
 bool under_way(const nlohmann::json& change) {
   if (change.is_null()) return false;
   const std::string state = change.value("state", "");
@@ -49,15 +57,15 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
 
 }  // namespace
 
-SubjectChanges::SubjectChanges(SubjectChangesOptions options, std::vector<SubjectStream*> subjects,
+SubjectChanges::SubjectChanges(SubjectChangesOptions options, const std::vector<SubjectStream*>& subjects,
                                Host& host, TakeRecorder* recorder)
-    : options_(std::move(options)),
-      subjects_(std::move(subjects)),
-      host_(host),
-      recorder_(recorder),
-      captures_(subjects_.size()),
-      capture_meshes_(subjects_.size()),
-      changes_(subjects_.size()) {
+    : options_(std::move(options)), host_(host), recorder_(recorder) {
+  for (SubjectStream* subject : subjects) {
+    auto entry = std::make_shared<Entry>();
+    entry->name = subject->name();
+    entry->stream = subject;
+    entries_.push_back(std::move(entry));
+  }
   thread_ = std::thread([this] { run(); });
 }
 
@@ -71,34 +79,42 @@ SubjectChanges::~SubjectChanges() {
   if (thread_.joinable()) thread_.join();
 }
 
-int SubjectChanges::index_of(const std::string& name) const {
-  for (size_t k = 0; k < subjects_.size(); ++k)
-    if (subjects_[k]->name() == name) return static_cast<int>(k);
-  return -1;
+std::shared_ptr<SubjectChanges::Entry> SubjectChanges::find(const std::string& name) const {
+  for (const auto& entry : entries_)
+    if (entry->name == name) return entry;
+  return nullptr;
 }
 
-ControlAnswer SubjectChanges::begin(int index, const std::string& kind, const std::string& state,
+ControlAnswer SubjectChanges::begin(Entry& entry, const std::string& kind, const std::string& state,
                                     const std::string& who, nlohmann::json details) {
   std::lock_guard lock(mutex_);
-  nlohmann::json& change = changes_[static_cast<size_t>(index)];
-  if (under_way(change))
+  if (under_way(entry.change))
     return {409,
-            {{"error", "subject " + subjects_[static_cast<size_t>(index)]->name() + ": a " +
-                           change.value("kind", "") + " is under way (" + change.value("state", "") +
-                           "): wait for it to end"}}};
+            {{"error", "subject " + entry.name + ": a " + entry.change.value("kind", "") + " is under way (" +
+                           entry.change.value("state", "") + "): wait for it to end"}}};
   details["kind"] = kind;
   details["state"] = state;
   details["who"] = who;
   details["started"] = utc_now("%Y-%m-%dT%H:%M:%SZ");
   details["started_steady_ns"] = std::chrono::steady_clock::now().time_since_epoch().count();
-  change = std::move(details);
-  return {202, change};
+  entry.change = std::move(details);
+  nlohmann::json shown = entry.change;
+  shown.erase("started_steady_ns");
+  return {202, shown};
 }
+
+namespace {
+
+ControlAnswer no_subject(const std::string& name) {
+  return {404, {{"error", "no subject " + quoted_text(name) + " here"}}};
+}
+
+}  // namespace
 
 ControlAnswer SubjectChanges::calibrate(const std::string& name, const nlohmann::json& request,
                                         const std::string& who) {
-  const int index = index_of(name);
-  if (index < 0) return {404, {{"error", "no subject " + quoted_text(name) + " here"}}};
+  const std::shared_ptr<Entry> entry = find(name);
+  if (!entry || !entry->stream) return no_subject(name);
   const nlohmann::json seconds_value = request.value("seconds", nlohmann::json(30));
   if (!seconds_value.is_number() || !(seconds_value.get<double>() >= 1.0) ||
       seconds_value.get<double>() > options_.max_seconds)
@@ -106,7 +122,7 @@ ControlAnswer SubjectChanges::calibrate(const std::string& name, const nlohmann:
   const nlohmann::json mesh_value = request.value("mesh", nlohmann::json(options_.mesh));
   if (!mesh_value.is_string()) return {400, {{"error", "mesh must be a file's path"}}};
   const std::string mesh = mesh_value.get<std::string>();
-  SubjectStream& subject = *subjects_[static_cast<size_t>(index)];
+  SubjectStream& subject = *entry->stream;
   if (mesh.empty() && subject.has_mesh())
     return {409,
             {{"error", "subject " + name +
@@ -116,15 +132,14 @@ ControlAnswer SubjectChanges::calibrate(const std::string& name, const nlohmann:
     return {400, {{"error", "mesh " + quoted_text(mesh) + ": no such file"}}};
   const double rate = host_.source_rate_hz() > 0 ? host_.source_rate_hz() : options_.default_rate_hz;
   const int frames = static_cast<int>(std::lround(seconds_value.get<double>() * rate));
-  ControlAnswer answer = begin(index, "calibration", "recording", who,
+  ControlAnswer answer = begin(*entry, "calibration", "recording", who,
                                {{"seconds", seconds_value.get<double>()},
                                 {"frames_wanted", frames},
                                 {"frames_recorded", 0},
                                 {"mesh", mesh}});
   if (answer.status != 202) return answer;
-  captures_[static_cast<size_t>(index)] =
-      std::make_unique<CalibrationCapture>(subject.model().marker_names, frames, rate);
-  capture_meshes_[static_cast<size_t>(index)] = mesh;
+  entry->capture = std::make_unique<CalibrationCapture>(subject.model().marker_names, frames, rate);
+  entry->capture_mesh = mesh;
   ++capturing_count_;
   spdlog::info("subject {}: calibration asked by {}: recording {} frames ({} s) of its range of motion", name,
                who, frames, seconds_value.get<double>());
@@ -133,62 +148,104 @@ ControlAnswer SubjectChanges::calibrate(const std::string& name, const nlohmann:
 
 ControlAnswer SubjectChanges::load_file(const std::string& name, const nlohmann::json& request,
                                         const std::string& who) {
-  const int index = index_of(name);
-  if (index < 0) return {404, {{"error", "no subject " + quoted_text(name) + " here"}}};
+  const std::shared_ptr<Entry> entry = find(name);
+  if (!entry || !entry->stream) return no_subject(name);
   const nlohmann::json file_value = request.value("file", nlohmann::json());
   if (!file_value.is_string() || file_value.get<std::string>().empty())
     return {400, {{"error", "file must be the subject file's path"}}};
   const std::string file = file_value.get<std::string>();
-  ControlAnswer answer = begin(index, "file", "loading", who, {{"subject_file", file}});
+  ControlAnswer answer = begin(*entry, "file", "loading", who, {{"subject_file", file}});
   if (answer.status != 202) return answer;
   spdlog::info("subject {}: subject file {} asked by {}", name, file, who);
-  post([this, index, file] { swap_in(index, file); });
+  post([this, entry, file] { swap_in(entry, file); });
+  return answer;
+}
+
+ControlAnswer SubjectChanges::add(const nlohmann::json& request, const std::string& who) {
+  const nlohmann::json name_value = request.value("name", nlohmann::json()),
+                       file_value = request.value("file", nlohmann::json());
+  if (!name_value.is_string() || !valid_subject_name(name_value.get<std::string>()))
+    return {400, {{"error", "name must be the source's subject name: 1-64 printable characters, no '/'"}}};
+  if (!file_value.is_string() || file_value.get<std::string>().empty())
+    return {400, {{"error", "file must be the subject file's path"}}};
+  const std::string name = name_value.get<std::string>(), file = file_value.get<std::string>();
+  std::shared_ptr<Entry> entry = find(name);
+  if (entry && entry->stream)
+    return {409, {{"error", "subject " + quoted_text(name) + " is served already"}}};
+  if (!entry) {
+    entry = std::make_shared<Entry>();
+    entry->name = name;
+    entries_.push_back(entry);
+  }
+  ControlAnswer answer = begin(*entry, "add", "loading", who, {{"subject_file", file}});
+  if (answer.status != 202) return answer;
+  spdlog::info("subject {}: added from {}, asked by {}", name, file, who);
+  post([this, entry, file] { add_subject(entry, file); });
+  return answer;
+}
+
+ControlAnswer SubjectChanges::remove(const std::string& name, const std::string& who) {
+  const std::shared_ptr<Entry> entry = find(name);
+  if (!entry || !entry->stream) return no_subject(name);
+  {
+    std::lock_guard lock(mutex_);
+    if (under_way(entry->change))
+      return {409,
+              {{"error", "subject " + name + ": a " + entry->change.value("kind", "") +
+                             " is under way: wait for it to end"}}};
+  }
+  ControlAnswer answer = host_.remove_subject(name, who);
+  if (answer.status != 200) return answer;
+  std::erase(entries_, entry);
   return answer;
 }
 
 ControlAnswer SubjectChanges::state(const std::string& name) const {
-  const int index = index_of(name);
-  if (index < 0) return {404, {{"error", "no subject " + quoted_text(name) + " here"}}};
-  const SubjectStream& subject = *subjects_[static_cast<size_t>(index)];
-  return {200,
-          {{"name", name},
-           {"file", subject.config().file},
-           {"markers", subject.model().marker_count()},
-           {"vertices", subject.vertex_count()},
-           {"change", health(index)}}};
+  const std::shared_ptr<Entry> entry = find(name);
+  if (!entry) return no_subject(name);
+  nlohmann::json out = {{"name", name}, {"change", health(name)}};
+  if (const SubjectStream* subject = entry->stream) {
+    out["file"] = subject->config().file;
+    out["markers"] = subject->model().marker_count();
+    out["vertices"] = subject->vertex_count();
+  }
+  return {200, out};
 }
 
 ControlAnswer SubjectChanges::list() const {
   nlohmann::json subjects = nlohmann::json::array();
-  for (const SubjectStream* s : subjects_) subjects.push_back(state(s->name()).body);
+  for (const auto& entry : entries_) subjects.push_back(state(entry->name).body);
   return {200, {{"subjects", subjects}}};
 }
 
-nlohmann::json SubjectChanges::health(int index) const {
+nlohmann::json SubjectChanges::health(const std::string& name) const {
+  const std::shared_ptr<Entry> entry = find(name);
+  if (!entry) return nullptr;
   std::lock_guard lock(mutex_);
-  nlohmann::json change = changes_[static_cast<size_t>(index)];
+  nlohmann::json change = entry->change;
   if (change.is_object()) change.erase("started_steady_ns");
   return change;
 }
 
-void SubjectChanges::capture_frame(int index, const MarkerFrame& frame) {
-  std::unique_ptr<CalibrationCapture>& capture = captures_[static_cast<size_t>(index)];
-  if (!capture) return;
-  const bool full = capture->add(frame);
-  if (!full && capture->frames() % 60 != 0) return;
-  const int recorded = capture->frames();
-  update(index, [&](nlohmann::json& change) {
+void SubjectChanges::capture_frame(const SubjectStream& subject, const MarkerFrame& frame) {
+  std::shared_ptr<Entry> entry;
+  for (const auto& e : entries_)
+    if (e->stream == &subject) entry = e;
+  if (!entry || !entry->capture) return;
+  CalibrationCapture& capture = *entry->capture;
+  const bool full = capture.add(frame);
+  if (!full && capture.frames() % 60 != 0) return;
+  const int recorded = capture.frames();
+  update(*entry, [&](nlohmann::json& change) {
     change["frames_recorded"] = recorded;
     if (full) change["state"] = "building";
   });
   if (!full) return;
   // The take goes to this object's thread; the capture's memory with it.
-  auto take = std::make_shared<Capture>(capture->take());
-  capture.reset();
+  auto take = std::make_shared<Capture>(capture.take());
+  entry->capture.reset();
   --capturing_count_;
-  post([this, index, take, mesh = capture_meshes_[static_cast<size_t>(index)]] {
-    build_and_swap(index, std::move(*take), mesh);
-  });
+  post([this, entry, take, mesh = entry->capture_mesh] { build_and_swap(entry, std::move(*take), mesh); });
 }
 
 void SubjectChanges::post(std::function<void()> job) {
@@ -215,70 +272,68 @@ void SubjectChanges::run() {
   }
 }
 
-void SubjectChanges::build_and_swap(int index, Capture capture, std::string mesh) {
-  const std::string name = subjects_[static_cast<size_t>(index)]->name();
-  const std::filesystem::path base = options_.dir / (file_stem_of(name) + "-" + utc_now("%Y%m%d-%H%M%S"));
+void SubjectChanges::build_and_swap(const std::shared_ptr<Entry>& entry, Capture capture, std::string mesh) {
+  const std::filesystem::path base =
+      options_.dir / (file_stem_of(entry->name) + "-" + utc_now("%Y%m%d-%H%M%S"));
   const std::filesystem::path take = base.string() + ".rom.c3d", built = base.string() + ".sksubj";
   try {
     std::filesystem::create_directories(options_.dir);
     write_capture(capture, take.string());
   } catch (const std::exception& e) {
-    return fail(index, std::string("cannot write the range of motion: ") + e.what());
+    return fail(*entry, std::string("cannot write the range of motion: ") + e.what());
   }
-  update(index, [&](nlohmann::json& change) { change["capture"] = take.string(); });
-  spdlog::info("subject {}: calibration: {} frames recorded to {}; building {} at the lowest priority", name,
-               capture.frame_count, take.string(), built.string());
+  update(*entry, [&](nlohmann::json& change) { change["capture"] = take.string(); });
+  spdlog::info("subject {}: calibration: {} frames recorded to {}; building {} at the lowest priority",
+               entry->name, capture.frame_count, take.string(), built.string());
   const SubjectBuildResult result =
       build_subject({options_.builder, take, built, mesh, options_.build_timeout}, cancel_);
-  update(index, [&](nlohmann::json& change) {
+  update(*entry, [&](nlohmann::json& change) {
     change["build_seconds"] = result.seconds;
     change["report"] = result.report.string();
   });
-  if (!result.ok) return fail(index, result.reason);
-  swap_in(index, built.string());
+  if (!result.ok) return fail(*entry, result.reason);
+  swap_in(entry, built.string());
 }
 
-void SubjectChanges::swap_in(int index, const std::string& file) {
-  SubjectStream& subject = *subjects_[static_cast<size_t>(index)];
+void SubjectChanges::swap_in(const std::shared_ptr<Entry>& entry, const std::string& file) {
+  SubjectStream& subject = *entry->stream;  // not removed while a change is under way
   const auto start = std::chrono::steady_clock::now();
-  update(index, [&](nlohmann::json& change) { change["state"] = "loading"; });
+  update(*entry, [&](nlohmann::json& change) { change["state"] = "loading"; });
   std::shared_ptr<SubjectStream::Replacement> replacement;
   try {
     replacement = subject.prepare_replacement(file);
   } catch (const std::exception& e) {
-    return fail(index, e.what());
+    return fail(*entry, e.what());
   }
   if (recorder_) {
     const std::vector<std::string> recorded = recorder_->recorded_marker_names(subject.name());
     if (!recorded.empty() && recorded != SubjectStream::model_of(*replacement).marker_names)
-      return fail(index, "takes record subject " + subject.name() + " with its " +
-                             std::to_string(recorded.size()) + " markers, and " + file +
-                             " has other markers (" +
-                             std::to_string(SubjectStream::model_of(*replacement).marker_count()) +
-                             "): restart the daemon to record it");
+      return fail(*entry, "takes record subject " + subject.name() + " with its " +
+                              std::to_string(recorded.size()) + " markers, and " + file +
+                              " has other markers (" +
+                              std::to_string(SubjectStream::model_of(*replacement).marker_count()) +
+                              "): restart the daemon to record it");
   }
   const double load_seconds = seconds_since(start);
-  update(index, [&](nlohmann::json& change) { change["state"] = "swapping"; });
+  update(*entry, [&](nlohmann::json& change) { change["state"] = "swapping"; });
   const auto switch_start = std::chrono::steady_clock::now();
   if (!host_.run_on_io_thread([&] {
         subject.switch_input(*replacement);
-        host_.retarget(index);
+        host_.retarget(subject);
       }))
-    return fail(index, "the daemon is stopping");
+    return fail(*entry, "the daemon is stopping");
   subject.complete_replacement(replacement);
   if (recorder_) recorder_->set_subject_file(subject.name(), file);
   const double swap_ms = 1000.0 * seconds_since(switch_start);
-  update(index, [&](nlohmann::json& change) {
+  update(*entry, [&](nlohmann::json& change) {
     change["state"] = "done";
     change["subject_file"] = file;
     change["load_seconds"] = load_seconds;
     change["swap_ms"] = swap_ms;
     change["markers"] = SubjectStream::model_of(*replacement).marker_count();
     change["vertices"] = subject.vertex_count();
-    change["seconds_in_all"] =
-        std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch() -
-                                      std::chrono::nanoseconds(change.value("started_steady_ns", int64_t{0})))
-            .count();
+    change["seconds_in_all"] = seconds_since(std::chrono::steady_clock::time_point(
+        std::chrono::steady_clock::duration(change.value("started_steady_ns", int64_t{0}))));
     change["finished"] = utc_now("%Y-%m-%dT%H:%M:%SZ");
   });
   spdlog::info(
@@ -288,20 +343,46 @@ void SubjectChanges::swap_in(int index, const std::string& file) {
       subject.name(), file, load_seconds, swap_ms);
 }
 
-void SubjectChanges::update(int index, const std::function<void(nlohmann::json&)>& edit) {
-  std::lock_guard lock(mutex_);
-  nlohmann::json& change = changes_[static_cast<size_t>(index)];
-  if (change.is_object()) edit(change);
+void SubjectChanges::add_subject(const std::shared_ptr<Entry>& entry, const std::string& file) {
+  const auto start = std::chrono::steady_clock::now();
+  std::unique_ptr<SubjectStream> made;
+  try {
+    made = host_.make_subject(entry->name, file);
+  } catch (const std::exception& e) {
+    return fail(*entry, e.what());
+  }
+  SubjectStream* subject = made.get();
+  const double load_seconds = seconds_since(start);
+  if (!host_.run_on_io_thread([&] {
+        host_.insert_subject(std::move(made));
+        entry->stream = subject;
+      }))
+    return fail(*entry, "the daemon is stopping");
+  update(*entry, [&](nlohmann::json& change) {
+    change["state"] = "done";
+    change["load_seconds"] = load_seconds;
+    change["markers"] = subject->model().marker_count();
+    change["vertices"] = subject->vertex_count();
+    change["finished"] = utc_now("%Y-%m-%dT%H:%M:%SZ");
+  });
+  spdlog::info("subject {}: added from {} ({} markers, {} vertices, loaded in {:.2f} s)", entry->name, file,
+               subject->model().marker_count(), subject->vertex_count(), load_seconds);
 }
 
-void SubjectChanges::fail(int index, const std::string& reason) {
-  update(index, [&](nlohmann::json& change) {
+void SubjectChanges::update(Entry& entry, const std::function<void(nlohmann::json&)>& edit) {
+  std::lock_guard lock(mutex_);
+  if (entry.change.is_object()) edit(entry.change);
+}
+
+void SubjectChanges::fail(Entry& entry, const std::string& reason) {
+  std::string kind;
+  update(entry, [&](nlohmann::json& change) {
     change["state"] = "failed";
     change["reason"] = reason;
     change["finished"] = utc_now("%Y-%m-%dT%H:%M:%SZ");
+    kind = change.value("kind", "change");
   });
-  spdlog::error("subject {}: {} failed, the subject served stays as it was: {}",
-                subjects_[static_cast<size_t>(index)]->name(), health(index).value("kind", "change"), reason);
+  spdlog::error("subject {}: {} failed, the subjects served stay as they were: {}", entry.name, kind, reason);
 }
 
 }  // namespace skinstream::server

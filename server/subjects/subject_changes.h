@@ -44,21 +44,30 @@ struct SubjectChangesOptions {
 
 class SubjectChanges {
  public:
-  // What the daemon does for a swap on its io thread.
+  // What the daemon does for a change on its io thread.
   class Host {
    public:
     virtual ~Host() = default;
     // Runs `job` on the io thread, between two frames, and waits for it; false when the daemon
     // stops first (the job then never runs).
     virtual bool run_on_io_thread(const std::function<void()>& job) = 0;
-    // The io thread: subject `index`'s router target is its new model's (SubjectStream::target()).
-    virtual void retarget(int index) = 0;
+    // The io thread: `subject`'s router target is its new model's (SubjectStream::target()).
+    virtual void retarget(SubjectStream& subject) = 0;
     // Any thread: the source's rate (0: not known yet).
     virtual double source_rate_hz() const = 0;
+    // This object's thread (slow): a new subject's stream, as the daemon would make it at
+    // start-up, not started. Throws FileError or ConfigError with the reason.
+    virtual std::unique_ptr<SubjectStream> make_subject(const std::string& name, const std::string& file) = 0;
+    // The io thread: `subject` routed, listed and started.
+    virtual void insert_subject(std::unique_ptr<SubjectStream> subject) = 0;
+    // The io thread: subject `name` no longer routed nor listed; its subscribers told and closed.
+    // 409 when it cannot go (the last subject).
+    virtual ControlAnswer remove_subject(const std::string& name, const std::string& who) = 0;
   };
 
-  // `subjects` outlive this object; `recorder` may be null (no record_dir).
-  SubjectChanges(SubjectChangesOptions options, std::vector<SubjectStream*> subjects, Host& host,
+  // `subjects` (those served at start) outlive this object, as do those added later until they
+  // are removed; `recorder` may be null (no record_dir).
+  SubjectChanges(SubjectChangesOptions options, const std::vector<SubjectStream*>& subjects, Host& host,
                  TakeRecorder* recorder);
   ~SubjectChanges();  // kills a build under way, then joins the thread
   SubjectChanges(const SubjectChanges&) = delete;
@@ -67,42 +76,49 @@ class SubjectChanges {
   // The io thread (control API). 202 with the change's state, or why it cannot start.
   ControlAnswer calibrate(const std::string& name, const nlohmann::json& request, const std::string& who);
   ControlAnswer load_file(const std::string& name, const nlohmann::json& request, const std::string& who);
+  ControlAnswer add(const nlohmann::json& request, const std::string& who);  // {"name", "file"}
+  ControlAnswer remove(const std::string& name, const std::string& who);     // 200 once removed
   ControlAnswer state(const std::string& name) const;
   ControlAnswer list() const;
 
-  // The io thread, for every frame routed to subject `index` (cheap when no calibration records).
-  void on_routed(int index, const MarkerFrame& frame) {
-    if (capturing_count_ > 0) capture_frame(index, frame);
+  // The io thread, for every frame routed to `subject` (cheap when no calibration records).
+  void on_routed(const SubjectStream& subject, const MarkerFrame& frame) {
+    if (capturing_count_ > 0) capture_frame(subject, frame);
   }
-  // /health's "change" of subject `index`: the last change asked for (null when none).
-  nlohmann::json health(int index) const;
+  // The io thread: /health's "change" of subject `name`: the last change asked for (null when none).
+  nlohmann::json health(const std::string& name) const;
 
  private:
-  int index_of(const std::string& name) const;
-  // 409 when a change of `index` is under way; else a new change in state `state`.
-  ControlAnswer begin(int index, const std::string& kind, const std::string& state, const std::string& who,
+  // One subject as changes see it: served (stream) or being added (null until inserted).
+  struct Entry {
+    std::string name;
+    SubjectStream* stream = nullptr;
+    std::unique_ptr<CalibrationCapture> capture;  // io thread: while a calibration records
+    std::string capture_mesh;
+    nlohmann::json change;  // under mutex_: the last change (null when none)
+  };
+  std::shared_ptr<Entry> find(const std::string& name) const;
+  // 409 when a change of `entry` is under way; else a new change in state `state`.
+  ControlAnswer begin(Entry& entry, const std::string& kind, const std::string& state, const std::string& who,
                       nlohmann::json details);
-  void capture_frame(int index, const MarkerFrame& frame);
+  void capture_frame(const SubjectStream& subject, const MarkerFrame& frame);
   void post(std::function<void()> job);
   void run();
   // On this object's thread.
-  void build_and_swap(int index, Capture capture, std::string mesh);
-  void swap_in(int index, const std::string& file);
-  void update(int index, const std::function<void(nlohmann::json&)>& edit);
-  void fail(int index, const std::string& reason);
+  void build_and_swap(const std::shared_ptr<Entry>& entry, Capture capture, std::string mesh);
+  void swap_in(const std::shared_ptr<Entry>& entry, const std::string& file);
+  void add_subject(const std::shared_ptr<Entry>& entry, const std::string& file);
+  void update(Entry& entry, const std::function<void(nlohmann::json&)>& edit);
+  void fail(Entry& entry, const std::string& reason);
 
   SubjectChangesOptions options_;
-  std::vector<SubjectStream*> subjects_;
   Host& host_;
   TakeRecorder* recorder_;
 
-  // The io thread only: each subject's calibration recording, while it records.
-  std::vector<std::unique_ptr<CalibrationCapture>> captures_;
-  std::vector<std::string> capture_meshes_;
-  int capturing_count_ = 0;
+  std::vector<std::shared_ptr<Entry>> entries_;  // the io thread's; the jobs hold theirs
+  int capturing_count_ = 0;                      // io thread
 
-  mutable std::mutex mutex_;
-  std::vector<nlohmann::json> changes_;  // per subject: its last change (null when none)
+  mutable std::mutex mutex_;  // every entry's change, and the jobs
   std::deque<std::function<void()>> jobs_;
   std::condition_variable wake_;
   bool stopping_ = false;

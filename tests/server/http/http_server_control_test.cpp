@@ -52,6 +52,14 @@ class RecordingControlActions : public ControlActions {
     record({"load_subject_file:" + name, caller, request});
     return {202, {{"state", "loading"}}};
   }
+  ControlAnswer add_subject(const ControlCaller& caller, const nlohmann::json& request) override {
+    record({"add_subject", caller, request});
+    return {202, {{"state", "loading"}}};
+  }
+  ControlAnswer remove_subject(const ControlCaller& caller, const std::string& name) override {
+    record({"remove_subject:" + name, caller, {}});
+    return {200, {{"removed", name}}};
+  }
   ControlAnswer subject_state(const std::string& name) override {
     record({"subject_state:" + name, {}, {}});
     return {200, {{"name", name}}};
@@ -215,16 +223,23 @@ TEST_F(HttpServerControl, TheSubjectRoutesCallTheirActionWithTheSubjectNamedInTh
             202);
   EXPECT_EQ(send(port, http::verb::get, "/subjects/Actor1", bearer).json().at("name"), "Actor1");
   EXPECT_EQ(send(port, http::verb::get, "/subjects", bearer).status, 200);
+  EXPECT_EQ(
+      send(port, http::verb::post, "/subjects", bearer, R"({"name":"Actor3","file":"c.sksubj"})").status,
+      202);
+  EXPECT_EQ(send(port, http::verb::delete_, "/subjects/Actor3", bearer).json().at("removed"), "Actor3");
   EXPECT_EQ(send(port, http::verb::get, "/subjects/Actor1/calibration", bearer).status, 405);
   EXPECT_EQ(send(port, http::verb::post, "/subjects/Actor1/other", bearer).status, 404);
   const std::vector<RecordingControlActions::Call> calls = actions->calls();
-  ASSERT_EQ(calls.size(), 4u);
+  ASSERT_EQ(calls.size(), 6u);
   EXPECT_EQ(calls[0].action, "calibrate_subject:Actor2");
   EXPECT_EQ(calls[0].request.at("seconds"), 30);
   EXPECT_EQ(calls[1].action, "load_subject_file:Actor1");
   EXPECT_EQ(calls[1].request.at("file"), "a.sksubj");
   EXPECT_EQ(calls[2].action, "subject_state:Actor1");
   EXPECT_EQ(calls[3].action, "list_subjects");
+  EXPECT_EQ(calls[4].action, "add_subject");
+  EXPECT_EQ(calls[4].request.at("name"), "Actor3");
+  EXPECT_EQ(calls[5].action, "remove_subject:Actor3");
 }
 
 TEST_F(HttpServerControl, BadRequestsAreRefusedBeforeTheAction) {
