@@ -3,7 +3,8 @@
 # - web.units: the page's decoders and tables in node (node's test runner);
 # - web.bad_input: the page in the system Chromium against a scripted server sending bad input;
 # - web.viewer: the page in Chromium against the real daemon (tests/clients/web/viewer_test.mjs);
-# - web.takes_panel: the page's take controls against the real daemon (takes_panel_test.mjs).
+# - web.takes_panel: the page's take controls against the real daemon (takes_panel_test.mjs);
+# - web.subject_swap: the page drawing on across subjects swapped at run time (subject_swap_test.mjs).
 # Needs node and npm (Debian: nodejs npm) and chromium (software WebGL).
 find_program(SKINSTREAM_NODE NAMES node nodejs)
 if(NOT TARGET skinstreamd)
@@ -38,6 +39,16 @@ else()
     --out ${CMAKE_BINARY_DIR}/test_tmp/web)
   set_tests_properties(web.takes_panel PROPERTIES FIXTURES_REQUIRED "web_bundle;demo_subject"
     LABELS browser TIMEOUT ${time_limit_300})
+  # Two pages (parameters on the GPU, compressed) across a subject file swapped in and back.
+  add_test(NAME web.subject_swap COMMAND ${SKINSTREAM_NODE} ${web_tests}/subject_swap_test.mjs
+    --daemon $<TARGET_FILE:skinstreamd>
+    --first ${CMAKE_BINARY_DIR}/test_tmp/swap_subjects/first.sksubj
+    --second ${CMAKE_BINARY_DIR}/test_tmp/swap_subjects/second.sksubj
+    --recording ${PROJECT_SOURCE_DIR}/replay_data/cmu/85_02.c3d
+    --web-root ${CMAKE_BINARY_DIR}/web
+    --out ${CMAKE_BINARY_DIR}/test_tmp/web)
+  set_tests_properties(web.subject_swap PROPERTIES FIXTURES_REQUIRED "web_bundle;swap_subjects"
+    LABELS browser TIMEOUT ${time_limit_300} PROCESSORS 2)
   # Chromium with SwiftShader keeps both cores busy: let ctest -j count it as two.
   set_tests_properties(web.viewer PROPERTIES FIXTURES_REQUIRED "web_bundle;demo_subject"
     LABELS browser TIMEOUT ${time_limit_600} PROCESSORS 2)
