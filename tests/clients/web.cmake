@@ -4,7 +4,8 @@
 # - web.bad_input: the page in the system Chromium against a scripted server sending bad input;
 # - web.viewer: the page in Chromium against the real daemon (tests/clients/web/viewer_test.mjs);
 # - web.takes_panel: the page's take controls against the real daemon (takes_panel_test.mjs);
-# - web.calibration_panel: the page's live calibration against the real daemon.
+# - web.calibration_panel: the page's live calibration against the real daemon;
+# - web.subject_swap: the page drawing on across subjects swapped at run time (subject_swap_test.mjs).
 # Needs node and npm (Debian: nodejs npm) and chromium (software WebGL).
 find_program(SKINSTREAM_NODE NAMES node nodejs)
 if(NOT TARGET skinstreamd)
@@ -42,13 +43,23 @@ else()
   # The page's live calibration: a CMU capture's subject recorded, built, checked and swapped in.
   add_test(NAME web.calibration_panel COMMAND ${SKINSTREAM_NODE} ${web_tests}/calibration_panel_test.mjs
     --daemon $<TARGET_FILE:skinstreamd>
-    --cli $<TARGET_FILE:skinstream>
+    --subject ${CMAKE_BINARY_DIR}/test_tmp/swap_subjects/first.sksubj
     --capture ${PROJECT_SOURCE_DIR}/replay_data/cmu/85_02.c3d
     --mesh ${PROJECT_SOURCE_DIR}/replay_data/makehuman/makehuman_hm08_body_only.obj
     --web-root ${CMAKE_BINARY_DIR}/web
     --out ${CMAKE_BINARY_DIR}/test_tmp/web)
   # Two processors: the builder runs at the lowest priority, and beside Chromium it waited minutes.
-  set_tests_properties(web.calibration_panel PROPERTIES FIXTURES_REQUIRED web_bundle LABELS browser TIMEOUT ${time_limit_300} PROCESSORS 2)
+  set_tests_properties(web.calibration_panel PROPERTIES FIXTURES_REQUIRED "web_bundle;swap_subjects" LABELS browser TIMEOUT ${time_limit_300} PROCESSORS 2)
+  # Two pages (parameters on the GPU, compressed) across a subject file swapped in and back.
+  add_test(NAME web.subject_swap COMMAND ${SKINSTREAM_NODE} ${web_tests}/subject_swap_test.mjs
+    --daemon $<TARGET_FILE:skinstreamd>
+    --first ${CMAKE_BINARY_DIR}/test_tmp/swap_subjects/first.sksubj
+    --second ${CMAKE_BINARY_DIR}/test_tmp/swap_subjects/second.sksubj
+    --recording ${PROJECT_SOURCE_DIR}/replay_data/cmu/85_02.c3d
+    --web-root ${CMAKE_BINARY_DIR}/web
+    --out ${CMAKE_BINARY_DIR}/test_tmp/web)
+  set_tests_properties(web.subject_swap PROPERTIES FIXTURES_REQUIRED "web_bundle;swap_subjects"
+    LABELS browser TIMEOUT ${time_limit_300} PROCESSORS 2)
   # Chromium with SwiftShader keeps both cores busy: let ctest -j count it as two.
   set_tests_properties(web.viewer PROPERTIES FIXTURES_REQUIRED "web_bundle;demo_subject"
     LABELS browser TIMEOUT ${time_limit_600} PROCESSORS 2)

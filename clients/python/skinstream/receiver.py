@@ -20,6 +20,7 @@ class Receiver:
         self.frames_received = 0  # since start()
         self.frames_replaced = 0  # arrived and gave way to a newer one before take()
         self.connections = 0  # subscriptions that got their MeshInfo
+        self.meshes_received = 0  # MeshInfos: one per connection, and one per subject swapped in by the daemon
         self.mesh = self.model = None  # of the current (or last) subscription
         self.decoder = None  # what decodes its frames (Subscriber.decoder)
         self._state, self._detail, self._retry_at = 'stopped', '', None
@@ -102,11 +103,15 @@ class Receiver:
             subscriber = None
             try:
                 subscriber = Subscriber(self.host, self.port, **self.options)
+                meshes_here = 0  # on this connection: after the first, subjects the daemon swapped in
                 while not self._stop.is_set():
                     frame = subscriber.next_frame(0.25)
                     if subscriber.mesh is not self.mesh and subscriber.mesh is not None:
                         self.mesh, self.model = subscriber.mesh, subscriber.model
-                        self.connections += 1
+                        if meshes_here == 0:
+                            self.connections += 1
+                        meshes_here += 1
+                        self.meshes_received += 1
                     if frame is None:
                         continue
                     self.model, self.decoder = subscriber.model, subscriber.decoder

@@ -7,6 +7,8 @@ add-on's timer function itself, as Blender's would.
   within 0.1 mm, for the parameter and compressed encodings (bit for bit when the C++ client
   library evaluates the parameters: the package carried finds it as outside Blender, and the
   system's libmeshoptimizer, and the panel says which decodes); markers as a point cloud;
+- across a subject swapped at run time (POST /subjects/NAME/file) the same body object goes on
+  taking the frames, of the new subject, with no error and no reconnection;
 - a daemon that stalls never holds the timer up; one that goes away is shown in the panel's
   status and reconnected to when it comes back;
 - a recording plays back through Blender's own Mesh Cache modifier, sample for sample;
@@ -23,7 +25,8 @@ import bpy
 import numpy as np
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', '..'))
-from support.python_clients import CLIENT_LIBRARY, DEMO, SCRATCH, SKINSTREAM_CLI, demo_daemon  # noqa: E402
+from support.python_clients import (CLIENT_LIBRARY, DEMO, SCRATCH, SKINSTREAM_CLI, demo_daemon, swap_daemon,  # noqa: E402
+                                    swap_subject_file, swap_subjects)
 import skinstream as source_package  # noqa: E402  (the source tree's, for the reference subscriber)
 
 ADDON_ZIP = sys.argv[sys.argv.index('--') + 1]
@@ -44,6 +47,9 @@ class FloatFrames:
             frame = self._subscriber.next_frame(0.2)
             if frame is not None:
                 self.frames[frame.frame_number] = frame
+
+    def mesh(self):
+        return self._subscriber.mesh
 
     def stop(self):
         self._stop.set()
@@ -111,6 +117,8 @@ class Addon(unittest.TestCase):
                     decoder = self.live._connection.receiver.decoder
                     self.assertIn(f'(decoded by {decoder})', self.live.status_lines()[0])
                     shown = vertices_of(body.data)
+                    markers = bpy.data.objects[self.live._connection.markers]
+                    shown_markers = vertices_of(markers.data)  # of the same frame: pumping on applies later ones
                     self.assertTrue(self.pump(lambda: number in reference.frames, 30), f'frame {number} not seen by the float subscriber')
                 finally:
                     reference.stop()
@@ -125,11 +133,55 @@ class Addon(unittest.TestCase):
                 if encoding == 'compressed' and self.live.skinstream.meshoptimizer_library.find_meshoptimizer()[0]:
                     self.assertEqual(decoder, 'libmeshoptimizer')
                 self.assertAlmostEqual(body.scale[0], 0.001)
-                markers = bpy.data.objects[self.live._connection.markers]
                 self.assertEqual(markers.instance_type, 'VERTS')
                 self.assertEqual(len(markers.data.vertices), len(truth.mesh.marker_names))
-                np.testing.assert_array_equal(vertices_of(markers.data), truth.markers)
+                np.testing.assert_array_equal(shown_markers, truth.markers)
                 bpy.ops.skinstream.disconnect()
+
+    def test_the_body_carries_on_across_a_swapped_subject(self):
+        first, second = swap_subjects()
+        with swap_daemon(first) as daemon:
+            reference = FloatFrames(daemon.sub_port)
+            try:
+                self.scene.skinstream.show_markers = True
+                self.connect(daemon.sub_port, 'parameters')
+                self.assertTrue(self.pump(lambda: self.live.frames_applied() >= 10), self.live.status_lines())
+                connection = self.live._connection
+                body, old_info, old_model = self.live.body_object(), connection.mesh_info, connection.receiver.model
+                before = vertices_of(body.data)
+                reference_before = reference.mesh()
+                swapped = swap_subject_file(daemon.http_port, second, wait=lambda seconds: self.pump(lambda: False, seconds))
+                self.assertEqual((swapped['change']['state'], swapped['file']), ('done', second), swapped)
+                applied = self.live.frames_applied()
+                # Built again from the new subject's MeshInfo, then its frames, 30 of them.
+                self.assertTrue(self.pump(lambda: connection.mesh_info is not old_info and
+                                          self.live.frames_applied() >= applied + 30), self.live.status_lines())
+                body_after = self.live.body_object()
+                number = body_after['skinstream_frame']
+                shown = vertices_of(body_after.data)
+                status = self.live.status_lines()
+                self.assertTrue(self.pump(lambda: number in reference.frames and reference.frames[number].mesh is not reference_before,
+                                          30), f'frame {number} of the new subject not seen by the float subscriber')
+            finally:
+                reference.stop()
+            self.assertEqual(daemon.stop(), 0, daemon.log())
+        new_info = connection.mesh_info
+        self.assertIs(self.live._connection, connection)
+        self.assertEqual((connection.receiver.connections, connection.receiver.meshes_received), (1, 2))  # never reconnected
+        self.assertEqual(connection.problem, '')
+        self.assertIn('streaming "body"', status[0])
+        # The same object, its mesh built again for the new subject and still moving.
+        self.assertEqual(body_after.name, body.name)
+        self.assertEqual(body_after['skinstream_subject'], 'body')
+        self.assertFalse(np.array_equal(new_info.marker_triangles, old_info.marker_triangles))
+        self.assertIsNot(connection.receiver.model, old_model)
+        self.assertEqual(shown.shape, before.shape)
+        self.assertGreater(np.abs(shown - before).max(), 1.0)
+        # What it shows is the daemon's: the new subject's vertices of that frame.
+        truth = reference.frames[number]
+        worst = np.abs(shown.astype(np.float64) - truth.vertices).max()
+        print(f'across the swap: frame {number} within {worst:.4g} mm of the daemon\'s vertices')
+        self.assertLessEqual(worst, 0.1)
 
     def test_a_stalled_or_vanished_daemon_is_shown_and_never_holds_blender_up(self):
         daemon = demo_daemon()

@@ -5,9 +5,10 @@
 // takes the new MeshInfo and keeps drawing. A calibration the builder refuses (1 s of an actor
 // barely moving is not asked here: a mesh that does not exist is refused at once) shows why.
 //
-// node calibration_panel_test.mjs --daemon skinstreamd --cli skinstream --capture C3D --mesh OBJ --web-root DIR --out DIR
+// node calibration_panel_test.mjs --daemon skinstreamd --subject S --capture C3D --mesh OBJ --web-root DIR --out DIR
+// (S: a subject built from C3D with the mesh OBJ, the swap_subjects fixture's first)
 import assert from 'node:assert/strict';
-import { spawn, spawnSync } from 'node:child_process';
+import { spawn } from 'node:child_process';
 import fs from 'node:fs';
 import path from 'node:path';
 import { launchChromium, sleep } from './support/browser.mjs';
@@ -15,7 +16,7 @@ import { launchChromium, sleep } from './support/browser.mjs';
 function parseArguments(argv) {
   const options = { chromium: '/usr/bin/chromium' };
   for (let i = 0; i + 1 < argv.length; i += 2) options[argv[i].replace(/^--/, '').replace(/-([a-z])/g, (_, c) => c.toUpperCase())] = argv[i + 1];
-  for (const required of ['daemon', 'cli', 'capture', 'mesh', 'webRoot', 'out'])
+  for (const required of ['daemon', 'subject', 'capture', 'mesh', 'webRoot', 'out'])
     if (!options[required]) throw new Error(`missing --${required}`);
   return options;
 }
@@ -34,9 +35,7 @@ async function main() {
   const out = path.join(options.out, `calibration_panel_${process.pid}`);
   fs.rmSync(out, { recursive: true, force: true });
   fs.mkdirSync(out, { recursive: true });
-  const subject = path.join(out, 'actor.sksubj');
-  const built = spawnSync(options.cli, ['build-subject', '--capture', options.capture, '--mesh', options.mesh, '--out', subject], { encoding: 'utf8' });
-  assert.equal(built.status, 0, built.stderr);
+  const subject = options.subject;
   const token = 'stage-token-calibrate-2026';
   const tokenFile = path.join(out, 'control-token');
   fs.writeFileSync(tokenFile, `${token}\n`, { mode: 0o600 });
