@@ -64,6 +64,7 @@ nlohmann::json latency_summaries(const Metrics& metrics) {
   add("encode", metrics.encode);
   add("encode_compressed", metrics.encode_compressed);
   add("receive_to_publish", metrics.receive_to_publish);
+  add("source_to_publish", metrics.source_to_publish);
   add("subscriber_queue_wait", metrics.subscriber_queue_wait);
   add("subscriber_write", metrics.subscriber_write);
   return out;

@@ -54,6 +54,7 @@ struct Arguments {
   std::string multicast_interface;  // NatNet: the interface multicast leaves by; empty: the system's
   std::string natnet_version = "4.1";
   double natnet_timestamp_jitter_us = 0.0;  // NatNet: a capture clock's jitter and resolution
+  double natnet_capture_latency_us = 0.0;   // NatNet: the latency the frames' stamps report
   double natnet_clock_hz = 0.0;
 };
 
@@ -177,6 +178,7 @@ int run_qtm_or_natnet(const Arguments& args) {
     options.start_on_first_request = !args.start_now;
     options.timestamp_jitter_us = args.natnet_timestamp_jitter_us;
     options.timestamp_clock_hz = args.natnet_clock_hz;
+    options.capture_latency_us = args.natnet_capture_latency_us;
     natnet = std::make_unique<server::NatNetServer>(io, recordings.subjects, options);
     natnet->start();
     port = natnet->command_port();
@@ -258,6 +260,11 @@ int main(int argc, char** argv) {
   app.add_option("--natnet-clock-hz", args.natnet_clock_hz,
                  "natnet: round each frame's timestamp to the ticks of a clock of this frequency (e.g. 10000000)")
       ->check(CLI::Range(1.0, 1e12));
+  app.add_option(
+         "--natnet-capture-latency-us", args.natnet_capture_latency_us,
+         "natnet: stamp each frame as transmitted this long after its cameras' mid-exposure (the capture "
+         "system's own latency, which the daemon adds to its source-to-publish latency)")
+      ->check(CLI::Range(0.0, 1e6));
   app.add_option("--multicast-ttl", args.multicast_ttl, "multicast TTL (hops)")
       ->check(CLI::Range(0, 255))
       ->capture_default_str();

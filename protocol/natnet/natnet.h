@@ -144,4 +144,9 @@ struct TimecodeFields {
 TimecodeFields split_timecode(uint32_t timecode);
 uint32_t join_timecode(const TimecodeFields& fields);
 
+// The frame's time from its cameras' mid-exposure to its transmission, as the server's clock
+// (ServerInfo's ticks per second) measured it, in ns; -1 when the stamps do not say (a server
+// that leaves them 0, or one that is not monotonic, or more than a second: not a latency).
+int64_t capture_latency_ns(const FrameOfData& frame, uint64_t clock_ticks_per_second);
+
 }  // namespace skinstream::natnet

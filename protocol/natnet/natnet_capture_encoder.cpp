@@ -91,7 +91,8 @@ const FrameOfData& CaptureEncoder::frame(uint64_t stream_index) {
   if (clock_.ticks_per_second > 0.0)
     frame_.timestamp_s = static_cast<double>(std::llround(frame_.timestamp_s * clock_.ticks_per_second)) / clock_.ticks_per_second;
   const auto ticks = static_cast<uint64_t>(std::llround(frame_.timestamp_s * 1e9));  // 1 GHz clock
-  frame_.stamp_mid_exposure = frame_.stamp_data_received = frame_.stamp_transmit = ticks;
+  frame_.stamp_mid_exposure = frame_.stamp_data_received = ticks;
+  frame_.stamp_transmit = ticks + static_cast<uint64_t>(std::llround(clock_.latency_s * 1e9));
   frame_.precise_seconds = static_cast<uint32_t>(frame_.timestamp_s);
   frame_.precise_fraction = static_cast<uint32_t>((frame_.timestamp_s - std::floor(frame_.timestamp_s)) * 4294967296.0);
   frame_.params = stream_index >= recording_first_ && stream_index < recording_end_ ? kFrameRecording : 0;

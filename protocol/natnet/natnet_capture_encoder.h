@@ -35,6 +35,8 @@ class CaptureEncoder {
     double jitter_s = 0.0;       // each timestamp moved by a uniform random offset in [-jitter, +jitter]
     double ticks_per_second = 0.0;  // > 0: then rounded to the ticks of a clock of this frequency
     uint32_t seed = 1;
+    double latency_s =
+        0.0;  // the transmit stamp this long after the mid-exposure stamp (the system's own latency)
   };
   void set_clock(const Clock& clock);
 

@@ -132,6 +132,16 @@ TimecodeFields split_timecode(uint32_t timecode) {
           static_cast<int>(timecode >> 8 & 0xFF), static_cast<int>(timecode & 0xFF)};
 }
 
+int64_t capture_latency_ns(const FrameOfData& frame, uint64_t clock_ticks_per_second) {
+  if (clock_ticks_per_second == 0 || frame.stamp_mid_exposure == 0 ||
+      frame.stamp_transmit < frame.stamp_mid_exposure)
+    return -1;
+  const uint64_t ticks = frame.stamp_transmit - frame.stamp_mid_exposure;
+  if (ticks > clock_ticks_per_second) return -1;
+  return static_cast<int64_t>(static_cast<long double>(ticks) * 1e9L /
+                              static_cast<long double>(clock_ticks_per_second));
+}
+
 uint32_t join_timecode(const TimecodeFields& f) {
   return static_cast<uint32_t>(f.hours & 0xFF) << 24 | static_cast<uint32_t>(f.minutes & 0xFF) << 16 |
          static_cast<uint32_t>(f.seconds & 0xFF) << 8 | static_cast<uint32_t>(f.frames & 0xFF);

@@ -18,6 +18,7 @@ struct MarkerFrame {
   uint32_t frame_number = 0;         // as the source numbers it
   int64_t source_time_ns = 0;        // capture time: the source's timecode or frame * period
   int64_t receive_time_ns = 0;       // wall clock (system_clock, ns since epoch) when complete
+  int64_t capture_latency_ns = -1;   // SourceFrame::capture_latency_ns
   double source_rate_hz = 0.0;       // from the source (StreamInfo frame period, file rate)
   SourceTimecode timecode;           // the source's SMPTE timecode, when it sends one
 

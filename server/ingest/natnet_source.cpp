@@ -272,6 +272,7 @@ struct NatNetSource::State : std::enable_shared_from_this<NatNetSource::State> {
     frame.capture_recording = (data.params & natnet::kFrameRecording) ? CaptureRecording::Recording
                                                                       : CaptureRecording::NotRecording;
     frame.source_time_ns = static_cast<int64_t>(std::llround(data.timestamp_s * 1e9));
+    frame.capture_latency_ns = natnet::capture_latency_ns(data, server_info.clock_ticks_per_second);
     const natnet::TimecodeFields tc = natnet::split_timecode(data.timecode);
     frame.timecode.valid = data.timecode != 0 || data.timecode_subframe != 0;
     frame.timecode.hours = static_cast<uint8_t>(tc.hours);

@@ -46,6 +46,9 @@ struct SourceFrame {
   uint32_t frame_number = 0;   // as the capture system's SDK reports it
   int64_t source_time_ns = 0;  // capture time (timecode, or frame x period)
   int64_t receive_time_ns = 0;  // wall clock (system_clock, ns since the epoch) when complete
+  // How long the capture system says the frame took from its cameras' exposure to leaving it
+  // (its own clock: NatNet's transmit minus mid-exposure stamps); -1 when it does not say.
+  int64_t capture_latency_ns = -1;
   double rate_hz = 0.0;         // the source's frame rate; 0 when not known yet
   SourceTimecode timecode;
   CaptureRecording capture_recording = CaptureRecording::Unknown;

@@ -172,6 +172,7 @@ void SubjectRouter::fill_labelled(Target& target, const SourceFrame& frame, Mark
   out.frame_number = frame.frame_number;
   out.source_time_ns = frame.source_time_ns;
   out.receive_time_ns = frame.receive_time_ns;
+  out.capture_latency_ns = frame.capture_latency_ns;
   out.source_rate_hz = frame.rate_hz;
   out.timecode = frame.timecode;
   for (size_t k = 0; k < target.slots.size(); ++k) {

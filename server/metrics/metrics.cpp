@@ -187,6 +187,11 @@ std::string render_prometheus(const Metrics& source, const std::vector<SubjectMe
   histogram("encode_compressed_seconds", "The compressed encoding's time per frame (vertex codec, after the other encodings were handed over).",
             &Metrics::encode_compressed);
   histogram("receive_to_publish_seconds", "From frame received to handed to the publishers.", &Metrics::receive_to_publish);
+  histogram("source_to_publish_seconds",
+            "From the cameras' exposure to handed to the publishers, where the capture system reports its "
+            "own latency "
+            "(NatNet): its latency plus receive_to_publish; the network between is not in it.",
+            &Metrics::source_to_publish);
   histogram("subscriber_queue_wait_seconds",
             "Per frame and subscriber: from published to its write starting (the subscriber's queue and its io thread's turn).",
             &Metrics::subscriber_queue_wait);

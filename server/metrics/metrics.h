@@ -87,6 +87,9 @@ class Metrics {
 
   // receive_to_take: waiting in the mailbox, the pipeline thread's wake-up included.
   LatencyHistogram receive_to_take, fill, deform, normals, encode, encode_compressed, receive_to_publish;
+  // Where the capture system says how long a frame took from its cameras to leaving it (NatNet's
+  // stamps): that plus receive_to_publish. The network between is not in it (no shared clock).
+  LatencyHistogram source_to_publish;
   // Delivery inside the daemon, per frame and subscriber: published -> its write starts (the
   // subscriber's queue and its io thread's turn), and write started -> the socket took the last
   // byte (a subscriber that reads slowly fills its socket buffers and lengthens this one).

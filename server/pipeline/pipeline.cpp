@@ -194,9 +194,14 @@ void Pipeline::process(const MarkerFrame& frame, uint64_t generation) {
   metrics_.markers_held.fetch_add(static_cast<uint64_t>(stats.held), std::memory_order_relaxed);
 
   const long sequence = sequence_++;
-  held_[static_cast<size_t>(sequence) % held_.size()] = {frame.frame_number, frame.source_time_ns, frame.receive_time_ns,
-                                                        clamp16(stats.filled + stats.held), clamp16(stats.relabelled),
-                                                        frame_timecode(frame.timecode), frame.timecode.valid};
+  held_[static_cast<size_t>(sequence) % held_.size()] = {frame.frame_number,
+                                                         frame.source_time_ns,
+                                                         frame.receive_time_ns,
+                                                         frame.capture_latency_ns,
+                                                         clamp16(stats.filled + stats.held),
+                                                         clamp16(stats.relabelled),
+                                                         frame_timecode(frame.timecode),
+                                                         frame.timecode.valid};
   long released = 0;
   if (blender_.push(filled_, filled_status_, sequence, {released_positions_, released_status_}, released, filled_revoked_))
     publish(held_[static_cast<size_t>(released) % held_.size()], released_positions_, released_status_);
@@ -399,7 +404,12 @@ void Pipeline::hand_over(FrameRef ref, const Released& meta, bool first) {
     metrics_.frames_published.fetch_add(1, std::memory_order_relaxed);
   }
   consumer_.publish(ref);
-  if (first && meta.receive_time_ns > 0) metrics_.receive_to_publish.observe_ns(wall_clock_ns() - meta.receive_time_ns);
+  if (first && meta.receive_time_ns > 0) {
+    const int64_t processing = wall_clock_ns() - meta.receive_time_ns;
+    metrics_.receive_to_publish.observe_ns(processing);
+    if (meta.capture_latency_ns >= 0)
+      metrics_.source_to_publish.observe_ns(meta.capture_latency_ns + processing);
+  }
 }
 
 }  // namespace skinstream::server

@@ -117,6 +117,7 @@ class Pipeline {
     uint32_t frame_number = 0;
     int64_t source_time_ns = 0;
     int64_t receive_time_ns = 0;
+    int64_t capture_latency_ns = -1;
     uint16_t filled = 0;
     uint16_t relabelled = 0;
     subscriber::FrameTimecode timecode;

@@ -555,6 +555,27 @@ TEST_F(DaemonProgram, NatNetTenMegahertzClockChangesNoRate) {
   expect_natnet_clock_changes_nothing(subject_, take_, "--natnet-clock-hz 10000000");
 }
 
+// A NatNet server whose frames say they left it 6 ms after their cameras' exposure: /health and
+// /metrics report the source-to-publish latency as that plus the daemon's own processing.
+TEST_F(DaemonProgram, NatNetsOwnLatencyIsInTheSourceToPublishLatency) {
+  ReplayProcess replay(take_, 0, "--protocol natnet --unicast --natnet-capture-latency-us 6000");
+  DaemonProcess daemon("--subject " + subject_ + " --natnet 127.0.0.1:" + std::to_string(replay.port));
+  const ProgramRun sub = run(std::string(SKINSTREAM_SUB) + " 127.0.0.1:" + std::to_string(daemon.sub_port) +
+                             " --markers --no-mesh --frames 240");
+  const nlohmann::json health = server::fetch_health(daemon.http_port);
+  const std::string metrics =
+      server::http_exchange("127.0.0.1", daemon.http_port,
+                            "GET /metrics HTTP/1.1\r\nHost: 127.0.0.1\r\nConnection: close\r\n\r\n")
+          .body;
+  EXPECT_EQ(daemon.stop(), 0) << daemon.log();
+  ASSERT_EQ(sub.exit_code, 0) << sub.output << daemon.log();
+  const nlohmann::json& latency = health["subjects"][0]["latency_ms"];
+  EXPECT_GE(latency["source_to_publish"]["count"].get<uint64_t>(), 200u) << latency.dump();
+  EXPECT_GE(latency["source_to_publish"]["p50_le"].get<double>(), 6.0) << latency.dump();
+  EXPECT_LT(latency["receive_to_publish"]["p50_le"].get<double>(), 6.0) << latency.dump();
+  EXPECT_NE(metrics.find("skinstream_source_to_publish_seconds_count"), std::string::npos);
+}
+
 // A capture server that answers the handshake, sends a few frames and then nothing with its
 // connection open (a QTM, Motive or Nexus whose stream stopped) was shown "streaming" at 120 Hz
 // while the frames stayed frozen: with the daemon's defaults it is "stalled" on /health, in the

@@ -28,7 +28,8 @@ struct NatNetServer::State : std::enable_shared_from_this<NatNetServer::State> {
         command_socket(io),
         timeline(io, encoder.rate_hz(), options.speed, static_cast<uint64_t>(encoder.frame_count()), options.loop) {
     receive_buffer.resize(natnet::kMaxMessageBytes);
-    encoder.set_clock({options.timestamp_jitter_us * 1e-6, options.timestamp_clock_hz});
+    encoder.set_clock({options.timestamp_jitter_us * 1e-6, options.timestamp_clock_hz, 1,
+                       options.capture_latency_us * 1e-6});
     encoder.set_recording_frames(options.recording_first, options.recording_end);
   }
 

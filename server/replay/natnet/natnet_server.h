@@ -56,6 +56,8 @@ struct NatNetServerOptions {
   // timestamp_clock_hz clock (protocol/natnet/natnet_capture_encoder.h).
   double timestamp_jitter_us = 0.0;
   double timestamp_clock_hz = 0.0;
+  // The latency the frames' stamps say the capture system had (transmit minus mid-exposure).
+  double capture_latency_us = 0.0;
   // Stream indices [first, end) flagged as recorded by Motive (frame params bit 0); none by default.
   uint64_t recording_first = 0, recording_end = 0;
 };

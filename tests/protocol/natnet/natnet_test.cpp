@@ -62,6 +62,22 @@ std::string error_of(const ByteVector& datagram, Version version) {
 
 void put_i32(ByteVector& bytes, size_t offset, int32_t value) { std::memcpy(bytes.data() + offset, &value, 4); }
 
+// Motive stamps each frame at its cameras' mid-exposure and as it transmits, in the ticks of the
+// clock ServerInfo names: their difference is the system's own latency.
+TEST(NatNet, TheCaptureLatencyIsTransmitMinusMidExposureInTheServersClock) {
+  FrameOfData frame;
+  frame.stamp_mid_exposure = 10'000'000;
+  frame.stamp_transmit = 10'045'000;  // 45,000 ticks of a 10 MHz clock: 4.5 ms
+  EXPECT_EQ(capture_latency_ns(frame, 10'000'000), 4'500'000);
+  EXPECT_EQ(capture_latency_ns(frame, 0), -1);  // no clock: nothing to say
+  frame.stamp_transmit = frame.stamp_mid_exposure - 1;
+  EXPECT_EQ(capture_latency_ns(frame, 10'000'000), -1);  // not monotonic
+  frame.stamp_transmit = frame.stamp_mid_exposure + 10'000'001;
+  EXPECT_EQ(capture_latency_ns(frame, 10'000'000), -1);  // over a second: no latency
+  frame.stamp_mid_exposure = frame.stamp_transmit = 0;
+  EXPECT_EQ(capture_latency_ns(frame, 10'000'000), -1);  // a server that leaves them 0
+}
+
 TEST(NatNet, KeepAliveAndRequestsAreSpelledOutByHand) {
   EXPECT_EQ(encode_empty(message::KeepAlive), (ByteVector{0x0A, 0x00, 0x00, 0x00}));  // u16 id 10, u16 0 bytes
   EXPECT_EQ(fixture("keep_alive.bin"), encode_empty(message::KeepAlive));
