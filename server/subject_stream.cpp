@@ -199,6 +199,7 @@ void SubjectStream::switch_input(Replacement& replacement) { input_ = &replaceme
 void SubjectStream::complete_replacement(std::shared_ptr<Replacement> next) {
   const std::shared_ptr<Replacement> old = served();
   old->pipeline->stop();  // its last frame published; nothing publishes until the new one starts
+  next->mailbox.add_counts_of(old->mailbox);
   Pipeline* pipeline = next->pipeline.get();
   if (multicast_ && next->model_message)
     multicast_->set_model(

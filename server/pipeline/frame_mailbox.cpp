@@ -67,6 +67,15 @@ uint64_t FrameMailbox::dropped() const {
   return dropped_waited_too_long_ + dropped_mailbox_full_;
 }
 
+void FrameMailbox::add_counts_of(const FrameMailbox& replaced) {
+  const uint64_t waited = replaced.dropped_waited_too_long(), full = replaced.dropped_mailbox_full(),
+                 posted = replaced.posted();
+  std::lock_guard lock(mutex_);
+  dropped_waited_too_long_ += waited;
+  dropped_mailbox_full_ += full;
+  posted_ += posted;
+}
+
 uint64_t FrameMailbox::dropped_waited_too_long() const {
   std::lock_guard lock(mutex_);
   return dropped_waited_too_long_;

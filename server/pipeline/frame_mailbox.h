@@ -61,6 +61,9 @@ class FrameMailbox {
   uint64_t dropped_mailbox_full() const;
   uint64_t posted() const;
   int waiting() const;  // posted and not yet taken
+  // The counts of the mailbox this one replaces (a subject swapped), added to its own, so that
+  // the subject's counters never go back.
+  void add_counts_of(const FrameMailbox& replaced);
 
  private:
   using Clock = std::chrono::steady_clock;

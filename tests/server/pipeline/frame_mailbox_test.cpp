@@ -97,6 +97,19 @@ TEST(FrameMailbox, BeyondItsCapacityTheOldestWaitingFramesGiveWay) {
   EXPECT_EQ(mailbox.dropped_waited_too_long(), 0u);
 }
 
+// A subject swapped: its new mailbox carries on the counts of the one it replaces.
+TEST(FrameMailbox, AReplacementAddsTheCountsOfTheMailboxItReplaces) {
+  FrameMailbox old(3, std::chrono::seconds(10), 3);
+  for (uint32_t n = 1; n <= 7; ++n) post_frame(old, n);
+  FrameMailbox next(3, std::chrono::seconds(10), 3);
+  for (uint32_t n = 8; n <= 12; ++n) post_frame(next, n);
+  next.add_counts_of(old);
+  EXPECT_EQ(next.dropped_mailbox_full(), 4u + 2u);
+  EXPECT_EQ(next.dropped(), 6u);
+  EXPECT_EQ(next.posted(), 12u);
+  EXPECT_EQ(take_all(next), (std::vector<uint32_t>{10, 11, 12}));
+}
+
 TEST(FrameMailbox, WaitLimitOfZeroIsNewestFrameWins) {
   FrameMailbox mailbox(3, std::chrono::nanoseconds(0), 32);
   post_frame(mailbox, 10);
