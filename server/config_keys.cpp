@@ -649,7 +649,7 @@ std::vector<ConfigKey> make_config_keys() {
             {.name = "subject_builder",
              .doc =
         "The program that builds a live calibration's subject (`PROGRAM build-subject ...`, run as a\n"
-        "separate process at the lowest priority). \"\" = the skinstream program beside skinstreamd."}),
+        "separate process at nice 10). \"\" = the skinstream program beside skinstreamd."}),
       bound(&DaemonConfig::log_level,
             {.name = "log_level", .flag = "--log-level", .new_group = true,
              .flag_help = "trace, debug, info, warn, error, critical, off",

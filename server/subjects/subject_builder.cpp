@@ -17,6 +17,11 @@
 namespace skinstream::server {
 namespace {
 
+// Below the daemon's frame threads (nice 0), which preempt it at once, level with the take
+// recorder. At nice 19 it starved beside a browser on both cores: a 3 s calibration's build took
+// 187 s instead of 4-17 s (docs/method-notes.md, "Swapping a subject between two frames").
+constexpr int kBuilderNice = 10;
+
 // The last non-empty line of a file, made printable and bounded: what a failed build said.
 std::string last_line_of(const std::filesystem::path& path) {
   std::ifstream in(path);
@@ -56,9 +61,9 @@ SubjectBuildResult build_subject(const SubjectBuildRequest& request, const std::
     return result;
   }
   if (pid == 0) {
-    // The child: never outlives the daemon, holds none of its sockets, runs at the lowest priority.
+    // The child: never outlives the daemon, holds none of its sockets, runs below the frame threads.
     prctl(PR_SET_PDEATHSIG, SIGKILL);
-    setpriority(PRIO_PROCESS, 0, 19);
+    setpriority(PRIO_PROCESS, 0, kBuilderNice);
     const int out = ::open(result.report.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
     const int err = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
     if (out < 0 || err < 0) _exit(126);

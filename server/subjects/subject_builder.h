@@ -1,6 +1,6 @@
 #pragma once
 // Builds a subject file from a range-of-motion take by running `skinstream build-subject` (the
-// real-actor fit, build and checks) as a separate process at the lowest priority, so that no
+// real-actor fit, build and checks) as a separate process at a low priority (nice 10), so that no
 // cost of the build ever lands on the daemon's threads and a build that crashes or hangs takes
 // nothing else with it. Its JSON report is kept beside the subject file; on failure the reason
 // is the builder's own last line.

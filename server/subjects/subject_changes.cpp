@@ -283,7 +283,7 @@ void SubjectChanges::build_and_swap(const std::shared_ptr<Entry>& entry, Capture
     return fail(*entry, std::string("cannot write the range of motion: ") + e.what());
   }
   update(*entry, [&](nlohmann::json& change) { change["capture"] = take.string(); });
-  spdlog::info("subject {}: calibration: {} frames recorded to {}; building {} at the lowest priority",
+  spdlog::info("subject {}: calibration: {} frames recorded to {}; building {} at a low priority (nice 10)",
                entry->name, capture.frame_count, take.string(), built.string());
   const SubjectBuildResult result =
       build_subject({options_.builder, take, built, mesh, options_.build_timeout}, cancel_);

@@ -2,7 +2,7 @@
 // A subject changed while the daemon serves it, without a restart and without its subscribers
 // reconnecting (docs/control-api.md): a live calibration (N seconds of the subject's range of
 // motion recorded from the stream, built into a subject file by `skinstream build-subject` in a
-// separate process at the lowest priority, with the real-actor checks), or another subject file.
+// separate process at a low priority, with the real-actor checks), or another subject file.
 // Either way the new subject file is read and checked as at start-up and swapped in between two
 // frames (SubjectStream's three steps); when anything fails, the served subject stays and the
 // reason is kept for /health and GET /subjects/NAME.

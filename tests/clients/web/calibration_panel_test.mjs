@@ -8,30 +8,13 @@
 // node calibration_panel_test.mjs --daemon skinstreamd --subject S --capture C3D --mesh OBJ --web-root DIR --out DIR
 // (S: a subject built from C3D with the mesh OBJ, the swap_subjects fixture's first)
 import assert from 'node:assert/strict';
-import { spawn } from 'node:child_process';
 import fs from 'node:fs';
 import path from 'node:path';
-import { launchChromium, sleep } from './support/browser.mjs';
-
-function parseArguments(argv) {
-  const options = { chromium: '/usr/bin/chromium' };
-  for (let i = 0; i + 1 < argv.length; i += 2) options[argv[i].replace(/^--/, '').replace(/-([a-z])/g, (_, c) => c.toUpperCase())] = argv[i + 1];
-  for (const required of ['daemon', 'subject', 'capture', 'mesh', 'webRoot', 'out'])
-    if (!options[required]) throw new Error(`missing --${required}`);
-  return options;
-}
-
-async function waitFor(what, check, timeoutMs = 30000) {
-  for (let waited = 0; waited < timeoutMs; waited += 100) {
-    const value = await check();
-    if (value) return value;
-    await sleep(100);
-  }
-  throw new Error(`${what} (after ${timeoutMs} ms)`);
-}
+import { launchChromium } from './support/browser.mjs';
+import { parseArguments, startDaemon, waitFor } from './support/test_run.mjs';
 
 async function main() {
-  const options = parseArguments(process.argv.slice(2));
+  const options = parseArguments(process.argv.slice(2), ['daemon', 'subject', 'capture', 'mesh', 'webRoot', 'out']);
   const out = path.join(options.out, `calibration_panel_${process.pid}`);
   fs.rmSync(out, { recursive: true, force: true });
   fs.mkdirSync(out, { recursive: true });
@@ -41,21 +24,12 @@ async function main() {
   fs.writeFileSync(tokenFile, `${token}\n`, { mode: 0o600 });
   const configFile = path.join(out, 'config.json');
   fs.writeFileSync(configFile, JSON.stringify({ calibration_dir: path.join(out, 'calibrations'), deform_threads: 1 }));
-  const portsFile = path.join(out, 'ports.json');
-  const logFile = path.join(out, 'skinstreamd.log');
-  const log = fs.openSync(logFile, 'w');
-  const daemon = spawn(options.daemon, [
-    '--config', configFile, '--subject', subject, '--replay', options.capture, '--loop', '--http-port', '0', '--sub-port', '0',
-    '--ports-file', portsFile, '--web-root', options.webRoot, '--control-token-file', tokenFile,
-  ], { stdio: ['ignore', log, log] });
-  for (const signal of ['SIGINT', 'SIGTERM']) process.on(signal, () => { daemon.kill('SIGKILL'); process.exit(1); });
+  const { daemon, ports } = await startDaemon(options.daemon, [
+    '--config', configFile, '--subject', subject, '--replay', options.capture, '--loop', '--web-root', options.webRoot, '--control-token-file', tokenFile,
+  ], out);
 
   let browser = null;
   try {
-    const ports = await waitFor('skinstreamd wrote no ports file', () => {
-      if (daemon.exitCode !== null) throw new Error(`skinstreamd exited: ${fs.readFileSync(logFile, 'utf8').slice(-2000)}`);
-      try { return JSON.parse(fs.readFileSync(portsFile, 'utf8')); } catch { return null; }
-    }, 60000);
     browser = await launchChromium(options.chromium);
     const page = await browser.newPage({ viewport: { width: 800, height: 600 } });
     const pageErrors = [];

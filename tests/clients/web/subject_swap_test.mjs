@@ -10,32 +10,15 @@
 // node subject_swap_test.mjs --daemon BIN --first FILE --second FILE --recording C3D
 //                            --web-root DIR --out DIR [--chromium /usr/bin/chromium]
 import assert from 'node:assert/strict';
-import { spawn } from 'node:child_process';
 import fs from 'node:fs';
 import path from 'node:path';
 import { launchChromium, waitUntil, sleep, readDrawnFrame } from './support/browser.mjs';
+import { parseArguments, startDaemon, waitFor } from './support/test_run.mjs';
 import { worstDistance } from './support/comparisons.mjs';
 import { ReferenceSubscriber } from './support/reference_subscriber.mjs';
 
 const NAME = 'body';
 const TOKEN = 'swap-page-token-0123456789';
-
-function parseArguments(argv) {
-  const options = { chromium: '/usr/bin/chromium' };
-  for (let i = 0; i + 1 < argv.length; i += 2) options[argv[i].replace(/^--/, '').replace(/-([a-z])/g, (_, c) => c.toUpperCase())] = argv[i + 1];
-  for (const required of ['daemon', 'first', 'second', 'recording', 'webRoot', 'out'])
-    if (!options[required]) throw new Error(`missing --${required.replace(/[A-Z]/g, (c) => `-${c.toLowerCase()}`)}`);
-  return options;
-}
-
-async function waitFor(what, check, timeoutMs = 30000) {
-  for (let waited = 0; waited < timeoutMs; waited += 100) {
-    const value = await check();
-    if (value) return value;
-    await sleep(100);
-  }
-  throw new Error(`${what} (after ${timeoutMs} ms)`);
-}
 
 async function control(port, method, route, body) {
   const response = await fetch(`http://127.0.0.1:${port}${route}`, {
@@ -120,30 +103,22 @@ async function expectCarriesOn(page, before, what) {
 }
 
 async function main() {
-  const options = parseArguments(process.argv.slice(2));
+  const options = parseArguments(process.argv.slice(2), ['daemon', 'first', 'second', 'recording', 'webRoot', 'out']);
   const out = path.join(options.out, `subject_swap_${process.pid}`);
   fs.rmSync(out, { recursive: true, force: true });
   fs.mkdirSync(out, { recursive: true });
   const tokenFile = path.join(out, 'control-token');
   fs.writeFileSync(tokenFile, `${TOKEN}\n`, { mode: 0o600 });
-  const portsFile = path.join(out, 'ports.json');
-  const logFile = path.join(out, 'skinstreamd.log');
-  const log = fs.openSync(logFile, 'w');
   // Half speed: the page on SwiftShader draws a fraction of the frames either way.
-  const daemon = spawn(options.daemon, [
+  const { daemon, ports } = await startDaemon(options.daemon, [
     '--subject', `${NAME}=${options.first}`, '--replay', options.recording, '--replay-subject', NAME, '--loop', '--speed', '0.5',
-    '--http-port', '0', '--sub-port', '0', '--ports-file', portsFile, '--web-root', options.webRoot,
+    '--web-root', options.webRoot,
     '--control-token-file', tokenFile,
-  ], { stdio: ['ignore', log, log] });
-  for (const signal of ['SIGINT', 'SIGTERM']) process.on(signal, () => { daemon.kill('SIGKILL'); process.exit(1); });
+  ], out);
 
   let browser = null;
   let reference = null;
   try {
-    const ports = await waitFor('skinstreamd wrote no ports file', () => {
-      if (daemon.exitCode !== null) throw new Error(`skinstreamd exited: ${fs.readFileSync(logFile, 'utf8').slice(-2000)}`);
-      try { return JSON.parse(fs.readFileSync(portsFile, 'utf8')); } catch { return null; }
-    }, 60000);
     phase('daemon listening');
     browser = await launchChromium(options.chromium);
     const pageErrors = [];
@@ -197,7 +172,6 @@ async function main() {
     if (reference) reference.close();
     if (browser) await browser.close();
     daemon.kill('SIGTERM');
-    fs.closeSync(log);
   }
 }
 

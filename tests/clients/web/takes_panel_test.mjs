@@ -6,30 +6,13 @@
 //
 // node takes_panel_test.mjs --daemon skinstreamd --subject S --recording R --web-root DIR --out DIR
 import assert from 'node:assert/strict';
-import { spawn } from 'node:child_process';
 import fs from 'node:fs';
 import path from 'node:path';
-import { launchChromium, sleep } from './support/browser.mjs';
-
-function parseArguments(argv) {
-  const options = { chromium: '/usr/bin/chromium' };
-  for (let i = 0; i + 1 < argv.length; i += 2) options[argv[i].replace(/^--/, '').replace(/-([a-z])/g, (_, c) => c.toUpperCase())] = argv[i + 1];
-  for (const required of ['daemon', 'subject', 'recording', 'webRoot', 'out'])
-    if (!options[required]) throw new Error(`missing --${required}`);
-  return options;
-}
-
-async function waitFor(what, check, timeoutMs = 30000) {
-  for (let waited = 0; waited < timeoutMs; waited += 100) {
-    const value = await check();
-    if (value) return value;
-    await sleep(100);
-  }
-  throw new Error(`${what} (after ${timeoutMs} ms)`);
-}
+import { launchChromium } from './support/browser.mjs';
+import { parseArguments, startDaemon, waitFor } from './support/test_run.mjs';
 
 async function main() {
-  const options = parseArguments(process.argv.slice(2));
+  const options = parseArguments(process.argv.slice(2), ['daemon', 'subject', 'recording', 'webRoot', 'out']);
   const out = path.join(options.out, `takes_panel_${process.pid}`);
   fs.rmSync(out, { recursive: true, force: true });
   fs.mkdirSync(out, { recursive: true });
@@ -37,21 +20,12 @@ async function main() {
   const token = 'stage-token-vmpw-2026';  // v, m, p, w: the toggles' keys
   const tokenFile = path.join(out, 'control-token');
   fs.writeFileSync(tokenFile, `${token}\n`, { mode: 0o600 });
-  const portsFile = path.join(out, 'ports.json');
-  const logFile = path.join(out, 'skinstreamd.log');
-  const log = fs.openSync(logFile, 'w');
-  const daemon = spawn(options.daemon, [
-    '--subject', options.subject, '--replay', options.recording, '--loop', '--http-port', '0', '--sub-port', '0',
-    '--ports-file', portsFile, '--web-root', options.webRoot, '--record-dir', takes, '--control-token-file', tokenFile,
-  ], { stdio: ['ignore', log, log] });
-  for (const signal of ['SIGINT', 'SIGTERM']) process.on(signal, () => { daemon.kill('SIGKILL'); process.exit(1); });
+  const { daemon, ports, log } = await startDaemon(options.daemon, [
+    '--subject', options.subject, '--replay', options.recording, '--loop', '--web-root', options.webRoot, '--record-dir', takes, '--control-token-file', tokenFile,
+  ], out);
 
   let browser = null;
   try {
-    const ports = await waitFor('skinstreamd wrote no ports file', () => {
-      if (daemon.exitCode !== null) throw new Error(`skinstreamd exited: ${fs.readFileSync(logFile, 'utf8').slice(-2000)}`);
-      try { return JSON.parse(fs.readFileSync(portsFile, 'utf8')); } catch { return null; }
-    }, 60000);
     browser = await launchChromium(options.chromium);
     const page = await browser.newPage({ viewport: { width: 800, height: 600 } });
     const pageErrors = [];
@@ -87,7 +61,7 @@ async function main() {
     assert.equal(sidecar.started_by, 'control from 127.0.0.1 (web page)');
     assert.ok(sidecar.subjects[0].raw.frames >= 60, `${sidecar.subjects[0].raw.frames} frames recorded`);
     assert.deepEqual(pageErrors, [], 'errors on the page');
-    assert.equal(fs.readFileSync(logFile, 'utf8').includes(token), false, 'the token reached the log');
+    assert.equal(log().includes(token), false, 'the token reached the log');
     console.log(`take page-take: ${sidecar.subjects[0].raw.frames} frames, started by ${sidecar.started_by}`);
   } finally {
     if (browser) await browser.close();
