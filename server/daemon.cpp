@@ -208,6 +208,7 @@ Daemon::Daemon(const DaemonConfig& config)
                       config.subscriber_unsent_kb * 1024});
   HttpRoutes routes;
   routes.stream_admission = admission_;
+  routes.stream_hub = [this]() -> SubscriberHub& { return subject(0).hub(); };
   routes.health_json = [this] { return health_json(); };
   routes.metrics_text = [this] { return metrics_text(); };
   routes.web_root = config.web_root;
@@ -221,9 +222,10 @@ Daemon::Daemon(const DaemonConfig& config)
   if (!config.web_root.empty() && !std::filesystem::is_directory(config.web_root))
     throw FileError(config.web_root, "web root is not a directory");
   // Out of descriptors, the HTTP port spends the reserve: /health answers while subscribers hold the rest.
-  http_ = std::make_unique<HttpServer>(io_, config.bind_address, config.http_port, subject(0).hub(), std::move(routes),
-                                       ListenerOptions{config.subscriber_tcp_congestion, &source_metrics_, &descriptor_reserve_, true,
-                                                       config.subscriber_unsent_kb * 1024});
+  http_ = std::make_unique<HttpServer>(
+      io_, config.bind_address, config.http_port, std::move(routes),
+      ListenerOptions{config.subscriber_tcp_congestion, &source_metrics_, &descriptor_reserve_, true,
+                      config.subscriber_unsent_kb * 1024});
 }
 
 Daemon::~Daemon() { stop(); }

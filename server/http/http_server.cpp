@@ -30,11 +30,10 @@ std::string remote_of(const tcp::socket& socket) {
 // One HTTP connection: requests one after another (keep-alive) until it upgrades or closes.
 class HttpSession : public std::enable_shared_from_this<HttpSession> {
  public:
-  HttpSession(asio::io_context& io, tcp::socket socket, SubscriberHub& hub,
-              std::shared_ptr<const HttpRoutes> routes, std::shared_ptr<ControlRateLimit> control_rate_limit)
+  HttpSession(asio::io_context& io, tcp::socket socket, std::shared_ptr<const HttpRoutes> routes,
+              std::shared_ptr<ControlRateLimit> control_rate_limit)
       : io_(io),
         stream_(std::move(socket)),
-        hub_(hub),
         routes_(std::move(routes)),
         control_rate_limit_(std::move(control_rate_limit)) {}
 
@@ -100,9 +99,10 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
     stream_.expires_never();
     tcp::socket socket = stream_.release_socket();
     const std::string remote = remote_of(socket);
-    auto subscriber = std::make_shared<WebSocketSubscriber>(io_, hub_, std::move(socket), remote);
+    SubscriberHub& hub = routes_->stream_hub();
+    auto subscriber = std::make_shared<WebSocketSubscriber>(io_, hub, std::move(socket), remote);
     subscriber->set_admission(std::move(decision), std::move(authenticate), peer.address());
-    hub_.add(subscriber);
+    hub.add(subscriber);
     subscriber->accept(std::move(request_));
   }
 
@@ -222,13 +222,14 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
   beast::flat_buffer buffer_;
   http::request<http::string_body> request_;
   std::shared_ptr<http::response<http::string_body>> response_;
-  SubscriberHub& hub_;
   std::shared_ptr<const HttpRoutes> routes_;
   std::shared_ptr<ControlRateLimit> control_rate_limit_;
 };
 
 // The routes as the sessions read them: the control API's counters made when the daemon gave none.
 std::shared_ptr<const HttpRoutes> checked_routes(HttpRoutes routes) {
+  if (!routes.stream_hub)
+    throw std::invalid_argument("the HTTP routes need the subscribers' hub (stream_hub)");
   if (routes.control && routes.control_token.empty())
     throw std::invalid_argument("the control API needs a token (control_token_file)");
   if (!routes.control_counters) routes.control_counters = std::make_shared<ControlCounters>();
@@ -237,17 +238,15 @@ std::shared_ptr<const HttpRoutes> checked_routes(HttpRoutes routes) {
 
 }  // namespace
 
-HttpServer::HttpServer(asio::io_context& io, const std::string& address, int port, SubscriberHub& hub,
-                       HttpRoutes routes, ListenerOptions listening)
+HttpServer::HttpServer(asio::io_context& io, const std::string& address, int port, HttpRoutes routes,
+                       ListenerOptions listening)
     : io_(io),
-      hub_(hub),
       routes_(checked_routes(std::move(routes))),
       control_rate_limit_(std::make_shared<ControlRateLimit>(routes_->control_rate_limit)),
       listener_(
           io, address, port, "HTTP port",
           [this](tcp::socket socket) {
-            std::make_shared<HttpSession>(io_, std::move(socket), hub_, routes_, control_rate_limit_)
-                ->read_next();
+            std::make_shared<HttpSession>(io_, std::move(socket), routes_, control_rate_limit_)->read_next();
           },
           std::move(listening)) {}
 

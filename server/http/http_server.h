@@ -18,6 +18,9 @@
 namespace skinstream::server {
 
 struct HttpRoutes {
+  // The io thread, for each WebSocket subscriber: the hub it starts in (the first subject's; its
+  // Hello may name another). Subjects come and go at run time, so it is asked each time.
+  std::function<SubscriberHub&()> stream_hub;
   std::function<std::string()> health_json;
   std::function<std::string()> metrics_text;
   std::filesystem::path web_root;  // empty: no static files
@@ -36,7 +39,8 @@ class HttpServer {
  public:
   // `listening.tcp_congestion`: set on every connection, so WebSocket subscribers get it.
   // Throws std::invalid_argument for a control API without a token.
-  HttpServer(asio::io_context& io, const std::string& address, int port, SubscriberHub& hub, HttpRoutes routes,
+  // Throws std::invalid_argument for routes without a stream_hub.
+  HttpServer(asio::io_context& io, const std::string& address, int port, HttpRoutes routes,
              ListenerOptions listening = {});
   void start() { listener_.start(); }
   void stop() { listener_.stop(); }
@@ -45,7 +49,6 @@ class HttpServer {
 
  private:
   asio::io_context& io_;
-  SubscriberHub& hub_;
   std::shared_ptr<const HttpRoutes> routes_;
   std::shared_ptr<ControlRateLimit> control_rate_limit_;
   Listener listener_;

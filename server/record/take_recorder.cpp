@@ -17,6 +17,7 @@
 #include "protocol/files/c3d_take_writer.h"
 #include "protocol/files/file_error.h"
 #include "protocol/files/whole_file.h"
+#include "server/file_naming.h"
 #include "server/record/frame_table.h"
 #include "server/record/unlabelled_slots.h"
 #include "server/thread_name.h"
@@ -29,19 +30,6 @@ constexpr size_t kMaxListedTakes = 100;
 constexpr std::chrono::milliseconds kDrainInterval{50};
 // The writer is a background job: it yields the CPU to the stream's threads.
 constexpr int kRecorderNice = 10;
-
-std::string utc_text(std::chrono::system_clock::time_point when, const char* format) {
-  const std::time_t t = std::chrono::system_clock::to_time_t(when);
-  std::tm parts{};
-  gmtime_r(&t, &parts);
-  char text[64];
-  std::strftime(text, sizeof text, format, &parts);
-  return text;
-}
-
-std::string iso_utc(std::chrono::system_clock::time_point when) {
-  return utc_text(when, "%Y-%m-%dT%H:%M:%SZ");
-}
 
 std::string sha256_of_file(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
@@ -63,14 +51,6 @@ std::string sha256_of_file(const std::string& path) {
 }
 
 // A subject's name as a file name: what is not a letter, digit, '-', '_' or '.' becomes '_'.
-std::string file_stem_of(const std::string& subject) {
-  std::string stem;
-  for (char c : subject.substr(0, kMaxTakeName))
-    stem += std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_' || c == '.' ? c : '_';
-  if (stem.empty() || stem.front() == '.') stem.insert(stem.begin(), 's');
-  return stem;
-}
-
 char status_letter(uint8_t status) {
   switch (static_cast<MarkerStatus>(status)) {
     case MarkerStatus::Measured:

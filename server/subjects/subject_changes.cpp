@@ -6,10 +6,10 @@
 
 #include <algorithm>
 #include <cmath>
-#include <ctime>
 
 #include "protocol/files/capture_file.h"
 #include "protocol/printable_text.h"
+#include "server/file_naming.h"
 #include "server/record/take_recorder.h"
 #include "server/subject_stream.h"
 #include "server/subjects/subject_builder.h"
@@ -18,25 +18,8 @@
 namespace skinstream::server {
 namespace {
 
-// Below the stream's threads, above the recorder's (nice 10 too: a swap waits for it).
+// Below the stream's threads, level with the take recorder: a swap's load and check run here.
 constexpr int kChangesNice = 10;
-
-std::string utc_now(const char* format) {
-  const std::time_t now = std::time(nullptr);
-  std::tm tm{};
-  gmtime_r(&now, &tm);
-  char text[64];
-  std::strftime(text, sizeof text, format, &tm);
-  return text;
-}
-
-// A subject's name made safe for a file name.
-std::string file_stem_of(const std::string& name) {
-  std::string out;
-  for (const char c : name)
-    out += std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_' ? c : '_';
-  return out.empty() ? "subject" : out;
-}
 
 // A source subject's name as a route's segment carries it.
 bool valid_subject_name(const std::string& name) {
@@ -95,7 +78,7 @@ ControlAnswer SubjectChanges::begin(Entry& entry, const std::string& kind, const
   details["kind"] = kind;
   details["state"] = state;
   details["who"] = who;
-  details["started"] = utc_now("%Y-%m-%dT%H:%M:%SZ");
+  details["started"] = iso_utc(std::chrono::system_clock::now());
   details["started_steady_ns"] = std::chrono::steady_clock::now().time_since_epoch().count();
   entry.change = std::move(details);
   nlohmann::json shown = entry.change;
@@ -274,7 +257,8 @@ void SubjectChanges::run() {
 
 void SubjectChanges::build_and_swap(const std::shared_ptr<Entry>& entry, Capture capture, std::string mesh) {
   const std::filesystem::path base =
-      options_.dir / (file_stem_of(entry->name) + "-" + utc_now("%Y%m%d-%H%M%S"));
+      options_.dir /
+      (file_stem_of(entry->name) + "-" + utc_text(std::chrono::system_clock::now(), "%Y%m%d-%H%M%S"));
   const std::filesystem::path take = base.string() + ".rom.c3d", built = base.string() + ".sksubj";
   try {
     std::filesystem::create_directories(options_.dir);
@@ -334,7 +318,7 @@ void SubjectChanges::swap_in(const std::shared_ptr<Entry>& entry, const std::str
     change["vertices"] = subject.vertex_count();
     change["seconds_in_all"] = seconds_since(std::chrono::steady_clock::time_point(
         std::chrono::steady_clock::duration(change.value("started_steady_ns", int64_t{0}))));
-    change["finished"] = utc_now("%Y-%m-%dT%H:%M:%SZ");
+    change["finished"] = iso_utc(std::chrono::system_clock::now());
   });
   spdlog::info(
       "subject {}: now served from {} (loaded in {:.2f} s, swapped between two frames in {:.1f} ms); its "
@@ -363,7 +347,7 @@ void SubjectChanges::add_subject(const std::shared_ptr<Entry>& entry, const std:
     change["load_seconds"] = load_seconds;
     change["markers"] = subject->model().marker_count();
     change["vertices"] = subject->vertex_count();
-    change["finished"] = utc_now("%Y-%m-%dT%H:%M:%SZ");
+    change["finished"] = iso_utc(std::chrono::system_clock::now());
   });
   spdlog::info("subject {}: added from {} ({} markers, {} vertices, loaded in {:.2f} s)", entry->name, file,
                subject->model().marker_count(), subject->vertex_count(), load_seconds);
@@ -379,7 +363,7 @@ void SubjectChanges::fail(Entry& entry, const std::string& reason) {
   update(entry, [&](nlohmann::json& change) {
     change["state"] = "failed";
     change["reason"] = reason;
-    change["finished"] = utc_now("%Y-%m-%dT%H:%M:%SZ");
+    change["finished"] = iso_utc(std::chrono::system_clock::now());
     kind = change.value("kind", "change");
   });
   spdlog::error("subject {}: {} failed, the subjects served stay as they were: {}", entry.name, kind, reason);

@@ -12,6 +12,8 @@
 #include <thread>
 
 #include "protocol/files/capture_file.h"
+#include "protocol/subscriber/subscriber_stream.h"
+#include "server/beast.h"
 #include "server/client/health_probe.h"
 #include "support/program_processes.h"
 #include "support/program_run.h"
@@ -349,6 +351,55 @@ TEST_F(DaemonSubjectChanges, ASubjectAddedAndRemovedAtRunTimeWhileTheOtherMisses
   ASSERT_EQ(health["subjects"].size(), 1u);
   EXPECT_EQ(health["subjects"][0]["name"], "Actor1");
   EXPECT_EQ(health["subjects"][0]["frames"]["dropped"], 0);
+}
+
+// The first subject removed: a subscriber that names none now gets the next one (the subscriber
+// port and the WebSocket path both start a subscriber in the first subject's hub, asked anew at
+// each connection), and the removed one's subscriber is told.
+TEST_F(DaemonSubjectChanges, WhenTheFirstSubjectIsRemovedTheNextOneIsTheDefault) {
+  ReplayProcess replay(replay_arguments(), 0, "--subject Actor1 --subject Actor2");
+  DaemonProcess daemon(daemon_arguments(replay.port));
+  ProgramRun leaving;
+  std::thread stays([&] { leaving = test::run_program(sub(daemon) + "--no-mesh"); });
+  std::this_thread::sleep_for(std::chrono::seconds(1));
+  const ProgramRun removed = test::run_program(ctl(daemon) + "subject remove Actor1", false);
+  stays.join();
+  const ProgramRun unnamed = test::run_program(sub(daemon) + "--markers --frames 60", false);
+  // Over WebSocket, a Hello naming no subject: Actor2's MeshInfo.
+  std::string websocket_subject;
+  {
+    namespace beast = server::beast;
+    namespace websocket = server::websocket;
+    server::asio::io_context io;
+    websocket::stream<beast::tcp_stream> ws(io);
+    beast::get_lowest_layer(ws).connect(server::tcp::endpoint(server::asio::ip::make_address("127.0.0.1"),
+                                                              static_cast<unsigned short>(daemon.http_port)));
+    ws.handshake("127.0.0.1", "/stream");
+    ws.binary(true);
+    subscriber::Hello hello;
+    hello.version = subscriber::kVersion2;
+    hello.wants = subscriber::kWantMarkers | subscriber::kWantNoMesh;
+    ws.write(server::asio::buffer(subscriber::encode_hello(hello)));
+    for (int message = 0; message < 10 && websocket_subject.empty(); ++message) {
+      beast::flat_buffer buffer;
+      ws.read(buffer);
+      const std::span<const unsigned char> bytes(static_cast<const unsigned char*>(buffer.cdata().data()),
+                                                 buffer.size());
+      const subscriber::MessageHeader header = subscriber::decode_header(bytes);
+      if (header.type == subscriber::MessageType::MeshInfo)
+        websocket_subject =
+            subscriber::decode_mesh_info(bytes.subspan(subscriber::kHeaderBytes), header.version).subject;
+    }
+  }
+  EXPECT_EQ(daemon.stop(), 0) << daemon.log();
+  EXPECT_EQ(websocket_subject, "Actor2");
+
+  ASSERT_EQ(removed.exit_code, 0) << removed.output << daemon.log();
+  EXPECT_EQ(leaving.exit_code, 1);
+  EXPECT_NE(leaving.output.find("subject Actor1 was removed from this daemon"), std::string::npos)
+      << leaving.output;
+  ASSERT_EQ(unnamed.exit_code, 0) << unnamed.output.substr(0, 2000) << daemon.log();
+  test::expect_frames_follow_recording(read_capture(take_b_), test::frames_of(unnamed.output), -kApartMm);
 }
 
 }  // namespace

@@ -127,7 +127,8 @@ class HttpServerControl : public ::testing::Test {
                                    .max_addresses = 16};
     }
     server = io_thread.call([&] {
-      auto made = std::make_unique<HttpServer>(io_thread.io, "127.0.0.1", 0, hub, std::move(routes));
+      routes.stream_hub = [this]() -> SubscriberHub& { return hub; };
+      auto made = std::make_unique<HttpServer>(io_thread.io, "127.0.0.1", 0, std::move(routes));
       made->start();
       return made;
     });
@@ -275,7 +276,8 @@ TEST_F(HttpServerControl, AFloodOfWrongTokensIsRateLimitedEvenForTheRightOne) {
 TEST_F(HttpServerControl, AControlApiWithoutATokenIsRefusedAtConstruction) {
   HttpRoutes routes;
   routes.control = actions;
-  EXPECT_THROW(HttpServer(io_thread.io, "127.0.0.1", 0, hub, std::move(routes)), std::invalid_argument);
+  routes.stream_hub = [&]() -> SubscriberHub& { return hub; };
+  EXPECT_THROW(HttpServer(io_thread.io, "127.0.0.1", 0, std::move(routes)), std::invalid_argument);
 }
 
 // skinstream-ctl, the real program, beside this test's program in the build's bin/.
