@@ -1,9 +1,9 @@
 #pragma once
 // skinstreamd put together: wiring and lifecycle. The subjects (each a SubjectStream: its
 // mailbox, pipeline thread, subscribers, metrics and status), the source (a recording, Vicon
-// DataStream over TCP or multicast, QTM RT or NatNet) and the SubjectRouter that gives each subject its part of every source frame, the
-// publishers (TCP subscriber port, HTTP port with /stream, /health, /metrics, the control API
-// and static files), the take recorder, and the subjects' changes at run time (SubjectChanges:
+// DataStream over TCP or multicast, QTM RT or NatNet) and the SubjectRouter that gives each subject its part
+// of every source frame, the publishers (TCP subscriber port, HTTP port with /stream, /health, /metrics, the
+// control API and static files), the take recorder, and the subjects' changes at run time (SubjectChanges:
 // live calibration, swaps, subjects added and removed) and the 1 Hz Status. One io thread runs
 // the source, the routing, HTTP, the WebSocket subscribers and the timers; the TCP subscribers
 // are written by the publish threads.

@@ -11,14 +11,18 @@ if(TARGET skinstreamd AND TARGET skinstream_client)
   target_compile_definitions(client_library_tests PRIVATE
     SKINSTREAMD="$<TARGET_FILE:skinstreamd>"
     SKINSTREAM_DEMO_DIR="${CMAKE_BINARY_DIR}/demo"
+    SKINSTREAM_SWAP_SUBJECTS_DIR="${CMAKE_BINARY_DIR}/test_tmp/swap_subjects"
     SKINSTREAM_SHARED_DIR="${SKINSTREAM_SHARED_DIR}"
     SKINSTREAM_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
     SKINSTREAM_TEST_TMP_DIR="${CMAKE_BINARY_DIR}/test_tmp/client_library")
   add_dependencies(client_library_tests skinstreamd)
-  gtest_discover_tests(client_library_tests TEST_FILTER "-ClientSubscriberDemo.*:EvaluatorCDemo.*:MulticastDemo.*:MulticastKeyDemo.*" DISCOVERY_TIMEOUT 60
+  gtest_discover_tests(client_library_tests TEST_FILTER "-ClientSubscriberDemo.*:EvaluatorCDemo.*:MulticastDemo.*:MulticastKeyDemo.*:MulticastSwap.*" DISCOVERY_TIMEOUT 60
     PROPERTIES LABELS clients TIMEOUT ${time_limit_120})
   # MulticastDemo needs root and iproute2 (network namespaces on a bridge); without them it is
   # skipped with the reason.
   gtest_discover_tests(client_library_tests TEST_FILTER "ClientSubscriberDemo.*:EvaluatorCDemo.*:MulticastDemo.*:MulticastKeyDemo.*" DISCOVERY_TIMEOUT 60
     PROPERTIES LABELS clients TIMEOUT ${time_limit_300} FIXTURES_REQUIRED demo_subject)
+  # Two subject files of one body (tests/support/make_swap_subjects.sh), swapped under a multicast receiver.
+  gtest_discover_tests(client_library_tests TEST_FILTER "MulticastSwap.*" DISCOVERY_TIMEOUT 60
+    PROPERTIES LABELS clients TIMEOUT ${time_limit_300} FIXTURES_REQUIRED swap_subjects)
 endif()

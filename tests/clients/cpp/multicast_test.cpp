@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 #include <netinet/in.h>
 #include <sys/socket.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -20,6 +21,7 @@
 
 #include "protocol/subscriber/multicast_datagram.h"
 #include "server/client/daemon_process.h"
+#include "server/client/health_probe.h"
 #include "skinstream/client.h"
 #include "support/bridged_namespaces.h"
 #include "support/client_frames.h"
@@ -506,6 +508,94 @@ TEST_F(MulticastDemo, OnlyFramesOfAnotherModelMakeTheReceiverFetchTheModelAgain)
   EXPECT_EQ(stats.frames_completed, stats.frames_other_model);
   std::printf("%llu frames of another Model skipped, the Model fetched again %llu times\n",
               static_cast<unsigned long long>(stats.frames_other_model), static_cast<unsigned long long>(stats.model_fetches));
+}
+
+// A subject swapped while receivers take its parameters by multicast (the operator's
+// POST /subjects/NAME/file): the sender stamps the new model's id, the receiver fetches the new
+// Model over TCP and evaluates the frames after it with it. Two fits of one body to two CMU takes
+// (tests/support/make_swap_subjects.sh), a CMU take replayed at half speed.
+TEST(MulticastSwap, AReceiverFetchesTheNewModelWhenTheSubjectIsSwapped) {
+  const std::string skip = test::BridgedNamespaces::unavailable_reason();
+  if (!skip.empty()) GTEST_SKIP() << skip;
+  test::BridgedNamespaces lan(3);
+  const std::string swap_dir = SKINSTREAM_SWAP_SUBJECTS_DIR;
+  const std::string token = "multicast-swap-token-0123456789";
+  const std::string token_file = test::scratch_path("multicast_swap_token_" + std::to_string(getpid()));
+  std::ofstream(token_file) << token << "\n";
+  ASSERT_EQ(chmod(token_file.c_str(), 0600), 0);
+  server::DaemonLaunch launch;
+  launch.program = SKINSTREAMD;
+  launch.arguments = "--subject body=" + swap_dir + "/first.sksubj --replay " +
+                     test::source_path("replay_data/cmu/85_02.c3d") +
+                     " --replay-subject body --loop --speed 0.5 --multicast " + kGroup + ":" +
+                     std::to_string(kGroupPort) + " --multicast-interface " + lan.address(0) +
+                     " --control-token-file " + token_file;
+  launch.exec_prefix = lan.exec_prefix(0);
+  launch.bind = "0.0.0.0";
+  launch.files_stem = test::scratch_path("multicast_swap_daemon_" + std::to_string(getpid()));
+  server::DaemonProcess daemon(launch);
+
+  std::atomic<bool> swapped{false};
+  client::MulticastStats before, after;
+  uint64_t frames_after = 0, meshes = 0;
+  std::string error;
+  std::thread receiver([&] {
+    try {
+      lan.enter(2);
+      client::Options options;
+      options.host = lan.address(0);
+      options.port = static_cast<uint16_t>(daemon.sub_port());
+      options.connect_timeout = std::chrono::seconds(10);
+      options.multicast = {kGroup, kGroupPort, lan.address(2), 0, std::chrono::milliseconds(50)};
+      client::Subscriber sub(options);
+      client::Frame frame;
+      const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+      while (!swapped.load() && std::chrono::steady_clock::now() < give_up)
+        sub.next(frame, std::chrono::milliseconds(200));
+      before = sub.multicast_stats();
+      for (const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(3);
+           std::chrono::steady_clock::now() < end;)
+        if (sub.next(frame, std::chrono::milliseconds(200))) ++frames_after;
+      after = sub.multicast_stats();
+      meshes = sub.meshes_received();
+    } catch (const std::exception& e) {
+      error = e.what();
+    }
+  });
+  std::string swap_answer;
+  std::thread operator_([&] {
+    lan.enter(1);
+    std::this_thread::sleep_for(std::chrono::seconds(2));
+    const std::string body = R"({"file": ")" + swap_dir + R"(/second.sksubj"})";
+    const std::string post =
+        "POST /subjects/body/file HTTP/1.1\r\nHost: x\r\nAuthorization: Bearer " + token +
+        "\r\nContent-Type: application/json\r\nContent-Length: " + std::to_string(body.size()) +
+        "\r\nConnection: close\r\n\r\n" + body;
+    swap_answer = server::http_exchange(lan.address(0), daemon.http_port(), post).body;
+    for (int i = 0; i < 100; ++i) {
+      const std::string get = "GET /subjects/body HTTP/1.1\r\nHost: x\r\nAuthorization: Bearer " + token +
+                              "\r\nConnection: close\r\n\r\n";
+      swap_answer = server::http_exchange(lan.address(0), daemon.http_port(), get).body;
+      if (swap_answer.find("\"done\"") != std::string::npos ||
+          swap_answer.find("\"failed\"") != std::string::npos)
+        break;
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    }
+    swapped = true;
+  });
+  operator_.join();
+  receiver.join();
+  EXPECT_EQ(daemon.stop(), 0) << daemon.log();
+  ASSERT_EQ(error, "");
+  EXPECT_NE(swap_answer.find("\"state\":\"done\""), std::string::npos) << swap_answer;
+  EXPECT_GT(before.frames_completed, 0u);
+  EXPECT_GE(after.model_fetches, before.model_fetches + 1) << "the receiver kept the old Model";
+  EXPECT_GT(frames_after, 30u);
+  EXPECT_GE(meshes, 2u);
+  std::printf(
+      "multicast across a swap: %llu frames after it, the Model fetched again %llu times, %llu MeshInfos\n",
+      static_cast<unsigned long long>(frames_after), static_cast<unsigned long long>(after.model_fetches),
+      static_cast<unsigned long long>(meshes));
 }
 
 // The daemon signs its datagrams (--multicast-key-file); a receiver with the key takes none of
