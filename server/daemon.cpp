@@ -558,8 +558,7 @@ std::string Daemon::health_json() const {
   nlohmann::json subjects = nlohmann::json::array();
   size_t subscribers = 0;
   uint64_t dropped_write_stall = 0;
-  for (size_t k = 0; k < subjects_.size(); ++k) {
-    const auto& s = subjects_[k];
+  for (const auto& s : subjects_) {
     subjects.push_back(s->health());
     subjects.back()["change"] = changes_ ? changes_->health(s->name()) : nlohmann::json();
     subscribers += subjects.back()["subscribers"].get<size_t>();

@@ -79,11 +79,9 @@ ControlAnswer SubjectChanges::begin(Entry& entry, const std::string& kind, const
   details["state"] = state;
   details["who"] = who;
   details["started"] = iso_utc(std::chrono::system_clock::now());
-  details["started_steady_ns"] = std::chrono::steady_clock::now().time_since_epoch().count();
   entry.change = std::move(details);
-  nlohmann::json shown = entry.change;
-  shown.erase("started_steady_ns");
-  return {202, shown};
+  entry.change_started = std::chrono::steady_clock::now();
+  return {202, entry.change};
 }
 
 namespace {
@@ -205,9 +203,7 @@ nlohmann::json SubjectChanges::health(const std::string& name) const {
   const std::shared_ptr<Entry> entry = find(name);
   if (!entry) return nullptr;
   std::lock_guard lock(mutex_);
-  nlohmann::json change = entry->change;
-  if (change.is_object()) change.erase("started_steady_ns");
-  return change;
+  return entry->change;
 }
 
 void SubjectChanges::capture_frame(const SubjectStream& subject, const MarkerFrame& frame) {
@@ -316,8 +312,7 @@ void SubjectChanges::swap_in(const std::shared_ptr<Entry>& entry, const std::str
     change["swap_ms"] = swap_ms;
     change["markers"] = SubjectStream::model_of(*replacement).marker_count();
     change["vertices"] = subject.vertex_count();
-    change["seconds_in_all"] = seconds_since(std::chrono::steady_clock::time_point(
-        std::chrono::steady_clock::duration(change.value("started_steady_ns", int64_t{0}))));
+    change["seconds_in_all"] = seconds_since(entry->change_started);
     change["finished"] = iso_utc(std::chrono::system_clock::now());
   });
   spdlog::info(

@@ -95,7 +95,8 @@ class SubjectChanges {
     SubjectStream* stream = nullptr;
     std::unique_ptr<CalibrationCapture> capture;  // io thread: while a calibration records
     std::string capture_mesh;
-    nlohmann::json change;  // under mutex_: the last change (null when none)
+    nlohmann::json change;                                 // under mutex_: the last change (null when none)
+    std::chrono::steady_clock::time_point change_started;  // under mutex_: when it was asked for
   };
   std::shared_ptr<Entry> find(const std::string& name) const;
   // 409 when a change of `entry` is under way; else a new change in state `state`.

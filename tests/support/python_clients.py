@@ -3,6 +3,7 @@ the programs, demo subject, scratch folder and C++ client library ctest hands th
 environment (by hand: the build tree's)."""
 import os
 import sys
+import time
 
 TESTS = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SOURCE = os.path.dirname(TESTS)
@@ -16,6 +17,16 @@ FIXTURES = os.path.join(TESTS, 'protocol', 'fixtures', 'subscriber')
 # The package finds libskinstream_client by this variable (skinstream/client_library.py).
 CLIENT_LIBRARY = os.environ.setdefault('SKINSTREAM_CLIENT_LIBRARY',
                                        os.path.join(SOURCE, 'build', 'clients', 'cpp', 'libskinstream_client.so.0'))
+
+
+def wait_until(condition, seconds=60):
+    """Polls `condition` every 20 ms: True once it holds, False after `seconds`."""
+    deadline = time.monotonic() + seconds
+    while not condition():
+        if time.monotonic() > deadline:
+            return False
+        time.sleep(0.02)
+    return True
 
 
 def demo_daemon(*extra, port=0, speed='0.2'):

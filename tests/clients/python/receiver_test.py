@@ -8,18 +8,9 @@ import time
 import unittest
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', '..'))
-from support.python_clients import SCRATCH, demo_daemon  # noqa: E402
+from support.python_clients import SCRATCH, demo_daemon, wait_until  # noqa: E402
 import numpy as np  # noqa: E402
 import skinstream  # noqa: E402
-
-
-def wait_until(condition, seconds=60):
-    deadline = time.monotonic() + seconds
-    while not condition():
-        if time.monotonic() > deadline:
-            return False
-        time.sleep(0.02)
-    return True
 
 
 class Receiver(unittest.TestCase):

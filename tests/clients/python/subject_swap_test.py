@@ -6,11 +6,10 @@ the new subject's frames, rejecting none and never reconnecting."""
 import os
 import sys
 import threading
-import time
 import unittest
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', '..'))
-from support.python_clients import SWAP_SUBJECT, swap_daemon, swap_subject_file, swap_subjects  # noqa: E402
+from support.python_clients import SWAP_SUBJECT, swap_daemon, swap_subject_file, swap_subjects, wait_until  # noqa: E402
 import numpy as np  # noqa: E402
 import skinstream  # noqa: E402
 
@@ -44,15 +43,6 @@ class Collector:
         self._stop.set()
         self._thread.join()
         self.subscriber.close()
-
-
-def wait_until(condition, seconds=60):
-    deadline = time.monotonic() + seconds
-    while not condition():
-        if time.monotonic() > deadline:
-            return False
-        time.sleep(0.02)
-    return True
 
 
 class SubjectSwap(unittest.TestCase):
