@@ -84,6 +84,7 @@ const char* to_string(MessageType type) {
     case MessageType::Frame: return "Frame";
     case MessageType::Status: return "Status";
     case MessageType::Model: return "Model";
+    case MessageType::Packed: return "Packed";
   }
   return "unknown";
 }
@@ -324,7 +325,7 @@ MessageHeader decode_header(std::span<const unsigned char> bytes, uint32_t max_p
   if (magic != kMagic) throw DecodeError("bad magic (not a skinstream subscriber stream)");
   if (version != kVersion1 && version != kVersion2)
     throw DecodeError("unsupported protocol version " + std::to_string(version) + " (this side speaks 1 and 2)");
-  const uint16_t last_type = version >= kVersion2 ? 6 : 5;
+  const uint16_t last_type = version >= kVersion2 ? 7 : 5;
   if (type < 1 || type > last_type)
     throw DecodeError("unknown message type " + std::to_string(type) + " in version " + std::to_string(version));
   if (payload > max_payload)
