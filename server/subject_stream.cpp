@@ -4,6 +4,7 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <cstring>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
@@ -82,6 +83,7 @@ struct SubjectStream::Replacement {
   std::unique_ptr<Pipeline> pipeline;
   subscriber::MeshInfo mesh_info;
   ControlMessage model_message;  // null without a mesh
+  SubscriberHub::PackedFirstContact packed;
   uint32_t epoch = 0;
   std::chrono::steady_clock::time_point retired;
 };
@@ -130,6 +132,8 @@ SubjectStream::SubjectStream(SubjectConfig config, const SubjectStreamOptions& o
                                .request = [pipeline](StreamKey key) { pipeline->request_encoding(key); },
                                .activated = [pipeline](StreamKey key) { pipeline->encoding_activated(key); }});
   hub_->set_compressed_order(pipeline->compressed_order());
+  pack_first_contact(*body);
+  hub_->set_packed_first_contact(body->packed);
   if (body->model_message) {
     hub_->set_model_message(body->model_message);
     const EvaluationModel& evaluation = *pipeline->evaluation_model();
@@ -170,6 +174,25 @@ void SubjectStream::make_pipeline(Replacement& body, uint32_t epoch) {
         std::make_shared<const std::vector<unsigned char>>(subscriber::encode_model(*evaluation));
 }
 
+void SubjectStream::pack_first_contact(Replacement& body) {
+  const auto start = std::chrono::steady_clock::now();
+  body.packed =
+      hub_->pack_first_contact(body.mesh_info, body.pipeline->compressed_order(), body.model_message);
+  // A Packed message's size, and the plain message's it holds (header included).
+  size_t packed = 0, plain = 0;
+  for (const ControlMessage& m :
+       {body.packed.mesh_info[static_cast<size_t>(subscriber::Encoding::Parameters)], body.packed.model}) {
+    if (!m) continue;
+    uint32_t unpacked;
+    std::memcpy(&unpacked, m->data() + subscriber::kHeaderBytes + 4, sizeof unpacked);
+    packed += m->size();
+    plain += subscriber::kHeaderBytes + unpacked;
+  }
+  spdlog::info(
+      "subject {}: what a parameter subscriber is sent as it joins, packed in {:.2f} s: {} bytes (plain {})",
+      name_, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), packed, plain);
+}
+
 std::shared_ptr<SubjectStream::Replacement> SubjectStream::prepare_replacement(const std::string& file) {
   auto body = std::make_shared<Replacement>(file, read_served_subject(file, name_), options_.max_frame_wait);
   if (body->subject.deformation.has_value() != has_mesh())
@@ -179,6 +202,7 @@ std::shared_ptr<SubjectStream::Replacement> SubjectStream::prepare_replacement(c
                               : "refused: it has a deformation model, and subject " + name_ +
                                     " is served as markers only (restart the daemon to serve a mesh)");
   make_pipeline(*body, last_epoch_.fetch_add(1) + 1);
+  pack_first_contact(*body);
   // The buffers of every encoding its subscribers receive, made here: its first frames would
   // otherwise make them on its thread.
   hub_->wanted_encodings().for_each([&](StreamKey key) { body->pipeline->prepare_encoding(key); });
@@ -210,7 +234,8 @@ void SubjectStream::complete_replacement(std::shared_ptr<Replacement> next) {
                        {.ready = [pipeline](StreamKey key) { return pipeline->encoding_ready(key); },
                         .request = [pipeline](StreamKey key) { pipeline->request_encoding(key); },
                         .activated = [pipeline](StreamKey key) { pipeline->encoding_activated(key); }},
-                       next->epoch});
+                       next->epoch,
+                       next->packed});
   pipeline->set_filled_observer(take_tap_);
   pipeline->start();
   old->retired = std::chrono::steady_clock::now();

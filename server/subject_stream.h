@@ -109,6 +109,8 @@ class SubjectStream {
  private:
   // The pipeline for `subject` (its models in `body`), publishing to consumer_.
   void make_pipeline(Replacement& body, uint32_t epoch);
+  // The body's MeshInfo and Model packed for joiners (SubscriberHub::PackedFirstContact).
+  void pack_first_contact(Replacement& body);
   std::shared_ptr<Replacement> served() const;
 
   SubjectConfig config_;  // its file: under mutex_ (a swap changes it)

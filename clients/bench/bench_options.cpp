@@ -25,6 +25,9 @@ std::optional<int> parse_bench_options(int argc, char** argv, BenchOptions& o) {
                "subscribers decode each frame (and evaluate parameters) as a renderer would; off, they read the bytes and the "
                "header only, so this machine's CPU goes to the daemon");
   app.add_flag("--paced", o.paced, "subscribers acknowledge each frame (at most 2 in flight)");
+  app.add_flag("--plain-first-contact", o.plain_first_contact,
+               "subscribers ask for MeshInfo and the Model plain, as clients before the Packed message did "
+               "(default: packed)");
   app.add_option("--link-mbit", o.link_mbit,
                  "run the daemon in a network namespace behind a veth pair shaped by tc to this rate (Mbit/s, both ways); needs root "
                  "and iproute2")

@@ -27,6 +27,7 @@ struct BenchOptions {
   bool normals = false;
   bool decode = false;  // decode (and evaluate) each frame as a renderer would, on this machine's CPU
   bool paced = false;
+  bool plain_first_contact = false;  // MeshInfo and the Model asked for plain, not packed
   // The daemon's threads and sockets (unset: its defaults).
   int deform_threads = 2;
   std::string deform_cpus;

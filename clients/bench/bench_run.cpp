@@ -78,6 +78,7 @@ void subscribe(const BenchOptions& o, const std::string& host, int port, int ind
   options.encoding = o.encoding;
   options.normals = o.normals;
   options.paced = o.paced;
+  options.packed = !o.plain_first_contact;
   options.decode = o.decode;
   options.evaluate = o.decode;
   options.subject = subscriber_subject(index, o.subjects);
@@ -440,7 +441,8 @@ nlohmann::json run_bench(const BenchOptions& o, const std::atomic<bool>& stop) {
        {{"normals", o.normals},
         {"quantised", o.encoding == client::Encoding::Quantised},
         {"decode", o.decode},
-        {"paced", o.paced}}},
+        {"paced", o.paced},
+        {"packed_first_contact", !o.plain_first_contact}}},
       {"seconds_until_every_subscriber_had_a_frame", seconds_to_first_frames},
       {"deform_threads", o.deform_threads},
       {"deform", health["deform"]},  // as the daemon applied it: threads, CPUs pinned to, spin lead

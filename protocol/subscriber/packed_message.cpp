@@ -50,7 +50,8 @@ void uncode_array(std::span<unsigned char> bytes) {
   std::vector<uint32_t> values(count);
   for (size_t i = 0; i < count; ++i) {
     uint32_t v = 0;
-    for (size_t plane = 0; plane < 4; ++plane) v |= static_cast<uint32_t>(bytes[plane * count + i]) << (8 * plane);
+    for (size_t plane = 0; plane < 4; ++plane)
+      v |= static_cast<uint32_t>(bytes[plane * count + i]) << (8 * plane);
     values[i] = i >= 3 ? v + values[i - 3] : v;
   }
   if (count > 0) std::memcpy(bytes.data(), values.data(), count * 4);
@@ -58,13 +59,18 @@ void uncode_array(std::span<unsigned char> bytes) {
 
 }  // namespace
 
-std::vector<unsigned char> encode_packed(MessageType type, std::span<const unsigned char> payload, int level) {
+std::vector<unsigned char> encode_packed(MessageType type, std::span<const unsigned char> payload,
+                                         int level) {
   const std::optional<Layout> layout = layout_of(type);
-  if (!layout) throw std::invalid_argument(std::string("encode_packed: a ") + to_string(type) + " is not packed");
-  if (payload.size() < layout->head_bytes) throw std::invalid_argument("encode_packed: payload shorter than its counts");
+  if (!layout)
+    throw std::invalid_argument(std::string("encode_packed: a ") + to_string(type) + " is not packed");
+  if (payload.size() < layout->head_bytes)
+    throw std::invalid_argument("encode_packed: payload shorter than its counts");
   const size_t array_bytes = size_t{12} * u32_at(payload.data() + layout->count_offset);
-  std::vector<unsigned char> rest(payload.begin() + static_cast<std::ptrdiff_t>(layout->head_bytes), payload.end());
-  if (array_bytes > rest.size()) throw std::invalid_argument(std::string("encode_packed: its ") + layout->count_name + " does not fit");
+  std::vector<unsigned char> rest(payload.begin() + static_cast<std::ptrdiff_t>(layout->head_bytes),
+                                  payload.end());
+  if (array_bytes > rest.size())
+    throw std::invalid_argument(std::string("encode_packed: its ") + layout->count_name + " does not fit");
   code_array(std::span(rest).first(array_bytes));
 
   uLongf stream_bytes = compressBound(static_cast<uLong>(rest.size()));
@@ -80,7 +86,8 @@ std::vector<unsigned char> encode_packed(MessageType type, std::span<const unsig
   if (compress2(stream, &stream_bytes, rest.data(), static_cast<uLong>(rest.size()), level) != Z_OK)
     throw std::invalid_argument("encode_packed: zlib could not deflate it");
   out.resize(static_cast<size_t>(stream - out.data()) + stream_bytes);
-  write_header(MessageType::Packed, kVersion2, out.size() - kHeaderBytes, std::span(out).first<kHeaderBytes>());
+  write_header(MessageType::Packed, kVersion2, out.size() - kHeaderBytes,
+               std::span(out).first<kHeaderBytes>());
   return out;
 }
 
@@ -91,10 +98,13 @@ Unpacked decode_packed(std::span<const unsigned char> payload, uint32_t max_payl
   const uint32_t unpacked_bytes = r.get<uint32_t>("unpacked size");
   if (!r.ok()) throw DecodeError("Packed: " + r.error().message());
   const std::optional<Layout> layout = layout_of(static_cast<MessageType>(packed_type));
-  if (!layout) throw DecodeError("Packed: holds a message of type " + std::to_string(packed_type) + " (only MeshInfo and Model are packed)");
+  if (!layout)
+    throw DecodeError("Packed: holds a message of type " + std::to_string(packed_type) +
+                      " (only MeshInfo and Model are packed)");
   if (reserved != 0) throw DecodeError("Packed: reserved field is " + std::to_string(reserved) + ", not 0");
   if (unpacked_bytes > max_payload)
-    throw DecodeError("Packed: unpacked size " + std::to_string(unpacked_bytes) + " over the limit of " + std::to_string(max_payload));
+    throw DecodeError("Packed: unpacked size " + std::to_string(unpacked_bytes) + " over the limit of " +
+                      std::to_string(max_payload));
   const std::span<const unsigned char> head = r.take(layout->head_bytes, "packed head");
   if (!r.ok()) throw DecodeError("Packed: " + r.error().message());
   if (unpacked_bytes < layout->head_bytes)
@@ -102,11 +112,13 @@ Unpacked decode_packed(std::span<const unsigned char> payload, uint32_t max_payl
   const size_t rest_bytes = unpacked_bytes - layout->head_bytes;
   const size_t stream_bytes = r.remaining();
   if (rest_bytes > stream_bytes * kMostInflatedPerByte + 64)
-    throw DecodeError("Packed: " + std::to_string(stream_bytes) + " deflated bytes cannot make " + std::to_string(rest_bytes));
+    throw DecodeError("Packed: " + std::to_string(stream_bytes) + " deflated bytes cannot make " +
+                      std::to_string(rest_bytes));
   const size_t array_bytes = size_t{12} * u32_at(head.data() + layout->count_offset);
   if (array_bytes > rest_bytes)
-    throw DecodeError(std::string("Packed: its ") + layout->count_name + " needs " + std::to_string(array_bytes) +
-                      " bytes, the unpacked size leaves " + std::to_string(rest_bytes));
+    throw DecodeError(std::string("Packed: its ") + layout->count_name + " needs " +
+                      std::to_string(array_bytes) + " bytes, the unpacked size leaves " +
+                      std::to_string(rest_bytes));
 
   Unpacked out{static_cast<MessageType>(packed_type), std::vector<unsigned char>(unpacked_bytes)};
   std::memcpy(out.payload.data(), head.data(), head.size());
@@ -121,24 +133,27 @@ Unpacked decode_packed(std::span<const unsigned char> payload, uint32_t max_payl
   inflateEnd(&z);
   if (result != Z_STREAM_END)
     throw DecodeError(std::string("Packed: the deflated stream ") +
-                      (result == Z_BUF_ERROR ? "makes more than the unpacked size " + std::to_string(rest_bytes) +
-                                                   " or ends early (" + std::to_string(made) + " bytes made)"
-                                             : std::string("is corrupt (") + (z.msg ? z.msg : "zlib error") + ")"));
+                      (result == Z_BUF_ERROR
+                           ? "makes more than the unpacked size " + std::to_string(rest_bytes) +
+                                 " or ends early (" + std::to_string(made) + " bytes made)"
+                           : std::string("is corrupt (") + (z.msg ? z.msg : "zlib error") + ")"));
   if (made != rest_bytes)
-    throw DecodeError("Packed: the deflated stream makes " + std::to_string(made) + " bytes, the unpacked size says " +
-                      std::to_string(rest_bytes));
+    throw DecodeError("Packed: the deflated stream makes " + std::to_string(made) +
+                      " bytes, the unpacked size says " + std::to_string(rest_bytes));
   if (left != 0) throw DecodeError("Packed: " + std::to_string(left) + " bytes after the deflated stream");
   uncode_array(std::span(out.payload).subspan(layout->head_bytes, array_bytes));
   return out;
 }
 
 void set_packed_source_rate(std::span<unsigned char> packed_mesh_info, float rate_hz) {
-  if (packed_mesh_info.size() < kPackedSourceRateOffset + 4) throw std::invalid_argument("set_packed_source_rate: not a packed MeshInfo");
+  if (packed_mesh_info.size() < kPackedSourceRateOffset + 4)
+    throw std::invalid_argument("set_packed_source_rate: not a packed MeshInfo");
   std::memcpy(packed_mesh_info.data() + kPackedSourceRateOffset, &rate_hz, 4);
 }
 
 float packed_source_rate(std::span<const unsigned char> packed_mesh_info) {
-  if (packed_mesh_info.size() < kPackedSourceRateOffset + 4) throw std::invalid_argument("packed_source_rate: not a packed MeshInfo");
+  if (packed_mesh_info.size() < kPackedSourceRateOffset + 4)
+    throw std::invalid_argument("packed_source_rate: not a packed MeshInfo");
   float rate;
   std::memcpy(&rate, packed_mesh_info.data() + kPackedSourceRateOffset, 4);
   return rate;

@@ -33,7 +33,8 @@ inline constexpr size_t kPackedSourceRateOffset = kHeaderBytes + kPackedFieldsBy
 // The whole Packed message (header included, version 2) of a MeshInfo or Model payload (without
 // its header). `level`: zlib's, 1-9. Throws std::invalid_argument for another type or a payload
 // shorter than its counts say.
-std::vector<unsigned char> encode_packed(MessageType type, std::span<const unsigned char> payload, int level = 6);
+std::vector<unsigned char> encode_packed(MessageType type, std::span<const unsigned char> payload,
+                                         int level = 6);
 
 struct Unpacked {
   MessageType type = MessageType::MeshInfo;

@@ -84,7 +84,8 @@ const char* to_string(MessageType type) {
     case MessageType::Frame: return "Frame";
     case MessageType::Status: return "Status";
     case MessageType::Model: return "Model";
-    case MessageType::Packed: return "Packed";
+    case MessageType::Packed:
+      return "Packed";
   }
   return "unknown";
 }

@@ -28,7 +28,15 @@ inline constexpr size_t kHeaderBytes = 12;
 inline constexpr uint32_t kMaxPayloadBytes = 64u << 20;
 
 // Packed (version 2 only): a MeshInfo or Model deflated (protocol/subscriber/packed_message.h).
-enum class MessageType : uint16_t { Hello = 1, MeshInfo = 2, Frame = 3, Status = 4, Ack = 5, Model = 6, Packed = 7 };
+enum class MessageType : uint16_t {
+  Hello = 1,
+  MeshInfo = 2,
+  Frame = 3,
+  Status = 4,
+  Ack = 5,
+  Model = 6,
+  Packed = 7
+};
 const char* to_string(MessageType type);
 
 // Hello "wants" bits.
@@ -45,7 +53,8 @@ inline constexpr uint32_t kWantAll = 0x1F;
 // Version 2 only. Packed: the subscriber reads MeshInfo and Model as Packed messages, about 2.9
 // times fewer bytes when it joins (the daemon may still send them plain).
 inline constexpr uint32_t kWantPacked = 1u << 5;
-inline constexpr uint32_t kWantAllVersion2 = (kWantAll & ~kWantQuantised) | kWantPacked;  // version 2 says the encoding apart
+inline constexpr uint32_t kWantAllVersion2 =
+    (kWantAll & ~kWantQuantised) | kWantPacked;  // version 2 says the encoding apart
 
 // Version 2: how positions are sent (Hello.encoding, MeshInfo.encoding, Status.encoding).
 enum class Encoding : uint32_t { Float = 0, Quantised = 1, Compressed = 2, Parameters = 3 };

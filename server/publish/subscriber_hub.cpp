@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "protocol/subscriber/packed_message.h"
 #include "server/publish/subscriber_session.h"
 
 namespace skinstream::server {
@@ -107,6 +108,7 @@ void SubscriberHub::replace_model(ModelReplacement replacement) {
     mesh_info_ = std::move(replacement.mesh_info);
     for (ControlMessage& m : mesh_info_messages_) m.reset();
     model_message_ = std::move(replacement.model);
+    packed_ = std::move(replacement.packed);
     compressed_order_ = std::move(replacement.compressed_order);
     model_epoch_ = replacement.epoch;
   }
@@ -175,12 +177,39 @@ void SubscriberHub::set_model_message(ControlMessage model) {
   model_message_ = std::move(model);
 }
 
-ControlMessage SubscriberHub::model_message() const {
+ControlMessage SubscriberHub::model_message(bool packed) const {
   std::lock_guard lock(mesh_info_mutex_);
-  return model_message_;
+  return packed && packed_.model ? packed_.model : model_message_;
 }
 
-ControlMessage SubscriberHub::mesh_info_message(StreamKey key, uint32_t* epoch) {
+SubscriberHub::PackedFirstContact SubscriberHub::pack_first_contact(
+    subscriber::MeshInfo info, const std::vector<uint32_t>& compressed_order,
+    const ControlMessage& model) const {
+  auto payload_of = [](const std::vector<unsigned char>& message) {
+    return std::span<const unsigned char>(message).subspan(subscriber::kHeaderBytes);
+  };
+  PackedFirstContact packed;
+  info.subject = subject_;
+  for (uint32_t e = 0; e < subscriber::kEncodingCount; ++e) {
+    info.encoding = static_cast<subscriber::Encoding>(e);
+    info.compressed_order =
+        info.encoding == subscriber::Encoding::Compressed ? compressed_order : std::vector<uint32_t>{};
+    packed.mesh_info[e] = std::make_shared<const std::vector<unsigned char>>(
+        subscriber::encode_packed(subscriber::MessageType::MeshInfo,
+                                  payload_of(subscriber::encode_mesh_info(info, subscriber::kVersion2))));
+  }
+  if (model)
+    packed.model = std::make_shared<const std::vector<unsigned char>>(
+        subscriber::encode_packed(subscriber::MessageType::Model, payload_of(*model)));
+  return packed;
+}
+
+void SubscriberHub::set_packed_first_contact(PackedFirstContact packed) {
+  std::lock_guard lock(mesh_info_mutex_);
+  packed_ = std::move(packed);
+}
+
+ControlMessage SubscriberHub::mesh_info_message(StreamKey key, uint32_t* epoch, bool packed) {
   // What MeshInfo describes: whether positions come, and in version 2 their encoding; not
   // normals, markers or pacing. Keys that differ only in those share one message, so a
   // subscriber whose new Hello changes only them is not sent the 1.35 MB again.
@@ -189,6 +218,17 @@ ControlMessage SubscriberHub::mesh_info_message(StreamKey key, uint32_t* epoch) 
   const StreamKey described = stream_key(stream_flags(key) & described_flags, stream_version(key));
   std::lock_guard lock(mesh_info_mutex_);
   if (epoch) *epoch = model_epoch_;
+  const bool positions = (stream_flags(described) & subscriber::kFrameNoPositions) == 0;
+  if (packed && positions && stream_version(key) >= subscriber::kVersion2)
+    if (ControlMessage& message = packed_.mesh_info[static_cast<size_t>(encoding_of(described))]) {
+      // The source rate is outside the deflated stream: a copy with the new one (0.3 MB).
+      if (subscriber::packed_source_rate(*message) != mesh_info_.source_rate_hz) {
+        auto copy = std::make_shared<std::vector<unsigned char>>(*message);
+        subscriber::set_packed_source_rate(*copy, mesh_info_.source_rate_hz);
+        message = std::move(copy);
+      }
+      return message;
+    }
   ControlMessage& cached = mesh_info_messages_[described % kStreamKeys];
   if (!cached) {
     subscriber::MeshInfo info = mesh_info_;

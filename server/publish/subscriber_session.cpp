@@ -134,6 +134,7 @@ void SubscriberSession::on_hello(const subscriber::Hello& hello) {
     admission_ = std::move(admitted.ticket);
   }
   paced_ = (hello.wants & subscriber::kWantPaced) != 0;
+  packed_ = hello.version >= subscriber::kVersion2 && (hello.wants & subscriber::kWantPacked) != 0;
   // Version 2: the encoding asked for, or what can be served instead, and why.
   std::string notice;
   uint32_t flags = subscriber::frame_flags_for(hello.wants, hub_->has_mesh());
@@ -176,14 +177,15 @@ void SubscriberSession::send_model(StreamKey key) {
   // Sent again only when what it describes changed (MeshInfo is 1.35 MB for the 53,500-vertex
   // body; a Hello that changes normals or markers must not cost that), the Model once a model.
   uint32_t epoch = 0;
-  if (ControlMessage mesh_info = hub_->mesh_info_message(key, &epoch); mesh_info != mesh_info_sent_) {
+  if (ControlMessage mesh_info = hub_->mesh_info_message(key, &epoch, packed_);
+      mesh_info != mesh_info_sent_) {
     offer_control(mesh_info);
     mesh_info_sent_ = std::move(mesh_info);
   }
   if (epoch != model_epoch_) model_sent_ = false;
   model_epoch_ = epoch;
   if (stream_flags(key) & subscriber::kFrameParameters)
-    if (ControlMessage model = hub_->model_message(); model && !model_sent_) {
+    if (ControlMessage model = hub_->model_message(packed_); model && !model_sent_) {
       offer_control(std::move(model));
       model_sent_ = true;
     }

@@ -112,6 +112,7 @@ class SubscriberSession : public std::enable_shared_from_this<SubscriberSession>
   bool writing_ = false;
   bool close_after_write_ = false;  // refused: close once the Status is written
   bool paced_ = false;  // Hello asked for kWantPaced
+  bool packed_ = false;   // version 2's Hello asked for kWantPacked: MeshInfo and Model go packed
   uint16_t version_ = 0;  // of the first Hello; 0 before it
   ControlMessage mesh_info_sent_;  // the last MeshInfo queued for it
   bool model_sent_ = false;

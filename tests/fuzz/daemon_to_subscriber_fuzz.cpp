@@ -1,15 +1,16 @@
-// What the daemon sends a subscriber (MeshInfo, Model, Frame, Status; Hello and Ack too), in
+// What the daemon sends a subscriber (MeshInfo, Model, Frame, Status, Packed; Hello and Ack too), in
 // versions 1 and 2, as a renderer reads it: the whole input as one message through decode_header
 // and the decoder of its type and version, and as a stream through the StreamDecoder. Only
 // DecodeError may be thrown, with a one-line reason; view_frame, decode_frame_info and
-// decode_frame accept the same frames and agree on their FrameInfo, and a decoded Model
-// validates.
+// decode_frame accept the same frames and agree on their FrameInfo, a decoded Model
+// validates, and what a Packed message holds goes through its own type's decoder.
 #include <algorithm>
 #include <cstdlib>
 #include <cstring>
 #include <optional>
 
 #include "fuzz/one_line_file_error.h"
+#include "protocol/subscriber/packed_message.h"
 #include "protocol/subscriber/subscriber_model.h"
 #include "protocol/subscriber/subscriber_stream.h"
 
@@ -62,12 +63,24 @@ void decode_payload(subscriber::MessageType type, uint16_t version, std::span<co
         if (!subscriber::decode_model(payload).validate().empty()) std::abort();
       });
       break;
+    case subscriber::MessageType::Packed: {
+      std::optional<subscriber::Unpacked> unpacked;
+      decode_or_refuse([&] { unpacked = subscriber::decode_packed(payload, 1u << 24); });
+      if (unpacked) {
+        if (unpacked->type != subscriber::MessageType::MeshInfo &&
+            unpacked->type != subscriber::MessageType::Model)
+          std::abort();
+        decode_payload(unpacked->type, subscriber::kVersion2, unpacked->payload);
+      }
+      break;
+    }
   }
 }
 
-constexpr subscriber::MessageType kTypes[] = {subscriber::MessageType::Hello, subscriber::MessageType::MeshInfo,
-                                              subscriber::MessageType::Frame, subscriber::MessageType::Status,
-                                              subscriber::MessageType::Ack, subscriber::MessageType::Model};
+constexpr subscriber::MessageType kTypes[] = {
+    subscriber::MessageType::Hello,  subscriber::MessageType::MeshInfo, subscriber::MessageType::Frame,
+    subscriber::MessageType::Status, subscriber::MessageType::Ack,      subscriber::MessageType::Model,
+    subscriber::MessageType::Packed};
 
 }  // namespace
 

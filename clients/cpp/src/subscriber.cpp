@@ -9,6 +9,7 @@
 #include "protocol/subscriber/datagram_reassembler.h"
 #include "protocol/subscriber/finite_values.h"
 #include "protocol/subscriber/frame_parameters.h"
+#include "protocol/subscriber/packed_message.h"
 #include "protocol/subscriber/subscriber_model.h"
 #include "protocol/subscriber/subscriber_stream.h"
 #include "skinstream/client.h"
@@ -123,6 +124,7 @@ Subscriber::Subscriber(Options options) : state_(std::make_unique<State>()) {
   hello.wants = (o.normals ? wire::kWantNormals : 0) | (o.markers ? wire::kWantMarkers : 0) | (o.mesh ? 0 : wire::kWantNoMesh) |
                 (o.paced ? wire::kWantPaced : 0);
   if (s.version == wire::kVersion1 && o.encoding == Encoding::Quantised) hello.wants |= wire::kWantQuantised;
+  if (s.version == wire::kVersion2 && o.packed) hello.wants |= wire::kWantPacked;
   hello.encoding = static_cast<uint32_t>(o.encoding);
   hello.subject = o.subject;
   hello.token = o.token;
@@ -167,10 +169,22 @@ bool Subscriber::State::read_connection(Frame& frame, std::chrono::steady_clock:
       while (const std::optional<wire::RawMessage> message = s.decoder.next()) {
         if (message->version != s.version)
           throw Error("the daemon answered in protocol version " + std::to_string(message->version) + ", not " + std::to_string(s.version));
-        switch (message->type) {
-          case wire::MessageType::MeshInfo: s.on_mesh_info(message->payload); break;
+        wire::MessageType type = message->type;
+        std::span<const unsigned char> payload = message->payload;
+        wire::Unpacked unpacked;  // a Packed message's MeshInfo or Model
+        if (type == wire::MessageType::Packed) {
+          if (!(s.hello.wants & wire::kWantPacked))
+            throw Error("the daemon sent a Packed message, which this subscriber did not ask for");
+          unpacked = wire::decode_packed(payload);
+          type = unpacked.type;
+          payload = unpacked.payload;
+        }
+        switch (type) {
+          case wire::MessageType::MeshInfo:
+            s.on_mesh_info(payload);
+            break;
           case wire::MessageType::Model:
-            s.on_model(message->payload);
+            s.on_model(payload);
             if (s.group) {  // the frames come from the group from now on
               s.model_id = wire::model_id_of(s.model_payload);
               s.connection.reset();
@@ -198,7 +212,8 @@ bool Subscriber::State::read_connection(Frame& frame, std::chrono::steady_clock:
             if (ready) return true;
             break;
           }
-          default: throw Error(std::string("unexpected ") + wire::to_string(message->type) + " message from the daemon");
+          default:
+            throw Error(std::string("unexpected ") + wire::to_string(type) + " message from the daemon");
         }
       }
     } catch (const wire::DecodeError& e) {

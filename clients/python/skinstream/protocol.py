@@ -5,6 +5,7 @@ numpy arrays that view the payload where the layout allows; each raises Protocol
 the rule that was broken. No sockets here.
 """
 import struct
+import zlib
 
 import numpy as np
 
@@ -14,13 +15,15 @@ HEADER_BYTES = HEADER.size
 MAX_PAYLOAD = 64 << 20
 VERSIONS = (1, 2)
 
-HELLO, MESH_INFO, FRAME, STATUS, ACK, MODEL = 1, 2, 3, 4, 5, 6
-MESSAGE_NAMES = {HELLO: 'Hello', MESH_INFO: 'MeshInfo', FRAME: 'Frame', STATUS: 'Status', ACK: 'Ack', MODEL: 'Model'}
+HELLO, MESH_INFO, FRAME, STATUS, ACK, MODEL, PACKED = 1, 2, 3, 4, 5, 6, 7
+MESSAGE_NAMES = {HELLO: 'Hello', MESH_INFO: 'MeshInfo', FRAME: 'Frame', STATUS: 'Status', ACK: 'Ack', MODEL: 'Model',
+                 PACKED: 'Packed'}
 
 ENCODINGS = ('float', 'quantised', 'compressed', 'parameters')
 FLOAT, QUANTISED, COMPRESSED, PARAMETERS = range(4)
 
 WANT_NORMALS, WANT_QUANTISED, WANT_MARKERS, WANT_NO_MESH, WANT_PACED = 1, 2, 4, 8, 16
+WANT_PACKED = 32  # version 2: MeshInfo and Model come as Packed messages
 
 FRAME_NORMALS, FRAME_QUANTISED, FRAME_MARKERS, FRAME_NO_POSITIONS = 1, 2, 4, 8
 FRAME_PARAMETERS, FRAME_COMPRESSED, FRAME_KEY, FRAME_TIMECODE = 16, 32, 64, 128
@@ -116,11 +119,62 @@ def decode_header(data, versions=VERSIONS):
         raise ProtocolError('bad magic (not a skinstream subscriber stream)')
     if version not in versions:
         raise ProtocolError(f'unsupported protocol version {version} (this side speaks {" and ".join(map(str, versions))})')
-    if kind not in MESSAGE_NAMES or (kind == MODEL and version < 2):
+    if kind not in MESSAGE_NAMES or (kind in (MODEL, PACKED) and version < 2):
         raise ProtocolError(f'unknown message type {kind} in version {version}')
     if size > MAX_PAYLOAD:
         raise ProtocolError(f'payload of {size} bytes exceeds the limit of {MAX_PAYLOAD}')
     return version, kind, size
+
+
+# A packed type's fixed counts, kept before the deflated stream: (bytes, offset of the u32 N of
+# the 3N-value array after them, its name).
+_PACKED_HEADS = {MESH_INFO: (20, 4, 'face count'), MODEL: (16, 0, 'vertex count')}
+_MOST_INFLATED_PER_BYTE = 1032  # deflate's longest match in its shortest code
+
+
+def unpack(payload, max_payload=MAX_PAYLOAD):
+    """(type, payload) of the MeshInfo or Model a Packed message holds: its counts, then the rest
+    inflated with the first 3N u32 values decoded (byte planes joined, each value plus the value
+    three before it)."""
+    if len(payload) < 8:
+        raise ProtocolError(f'Packed: truncated ({len(payload)} of 8 bytes of its fields)')
+    kind, reserved, size = struct.unpack_from('<HHI', payload)
+    if kind not in _PACKED_HEADS:
+        raise ProtocolError(f'Packed: holds a message of type {kind} (only MeshInfo and Model are packed)')
+    if reserved:
+        raise ProtocolError(f'Packed: reserved field is {reserved}, not 0')
+    if size > max_payload:
+        raise ProtocolError(f'Packed: unpacked size {size} over the limit of {max_payload}')
+    head_bytes, count_at, count_name = _PACKED_HEADS[kind]
+    if len(payload) < 8 + head_bytes:
+        raise ProtocolError(f'Packed: truncated in its counts ({len(payload) - 8} of {head_bytes} bytes)')
+    if size < head_bytes:
+        raise ProtocolError(f'Packed: unpacked size {size} shorter than its counts')
+    head = bytes(payload[8:8 + head_bytes])
+    stream = bytes(payload[8 + head_bytes:])
+    rest_bytes = size - head_bytes
+    if rest_bytes > len(stream) * _MOST_INFLATED_PER_BYTE + 64:
+        raise ProtocolError(f'Packed: {len(stream)} deflated bytes cannot make {rest_bytes}')
+    count = 3 * struct.unpack_from('<I', head, count_at)[0]
+    if 4 * count > rest_bytes:
+        raise ProtocolError(f'Packed: its {count_name} needs {4 * count} bytes, the unpacked size leaves {rest_bytes}')
+    inflater = zlib.decompressobj()
+    try:
+        rest = inflater.decompress(stream, rest_bytes)
+    except zlib.error as e:
+        raise ProtocolError(f'Packed: the deflated stream is corrupt ({e})') from None
+    if inflater.unconsumed_tail:
+        raise ProtocolError(f'Packed: the deflated stream makes more than the unpacked size {rest_bytes}')
+    if not inflater.eof:
+        raise ProtocolError(f'Packed: the deflated stream ends early ({len(rest)} of {rest_bytes} bytes made)')
+    if inflater.unused_data:
+        raise ProtocolError(f'Packed: {len(inflater.unused_data)} bytes after the deflated stream')
+    if len(rest) != rest_bytes:
+        raise ProtocolError(f'Packed: the deflated stream makes {len(rest)} bytes, the unpacked size says {rest_bytes}')
+    planes = np.frombuffer(rest, np.uint8, 4 * count).reshape(4, count).astype(np.uint32)
+    deltas = planes[0] | planes[1] << 8 | planes[2] << 16 | planes[3] << 24
+    values = deltas.reshape(-1, 3).cumsum(axis=0, dtype=np.uint32)  # wraps modulo 2^32, as the differences did
+    return kind, head + values.astype('<u4').tobytes() + rest[4 * count:]
 
 
 def message(kind, payload, version):

@@ -90,6 +90,60 @@ TEST(ClientSubscriberDemo, EveryEncodingGivesTheDaemonsVertices) {
               quantised.position_mm, compressed.position_mm, compressed.normal_degrees, model_bytes);
 }
 
+// A subscriber that asks for MeshInfo and the Model packed (the default) and one that asks
+// for them plain: the same mesh, the same Model bytes and the same vertices, for a third of the
+// bytes before the first frame.
+TEST(ClientSubscriberDemo, PackedAndPlainJoinersGetTheSameMeshModelAndVertices) {
+  const std::string demo = SKINSTREAM_DEMO_DIR;
+  test::DaemonProcess daemon("--subject " + demo + "/subject.sksubj --replay " + demo +
+                             "/live.c3d --loop --speed 0.2");
+  ASSERT_GT(daemon.sub_port, 0);
+  struct Joiner {
+    std::map<uint32_t, Received> frames;
+    client::Mesh mesh;
+    std::vector<unsigned char> model;
+    uint64_t bytes_before_first_frame = 0;
+  };
+  Joiner joiners[2];  // packed, plain
+  // After the replay's first frames: the rate in MeshInfo is known (packed at start-up without
+  // it, the packed MeshInfo then carries it too).
+  std::this_thread::sleep_for(std::chrono::seconds(1));
+  std::vector<std::thread> threads;
+  for (int plain = 0; plain < 2; ++plain)
+    threads.emplace_back([&, plain] {
+      client::Options options;
+      options.port = static_cast<uint16_t>(daemon.sub_port);
+      options.encoding = Encoding::Parameters;
+      options.packed = plain == 0;
+      client::Subscriber sub(options);
+      Joiner& j = joiners[plain];
+      j.frames = test::receive_frames<Received>(sub, 20, [&](const client::Frame& frame, Received& kept) {
+        if (j.bytes_before_first_frame == 0) j.bytes_before_first_frame = sub.bytes_received();
+        test::keep_vertices(frame, kept);
+      });
+      j.mesh = sub.mesh();
+      j.model.assign(sub.model_payload().begin(), sub.model_payload().end());
+    });
+  for (std::thread& t : threads) t.join();
+  EXPECT_EQ(daemon.stop(), 0) << daemon.log();
+  const Joiner &packed = joiners[0], &plain = joiners[1];
+  EXPECT_EQ(packed.mesh.indices, plain.mesh.indices);
+  EXPECT_EQ(packed.mesh.dominant_part, plain.mesh.dominant_part);
+  EXPECT_EQ(packed.mesh.marker_names, plain.mesh.marker_names);
+  EXPECT_EQ(packed.mesh.source_rate_hz, 120.0f);
+  EXPECT_EQ(plain.mesh.source_rate_hz, 120.0f);
+  ASSERT_FALSE(plain.model.empty());
+  EXPECT_EQ(packed.model, plain.model) << "the Model's floats bit for bit";
+  const Difference difference = compare(plain.frames, packed.frames);
+  EXPECT_GE(difference.frames, 10);
+  EXPECT_EQ(difference.position_mm, 0.0);
+  EXPECT_LT(packed.bytes_before_first_frame * 2.5, plain.bytes_before_first_frame)
+      << packed.bytes_before_first_frame << " bytes packed, " << plain.bytes_before_first_frame << " plain";
+  std::printf("bytes before the first frame: packed %llu, plain %llu\n",
+              static_cast<unsigned long long>(packed.bytes_before_first_frame),
+              static_cast<unsigned long long>(plain.bytes_before_first_frame));
+}
+
 TEST(ClientSubscriberDemo, AnUnknownSubjectIsRefusedWithTheReason) {
   const std::string demo = SKINSTREAM_DEMO_DIR;
   test::DaemonProcess daemon("--subject " + demo + "/subject.sksubj");
@@ -179,6 +233,31 @@ TEST(ClientSubscriber, BytesThatBreakTheProtocolAreOneLineErrors) {
   EXPECT_NE(error_for(frame_first).find("before the Model"), std::string::npos);
   for (const std::string& e : {error_for(bad_magic), error_for(version_one), error_for(frame_first)})
     EXPECT_EQ(e.find('\n'), std::string::npos) << e;
+}
+
+TEST(ClientSubscriber, PackedMessagesGetThePlainOnesChecksAndTheirOwn) {
+  // Unpacked, a Model of 3 vertices after a MeshInfo of 4 is refused as it is plain.
+  std::vector<unsigned char> both = golden("packed_mesh_info_v2.bin");
+  const std::vector<unsigned char> model = golden("packed_model.bin");
+  both.insert(both.end(), model.begin(), model.end());
+  EXPECT_NE(error_for(both).find("vertices"), std::string::npos) << error_for(both);
+  // A deflated stream that does not inflate.
+  std::vector<unsigned char> corrupt = golden("packed_mesh_info_v2.bin");
+  corrupt[12 + 8 + 20 + 3] ^= 0xFF;
+  const std::string corrupt_error = error_for(corrupt);
+  EXPECT_NE(corrupt_error.find("bad message from the daemon: Packed"), std::string::npos) << corrupt_error;
+  EXPECT_EQ(corrupt_error.find('\n'), std::string::npos) << corrupt_error;
+  // Packed to a subscriber that asked for plain messages.
+  test::ScriptedDaemon daemon(golden("packed_mesh_info_v2.bin"), test::ScriptedDaemon::Then::Close);
+  client::Subscriber sub({.port = daemon.port, .encoding = Encoding::Parameters, .packed = false});
+  client::Frame frame;
+  try {
+    while (sub.next(frame, std::chrono::seconds(5))) {
+    }
+    FAIL() << "took a Packed message it did not ask for";
+  } catch (const client::Error& e) {
+    EXPECT_NE(std::string(e.what()).find("did not ask for"), std::string::npos) << e.what();
+  }
 }
 
 // One Frame whose parameters are not finite (an RBF weight) among good ones: skipped, counted and

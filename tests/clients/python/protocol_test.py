@@ -118,5 +118,54 @@ class BrokenBytes(unittest.TestCase):
         self.assert_one_line('unknown source state 7', wire.Status, struct.pack('<I', 7) + status[4:], 2)
 
 
+class Packed(unittest.TestCase):
+    """The golden Packed messages (written from the spec by make_v2_fixtures.py) hold the golden
+    plain ones byte for byte; forged fields are one-line ProtocolErrors."""
+
+    def test_the_golden_packed_messages_hold_the_plain_ones(self):
+        for plain, packed, kind in (('mesh_info_v2.bin', 'packed_mesh_info_v2.bin', wire.MESH_INFO),
+                                    ('model.bin', 'packed_model.bin', wire.MODEL)):
+            version, packed_kind, body = payload(packed)
+            self.assertEqual((version, packed_kind), (2, wire.PACKED))
+            self.assertEqual(wire.unpack(body), (kind, payload(plain)[2]))
+        kind, mesh = wire.unpack(payload('packed_mesh_info_v2.bin')[2])
+        self.assertEqual(wire.MeshInfo(mesh, 2).faces.tolist(), [[0, 1, 2], [0, 2, 3]])
+
+    def test_a_packed_message_needs_version_2(self):
+        data = fixture('packed_model.bin')
+        with self.assertRaisesRegex(wire.ProtocolError, 'unknown message type 7 in version 1'):
+            wire.decode_header(data[:4] + struct.pack('<H', 1) + data[6:])
+
+    def test_forged_fields_are_refused_with_the_reason(self):
+        good = payload('packed_mesh_info_v2.bin')[2]
+        size = struct.unpack_from('<I', good, 4)[0]
+
+        def forged(offset, fmt, value):
+            return good[:offset] + struct.pack(fmt, value) + good[offset + struct.calcsize(fmt):]
+
+        cases = {
+            'type 3 (only MeshInfo and Model are packed)': forged(0, '<H', 3),
+            'reserved field is 1': forged(2, '<H', 1),
+            'over the limit': forged(4, '<I', 100 << 20),
+            'shorter than its counts': forged(4, '<I', 5),
+            'deflated bytes cannot make': forged(4, '<I', 60_000_000),
+            'face count needs 12000000 bytes': forged(12, '<I', 1_000_000),
+            'the unpacked size says': forged(4, '<I', size + 1),
+            'makes more than the unpacked size': forged(4, '<I', size - 1),
+            'bytes after the deflated stream': good + b'\0',
+            'corrupt': good[:31] + bytes([good[31] ^ 0xFF]) + good[32:],
+            'truncated': good[:6],
+        }
+        for what, body in cases.items():
+            with self.subTest(what):
+                with self.assertRaises(wire.ProtocolError) as raised:
+                    wire.unpack(body)
+                self.assertIn(what, str(raised.exception))
+                self.assertNotIn('\n', str(raised.exception))
+        for n in range(len(good)):
+            with self.assertRaises(wire.ProtocolError, msg=f'cut at {n}'):
+                wire.unpack(good[:n])
+
+
 if __name__ == '__main__':
     unittest.main(verbosity=2)

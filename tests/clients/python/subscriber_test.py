@@ -113,6 +113,54 @@ class DemoSubject(unittest.TestCase):
         self.assertNotIn('\n', str(raised.exception))
 
 
+class PackedJoiners(unittest.TestCase):
+    def test_packed_and_plain_joiners_get_the_same_mesh_model_and_vertices(self):
+        """MeshInfo and the Model asked for packed (the default) and plain: the same faces, Model
+        and vertices, for under 1 / 2.5 of the bytes before the first frame."""
+        results = {}
+
+        def join(packed):
+            frames, first_bytes = {}, None
+            with skinstream.Subscriber(port=daemon.sub_port, encoding='parameters', normals=False, packed=packed) as sub:
+                deadline = time.monotonic() + 120
+                while len(frames) < 20 and time.monotonic() < deadline:
+                    frame = sub.next_frame(1.0)
+                    if frame is not None:
+                        first_bytes = first_bytes or sub.bytes_received
+                        frames[frame.frame_number] = frame.vertices
+                results[packed] = (frames, sub.mesh, sub.model, first_bytes)
+
+        with demo_daemon() as daemon:
+            threads = [threading.Thread(target=join, args=(packed,)) for packed in (True, False)]
+            for t in threads:
+                t.start()
+            for t in threads:
+                t.join()
+            self.assertEqual(daemon.stop(), 0, daemon.log())
+        (packed_frames, packed_mesh, packed_model, packed_bytes) = results[True]
+        (plain_frames, plain_mesh, plain_model, plain_bytes) = results[False]
+        np.testing.assert_array_equal(packed_mesh.faces, plain_mesh.faces)
+        self.assertEqual(packed_mesh.marker_names, plain_mesh.marker_names)
+        for field in ('reference', 'rotation', 'translation', 'members', 'influences_per_vertex'):
+            np.testing.assert_array_equal(getattr(packed_model, field), getattr(plain_model, field), field)
+        common = sorted(set(packed_frames) & set(plain_frames))
+        self.assertGreaterEqual(len(common), 5)
+        for n in common:
+            np.testing.assert_array_equal(packed_frames[n], plain_frames[n])
+        print(f'bytes before the first frame: packed {packed_bytes}, plain {plain_bytes}')
+        self.assertLess(packed_bytes * 2.5, plain_bytes)
+
+    def test_a_packed_message_not_asked_for_is_an_error(self):
+        fake = FakeDaemon(fixture('packed_mesh_info_v2.bin'))
+        try:
+            with skinstream.Subscriber(port=fake.port, encoding='parameters', packed=False) as sub:
+                with self.assertRaisesRegex(skinstream.ProtocolError, 'did not ask for'):
+                    sub.next_frame(5)
+        finally:
+            fake.thread.join()
+            fake.listener.close()
+
+
 class FakeDaemon:
     """Answers the Hello with the bytes given, then closes."""
 
@@ -159,17 +207,19 @@ class BadDaemons(unittest.TestCase):
     def test_bytes_that_break_the_protocol_are_one_line_errors(self):
         mesh_info = fixture('mesh_info_v2.bin')
         model = fixture('model.bin')  # 3 vertices; the MeshInfo has 4
-        cases = {
-            'bad magic': b'X' + mesh_info[1:],
-            'version 1, not 2': fixture('mesh_info.bin'),  # a version 1 answer to a version 2 Hello
-            'unsupported protocol version 7': mesh_info[:4] + struct.pack('<H', 7) + mesh_info[6:],
-            'exceeds the limit': mesh_info[:8] + struct.pack('<I', 100 << 20),
-            'Model message before MeshInfo': model,
-            'the Model has 3 vertices, MeshInfo 4': mesh_info + model,
-            'closed the connection': mesh_info + model[:-10],  # truncated: the connection ends inside it
-            'before the Model': mesh_info + fixture('frame_v2_parameters.bin'),
-        }
-        for what, reply in cases.items():
+        cases = [
+            ('bad magic', b'X' + mesh_info[1:]),
+            ('version 1, not 2', fixture('mesh_info.bin')),  # a version 1 answer to a version 2 Hello
+            ('unsupported protocol version 7', mesh_info[:4] + struct.pack('<H', 7) + mesh_info[6:]),
+            ('exceeds the limit', mesh_info[:8] + struct.pack('<I', 100 << 20)),
+            ('Model message before MeshInfo', model),
+            ('the Model has 3 vertices, MeshInfo 4', mesh_info + model),
+            ('closed the connection', mesh_info + model[:-10]),  # truncated: the connection ends inside it
+            ('before the Model', mesh_info + fixture('frame_v2_parameters.bin')),
+            ('Packed: the deflated stream is corrupt', fixture('packed_mesh_info_v2.bin')[:43] + b'\xff' + fixture('packed_mesh_info_v2.bin')[44:]),
+            ('the Model has 3 vertices, MeshInfo 4', fixture('packed_mesh_info_v2.bin') + fixture('packed_model.bin')),
+        ]
+        for what, reply in cases:
             with self.subTest(what):
                 error = error_for(reply)
                 self.assertIn(what, error)

@@ -21,8 +21,9 @@ std::vector<unsigned char> plain_payload(const std::string& fixture) {
 // packed_*.bin are written from the spec by make_v2_fixtures.py (Python's own coding of the
 // arrays, zlib at level 6): the encoder must make the same bytes and the decoder take them back.
 TEST(PackedMessage, MatchesGoldenBytesBothWays) {
-  for (const auto& [plain, packed, type] : {std::tuple{"mesh_info_v2.bin", "packed_mesh_info_v2.bin", MessageType::MeshInfo},
-                                            std::tuple{"model.bin", "packed_model.bin", MessageType::Model}}) {
+  for (const auto& [plain, packed, type] :
+       {std::tuple{"mesh_info_v2.bin", "packed_mesh_info_v2.bin", MessageType::MeshInfo},
+        std::tuple{"model.bin", "packed_model.bin", MessageType::Model}}) {
     const std::vector<unsigned char> golden = subscriber_fixture(packed);
     const MessageHeader header = decode_header(golden);
     EXPECT_EQ(header.type, MessageType::Packed);
@@ -50,7 +51,8 @@ std::vector<unsigned char> strip_mesh_info(uint32_t faces) {
 TEST(PackedMessage, AMeshsFacesComeBackExactlyInAFractionOfTheBytes) {
   const std::vector<unsigned char> plain = strip_mesh_info(100'000);
   const std::vector<unsigned char> packed = encode_packed(MessageType::MeshInfo, plain);
-  EXPECT_LT(packed.size() * 20, plain.size()) << "faces that differ by the same step each pack to almost nothing";
+  EXPECT_LT(packed.size() * 20, plain.size())
+      << "faces that differ by the same step each pack to almost nothing";
   const Unpacked unpacked = decode_packed(payload_of(packed));
   EXPECT_EQ(unpacked.payload, plain);
   EXPECT_EQ(decode_mesh_info(unpacked.payload, kVersion2).faces.size(), 100'000u);
@@ -63,7 +65,8 @@ TEST(PackedMessage, TheModelsFloatsComeBackBitForBit) {
   const uint32_t vertices = 5000;
   std::vector<unsigned char> plain(kPackedModelHeadBytes + 12 * vertices + 37);
   std::memcpy(plain.data(), &vertices, 4);
-  for (size_t i = kPackedModelHeadBytes; i < plain.size(); ++i) plain[i] = static_cast<unsigned char>(random());
+  for (size_t i = kPackedModelHeadBytes; i < plain.size(); ++i)
+    plain[i] = static_cast<unsigned char>(random());
   const Unpacked unpacked = decode_packed(payload_of(encode_packed(MessageType::Model, plain, 1)));
   EXPECT_EQ(unpacked.type, MessageType::Model);
   EXPECT_EQ(unpacked.payload, plain);
@@ -86,7 +89,8 @@ TEST(PackedMessage, OnlyMeshInfoAndModelArePacked) {
   EXPECT_THROW(encode_packed(MessageType::Model, counts_too_big), std::invalid_argument);
 }
 
-void expect_refused(std::vector<unsigned char> payload, const std::string& reason, uint32_t max_payload = kMaxPayloadBytes) {
+void expect_refused(std::vector<unsigned char> payload, const std::string& reason,
+                    uint32_t max_payload = kMaxPayloadBytes) {
   try {
     decode_packed(payload, max_payload);
     FAIL() << "accepted a Packed message with " << reason;

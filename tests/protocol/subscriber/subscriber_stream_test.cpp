@@ -216,7 +216,9 @@ TEST(SubscriberStream, EveryTruncationOfEveryMessageIsRejected) {
           case MessageType::Frame: decode_frame(cut, v); break;
           case MessageType::Status: decode_status(cut, v); break;
           case MessageType::Model:
-          case MessageType::Packed: FAIL() << "no decoder of it here"; break;
+          case MessageType::Packed:
+            FAIL() << "no decoder of it here";
+            break;
         }
       };
       EXPECT_THROW(decode(), DecodeError) << name << " cut at " << n;
