@@ -347,6 +347,7 @@ void Subscriber::State::on_mesh_info(std::span<const unsigned char> payload) {
   markers.assign(3 * info.marker_names.size(), 0.0f);
   marker_status.assign(info.marker_names.size(), 0);
   evaluator.reset();
+  model_payload.clear();  // the Model of this MeshInfo comes after it
   compressed.reset();
   if (mesh.encoding == Encoding::Compressed) {
     try {
@@ -367,6 +368,9 @@ void Subscriber::State::on_model(std::span<const unsigned char> payload) {
   model_payload.assign(payload.begin(), payload.end());
   parameters.resize(model.part_count(), model.member_count());
   parameter_block.reserve(wire::parameter_block_bytes(model.part_count(), model.member_count()));
+  // Made only for what evaluates (0.1 s of CPU for the demo body): a load generator that reads
+  // headers alone must not spend it, 60 of them joining at once on the daemon's machine.
+  if (!options.decode || !options.evaluate) return;
   try {
     evaluator = std::make_unique<MeshEvaluator>(model);
   } catch (const std::invalid_argument& e) {
@@ -395,7 +399,7 @@ bool Subscriber::State::on_frame(std::span<const unsigned char> payload, Frame& 
   if (!options.decode) {
     // The header, markers and times below only.
   } else if (info.flags & wire::kFrameParameters) {
-    if (!evaluator) throw Error("a parameter Frame before the Model");
+    if (model_payload.empty()) throw Error("a parameter Frame before the Model");
     wire::decode_parameter_block(view.positions, parameters);
     parameter_block.assign(view.positions.begin(), view.positions.end());
     if (options.evaluate) {
