@@ -72,6 +72,16 @@ std::optional<int> parse_bench_options(int argc, char** argv, BenchOptions& o) {
       ->check(CLI::Range(0.0, 3600.0))
       ->capture_default_str();
   app.add_option(
+         "--joiner-nice", o.joiner_nice,
+         "--join-wave: the joiners' threads at this nice level, so that their own unpacking (on a stage: "
+         "other machines' CPU) does not take this machine's cores from the daemon")
+      ->check(CLI::Range(0, 19))
+      ->capture_default_str();
+  app.add_flag("--joiner-processes", o.joiner_processes,
+               "--join-wave: each joiner is a skinstream-sub process (beside this program) rather than a "
+               "thread of this one; "
+               "its summary is reported under join_wave.processes");
+  app.add_option(
          "--record-ab", o.record_ab_seconds,
          "recording A/B in one run: the daemon records a take for this many seconds, then none for as long, "
          "in turn (through its control API); the report's record_ab splits the figures by recording on and "

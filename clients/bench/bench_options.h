@@ -48,6 +48,12 @@ struct BenchOptions {
   int join_wave = 0;
   std::string daemon_config;  // skinstreamd --config (keys without a flag, e.g. subscriber_join_mbit)
   double join_after_seconds = 3.0;
+  // The joiners' threads at this nice level: render nodes are other machines on a stage, and on
+  // this one their unpacking competes with the daemon for the same cores (0: as the watchers).
+  int joiner_nice = 0;
+  // The joiners as skinstream-sub processes (as render nodes are programs of their own) instead
+  // of threads of this one.
+  bool joiner_processes = false;
   // Recording A/B in one run: a take starts and stops every this many seconds through the control
   // API (0: off); the report splits the subscribers' figures by whether a take was recording.
   double record_ab_seconds = 0.0;

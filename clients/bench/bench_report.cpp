@@ -27,6 +27,7 @@ void print_report(const nlohmann::json& report, bool as_json) {
   print_latency("daemon processing", report["daemon_processing"]);
   print_latency("  ingest", report["ingest"]);
   print_latency("  delivery", report["delivery"]);
+  print_latency("since receive", report["since_receive"]);
   for (const char* stage : {"subscriber_queue_wait", "subscriber_write"}) {
     const nlohmann::json& h = report["daemon_stages_ms"][stage];
     std::printf("    %-22s p50 <= %.3f ms  p99 <= %.3f ms  max %.3f ms  (daemon side, %lu samples)\n", stage, h["p50_le"].get<double>(),

@@ -6,13 +6,20 @@
 //   ingest            = receive_time_ns - replay send time (the network in, and the daemon's io thread)
 //   delivery          = subscriber arrival - publish_time_ns (the hand-off, the subscriber queue
 //                       and the network out)
+//   since receive     = subscriber arrival - receive_time_ns (processing + delivery)
 // so end to end = ingest + processing + delivery (+ decoding, with --decode), frame by frame.
 #include "clients/bench/bench_run.h"
 
+#include <fcntl.h>
+#include <poll.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <atomic>
+#include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -115,6 +122,7 @@ void subscribe(const BenchOptions& o, const std::string& host, int port, int ind
       tally.processing_by_recording[recording].ms.push_back((frame.publish_time_ns - frame.receive_time_ns) *
                                                             1e-6);
     tally.delivery.ms.push_back((frame.arrival_time_ns - frame.publish_time_ns) * 1e-6);
+    tally.since_receive.ms.push_back((frame.arrival_time_ns - frame.receive_time_ns) * 1e-6);
     tally.message_bytes += frame.message_bytes;
     if (static_cast<int64_t>(frame.frame_number) <= last_frame) ++tally.out_of_order;
     last_frame = frame.frame_number;
@@ -164,6 +172,92 @@ nlohmann::json join_wave_report(const BenchOptions& o, const std::vector<Subscri
           {"frames_per_second_since_joining",
            rates.empty() ? nlohmann::json(nullptr)
                          : nlohmann::json{{"slowest", rates.front()}, {"median", rates[rates.size() / 2]}}}};
+}
+
+// --joiner-processes: one joiner as a skinstream-sub process, until it has `frames` frames or
+// `limit` passes (then killed). Its summary (the JSON it prints last), or {"error": ...}.
+nlohmann::json run_joiner_process(const BenchOptions& o, const std::string& address, int port, long frames,
+                                  std::chrono::seconds limit) {
+  std::vector<std::string> args = {(own_folder() / "skinstream-sub").string(),
+                                   address + ":" + std::to_string(port),
+                                   "--encoding",
+                                   client::to_string(o.encoding),
+                                   "--frames",
+                                   std::to_string(frames)};
+  if (o.normals) args.push_back("--normals");
+  if (o.paced) args.push_back("--paced");
+  if (o.decode) args.push_back("--evaluate");
+  if (o.plain_first_contact) args.push_back("--plain-first-contact");
+  std::vector<char*> argv;  // made before fork: the child of a threaded process may not allocate
+  for (std::string& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  int out[2];
+  if (pipe2(out, O_CLOEXEC) != 0) return {{"error", std::string("pipe: ") + std::strerror(errno)}};
+  const pid_t pid = fork();
+  if (pid == 0) {
+    if (o.joiner_nice > 0) setpriority(PRIO_PROCESS, 0, o.joiner_nice);
+    dup2(out[1], STDOUT_FILENO);
+    dup2(out[1], STDERR_FILENO);
+    execv(argv[0], argv.data());
+    _exit(127);
+  }
+  close(out[1]);
+  std::string text;
+  const Clock::time_point give_up = Clock::now() + limit;
+  for (char buffer[4096];;) {
+    pollfd p{out[0], POLLIN, 0};
+    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(give_up - Clock::now()).count();
+    if (left <= 0 || poll(&p, 1, static_cast<int>(left)) <= 0) {
+      kill(pid, SIGKILL);
+      break;
+    }
+    const ssize_t n = read(out[0], buffer, sizeof buffer);
+    if (n <= 0) break;
+    text.append(buffer, static_cast<size_t>(n));
+  }
+  close(out[0]);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  const size_t json_start = text.find("\n{");
+  if (pid < 0 || json_start == std::string::npos || !WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+    const size_t last_line = text.find_last_of('\n', text.size() > 1 ? text.size() - 2 : 0);
+    return {{"error", "skinstream-sub " +
+                          std::string(WIFEXITED(status) ? "exited " + std::to_string(WEXITSTATUS(status))
+                                                        : "was killed") +
+                          ": " + text.substr(last_line == std::string::npos ? 0 : last_line + 1)}};
+  }
+  return nlohmann::json::parse(text.substr(json_start + 1), nullptr, false);
+}
+
+// The summaries of the joiner processes: the slowest rate once in, the first frames' wait, drops.
+nlohmann::json joiner_processes_report(const std::vector<nlohmann::json>& summaries) {
+  std::vector<double> rates, first;
+  long dropped = 0, pipeline_dropped = 0, failed = 0;
+  std::string first_error;
+  for (const nlohmann::json& s : summaries) {
+    if (!s.is_object() || s.contains("error") || s.value("frames", 0L) < 2) {
+      ++failed;
+      if (first_error.empty())
+        first_error = s.is_object() ? s.value("error", std::string("no frames")) : "no summary";
+      continue;
+    }
+    rates.push_back(s["frames_per_second_after_first"].get<double>());
+    first.push_back(s["first_frame_seconds"].get<double>());
+    dropped += s["subscriber_dropped_after_first"].get<long>();
+    pipeline_dropped = std::max(pipeline_dropped, s["pipeline_dropped"].get<long>());
+  }
+  std::sort(rates.begin(), rates.end());
+  std::sort(first.begin(), first.end());
+  auto at = [](const std::vector<double>& v, double q) {
+    return v.empty() ? 0.0 : v[static_cast<size_t>(q * (v.size() - 1))];
+  };
+  return {{"processes", summaries.size()},
+          {"failed", failed},
+          {"first_error", first_error},
+          {"frames_per_second_after_first", {{"slowest", at(rates, 0.0)}, {"median", at(rates, 0.5)}}},
+          {"first_frame_seconds", {{"p50", at(first, 0.5)}, {"max", at(first, 1.0)}}},
+          {"dropped_for_them_after_their_first_frame", dropped},
+          {"dropped_in_pipeline_by_their_last_frame", pipeline_dropped}};
 }
 
 // Sleeps until `until`, in short steps, throwing once `stop` is set.
@@ -303,8 +397,41 @@ nlohmann::json run_bench(const BenchOptions& o, const std::atomic<bool>& stop) {
   // The join wave: more subscribers at once, into the running stream.
   std::vector<SubscriberTally> joiner_tallies(static_cast<size_t>(o.join_wave));
   std::vector<std::string> joiner_errors(static_cast<size_t>(o.join_wave));
+  std::vector<nlohmann::json> joiner_summaries(static_cast<size_t>(o.join_wave));  // --joiner-processes
+  // Their threads are started now and wait: started at the join, 60 threads' stacks and first
+  // allocations stalled this whole process (the replay's sends and the watchers) for 55-65 ms.
   std::vector<std::thread> joiners;
-  JoinSubscribers join_joiners{window, joiners};  // the same guard: joined first, being declared later
+  std::atomic<bool> joiners_go{false};
+  struct ReleaseJoiners {  // (a run that ends before the join: they return at once)
+    Window& window;
+    std::atomic<bool>& go;
+    ~ReleaseJoiners() {
+      window.closed = true;
+      go = true;
+      go.notify_all();
+    }
+  };
+  JoinSubscribers join_joiners{window, joiners};       // the same guard: joined first, being declared later
+  ReleaseJoiners release_joiners{window, joiners_go};  // released before they are joined
+  for (int j = 0; j < o.join_wave; ++j)
+    joiners.emplace_back([&, j] {
+      if (o.joiner_nice > 0) setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), o.joiner_nice);
+      joiners_go.wait(false);
+      if (window.closed) return;
+      if (o.joiner_processes) {
+        const double in_window = o.seconds - o.join_after_seconds;
+        joiner_summaries[j] =
+            run_joiner_process(o, daemon_address, daemon.sub_port(), std::lround(in_window * 120.0),
+                               std::chrono::seconds(static_cast<long>(in_window) + 30));
+        return;
+      }
+      try {
+        subscribe(o, daemon_address, daemon.sub_port(), o.subscribers + j, send_times, window, stalls,
+                  joiner_tallies[j]);
+      } catch (const std::exception& e) {
+        joiner_errors[j] = e.what();
+      }
+    });
   const Clock::time_point join_at = Clock::now() + std::chrono::duration_cast<Clock::duration>(
                                                        std::chrono::duration<double>(o.join_after_seconds));
   bool joined = o.join_wave == 0;
@@ -347,15 +474,8 @@ nlohmann::json run_bench(const BenchOptions& o, const std::atomic<bool>& stop) {
     }
     if (!joined && join_at < next) {
       sleep_until_or_stop(join_at, stop);
-      for (int j = 0; j < o.join_wave; ++j)
-        joiners.emplace_back([&, j] {
-          try {
-            subscribe(o, daemon_address, daemon.sub_port(), o.subscribers + j, send_times, window, stalls,
-                      joiner_tallies[j]);
-          } catch (const std::exception& e) {
-            joiner_errors[j] = e.what();
-          }
-        });
+      joiners_go = true;
+      joiners_go.notify_all();
       joined = true;
     }
     sleep_until_or_stop(next, stop);
@@ -442,7 +562,9 @@ nlohmann::json run_bench(const BenchOptions& o, const std::atomic<bool>& stop) {
         {"quantised", o.encoding == client::Encoding::Quantised},
         {"decode", o.decode},
         {"paced", o.paced},
-        {"packed_first_contact", !o.plain_first_contact}}},
+        {"packed_first_contact", !o.plain_first_contact},
+        {"joiner_nice", o.joiner_nice},
+        {"joiner_processes", o.joiner_processes}}},
       {"seconds_until_every_subscriber_had_a_frame", seconds_to_first_frames},
       {"deform_threads", o.deform_threads},
       {"deform", health["deform"]},  // as the daemon applied it: threads, CPUs pinned to, spin lead
@@ -460,8 +582,11 @@ nlohmann::json run_bench(const BenchOptions& o, const std::atomic<bool>& stop) {
        {{"slowest", rates.front()}, {"median", rates[rates.size() / 2]}, {"fastest", rates.back()}}},
       {"end_to_end", all.end_to_end.summary()},
       {"daemon_processing", all.processing.summary()},
-      {"ingest", all.ingest.summary()},           // replay send -> daemon receive
-      {"delivery", all.delivery.summary()},       // daemon publish -> subscriber arrival
+      {"ingest", all.ingest.summary()},      // replay send -> daemon receive
+      {"delivery", all.delivery.summary()},  // daemon publish -> subscriber arrival
+      // daemon receive -> subscriber arrival (processing + delivery): the daemon's and the
+      // link's part, without the load generator's replay
+      {"since_receive", all.since_receive.summary()},
       {"replay_sends", send_times.regularity()},  // gaps between the replay's consecutive sends
       // The daemon's own stage histograms (/health's latency_ms) over its whole life, warm-up
       // included: quantiles as bucket upper bounds. Delivery splits into subscriber_queue_wait
@@ -513,7 +638,11 @@ nlohmann::json run_bench(const BenchOptions& o, const std::atomic<bool>& stop) {
       // This process: the replay server and the subscribers, sharing the machine with the daemon.
       {"load_generator", {{"cpu_seconds", own_cpu}, {"cpu_share_of_one_core", own_cpu / window_s}}}};
   if (link) report["shaped_link"] = nlohmann::json::parse(shaper);
-  if (o.join_wave > 0)
+  if (o.join_wave > 0 && o.joiner_processes)
+    report["join_wave"] = {{"joiners", o.join_wave},
+                           {"joined_after_s", o.join_after_seconds},
+                           {"processes", joiner_processes_report(joiner_summaries)}};
+  else if (o.join_wave > 0)
     report["join_wave"] = join_wave_report(o, joiner_tallies, window_start_ns, window_end_ns);
   if (o.record_ab_seconds > 0) {
     nlohmann::json halves;

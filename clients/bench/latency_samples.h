@@ -20,7 +20,7 @@ struct Samples {
 // What one subscriber thread saw: its own, so the threads share nothing while they run; merged
 // after they are joined.
 struct SubscriberTally {
-  Samples end_to_end, processing, ingest, delivery;  // see the report's keys
+  Samples end_to_end, processing, ingest, delivery, since_receive;  // see the report's keys
   long received = 0, unmatched = 0, out_of_order = 0;
   uint32_t dropped_first = 0, dropped_last = 0;  // the daemon's drop counter for it, first and last frame
   double longest_gap_ms = 0.0;                   // between two consecutive frames' arrivals
@@ -33,7 +33,7 @@ struct SubscriberTally {
   Samples end_to_end_by_recording[2], processing_by_recording[2];
 
   void reserve(size_t frames) {
-    for (Samples* s : {&end_to_end, &processing, &ingest, &delivery}) s->ms.reserve(frames);
+    for (Samples* s : {&end_to_end, &processing, &ingest, &delivery, &since_receive}) s->ms.reserve(frames);
   }
   uint32_t dropped() const { return dropped_last - dropped_first; }
   // Adds another subscriber's samples and counts (not its drop counter: see dropped()).
@@ -43,6 +43,7 @@ struct SubscriberTally {
     append(processing, other.processing);
     append(ingest, other.ingest);
     append(delivery, other.delivery);
+    append(since_receive, other.since_receive);
     for (int r = 0; r < 2; ++r) {
       append(end_to_end_by_recording[r], other.end_to_end_by_recording[r]);
       append(processing_by_recording[r], other.processing_by_recording[r]);

@@ -163,7 +163,9 @@ int main(int argc, char** argv) {
     uint64_t frame_bytes = 0;
     bool announced = false;
     double first_frame_seconds = 0;  // from connecting (MeshInfo and Model included)
+    std::chrono::steady_clock::time_point first_frame_at{}, last_frame_at{};
     uint64_t bytes_before_first_frame = 0;
+    uint32_t subscriber_dropped_before_first = 0;  // while MeshInfo and the Model were on their way
     Percentiles since_publish, since_receive, end_to_end, decode;
     const auto start = std::chrono::steady_clock::now();
     auto last_report = start;
@@ -196,9 +198,10 @@ int main(int argc, char** argv) {
       const client::Mesh& mesh = sub.mesh();
       if (!announced) {
         announced = true;
-        first_frame_seconds =
-            std::chrono::duration<double>(std::chrono::steady_clock::now() - connecting).count();
+        first_frame_at = std::chrono::steady_clock::now();
+        first_frame_seconds = std::chrono::duration<double>(first_frame_at - connecting).count();
         bytes_before_first_frame = sub.bytes_received();
+        subscriber_dropped_before_first = frame.subscriber_dropped;
         if (!json)
           std::printf("mesh: %u vertices, %zu faces, %zu markers, %u parts, %.2f Hz, subject \"%s\", encoding %s%s\n", mesh.vertex_count,
                       mesh.indices.size() / 3, mesh.marker_names.size(), mesh.part_count, mesh.source_rate_hz, printable_text(mesh.subject).c_str(),
@@ -210,6 +213,7 @@ int main(int argc, char** argv) {
         }
       }
       ++frames;
+      last_frame_at = std::chrono::steady_clock::now();
       frame_bytes += frame.message_bytes;
       if (static_cast<int64_t>(frame.frame_number) <= last_frame_number) ++out_of_order;
       last_frame_number = frame.frame_number;
@@ -279,6 +283,10 @@ int main(int argc, char** argv) {
         {"frames_per_second", seconds > 0 ? frames / seconds : 0.0},
         {"megabytes", sub.bytes_received() / 1e6},
         {"first_frame_seconds", first_frame_seconds},
+        // Once in: its wait for MeshInfo and the Model left out.
+        {"frames_per_second_after_first",
+         frames > 1 ? (frames - 1) / std::chrono::duration<double>(last_frame_at - first_frame_at).count()
+                    : 0.0},
         {"bytes_before_first_frame", bytes_before_first_frame},
         {"encoding", sub.has_mesh() ? client::to_string(sub.mesh().encoding) : "none"},
         {"bytes_per_frame", frames > 0 ? static_cast<double>(frame_bytes) / frames : 0.0},
@@ -288,6 +296,7 @@ int main(int argc, char** argv) {
         {"frames_rejected", sub.frames_rejected()},
         {"pipeline_dropped", pipeline_dropped},
         {"subscriber_dropped", subscriber_dropped},
+        {"subscriber_dropped_after_first", subscriber_dropped - subscriber_dropped_before_first},
         {"saved", saved},
         {"recorded", recording ? recording->sample_count() : 0},
         {"decode", decode.summary()},

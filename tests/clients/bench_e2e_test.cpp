@@ -51,7 +51,7 @@ TEST(BenchProgram, ShortRunReportsEveryFrameItCounted) {
   // Every received frame is timed, end to end and in the daemon.
   EXPECT_EQ(j["end_to_end"]["count"].get<long>(), received - frames["without_send_time"].get<long>());
   EXPECT_EQ(j["daemon_processing"]["count"].get<long>(), received);
-  for (const char* key : {"end_to_end", "daemon_processing", "ingest", "delivery"}) {
+  for (const char* key : {"end_to_end", "daemon_processing", "ingest", "delivery", "since_receive"}) {
     SCOPED_TRACE(key);
     const auto& s = j[key];
     EXPECT_GT(s["p50_ms"].get<double>(), 0.0);
@@ -136,6 +136,23 @@ TEST(BenchProgram, AJoinWaveIsReportedApartFromTheWatchers) {
   EXPECT_NE(late.exit_code, 0);
   EXPECT_NE(late.output.find("--join-after-seconds must be less than --seconds"), std::string::npos)
       << late.output;
+}
+
+// --joiner-processes: each joiner is a skinstream-sub process; their summaries are gathered.
+TEST(BenchProgram, JoinerProcessesReportTheirOwnSummaries) {
+  const test::ProgramRun r = test::run_program(
+      bench("--subject " + kDemo + "/subject.sksubj --recording " + kDemo +
+            "/live.c3d --seconds 3 --subscribers 1 --encoding parameters "
+            "--join-wave 2 --join-after-seconds 1 --joiner-processes --joiner-nice 5 --json"),
+      /*stderr_too=*/false);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto j = nlohmann::json::parse(r.output);
+  const auto& processes = j["join_wave"]["processes"];
+  EXPECT_EQ(processes["processes"], 2);
+  EXPECT_EQ(processes["failed"], 0) << processes["first_error"];
+  EXPECT_GT(processes["first_frame_seconds"]["max"].get<double>(), 0.0);
+  EXPECT_GT(processes["frames_per_second_after_first"]["slowest"].get<double>(), 10.0);
+  EXPECT_TRUE(j["subscribers_want"]["joiner_processes"].get<bool>());
 }
 
 // Recording A/B in one run: takes start and stop through the control API, and the figures are
