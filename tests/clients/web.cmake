@@ -18,6 +18,7 @@ else()
 
   set(web_tests ${CMAKE_CURRENT_SOURCE_DIR}/web)
   add_test(NAME web.units COMMAND ${SKINSTREAM_NODE} --test ${web_tests}/protocol_test.mjs ${web_tests}/model_message_test.mjs
+    ${web_tests}/packed_message_test.mjs
     ${web_tests}/compressed_decoder_test.mjs ${web_tests}/evaluation_tables_test.mjs)
   set_tests_properties(web.units PROPERTIES FIXTURES_REQUIRED web_bundle TIMEOUT ${time_limit_300})
 

@@ -358,7 +358,7 @@ window.skinstreamViewer = Object.freeze({
 worker.postMessage({
   kind: 'start',
   url: streamUrl,
-  hello: { wants: Wants.NORMALS | Wants.MARKERS | Wants.PACED, encoding: requested.encoding, subject: params.get('subject') || '', token: params.get('token') || '' },
+  hello: { wants: Wants.NORMALS | Wants.MARKERS | Wants.PACED | Wants.PACKED, encoding: requested.encoding, subject: params.get('subject') || '', token: params.get('token') || '' },
 });
 installSubjectPicker(document.getElementById('panel'), params);
 setInterval(updateStatus, STATUS_INTERVAL_MS);

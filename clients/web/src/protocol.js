@@ -10,7 +10,7 @@ export const HEADER_BYTES = 12;
 export const MAX_PAYLOAD_BYTES = 64 * 1024 * 1024;
 const MAX_HELLO_STRING_BYTES = 256;
 
-export const MessageType = Object.freeze({ HELLO: 1, MESH_INFO: 2, FRAME: 3, STATUS: 4, ACK: 5, MODEL: 6 });
+export const MessageType = Object.freeze({ HELLO: 1, MESH_INFO: 2, FRAME: 3, STATUS: 4, ACK: 5, MODEL: 6, PACKED: 7 });
 
 // How the positions travel (version 2 Hello, MeshInfo and Status).
 export const Encoding = Object.freeze({ FLOAT: 0, QUANTISED: 1, COMPRESSED: 2, PARAMETERS: 3 });
@@ -19,7 +19,8 @@ export const ENCODING_NAMES = Object.freeze(['float', 'quantised', 'compressed',
 // PACED: this side sends Ack for every Frame and the daemon keeps at most PACED_WINDOW Frames
 // unacknowledged, so a slow page never has seconds of frames queued in front of it.
 // QUANTISED is version 1 only (version 2 names the encoding instead).
-export const Wants = Object.freeze({ NORMALS: 1, QUANTISED: 2, MARKERS: 4, NO_MESH: 8, PACED: 16 });
+// PACKED (version 2): MeshInfo and the Model come as Packed messages (packed_message.js).
+export const Wants = Object.freeze({ NORMALS: 1, QUANTISED: 2, MARKERS: 4, NO_MESH: 8, PACED: 16, PACKED: 32 });
 export const PACED_WINDOW = 2;
 export const FrameFlags = Object.freeze({
   NORMALS: 1, QUANTISED: 2, MARKERS: 4, NO_POSITIONS: 8, // both versions
@@ -67,7 +68,7 @@ const utf8Encoder = new TextEncoder();
 // Hello: version 1 carries the wants alone; version 2 also the encoding, the subject's name
 // (empty: the daemon's first subject) and the daemon's shared token (empty when it has none).
 export function encodeHello(wants, { version = PROTOCOL_VERSION, encoding = Encoding.PARAMETERS, subject = '', token = '' } = {}) {
-  const allowed = version === 1 ? 0x1f : 0x1d;
+  const allowed = version === 1 ? 0x1f : 0x3d;
   if ((wants & ~allowed) !== 0) throw new ProtocolError(`Hello wants 0x${wants.toString(16)} has bits version ${version} does not define`);
   if (version === 1) {
     const buffer = new ArrayBuffer(HEADER_BYTES + 4);
@@ -112,7 +113,7 @@ export function readHeader(view, version = PROTOCOL_VERSION) {
   const messageVersion = view.getUint16(4, true);
   if (messageVersion !== version) throw new ProtocolError(`protocol version ${messageVersion}, expected ${version}`);
   const type = view.getUint16(6, true);
-  const lastType = version >= 2 ? MessageType.MODEL : MessageType.ACK;
+  const lastType = version >= 2 ? MessageType.PACKED : MessageType.ACK;
   if (type < MessageType.HELLO || type > lastType) throw new ProtocolError(`unknown message type ${type}`);
   const payload = view.getUint32(8, true);
   if (payload > MAX_PAYLOAD_BYTES) throw new ProtocolError(`payload of ${payload} bytes is over the 64 MiB limit`);

@@ -1,7 +1,10 @@
 // The WebSocket to the daemon's /stream: sends a version 2 Hello first, hands each binary
 // message to the listener, acknowledges each Frame when the Hello asked for pacing, and
 // reconnects with exponential backoff whenever the socket closes.
-import { encodeAck, encodeHello, MessageType, ProtocolError, Wants } from './protocol.js';
+import { encodeAck, encodeHello, MessageType, ProtocolError, readHeader, Wants } from './protocol.js';
+import { unpackMessage } from './packed_message.js';
+
+const isPacked = (data) => data.byteLength >= 8 && new DataView(data).getUint16(6, true) === MessageType.PACKED;
 
 export const ConnectionState = Object.freeze({ CONNECTING: 'connecting', OPEN: 'open', CLOSED: 'closed' });
 
@@ -15,12 +18,47 @@ export class StreamConnection {
     this.url = url;
     this.hello = encodeHello(hello.wants, hello);
     this.paced = (hello.wants & Wants.PACED) !== 0;
+    this.packed = (hello.wants & Wants.PACKED) !== 0;
     this.listener = listener;
     this.state = ConnectionState.CLOSED;
     this.retryMs = FIRST_RETRY_MS;
     this.reconnects = 0;
     this.socket = null;
     this.retryTimer = 0;
+    this.waiting = 0; // messages held behind a Packed one being inflated
+    this.queue = Promise.resolve();
+  }
+
+  async unpack(data) {
+    readHeader(new DataView(data));
+    if (!this.packed) throw new ProtocolError('the daemon sent a Packed message, which this page did not ask for');
+    return unpackMessage(data);
+  }
+
+  // One plain message to the listener (and its Ack when paced).
+  deliver(socket, data) {
+    try {
+      // Read before the listener runs: it may transfer the buffer to the page (detaching it).
+      let ack = null;
+      if (this.paced && data.byteLength >= 16) {
+        const view = new DataView(data);
+        if (view.getUint16(6, true) === MessageType.FRAME) ack = encodeAck(view.getUint32(12, true));
+      }
+      this.listener.onMessage(data);
+      // Acked on arrival: the window then bounds what waits in the sockets, and the worker
+      // keeps only the newest frame for the page.
+      if (ack) socket.send(ack);
+    } catch (error) {
+      this.fail(socket, error);
+    }
+  }
+
+  fail(socket, error) {
+    if (!(error instanceof ProtocolError)) throw error;
+    if (this.socket !== socket) return;
+    this.listener.onProtocolError(error);
+    this.lastError = error.message;
+    this.abort(error);
   }
 
   start() {
@@ -58,23 +96,21 @@ export class StreamConnection {
         this.abort(new ProtocolError('text message on a binary protocol'));
         return;
       }
-      try {
-        // Read before the listener runs: it may transfer the buffer to the page (detaching it).
-        let ack = null;
-        if (this.paced && event.data.byteLength >= 16) {
-          const view = new DataView(event.data);
-          if (view.getUint16(6, true) === MessageType.FRAME) ack = encodeAck(view.getUint32(12, true));
-        }
-        this.listener.onMessage(event.data);
-        // Acked on arrival: the window then bounds what waits in the sockets, and the worker
-        // keeps only the newest frame for the page.
-        if (ack) socket.send(ack);
-      } catch (error) {
-        if (!(error instanceof ProtocolError)) throw error;
-        this.listener.onProtocolError(error);
-        this.lastError = error.message;
-        this.abort(error);
+      // A Packed message is inflated asynchronously: it and every message behind it wait their
+      // turn, so the listener still gets them in order.
+      if (this.waiting === 0 && !isPacked(event.data)) {
+        this.deliver(socket, event.data);
+        return;
       }
+      const data = event.data;
+      ++this.waiting;
+      this.queue = this.queue
+        .then(async () => {
+          if (this.socket !== socket) return; // closed meanwhile: a new connection starts afresh
+          this.deliver(socket, isPacked(data) ? await this.unpack(data) : data);
+        })
+        .catch((error) => this.fail(socket, error))
+        .finally(() => { --this.waiting; });
     };
     socket.onclose = (event) => {
       if (this.socket !== socket) return;

@@ -133,7 +133,8 @@ test('another magic, version, type or a payload over the limit is rejected', () 
   rejects(patched(buffer, (v) => v.setUint8(0, 0x58)), /magic/, 'bad magic');
   rejects(patched(buffer, (v) => v.setUint16(4, 1, true)), /version 1, expected 2/, 'version 1');
   rejects(patched(buffer, (v) => v.setUint16(4, 3, true)), /version 3/, 'version 3');
-  rejects(patched(buffer, (v) => v.setUint16(6, 7, true)), /unknown message type 7/, 'type 7');
+  rejects(patched(buffer, (v) => v.setUint16(6, 8, true)), /unknown message type 8/, 'type 8');
+  rejects(patched(readFixture('status.bin'), (v) => v.setUint16(6, MessageType.PACKED, true)), /unknown message type 7/, 'a Packed message in version 1', 1);
   rejects(patched(readFixture('status.bin'), (v) => v.setUint16(6, MessageType.MODEL, true)), /unknown message type 6/, 'a Model in version 1', 1);
   rejects(patched(buffer, (v) => v.setUint32(8, 64 * 1024 * 1024 + 1, true)), /over the 64 MiB limit/, 'payload over the limit');
 });

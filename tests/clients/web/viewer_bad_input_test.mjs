@@ -17,7 +17,7 @@ import path from 'node:path';
 import { launchChromium, waitUntil, readDrawnFrame } from './support/browser.mjs';
 import { worstDistance, worstAngleDegrees } from './support/comparisons.mjs';
 import { ScriptedServer } from './support/scripted_server.mjs';
-import { repoRoot, resized, patched } from './support/fixtures.mjs';
+import { repoRoot, resized, patched, readFixture } from './support/fixtures.mjs';
 import {
   Encoding, makeSheetSubject, makeParameters, evaluateAsSpecified, vertexNormals, onGrid,
   encodeMeshInfo, encodeModel, encodeParameterFrame, encodeCompressedFrame,
@@ -53,11 +53,11 @@ async function main() {
     page.on('console', (message) => { if (message.type() === 'error') consoleErrors.push(message.text()); });
     await page.goto(`http://127.0.0.1:${port}/`);
 
-    // The Hello: version 2, parameters by default, normals, markers and pacing wanted.
+    // The Hello: version 2, parameters by default, normals, markers, pacing and packed MeshInfo and Model wanted.
     let connection = await server.nextConnection();
     const hello = new DataView(connection.hello);
     assert.equal(hello.getUint16(4, true), 2, 'the page speaks version 2');
-    assert.equal(hello.getUint32(12, true), 1 | 4 | 16, 'wants: normals, markers, paced');
+    assert.equal(hello.getUint32(12, true), 1 | 4 | 16 | 32, 'wants: normals, markers, paced, packed');
     assert.equal(hello.getUint32(16, true), Encoding.PARAMETERS, 'the page asks for parameters by default');
 
     let frameNumber = 0;
@@ -130,6 +130,8 @@ async function main() {
       ['an influence of a part past the count', () => [encodeMeshInfo(subject), encodeModel(subject, { partOf: (k, part) => (k === 7 ? 2 : part) })],
         /influenced by part 2 of 2/],
       ['a Model of version 1', () => [encodeMeshInfo(subject), encodeModel(subject, { version: 1 })], /protocol version 1, expected 2/],
+      ['a Packed MeshInfo whose stream is corrupt', () => [patched(readFixture('packed_mesh_info_v2.bin'), (v) => v.setUint8(43, v.getUint8(43) ^ 0xff))],
+        /Packed: the deflated stream is corrupt/],
       ['a compressed vertex order past the vertex count', () => [encodeMeshInfo(subject, { encoding: Encoding.COMPRESSED,
         order: Uint32Array.from({ length: subject.vertexCount }, (_, i) => (i === 5 ? subject.vertexCount : i)) })], /names vertex 96 \(V = 96\)/],
     ];
