@@ -1,8 +1,8 @@
 #pragma once
 // Cuts a QTM RT byte stream (TCP) into whole packets. Bytes go in as they arrive, in any pieces;
 // whole packets come out. A size field below the header or above the limit stops the stream with
-// a one-line reason: the stream cannot be resynchronised after it and must be closed. The buffer
-// is reused, so a framer fed packets of steady size stops allocating.
+// a one-line reason: the stream cannot be resynchronised after it and must be closed. The bytes
+// wait in a StreamBuffer, so a framer fed packets of steady size stops allocating.
 
 #include <cstdint>
 #include <span>
@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "protocol/qtm/qtm_rt.h"
+#include "protocol/stream_buffer.h"
 
 namespace skinstream::qtm {
 
@@ -20,23 +21,23 @@ class PacketFramer {
   explicit PacketFramer(uint32_t max_packet_bytes = kMaxPacketBytes) : max_bytes_(max_packet_bytes) {}
 
   // Room for `size` more bytes (a socket reads straight into it); then commit what was written.
-  std::span<unsigned char> prepare(size_t size);
-  void commit(size_t size);
-  void feed(Bytes bytes);  // prepare + copy + commit
-  void reserve(size_t bytes);  // sizes (and touches) the buffer now, so it need not grow later
+  std::span<unsigned char> prepare(size_t size) { return stream_.prepare(size); }
+  void commit(size_t size) { stream_.commit(size); }
+  void feed(Bytes bytes) { stream_.feed(bytes); }  // prepare + copy + commit
+  void reserve(size_t bytes) {
+    stream_.reserve(bytes);
+  }  // sizes (and touches) the buffer now, so it need not grow later
 
   // The next whole packet, header included; valid until the next prepare(), feed() or next().
   Status next(Bytes& out_packet);
 
   const std::string& error() const { return error_; }
-  size_t buffered() const { return end_ - begin_; }
+  size_t buffered() const { return stream_.buffered(); }
   void reset();  // forget everything, an error included (a new connection)
 
  private:
   uint32_t max_bytes_;
-  std::vector<unsigned char> buffer_;
-  size_t begin_ = 0;  // first unread byte
-  size_t end_ = 0;    // one past the last written byte
+  StreamBuffer stream_;
   std::string error_;
 };
 

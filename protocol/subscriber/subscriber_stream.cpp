@@ -585,33 +585,12 @@ Status decode_status(std::span<const unsigned char> payload, uint16_t version) {
   });
 }
 
-void StreamDecoder::feed(std::span<const unsigned char> bytes) {
-  const std::span<unsigned char> room = prepare(bytes.size());
-  std::copy(bytes.begin(), bytes.end(), room.begin());
-  commit(bytes.size());
-}
-
-std::span<unsigned char> StreamDecoder::prepare(size_t bytes) {
-  if (consumed_ == filled_) consumed_ = filled_ = 0;  // everything was cut: start at the front for free
-  if (buffer_.size() - filled_ < bytes) {
-    // Move what is not cut yet (at most one partial message) to the front, then grow if need be.
-    std::copy(buffer_.begin() + static_cast<std::ptrdiff_t>(consumed_), buffer_.begin() + static_cast<std::ptrdiff_t>(filled_),
-              buffer_.begin());
-    filled_ -= consumed_;
-    consumed_ = 0;
-    if (buffer_.size() - filled_ < bytes) buffer_.resize(filled_ + bytes);
-  }
-  return std::span(buffer_).subspan(filled_, bytes);
-}
-
-void StreamDecoder::commit(size_t bytes) { filled_ += std::min(bytes, buffer_.size() - filled_); }
-
 std::optional<RawMessage> StreamDecoder::next() {
-  const std::span<const unsigned char> pending(buffer_.data() + consumed_, filled_ - consumed_);
+  const std::span<const unsigned char> pending = stream_.unread();
   if (pending.size() < kHeaderBytes) return std::nullopt;
   const MessageHeader header = decode_header(pending, max_payload_);
   if (pending.size() - kHeaderBytes < header.payload_bytes) return std::nullopt;
-  consumed_ += kHeaderBytes + header.payload_bytes;
+  stream_.consume(kHeaderBytes + header.payload_bytes);
   return RawMessage{header.type, pending.subspan(kHeaderBytes, header.payload_bytes), header.version};
 }
 

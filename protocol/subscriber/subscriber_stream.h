@@ -17,6 +17,8 @@
 #include <string>
 #include <vector>
 
+#include "protocol/stream_buffer.h"
+
 namespace skinstream::subscriber {
 
 inline constexpr uint32_t kMagic = 0x46534B53;  // "SKSF"
@@ -265,20 +267,18 @@ struct RawMessage {
 class StreamDecoder {
  public:
   explicit StreamDecoder(uint32_t max_payload = kMaxPayloadBytes) : max_payload_(max_payload) {}
-  void feed(std::span<const unsigned char> bytes);
+  void feed(std::span<const unsigned char> bytes) { stream_.feed(bytes); }
   // Reading straight into the decoder, without a copy: prepare() gives room for at least
   // `bytes` more, the socket reads into it, commit() says how many it wrote.
-  std::span<unsigned char> prepare(size_t bytes);
-  void commit(size_t bytes);
+  std::span<unsigned char> prepare(size_t bytes) { return stream_.prepare(bytes); }
+  void commit(size_t bytes) { stream_.commit(bytes); }
   // The next complete message, or nullopt when more bytes are needed. Throws DecodeError.
   std::optional<RawMessage> next();
-  size_t buffered() const { return filled_ - consumed_; }
+  size_t buffered() const { return stream_.buffered(); }
 
  private:
   uint32_t max_payload_;
-  std::vector<unsigned char> buffer_;  // storage; [consumed_, filled_) is not yet cut
-  size_t filled_ = 0;
-  size_t consumed_ = 0;
+  StreamBuffer stream_;
 };
 
 }  // namespace skinstream::subscriber
