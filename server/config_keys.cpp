@@ -572,11 +572,12 @@ std::vector<ConfigKey> make_config_keys() {
             {.name = "subscriber_join_mbit",
              .doc =
         "What joining subscribers are sent first (MeshInfo, about 1.3 MB for the demo body, and\n"
-        "the Model, about 1 MB) goes out at most this fast, all joiners together (Mbit/s), so that\n"
-        "the frames of the subscribers already watching go first on the link: 60 render nodes\n"
-        "restarting at once otherwise put 140 MB on a gigabit in one burst, and the watchers' frames\n"
-        "queue behind it. Below the stage link's rate less the frames' (64 parameter subscribers:\n"
-        "about 480 Mbit/s). 0 = unpaced."},
+        "the Model, about 1 MB; 0.85 MB together for subscribers that read them packed) goes out\n"
+        "at most this fast, all joiners together (Mbit/s), so that the frames of the subscribers\n"
+        "already watching go first on the link: 60 render nodes restarting at once otherwise put\n"
+        "50-140 MB on a gigabit in one burst, and the watchers' frames queue behind it. Below the\n"
+        "stage link's rate less the frames' (64 parameter subscribers: about 480 Mbit/s). 0 =\n"
+        "unpaced."},
             between(0, 100'000), "0-100000 (0 = unpaced)"),
       bound(&DaemonConfig::record_dir,
             {.name = "record_dir", .flag = "--record-dir", .new_group = true,
