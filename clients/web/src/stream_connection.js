@@ -16,9 +16,11 @@ export class StreamConnection {
   // listener: { onOpen(), onMessage(ArrayBuffer), onProtocolError(error), onClose(reason, retryInMs) }
   constructor(url, hello, listener) {
     this.url = url;
-    this.hello = encodeHello(hello.wants, hello);
     this.paced = (hello.wants & Wants.PACED) !== 0;
-    this.packed = (hello.wants & Wants.PACKED) !== 0;
+    // Packed MeshInfo and Model only where the platform inflates (DecompressionStream).
+    const packed = (hello.wants & Wants.PACKED) !== 0 && typeof DecompressionStream === 'function';
+    this.hello = encodeHello(packed ? hello.wants : hello.wants & ~Wants.PACKED, hello);
+    this.packed = packed;
     this.listener = listener;
     this.state = ConnectionState.CLOSED;
     this.retryMs = FIRST_RETRY_MS;
@@ -109,7 +111,9 @@ export class StreamConnection {
           if (this.socket !== socket) return; // closed meanwhile: a new connection starts afresh
           this.deliver(socket, isPacked(data) ? await this.unpack(data) : data);
         })
-        .catch((error) => this.fail(socket, error))
+        // A fault that is not the daemon's (a bug here) ends this connection too: the messages
+        // behind it must not be read out of order.
+        .catch((error) => this.fail(socket, error instanceof ProtocolError ? error : new ProtocolError(`unpacking: ${error}`)))
         .finally(() => { --this.waiting; });
     };
     socket.onclose = (event) => {
