@@ -160,7 +160,7 @@ def unpack(payload, max_payload=MAX_PAYLOAD):
         raise ProtocolError(f'Packed: its {count_name} needs {4 * count} bytes, the unpacked size leaves {rest_bytes}')
     inflater = zlib.decompressobj()
     try:
-        rest = inflater.decompress(stream, rest_bytes)
+        rest = inflater.decompress(stream, rest_bytes or 1)  # (a max_length of 0 would mean no limit)
     except zlib.error as e:
         raise ProtocolError(f'Packed: the deflated stream is corrupt ({e})') from None
     if inflater.unconsumed_tail:

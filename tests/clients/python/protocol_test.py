@@ -5,6 +5,7 @@ import os
 import struct
 import sys
 import unittest
+import zlib
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', '..'))
 from support.python_clients import fixture  # noqa: E402
@@ -165,6 +166,11 @@ class Packed(unittest.TestCase):
         for n in range(len(good)):
             with self.assertRaises(wire.ProtocolError, msg=f'cut at {n}'):
                 wire.unpack(good[:n])
+        # Counts alone unpacked, and a stream that would make 10 MB: refused without making them
+        # (zlib reads a limit of 0 as none).
+        bomb = struct.pack('<HHI', wire.MODEL, 0, 16) + bytes(16) + zlib.compress(bytes(10 << 20), 9)
+        with self.assertRaisesRegex(wire.ProtocolError, 'makes more than the unpacked size 0'):
+            wire.unpack(bomb)
 
 
 if __name__ == '__main__':
