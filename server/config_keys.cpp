@@ -572,7 +572,7 @@ std::vector<ConfigKey> make_config_keys() {
             {.name = "subscriber_join_mbit",
              .doc =
         "What joining subscribers are sent first (MeshInfo, about 1.3 MB for the demo body, and\n"
-        "the Model, about 1 MB; 0.85 MB together for subscribers that read them packed) goes out\n"
+        "the Model, about 1 MB; 0.84 MB together for subscribers that read them packed) goes out\n"
         "at most this fast, all joiners together (Mbit/s), so that the frames of the subscribers\n"
         "already watching go first on the link: 60 render nodes restarting at once otherwise put\n"
         "50-140 MB on a gigabit in one burst, and the watchers' frames queue behind it. Below the\n"

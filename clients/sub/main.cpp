@@ -72,7 +72,7 @@ int main(int argc, char** argv) {
   app.add_flag("--paced", paced, "acknowledge each frame: at most 2 in flight");
   app.add_flag(
       "--plain-first-contact", plain_first_contact,
-      "ask for MeshInfo and the Model plain (default: packed, about 2.9 times fewer bytes; protocol 2)");
+      "ask for MeshInfo and the Model plain (default: packed, about 2.8 times fewer bytes; protocol 2)");
   app.add_option("--subject", subject, "the subject's name (protocol 2; default: the daemon's first)");
   std::string token_file;
   double timeout_seconds = 10.0;

@@ -52,7 +52,7 @@ inline constexpr uint32_t kWantNoMesh = 1u << 3;
 // socket buffers hold.
 inline constexpr uint32_t kWantPaced = 1u << 4;
 inline constexpr uint32_t kWantAll = 0x1F;
-// Version 2 only. Packed: the subscriber reads MeshInfo and Model as Packed messages, about 2.9
+// Version 2 only. Packed: the subscriber reads MeshInfo and Model as Packed messages, about 2.8
 // times fewer bytes when it joins (the daemon may still send them plain).
 inline constexpr uint32_t kWantPacked = 1u << 5;
 inline constexpr uint32_t kWantAllVersion2 =

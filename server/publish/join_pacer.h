@@ -1,6 +1,6 @@
 #pragma once
 // The bytes a subscriber is sent when it joins (MeshInfo, about 1.3 MB for the demo body, and the
-// Model, about 1 MB; 0.85 MB together packed), paced together for all joiners so that the frames of the
+// Model, about 1 MB; 0.84 MB together packed), paced together for all joiners so that the frames of the
 // subscribers already watching go first on the same link. Unpaced, 60 render nodes joining at once put about
 // 140 MB on a gigabit link in one burst: the stage switch's queue (or the shaper's) fills and
 // every watcher's frames wait behind it (p99 57.6 ms, 116 frames dropped for 4 watchers).

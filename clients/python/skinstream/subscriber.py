@@ -51,7 +51,7 @@ class Subscriber:
     is skipped instead, counted in frames_rejected with the reason in last_rejection, and logged
     as a warning ('skinstream' logger) at most once a second.
     libraries=False decodes in numpy even where libmeshoptimizer or libskinstream_client load.
-    packed=False asks for MeshInfo and the Model plain instead of packed (deflated; about 2.9
+    packed=False asks for MeshInfo and the Model plain instead of packed (deflated; about 2.8
     times fewer bytes to wait for as the subscriber joins)."""
 
     def __init__(self, host='127.0.0.1', port=8481, encoding='parameters', normals=True, markers=False, mesh=True,
@@ -73,7 +73,7 @@ class Subscriber:
         if protocol_version == 1 and self.encoding_asked == wire.QUANTISED:
             wants |= wire.WANT_QUANTISED
         if protocol_version == 2 and packed:
-            wants |= wire.WANT_PACKED  # MeshInfo and the Model deflated: about 2.9 times fewer bytes as it joins
+            wants |= wire.WANT_PACKED  # MeshInfo and the Model deflated: about 2.8 times fewer bytes as it joins
         self.packed = bool(wants & wire.WANT_PACKED)
         self.peer = f'{host}:{port}'
         self.mesh = None  # protocol.MeshInfo, once it came

@@ -1,5 +1,5 @@
 // The subscriber protocol's Packed message (docs/subscriber-protocol.md, type 7): a MeshInfo or
-// Model deflated, asked for with Hello's Wants.PACKED so that a joining page waits for 0.85 MB
+// Model deflated, asked for with Hello's Wants.PACKED so that a joining page waits for 0.84 MB
 // instead of 2.4 MB. unpackMessage() gives back the plain message (header and payload) that the
 // rest of the page reads as ever. Inflating is asynchronous here (DecompressionStream), so
 // StreamConnection holds the messages after a Packed one until it is unpacked.

@@ -79,7 +79,7 @@ struct Options {
   bool mesh = true;          // false: markers only, no vertices
   bool paced = false;        // acknowledge each frame: at most 2 in flight (for slow readers)
   bool evaluate = true;      // parameters: evaluate them into vertices (false: parameters only)
-  // Protocol 2: MeshInfo and the Model come packed (deflated), about 2.9 times fewer bytes to
+  // Protocol 2: MeshInfo and the Model come packed (deflated), about 2.8 times fewer bytes to
   // wait for as the subscriber joins; false asks for them plain.
   bool packed = true;
   // false: frames carry their numbers, times and markers only; positions and normals stay empty
