@@ -3,7 +3,7 @@
 // instead of 2.4 MB. unpackMessage() gives back the plain message (header and payload) that the
 // rest of the page reads as ever. Inflating is asynchronous here (DecompressionStream), so
 // StreamConnection holds the messages after a Packed one until it is unpacked.
-import { HEADER_BYTES, MAX_PAYLOAD_BYTES, MessageType, PROTOCOL_VERSION, ProtocolError } from './protocol.js';
+import { HEADER_BYTES, MAX_PAYLOAD_BYTES, MessageType, PROTOCOL_VERSION, ProtocolError, writeHeader } from './protocol.js';
 
 // A packed type's fixed counts, kept before the deflated stream: their bytes, and where among
 // them the N of the 3N-value array that follows them is.
@@ -52,10 +52,7 @@ export async function unpackMessage(buffer, maxPayload = MAX_PAYLOAD_BYTES) {
   }
   const out = new Uint8Array(HEADER_BYTES + size);
   const outView = new DataView(out.buffer);
-  outView.setUint32(0, 0x46534b53, true);
-  outView.setUint16(4, PROTOCOL_VERSION, true);
-  outView.setUint16(6, type, true);
-  outView.setUint32(8, size, true);
+  writeHeader(outView, PROTOCOL_VERSION, type, size);
   out.set(bytes.subarray(FIELD_BYTES, FIELD_BYTES + head.bytes), HEADER_BYTES);
   let at = HEADER_BYTES + head.bytes;
   const reader = new Blob([stream]).stream().pipeThrough(new DecompressionStream('deflate')).getReader();

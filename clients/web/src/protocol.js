@@ -56,7 +56,7 @@ export class ProtocolError extends Error {
 // Zero bytes after a block of this many bytes, so the next block starts at a multiple of 4.
 export const paddingTo4 = (bytes) => (4 - (bytes % 4)) % 4;
 
-function writeHeader(view, version, type, payloadBytes) {
+export function writeHeader(view, version, type, payloadBytes) {
   view.setUint32(0, MAGIC, true);
   view.setUint16(4, version, true);
   view.setUint16(6, type, true);
