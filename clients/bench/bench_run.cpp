@@ -10,16 +10,12 @@
 // so end to end = ingest + processing + delivery (+ decoding, with --decode), frame by frame.
 #include "clients/bench/bench_run.h"
 
-#include <fcntl.h>
-#include <poll.h>
 #include <sys/resource.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <atomic>
 #include <cmath>
 #include <cstdint>
-#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -27,6 +23,7 @@
 #include <optional>
 #include <thread>
 
+#include "clients/bench/child_command.h"
 #include "clients/bench/hostile_waves.h"
 #include "clients/bench/latency_samples.h"
 #include "clients/bench/replay_engine.h"
@@ -178,53 +175,30 @@ nlohmann::json join_wave_report(const BenchOptions& o, const std::vector<Subscri
 // `limit` passes (then killed). Its summary (the JSON it prints last), or {"error": ...}.
 nlohmann::json run_joiner_process(const BenchOptions& o, const std::string& address, int port, long frames,
                                   std::chrono::seconds limit) {
-  std::vector<std::string> args = {(own_folder() / "skinstream-sub").string(),
+  std::vector<std::string> argv = {(own_folder() / "skinstream-sub").string(),
                                    address + ":" + std::to_string(port),
                                    "--encoding",
                                    client::to_string(o.encoding),
                                    "--frames",
                                    std::to_string(frames)};
-  if (o.normals) args.push_back("--normals");
-  if (o.paced) args.push_back("--paced");
-  if (o.decode) args.push_back("--evaluate");
-  if (o.plain_first_contact) args.push_back("--plain-first-contact");
-  std::vector<char*> argv;  // made before fork: the child of a threaded process may not allocate
-  for (std::string& a : args) argv.push_back(a.data());
-  argv.push_back(nullptr);
-  int out[2];
-  if (pipe2(out, O_CLOEXEC) != 0) return {{"error", std::string("pipe: ") + std::strerror(errno)}};
-  const pid_t pid = fork();
-  if (pid == 0) {
-    if (o.joiner_nice > 0) setpriority(PRIO_PROCESS, 0, o.joiner_nice);
-    dup2(out[1], STDOUT_FILENO);
-    dup2(out[1], STDERR_FILENO);
-    execv(argv[0], argv.data());
-    _exit(127);
+  if (o.normals) argv.push_back("--normals");
+  if (o.paced) argv.push_back("--paced");
+  if (o.decode) argv.push_back("--evaluate");
+  if (o.plain_first_contact) argv.push_back("--plain-first-contact");
+  CommandResult run;
+  try {
+    run = run_command(argv, {.nice = o.joiner_nice, .limit = limit});
+  } catch (const std::runtime_error& e) {
+    return {{"error", e.what()}};
   }
-  close(out[1]);
-  std::string text;
-  const Clock::time_point give_up = Clock::now() + limit;
-  for (char buffer[4096];;) {
-    pollfd p{out[0], POLLIN, 0};
-    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(give_up - Clock::now()).count();
-    if (left <= 0 || poll(&p, 1, static_cast<int>(left)) <= 0) {
-      kill(pid, SIGKILL);
-      break;
-    }
-    const ssize_t n = read(out[0], buffer, sizeof buffer);
-    if (n <= 0) break;
-    text.append(buffer, static_cast<size_t>(n));
-  }
-  close(out[0]);
-  int status = 0;
-  waitpid(pid, &status, 0);
+  const std::string& text = run.output;
   const size_t json_start = text.find("\n{");
-  if (pid < 0 || json_start == std::string::npos || !WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+  if (json_start == std::string::npos || run.exit_code != 0) {
     const size_t last_line = text.find_last_of('\n', text.size() > 1 ? text.size() - 2 : 0);
-    return {{"error", "skinstream-sub " +
-                          std::string(WIFEXITED(status) ? "exited " + std::to_string(WEXITSTATUS(status))
-                                                        : "was killed") +
-                          ": " + text.substr(last_line == std::string::npos ? 0 : last_line + 1)}};
+    return {{"error",
+             "skinstream-sub " +
+                 std::string(run.exit_code >= 0 ? "exited " + std::to_string(run.exit_code) : "was killed") +
+                 ": " + text.substr(last_line == std::string::npos ? 0 : last_line + 1)}};
   }
   return nlohmann::json::parse(text.substr(json_start + 1), nullptr, false);
 }

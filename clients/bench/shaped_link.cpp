@@ -1,50 +1,14 @@
 #include "clients/bench/shaped_link.h"
 
-#include <sys/wait.h>
 #include <unistd.h>
 
-#include <array>
-#include <cstdio>
 #include <stdexcept>
 
+#include "clients/bench/child_command.h"
 #include "server/client/stale_namespaces.h"
 
 namespace skinstream::bench {
 namespace {
-
-struct CommandResult {
-  int exit_code = -1;
-  std::string output;  // stdout and stderr
-};
-
-// Runs argv (no shell), collecting what it prints.
-CommandResult run(const std::vector<std::string>& argv) {
-  int pipe_fds[2];
-  if (pipe(pipe_fds) != 0) throw std::runtime_error("pipe failed");
-  const pid_t pid = fork();
-  if (pid < 0) throw std::runtime_error("fork failed");
-  if (pid == 0) {
-    dup2(pipe_fds[1], STDOUT_FILENO);
-    dup2(pipe_fds[1], STDERR_FILENO);
-    close(pipe_fds[0]);
-    close(pipe_fds[1]);
-    std::vector<char*> args;
-    for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
-    args.push_back(nullptr);
-    execvp(args[0], args.data());
-    std::fprintf(stderr, "%s: not found\n", args[0]);
-    _exit(127);
-  }
-  close(pipe_fds[1]);
-  CommandResult result;
-  std::array<char, 4096> buffer;
-  for (ssize_t n; (n = read(pipe_fds[0], buffer.data(), buffer.size())) > 0;) result.output.append(buffer.data(), static_cast<size_t>(n));
-  close(pipe_fds[0]);
-  int status = 0;
-  waitpid(pid, &status, 0);
-  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return result;
-}
 
 std::string joined(const std::vector<std::string>& argv) {
   std::string text;
@@ -60,7 +24,7 @@ std::string one_line(std::string text) {
 }
 
 void must(const std::vector<std::string>& argv) {
-  const CommandResult result = run(argv);
+  const CommandResult result = run_command(argv);
   if (result.exit_code != 0) throw std::runtime_error("\"" + joined(argv) + "\" failed: " + one_line(result.output));
 }
 
@@ -69,12 +33,13 @@ void must(const std::vector<std::string>& argv) {
 ShapedLink::ShapedLink(const ShapedLinkOptions& options) {
   if (geteuid() != 0)
     throw std::runtime_error("--link-mbit needs root (CAP_NET_ADMIN) to make a network namespace and shape it with tc; run as root or leave --link-mbit out");
-  if (run({"ip", "-V"}).exit_code != 0 || run({"tc", "-V"}).exit_code != 0)
+  if (run_command({"ip", "-V"}).exit_code != 0 || run_command({"tc", "-V"}).exit_code != 0)
     throw std::runtime_error("--link-mbit needs iproute2's ip and tc (Debian: apt-get install iproute2)");
   if (options.rate_mbit < 1) throw std::runtime_error("--link-mbit must be at least 1");
   // What a bench killed before its destructor left (named after its process, now gone): the
   // namespace takes its veth pair with it.
-  for (const std::string& left_over : server::namespaces_of_dead_processes("skbench")) run({"ip", "netns", "del", left_over});
+  for (const std::string& left_over : server::namespaces_of_dead_processes("skbench"))
+    run_command({"ip", "netns", "del", left_over});
   // Names and a /30 of 10.213.0.0/16 from the process id: two benches at once do not collide.
   const unsigned id = static_cast<unsigned>(getpid()) & 0x3fff;
   namespace_ = "skbench" + std::to_string(getpid());
@@ -109,8 +74,10 @@ void ShapedLink::remove() noexcept {
   if (!made_) return;
   made_ = false;
   try {
-    run({"ip", "netns", "del", namespace_});  // takes its end of the veth pair, and so the pair, with it
-    run({"ip", "link", "del", host_link_});   // in case the pair outlived it; fails harmlessly otherwise
+    run_command(
+        {"ip", "netns", "del", namespace_});  // takes its end of the veth pair, and so the pair, with it
+    run_command(
+        {"ip", "link", "del", host_link_});  // in case the pair outlived it; fails harmlessly otherwise
   } catch (...) {
   }
 }
@@ -122,8 +89,8 @@ std::vector<std::string> ShapedLink::inside(const std::vector<std::string>& argv
 }
 
 std::string ShapedLink::shaper_stats() const {
-  const CommandResult host = run({"tc", "-s", "-j", "qdisc", "show", "dev", host_link_});
-  const CommandResult inner = run(inside({"tc", "-s", "-j", "qdisc", "show", "dev", inner_link_}));
+  const CommandResult host = run_command({"tc", "-s", "-j", "qdisc", "show", "dev", host_link_});
+  const CommandResult inner = run_command(inside({"tc", "-s", "-j", "qdisc", "show", "dev", inner_link_}));
   return "{\"to_namespace\":" + (host.exit_code == 0 ? one_line(host.output) : "null") +
          ",\"from_namespace\":" + (inner.exit_code == 0 ? one_line(inner.output) : "null") + "}";
 }
