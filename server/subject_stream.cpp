@@ -4,12 +4,12 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
-#include <cstring>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
 #include "core/deform/body_plausibility.h"
 #include "protocol/files/file_error.h"
+#include "protocol/subscriber/packed_message.h"
 #include "protocol/subscriber/subscriber_model.h"
 
 namespace skinstream::server {
@@ -183,10 +183,8 @@ void SubjectStream::pack_first_contact(Replacement& body) {
   for (const ControlMessage& m :
        {body.packed.mesh_info[static_cast<size_t>(subscriber::Encoding::Parameters)], body.packed.model}) {
     if (!m) continue;
-    uint32_t unpacked;
-    std::memcpy(&unpacked, m->data() + subscriber::kHeaderBytes + 4, sizeof unpacked);
     packed += m->size();
-    plain += subscriber::kHeaderBytes + unpacked;
+    plain += subscriber::plain_message_bytes(*m);
   }
   spdlog::info(
       "subject {}: what a parameter subscriber is sent as it joins, packed in {:.2f} s: {} bytes (plain {})",

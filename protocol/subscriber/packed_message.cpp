@@ -145,6 +145,12 @@ Unpacked decode_packed(std::span<const unsigned char> payload, uint32_t max_payl
   return out;
 }
 
+size_t plain_message_bytes(std::span<const unsigned char> packed_message) {
+  if (packed_message.size() < kHeaderBytes + kPackedFieldsBytes)
+    throw std::invalid_argument("plain_message_bytes: not a Packed message");
+  return kHeaderBytes + u32_at(packed_message.data() + kHeaderBytes + 4);
+}
+
 void set_packed_source_rate(std::span<unsigned char> packed_mesh_info, float rate_hz) {
   if (packed_mesh_info.size() < kPackedSourceRateOffset + 4)
     throw std::invalid_argument("set_packed_source_rate: not a packed MeshInfo");

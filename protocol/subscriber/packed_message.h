@@ -45,6 +45,9 @@ struct Unpacked {
 // that does not inflate to exactly that size, or counts that do not fit it.
 Unpacked decode_packed(std::span<const unsigned char> payload, uint32_t max_payload = kMaxPayloadBytes);
 
+// The size of the plain message (header included) a whole Packed message says it holds.
+size_t plain_message_bytes(std::span<const unsigned char> packed_message);
+
 // A packed MeshInfo message with another source rate (in place; the rate is outside the stream).
 void set_packed_source_rate(std::span<unsigned char> packed_mesh_info, float rate_hz);
 float packed_source_rate(std::span<const unsigned char> packed_mesh_info);

@@ -31,6 +31,7 @@ TEST(PackedMessage, MatchesGoldenBytesBothWays) {
     EXPECT_EQ(encode_packed(type, plain_payload(plain)), golden) << packed;
     const Unpacked unpacked = decode_packed(payload_of(golden));
     EXPECT_EQ(unpacked.type, type);
+    EXPECT_EQ(plain_message_bytes(golden), subscriber_fixture(plain).size());
     EXPECT_EQ(unpacked.payload, plain_payload(plain)) << packed;
   }
 }
