@@ -162,7 +162,6 @@ int main(int argc, char** argv) {
     uint32_t pipeline_dropped = 0, subscriber_dropped = 0;
     uint64_t frame_bytes = 0;
     bool announced = false;
-    double first_frame_seconds = 0;  // from connecting (MeshInfo and Model included)
     std::chrono::steady_clock::time_point first_frame_at{}, last_frame_at{};
     uint64_t bytes_before_first_frame = 0;
     uint32_t subscriber_dropped_before_first = 0;  // while MeshInfo and the Model were on their way
@@ -199,7 +198,6 @@ int main(int argc, char** argv) {
       if (!announced) {
         announced = true;
         first_frame_at = std::chrono::steady_clock::now();
-        first_frame_seconds = std::chrono::duration<double>(first_frame_at - connecting).count();
         bytes_before_first_frame = sub.bytes_received();
         subscriber_dropped_before_first = frame.subscriber_dropped;
         if (!json)
@@ -282,7 +280,9 @@ int main(int argc, char** argv) {
         {"seconds", seconds},
         {"frames_per_second", seconds > 0 ? frames / seconds : 0.0},
         {"megabytes", sub.bytes_received() / 1e6},
-        {"first_frame_seconds", first_frame_seconds},
+        // From connecting: MeshInfo and the Model included.
+        {"first_frame_seconds",
+         frames > 0 ? std::chrono::duration<double>(first_frame_at - connecting).count() : 0.0},
         // Once in: its wait for MeshInfo and the Model left out.
         {"frames_per_second_after_first",
          frames > 1 ? (frames - 1) / std::chrono::duration<double>(last_frame_at - first_frame_at).count()

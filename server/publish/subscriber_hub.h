@@ -92,7 +92,7 @@ class SubscriberHub : public FrameConsumer {
 
   // What a joining subscriber that reads Packed messages is sent (version 2, with positions):
   // the MeshInfo of each encoding and the Model, packed once per model, off the threads that
-  // write to subscribers (0.2-0.3 s for the 53,500-vertex body), so a joiner never waits for it.
+  // write to subscribers (0.4-0.5 s for the 53,500-vertex body), so a joiner never waits for it.
   struct PackedFirstContact {
     std::array<ControlMessage, subscriber::kEncodingCount> mesh_info;
     ControlMessage model;

@@ -50,7 +50,6 @@ std::string sha256_of_file(const std::string& path) {
   return hex;
 }
 
-// A subject's name as a file name: what is not a letter, digit, '-', '_' or '.' becomes '_'.
 char status_letter(uint8_t status) {
   switch (static_cast<MarkerStatus>(status)) {
     case MarkerStatus::Measured:
