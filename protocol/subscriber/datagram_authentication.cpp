@@ -53,6 +53,15 @@ DatagramTag DatagramAuthenticator::tag(std::span<const std::span<const unsigned 
   return out;
 }
 
+void check_datagram_tag(const DatagramAuthenticator& authenticator, std::span<const unsigned char> datagram,
+                        const DatagramHeader& header) {
+  if (!header.authenticated) throw DecodeError("a datagram without a tag, and this receiver has a key");
+  const std::span<const unsigned char> signed_parts[] = {
+      datagram.first(datagram.size() - kDatagramTrailerBytes)};
+  if (!authenticator.verify(signed_parts, datagram.last(kDatagramTrailerBytes)))
+    throw DecodeError("a datagram whose tag is not the key's (forged, or sent with another key)");
+}
+
 bool DatagramAuthenticator::verify(std::span<const std::span<const unsigned char>> parts, std::span<const unsigned char> given) const {
   if (given.size() != kDatagramTagBytes) return false;
   const DatagramTag expected = tag(parts);

@@ -38,6 +38,11 @@ class DatagramAuthenticator {
   States* states_;
 };
 
+// Throws DecodeError unless `datagram` (whose header is `header`) carries the tag `authenticator`
+// computes for its header and fragment.
+void check_datagram_tag(const DatagramAuthenticator& authenticator, std::span<const unsigned char> datagram,
+                        const DatagramHeader& header);
+
 inline constexpr size_t kMinDatagramKeyBytes = 16;
 
 // A key file's bytes: its first line, at least kMinDatagramKeyBytes long (a passphrase or hex).

@@ -59,14 +59,17 @@ std::optional<DatagramReassembler::Message> DatagramReassembler::add(std::span<c
   }
   const size_t fragment_size = datagram.size() - kDatagramHeaderBytes - (h.authenticated ? kDatagramTrailerBytes : 0);
   if (options_.authenticator) {
-    const std::span<const unsigned char> signed_parts[] = {datagram.first(kDatagramHeaderBytes + fragment_size)};
-    const bool authentic = h.authenticated && options_.authenticator->verify(signed_parts, datagram.last(kDatagramTrailerBytes));
-    if (!authentic) {
+    try {
+      check_datagram_tag(*options_.authenticator, datagram, h);
+    } catch (const DecodeError&) {
       ++stats_.datagrams_rejected;
       ++stats_.datagrams_unauthenticated;
-      throw DecodeError(h.authenticated ? "a datagram whose tag is not the key's (forged, or sent with another key)"
-                                        : "a datagram without a tag, and this receiver has a key");
+      throw;
     }
+  }
+  if (h.offer) {  // the offer has a port of its own
+    ++stats_.datagrams_rejected;
+    throw DecodeError("a datagram of the offer among the frames");
   }
   if (h.stream_id != options_.stream_id) {
     ++stats_.datagrams_other_stream;

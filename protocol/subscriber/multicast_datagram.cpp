@@ -15,9 +15,9 @@ size_t stride(size_t message_bytes, uint16_t count) { return (message_bytes + co
 
 }  // namespace
 
-uint16_t fragment_count(size_t message_bytes, bool authenticated) {
+uint16_t fragment_count(size_t message_bytes, bool authenticated, uint16_t max_fragments) {
   const size_t largest = authenticated ? kMaxAuthenticatedFragmentBytes : kMaxFragmentBytes;
-  if (message_bytes == 0 || message_bytes > kMaxFragments * largest) return 0;
+  if (message_bytes == 0 || message_bytes > max_fragments * largest) return 0;
   return static_cast<uint16_t>((message_bytes + largest - 1) / largest);
 }
 
@@ -32,7 +32,8 @@ void encode_datagram_header(const DatagramHeader& h, std::span<unsigned char, kD
   SpanWriter w(out);
   w.put<uint32_t>(kDatagramMagic);
   w.put<uint16_t>(kDatagramVersion);
-  w.put<uint16_t>(h.authenticated ? kDatagramAuthenticated : 0);  // flags; the other bits reserved
+  w.put<uint16_t>((h.authenticated ? kDatagramAuthenticated : 0) |
+                  (h.offer ? kDatagramOffer : 0));  // flags; the other bits reserved
   w.put<uint32_t>(h.stream_id);
   w.put<uint32_t>(h.model_id);
   w.put<uint32_t>(h.sequence);
@@ -53,9 +54,11 @@ DatagramHeader decode_datagram_header(std::span<const unsigned char> datagram) {
   const uint16_t version = r.get<uint16_t>("version");
   if (version != kDatagramVersion) throw DecodeError("multicast datagram version " + std::to_string(version) + " (this side speaks 1)");
   const uint16_t flags = r.get<uint16_t>("flags");
-  if (flags & ~kDatagramAuthenticated) throw DecodeError("reserved header bits set");
+  if (flags & ~(kDatagramAuthenticated | kDatagramOffer)) throw DecodeError("reserved header bits set");
   DatagramHeader h;
   h.authenticated = (flags & kDatagramAuthenticated) != 0;
+  h.offer = (flags & kDatagramOffer) != 0;
+  const uint16_t max_fragments = h.offer ? kMaxOfferFragments : kMaxFragments;
   const size_t largest = h.authenticated ? kMaxAuthenticatedFragmentBytes : kMaxFragmentBytes;
   const size_t trailer = h.authenticated ? kDatagramTrailerBytes : 0;
   h.stream_id = r.get<uint32_t>("stream id");
@@ -64,8 +67,9 @@ DatagramHeader decode_datagram_header(std::span<const unsigned char> datagram) {
   h.index = r.get<uint16_t>("fragment index");
   h.count = r.get<uint16_t>("fragment count");
   h.message_bytes = r.get<uint32_t>("message bytes");
-  if (h.count == 0 || h.count > kMaxFragments)
-    throw DecodeError("fragment count " + std::to_string(h.count) + " (1-" + std::to_string(kMaxFragments) + ")");
+  if (h.count == 0 || h.count > max_fragments)
+    throw DecodeError("fragment count " + std::to_string(h.count) + " (1-" + std::to_string(max_fragments) +
+                      ")");
   if (h.index >= h.count) throw DecodeError("fragment " + std::to_string(h.index) + " of " + std::to_string(h.count));
   if (h.message_bytes == 0 || stride(h.message_bytes, h.count) > largest ||
       fragment_bytes(h.message_bytes, h.count, static_cast<uint16_t>(h.count - 1)) == 0)

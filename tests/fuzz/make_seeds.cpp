@@ -230,6 +230,20 @@ int main(int argc, char** argv) {
       }
       write_bytes(out / "multicast_datagrams" / (reversed ? "last_first.bin" : "in_order.bin"), seed);
     }
+    // The golden offer's one datagram among the frame's: the offer's port is fed the same bytes.
+    {
+      std::ifstream in(fs::path(SKINSTREAM_SOURCE_DIR "/tests/protocol/fixtures/multicast") / "offer_0.bin",
+                       std::ios::binary);
+      const std::vector<unsigned char> offer{std::istreambuf_iterator<char>(in),
+                                             std::istreambuf_iterator<char>()};
+      std::vector<unsigned char> seed;
+      for (const std::vector<unsigned char>* d : {&datagrams[0], &offer, &datagrams[1]}) {
+        seed.push_back(static_cast<unsigned char>(d->size() & 0xFF));
+        seed.push_back(static_cast<unsigned char>(d->size() >> 8));
+        seed.insert(seed.end(), d->begin(), d->end());
+      }
+      write_bytes(out / "multicast_datagrams" / "with_offer.bin", seed);
+    }
   } catch (const std::exception& e) {
     std::fprintf(stderr, "fuzz_make_seeds: %s\n", e.what());
     return 1;

@@ -4,7 +4,9 @@
 // datagram is first signed with it (a tag appended, the flag set), so forged and signed ones
 // mix. Only DecodeError may be thrown, with a one-line reason; every message completed has the
 // size its datagrams said; the reassembler with the key completes only messages whose every
-// datagram it saw signed, and counts every datagram it refused for its tag.
+// datagram it saw signed, and counts every datagram it refused for its tag. The same datagrams go
+// to an OfferReassembler, as to the offer's port: an offer it completes has its datagrams' size,
+// and unpacking it (decode_offer) throws only DecodeError with one line.
 #include <cstdlib>
 #include <cstring>
 #include <vector>
@@ -12,6 +14,8 @@
 #include "fuzz/one_line_file_error.h"
 #include "protocol/subscriber/datagram_authentication.h"
 #include "protocol/subscriber/datagram_reassembler.h"
+#include "protocol/subscriber/offer_content.h"
+#include "protocol/subscriber/offer_reassembler.h"
 
 namespace subscriber = skinstream::subscriber;
 
@@ -29,6 +33,18 @@ void add(subscriber::DatagramReassembler& reassembler, std::span<const unsigned 
   }
 }
 
+void add(subscriber::OfferReassembler& reassembler, std::span<const unsigned char> datagram,
+         subscriber::OfferReassembler::Clock::time_point now) {
+  try {
+    const auto offer = reassembler.add(datagram, now);
+    if (!offer) return;
+    if (offer->bytes.size() != offer->header.message_bytes) std::abort();
+    subscriber::decode_offer(offer->bytes, offer->header.model_id);
+  } catch (const subscriber::DecodeError& e) {
+    skinstream::fuzz::expect_one_printable_line(e.what());
+  }
+}
+
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
@@ -36,6 +52,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   subscriber::DatagramReassembler plain({.stream_id = 0, .window = std::chrono::milliseconds(20)});
   subscriber::DatagramReassembler keyed(
       {.stream_id = 0, .window = std::chrono::milliseconds(20), .max_ahead = 120, .resync_after = std::chrono::milliseconds(100), .authenticator = authenticator});
+  subscriber::OfferReassembler offer({.stream_id = 0, .stale_after = std::chrono::milliseconds(20)});
   subscriber::DatagramReassembler::Clock::time_point now{};
   std::vector<unsigned char> signed_datagram;
   uint64_t unsigned_seen = 0;
@@ -48,6 +65,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     at += n;
     now += std::chrono::milliseconds(5);
     add(plain, datagram, now);
+    add(offer, datagram, now);
     if (k % 2 == 1 && n >= subscriber::kDatagramHeaderBytes) {
       // Signed as the daemon would: the flag set, the tag of header and fragment appended.
       signed_datagram.assign(datagram.begin(), datagram.end());

@@ -36,7 +36,7 @@ TEST(MulticastDatagram, BadDatagramsAreRejectedWithTheRuleTheyBreak) {
   EXPECT_NE(rejection(oversized).find("over the 1400"), std::string::npos);
   EXPECT_NE(rejection(with<uint32_t>(good, 0, 0x46534B53)).find("bad magic"), std::string::npos);  // a TCP message's magic
   EXPECT_NE(rejection(with<uint16_t>(good, 4, 2)).find("version 2"), std::string::npos);
-  EXPECT_NE(rejection(with<uint16_t>(good, 6, 2)).find("reserved"), std::string::npos);
+  EXPECT_NE(rejection(with<uint16_t>(good, 6, 4)).find("reserved"), std::string::npos);
   EXPECT_NE(rejection(with<uint16_t>(good, 6, kDatagramAuthenticated)).find("holds 932 bytes, not 964"), std::string::npos);  // no tag
   EXPECT_NE(rejection(with<uint16_t>(good, 20, 2)).find("fragment 2 of 2"), std::string::npos);
   EXPECT_NE(rejection(with<uint16_t>(good, 22, 0)).find("fragment count 0"), std::string::npos);
@@ -78,6 +78,47 @@ TEST(MulticastDatagram, MatchesGoldenBytesBothWays) {
   const FrameView view = view_frame(std::span(message).subspan(kHeaderBytes), kVersion2);
   EXPECT_EQ(view.info.flags, kFrameParameters);
   EXPECT_EQ(view.positions.size(), parameter_block_bytes(10, 20));
+}
+
+// offer_0.bin, written from the spec by make_fixtures.py: the offer of the subscriber fixtures'
+// packed MeshInfo and Model, in one datagram with the offer flag.
+TEST(MulticastDatagram, TheOffersDatagramMatchesGoldenBytesBothWays) {
+  const ByteVector golden = fixture_bytes("multicast/offer_0.bin");
+  const DatagramHeader h = decode_datagram_header(golden);
+  EXPECT_TRUE(h.offer);
+  EXPECT_FALSE(h.authenticated);
+  EXPECT_EQ(h.sequence, 3u);  // its edition
+  EXPECT_EQ(h.count, 1);
+  EXPECT_EQ(h.message_bytes, golden.size() - kDatagramHeaderBytes);
+  const ByteVector model = fixture_bytes("subscriber/model.bin");
+  EXPECT_EQ(h.model_id, model_id_of(std::span(model).subspan(kHeaderBytes)));
+  ByteVector encoded(kDatagramHeaderBytes);
+  encode_datagram_header(
+      h, std::span<unsigned char, kDatagramHeaderBytes>(encoded.data(), kDatagramHeaderBytes));
+  EXPECT_TRUE(std::equal(encoded.begin(), encoded.end(), golden.begin()));
+}
+
+// A frame is at most 64 datagrams; the offer, which holds a whole body, 4,096.
+TEST(MulticastDatagram, TheOfferMayBeCutIntoMoreFragmentsThanAFrame) {
+  const size_t offer_bytes = 837'036;  // the demo body's packed MeshInfo and Model
+  EXPECT_EQ(fragment_count(offer_bytes), 0);
+  const uint16_t count = fragment_count(offer_bytes, false, kMaxOfferFragments);
+  EXPECT_EQ(count, 611);
+  EXPECT_EQ(fragment_count(size_t{kMaxOfferFragments} * kMaxFragmentBytes + 1, false, kMaxOfferFragments), 0);
+  EXPECT_EQ(fragment_count(size_t{kMaxOfferFragments} * kMaxAuthenticatedFragmentBytes + 1, true,
+                           kMaxOfferFragments),
+            0);
+  const DatagramHeader last{
+      1, 2, 3, static_cast<uint16_t>(count - 1), count, static_cast<uint32_t>(offer_bytes), false, true};
+  ByteVector datagram(kDatagramHeaderBytes);
+  encode_datagram_header(
+      last, std::span<unsigned char, kDatagramHeaderBytes>(datagram.data(), kDatagramHeaderBytes));
+  datagram.resize(kDatagramHeaderBytes + fragment_bytes(offer_bytes, count, last.index));
+  EXPECT_EQ(rejection(datagram), "accepted");
+  // The same count without the offer flag is a frame's, and too many.
+  EXPECT_NE(rejection(with<uint16_t>(datagram, 6, 0)).find("fragment count 611 (1-64)"), std::string::npos);
+  EXPECT_NE(rejection(with<uint16_t>(datagram, 22, 4097)).find("fragment count 4097 (1-4096)"),
+            std::string::npos);
 }
 
 TEST(MulticastDatagram, EveryFragmentFitsADatagramAndNoneIsEmpty) {
