@@ -62,6 +62,8 @@ struct DaemonConfig {
   std::string multicast_interface = "0.0.0.0";  // multicast: this host's address to send from; 0.0.0.0 = the system's route
   int multicast_ttl = 1;          // multicast: hops the datagrams may cross (1: this link)
   std::string multicast_key_file;  // multicast: a file whose first line is the key the datagrams are signed with; empty = unsigned
+  int multicast_offer_mbit =
+      20;  // multicast: the packed MeshInfo and Model offered round and round to port + 1 this fast; 0 = not
   double default_rate_hz = 120.0;  // until the source says its rate
   // What one source message may describe (vicon::DescriptionLimits); more is a malformed packet.
   int source_max_subjects = 128;

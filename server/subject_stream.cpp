@@ -149,6 +149,17 @@ SubjectStream::SubjectStream(SubjectConfig config, const SubjectStreamOptions& o
                    options.multicast->group, options.multicast->port, options.multicast->interface_address, options.multicast->ttl,
                    options.multicast->stream_id, multicast_->model_id());
     }
+    if (multicast_ && options.multicast->offer_mbit > 0) {
+      offer_ = std::make_unique<MulticastOffer>(*options.multicast, [hub = hub_.get()] {
+        const SubscriberHub::PackedParameterJoin join = hub->packed_parameter_join();
+        return MulticastOffer::Content{join.mesh_info, join.model, join.plain_model};
+      });
+      spdlog::info(
+          "subject {}: multicast: the packed MeshInfo and Model offered round and round to {}:{} at {} "
+          "Mbit/s",
+          name_, options.multicast->group, options.multicast->offer_address().port,
+          options.multicast->offer_mbit);
+    }
   }
   input_ = body.get();
   body_ = std::move(body);
@@ -257,13 +268,20 @@ uint32_t SubjectStream::vertex_count() const { return served()->pipeline->vertex
 
 void SubjectStream::render_multicast_metrics(std::string& out) const {
   if (multicast_) multicast_->render_prometheus(out);
+  if (offer_) offer_->render_prometheus(out);
 }
 
 SubjectStream::~SubjectStream() { stop(); }
 
-void SubjectStream::start() { served()->pipeline->start(); }
+void SubjectStream::start() {
+  served()->pipeline->start();
+  if (offer_) offer_->start();
+}
 
-void SubjectStream::stop() { served()->pipeline->stop(); }
+void SubjectStream::stop() {
+  if (offer_) offer_->stop();
+  served()->pipeline->stop();
+}
 
 void SubjectStream::set_take_tap(TakeTap* tap) {
   take_tap_ = tap;
@@ -404,7 +422,10 @@ nlohmann::json SubjectStream::health() const {
                        {"in_use_high_water", pipeline.pool_frames_in_use_high_water()},
                        {"kept_free", Pipeline::pool_frames_kept_free()},
                        {"unwanted_encoding_hold_off_s", Pipeline::unwanted_encoding_hold_off().count()}};
-  if (multicast_) out["multicast"] = multicast_->health();
+  if (multicast_) {
+    out["multicast"] = multicast_->health();
+    if (offer_) out["multicast"]["offer"] = offer_->health();
+  }
   return out;
 }
 

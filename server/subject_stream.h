@@ -26,6 +26,7 @@
 #include "server/metrics/status_line.h"
 #include "server/pipeline/frame_mailbox.h"
 #include "server/pipeline/pipeline.h"
+#include "server/publish/multicast_offer.h"
 #include "server/publish/multicast_sender.h"
 #include "server/publish/subscriber_hub.h"
 #include "server/record/take_tap.h"
@@ -122,6 +123,7 @@ class SubjectStream {
   StatusLine status_line_;
   std::unique_ptr<SubscriberHub> hub_;
   std::unique_ptr<MulticastSender> multicast_;  // the pipeline's consumer in front of the hub, when on
+  std::unique_ptr<MulticastOffer> offer_;       // the packed MeshInfo and Model offered to the group, when on
   FrameConsumer* consumer_ = nullptr;           // multicast_ or hub_
   std::shared_ptr<Replacement> body_;  // the subject file, mailbox and pipeline served (under mutex_)
   Replacement* input_ = nullptr;       // whose mailbox the io thread fills: body_'s, or the next one's

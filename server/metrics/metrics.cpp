@@ -5,6 +5,7 @@
 #include <cstdio>
 
 namespace skinstream::server {
+
 namespace {
 
 void header(std::string& out, std::string_view name, std::string_view help, std::string_view type) {
@@ -30,6 +31,11 @@ std::string number(double v) {
 }
 
 }  // namespace
+
+void render_counter(std::string& out, std::string_view name, std::string_view help, uint64_t value) {
+  header(out, name, help, "counter");
+  out += "skinstream_" + std::string(name) + " " + std::to_string(value) + "\n";
+}
 
 void LatencyHistogram::observe_ns(int64_t ns) {
   const double seconds = ns * 1e-9;

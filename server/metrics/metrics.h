@@ -13,6 +13,9 @@
 
 namespace skinstream::server {
 
+// A counter as Prometheus text: HELP, TYPE and its one sample, named skinstream_<name>.
+void render_counter(std::string& out, std::string_view name, std::string_view help, uint64_t value);
+
 // Fixed buckets (seconds) so observing never allocates. Fine between 0.1 and 10 ms, where a
 // 120 Hz frame's stages and their targets (1 ms deformation, 2 ms processing, 8.3 ms between
 // frames) lie: with a bucket from 1 to 2.5 ms a p99 of 1.9 ms could not be told from 2.4.

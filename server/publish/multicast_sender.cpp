@@ -1,7 +1,5 @@
 #include "server/publish/multicast_sender.h"
 
-#include <arpa/inet.h>
-#include <netinet/in.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -15,36 +13,14 @@ namespace {
 
 namespace wire = skinstream::subscriber;
 
-std::string where(const MulticastSenderOptions& o) { return "multicast " + o.group + ":" + std::to_string(o.port); }
+std::string where(const MulticastSenderOptions& o) { return describe(o.frames_address()); }
 
 }  // namespace
 
 StreamKey MulticastSender::sent_key() { return stream_key(wire::kFrameParameters, wire::kVersion2); }
 
 MulticastSender::MulticastSender(FrameConsumer& next, const MulticastSenderOptions& options) : next_(next), options_(options) {
-  in_addr group{}, interface{};
-  if (inet_pton(AF_INET, options.group.c_str(), &group) != 1 || !IN_MULTICAST(ntohl(group.s_addr)))
-    throw std::runtime_error(where(options) + ": " + options.group + " is not an IPv4 multicast address (224.0.0.0-239.255.255.255)");
-  if (inet_pton(AF_INET, options.interface_address.c_str(), &interface) != 1)
-    throw std::runtime_error(where(options) + ": interface " + options.interface_address + " is not an IPv4 address");
-  if (options.ttl < 0 || options.ttl > 255) throw std::runtime_error(where(options) + ": ttl must be 0-255");
-  fd_ = socket(AF_INET, SOCK_DGRAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
-  if (fd_ < 0) throw std::runtime_error(where(options) + ": socket: " + std::strerror(errno));
-  sockaddr_in to{};
-  to.sin_family = AF_INET;
-  to.sin_addr = group;
-  to.sin_port = htons(options.port);
-  const int ttl = options.ttl;
-  const char* failed = nullptr;
-  if (setsockopt(fd_, IPPROTO_IP, IP_MULTICAST_TTL, &ttl, sizeof ttl) != 0) failed = "the TTL";
-  else if (interface.s_addr != INADDR_ANY && setsockopt(fd_, IPPROTO_IP, IP_MULTICAST_IF, &interface, sizeof interface) != 0)
-    failed = "the interface (an address of this host?)";
-  else if (connect(fd_, reinterpret_cast<const sockaddr*>(&to), sizeof to) != 0) failed = "the group (a route to it?)";
-  if (failed) {
-    const std::string reason = std::strerror(errno);
-    close(fd_);
-    throw std::runtime_error(where(options) + ": cannot set " + failed + ": " + reason);
-  }
+  fd_ = open_multicast_group_socket(options.frames_address());
   if (!options.key.empty()) {
     try {
       authenticator_ = std::make_unique<wire::DatagramAuthenticator>(options.key);
@@ -170,9 +146,7 @@ void MulticastSender::render_prometheus(std::string& out) const {
       {"multicast_send_errors_total", "Failed multicast sends (each drops the rest of its frame).", send_errors_},
       {"multicast_frames_too_large_total", "Frames over 64 datagrams, not sent.", frames_too_large_},
   };
-  for (const auto& c : counters)
-    out += std::string("# HELP skinstream_") + c.name + " " + c.help + "\n# TYPE skinstream_" + c.name + " counter\nskinstream_" + c.name +
-           " " + std::to_string(c.value.load(std::memory_order_relaxed)) + "\n";
+  for (const auto& c : counters) render_counter(out, c.name, c.help, c.value.load(std::memory_order_relaxed));
   send_time_.render(out, "multicast_send_seconds", "Time per frame to hand its datagrams to the socket (pipeline thread).");
 }
 

@@ -27,6 +27,7 @@
 #include "server/logging.h"
 #include "server/metrics/metrics.h"
 #include "server/pipeline/pipeline.h"
+#include "server/publish/multicast_group_socket.h"
 
 namespace skinstream::server {
 
@@ -37,6 +38,12 @@ struct MulticastSenderOptions {
   int ttl = 1;                               // 1: the link only
   uint32_t stream_id = 0;                    // the subject's stream
   std::vector<unsigned char> key{};          // the shared key (at least 16 bytes); empty: datagrams are not signed
+  double offer_mbit = 0;                     // the offer (MulticastOffer) to port + 1 at this rate; 0: none
+
+  MulticastGroupAddress frames_address() const { return {group, port, interface_address, ttl}; }
+  MulticastGroupAddress offer_address() const {
+    return {group, static_cast<uint16_t>(port + 1), interface_address, ttl};
+  }
 };
 
 class MulticastSender : public FrameConsumer {

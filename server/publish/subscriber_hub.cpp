@@ -220,15 +220,7 @@ ControlMessage SubscriberHub::mesh_info_message(StreamKey key, uint32_t* epoch, 
   if (epoch) *epoch = model_epoch_;
   const bool positions = (stream_flags(described) & subscriber::kFrameNoPositions) == 0;
   if (packed && positions && stream_version(key) >= subscriber::kVersion2)
-    if (ControlMessage& message = packed_.mesh_info[static_cast<size_t>(encoding_of(described))]) {
-      // The source rate is outside the deflated stream: a copy with the new one (0.3 MB).
-      if (subscriber::packed_source_rate(*message) != mesh_info_.source_rate_hz) {
-        auto copy = std::make_shared<std::vector<unsigned char>>(*message);
-        subscriber::set_packed_source_rate(*copy, mesh_info_.source_rate_hz);
-        message = std::move(copy);
-      }
-      return message;
-    }
+    if (ControlMessage message = packed_mesh_info_locked(encoding_of(described))) return message;
   ControlMessage& cached = mesh_info_messages_[described % kStreamKeys];
   if (!cached) {
     subscriber::MeshInfo info = mesh_info_;
@@ -242,6 +234,22 @@ ControlMessage SubscriberHub::mesh_info_message(StreamKey key, uint32_t* epoch, 
     cached = std::make_shared<const std::vector<unsigned char>>(subscriber::encode_mesh_info(info, stream_version(key)));
   }
   return cached;
+}
+
+ControlMessage SubscriberHub::packed_mesh_info_locked(subscriber::Encoding encoding) {
+  ControlMessage& message = packed_.mesh_info[static_cast<size_t>(encoding)];
+  // The source rate is outside the deflated stream: a copy with the new one (0.3 MB).
+  if (message && subscriber::packed_source_rate(*message) != mesh_info_.source_rate_hz) {
+    auto copy = std::make_shared<std::vector<unsigned char>>(*message);
+    subscriber::set_packed_source_rate(*copy, mesh_info_.source_rate_hz);
+    message = std::move(copy);
+  }
+  return message;
+}
+
+SubscriberHub::PackedParameterJoin SubscriberHub::packed_parameter_join() {
+  std::lock_guard lock(mesh_info_mutex_);
+  return {packed_mesh_info_locked(subscriber::Encoding::Parameters), packed_.model, model_message_};
 }
 
 void SubscriberHub::set_source_rate(float rate_hz) {

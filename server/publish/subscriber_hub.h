@@ -103,6 +103,14 @@ class SubscriberHub : public FrameConsumer {
                                         const ControlMessage& model) const;
   // Set before any subscriber connects; a replacement brings its own.
   void set_packed_first_contact(PackedFirstContact packed);
+  // What a version 2 subscriber of the parameter encoding that reads Packed messages is sent as
+  // it joins (its packed MeshInfo, with the source rate now, and the packed Model), and the plain
+  // Model, read together so that all three are of one model: the multicast offer's content.
+  // Null without a mesh.
+  struct PackedParameterJoin {
+    ControlMessage mesh_info, model, plain_model;
+  };
+  PackedParameterJoin packed_parameter_join();
 
   // A new subject model in place of the one served (a live calibration, another subject file),
   // called between the old model's last frame and the new one's first: its MeshInfo, Model,
@@ -142,6 +150,8 @@ class SubscriberHub : public FrameConsumer {
 
  private:
   void update_wanted_locked();
+  // The packed MeshInfo of `encoding` with the source rate now (null when none was packed).
+  ControlMessage packed_mesh_info_locked(subscriber::Encoding encoding);
 
   Metrics& metrics_;
   HubOptions options_;

@@ -262,6 +262,15 @@ TEST(Config, MulticastIsOffByDefaultAndComesFromFileAndFlags) {
     EXPECT_NE(error_of([&] { parse({"--multicast", bad}); }).find("multicast must be GROUP:PORT"), std::string::npos) << bad;
   EXPECT_NE(error_of([] { parse({"--multicast-interface", "eth0"}); }).find("multicast_interface"), std::string::npos);
   EXPECT_NE(error_of([] { parse({"--multicast-ttl", "256"}); }).find("multicast_ttl"), std::string::npos);
+  // The offer goes to the next port: on by default, off with 0, and none after port 65535.
+  EXPECT_EQ(DaemonConfig{}.multicast_offer_mbit, 20);
+  const auto no_offer = parse({"--multicast", "239.1.2.3:65535", "--multicast-offer-mbit", "0"});
+  ASSERT_TRUE(no_offer);
+  EXPECT_EQ(no_offer->config.multicast_offer_mbit, 0);
+  EXPECT_NE(error_of([] {
+              parse({"--multicast", "239.1.2.3:65535"});
+            }).find("leaves none"),
+            std::string::npos);
 }
 
 TEST(Config, PrintConfigIsAFlag) {
