@@ -87,10 +87,15 @@ int main(int argc, char** argv) {
   app.add_option("--max-markers", max_markers, "the most markers taken");
   app.add_option("--protocol", protocol, "subscriber protocol version: 2 (default) or 1 (float and quantised only)")->check(CLI::Range(1, 2));
   app.add_option("--multicast", multicast,
-                 "GROUP:PORT: the parameters of every frame from the daemon's multicast group (its --multicast; --evaluate "
-                 "turns them into vertices); MeshInfo and the Model still come from ADDRESS over TCP");
+                 "GROUP:PORT: the parameters of every frame from the daemon's multicast group (its "
+                 "--multicast; --evaluate "
+                 "turns them into vertices); MeshInfo and the Model from the daemon's offer on PORT + 1, "
+                 "else from ADDRESS over TCP");
   app.add_option("--multicast-interface", multicast_interface, "multicast: this host's IPv4 address to join the group on");
   app.add_option("--multicast-stream", multicast_stream, "multicast: the subject's stream id (0: the daemon's first)");
+  bool multicast_no_offer = false;
+  app.add_flag("--multicast-no-offer", multicast_no_offer,
+               "multicast: fetch MeshInfo and the Model over TCP, not from the daemon's offer");
   std::string multicast_key_file;
   app.add_option("--multicast-key-file", multicast_key_file,
                  "multicast: take only datagrams signed with the key on this file's first line (the daemon's multicast_key_file)");
@@ -146,6 +151,7 @@ int main(int argc, char** argv) {
       std::tie(options.multicast.group, options.multicast.port) = split_host_port(multicast);
       options.multicast.interface_address = multicast_interface;
       options.multicast.stream_id = multicast_stream;
+      options.multicast.offer = !multicast_no_offer;
       if (!multicast_key_file.empty()) {
         const std::vector<unsigned char> key = subscriber::read_datagram_key_file(multicast_key_file);
         options.multicast.key.assign(key.begin(), key.end());
@@ -320,6 +326,10 @@ int main(int argc, char** argv) {
                               {"resyncs", m.resyncs},
                               {"frames_other_model", m.frames_other_model},
                               {"model_fetches", m.model_fetches},
+                              {"offer_datagrams", m.offer_datagrams},
+                              {"offers_taken", m.offers_taken},
+                              {"offers_rejected", m.offers_rejected},
+                              {"offer_timeouts", m.offer_timeouts},
                               {"last_error", m.last_error}};
     }
     if (json) std::printf("%s\n", nlohmann::json{{"summary", summary}}.dump().c_str());

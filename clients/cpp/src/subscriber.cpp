@@ -9,6 +9,8 @@
 #include "protocol/subscriber/datagram_reassembler.h"
 #include "protocol/subscriber/finite_values.h"
 #include "protocol/subscriber/frame_parameters.h"
+#include "protocol/subscriber/offer_content.h"
+#include "protocol/subscriber/offer_reassembler.h"
 #include "protocol/subscriber/packed_message.h"
 #include "protocol/subscriber/subscriber_model.h"
 #include "protocol/subscriber/subscriber_stream.h"
@@ -82,6 +84,13 @@ struct Subscriber::State {
   uint64_t superseded = 0;
   uint64_t messages_rejected = 0;
   std::string last_error;
+  // The offer: MeshInfo and the Model from the group's next port, before the frames (and again
+  // when the subject changed), until offer_deadline; then over TCP.
+  std::optional<MulticastSocket> offer_socket;
+  std::optional<wire::OfferReassembler> offer;
+  std::chrono::steady_clock::time_point offer_deadline{};
+  std::optional<uint32_t> wanted_model_id;  // after a change: the id the new frames carry
+  uint64_t offers_taken = 0, offers_rejected = 0, offer_timeouts = 0;
 
   std::vector<float> positions, normals, markers;
   std::vector<uint8_t> marker_status;
@@ -96,6 +105,11 @@ struct Subscriber::State {
   bool read_connection(Frame& frame, std::chrono::steady_clock::time_point deadline);
   // Reads the group's datagrams until a frame is ready (true) or the deadline passes.
   bool read_group(Frame& frame, std::chrono::steady_clock::time_point deadline);
+  // Listens to the offer until MeshInfo and the Model are taken from it, or (its wait over) a
+  // TCP connection fetches them (true), or the deadline passes (false).
+  bool read_offer(std::chrono::steady_clock::time_point deadline);
+  // Takes MeshInfo and the Model from the group's offer, else over TCP.
+  void listen_to_offer();
   // Decodes and evaluates ready_message into `frame` (false: it broke the protocol; counted).
   bool take_ready_message(Frame& frame);
   void reject(const std::string& what);
@@ -141,9 +155,24 @@ Subscriber::Subscriber(Options options) : state_(std::make_unique<State>()) {
     s.datagram.resize(kDatagramReadBytes);
     s.ready_message.reserve(wire::kMaxDatagramMessageBytes);
     hello.wants &= ~(wire::kWantMarkers);  // the group's frames carry none
+    if (o.multicast.offer) {
+      wire::OfferReassembler::Options offer_options{.stream_id = o.multicast.stream_id,
+                                                    .authenticator = reassembly.authenticator};
+      s.offer.emplace(offer_options);
+    }
   }
   s.hello = hello;
-  s.connect();
+  if (s.offer)
+    s.listen_to_offer();
+  else
+    s.connect();
+}
+
+void Subscriber::State::listen_to_offer() {
+  const MulticastOptions& m = options.multicast;
+  offer->restart();
+  offer_socket.emplace(m.group, static_cast<uint16_t>(m.port + 1), m.interface_address);
+  offer_deadline = std::chrono::steady_clock::now() + m.offer_wait;
 }
 
 void Subscriber::State::connect() {
@@ -158,8 +187,62 @@ Subscriber::~Subscriber() = default;
 bool Subscriber::next(Frame& frame, std::chrono::milliseconds timeout) {
   State& s = *state_;
   const auto deadline = std::chrono::steady_clock::now() + timeout;
+  if (s.offer_socket && !s.read_offer(deadline)) return false;
   if (s.connection && s.read_connection(frame, deadline)) return true;
   return s.group && !s.connection && s.read_group(frame, deadline);
+}
+
+bool Subscriber::State::read_offer(std::chrono::steady_clock::time_point deadline) {
+  for (;;) {
+    const auto now = std::chrono::steady_clock::now();
+    if (now >= offer_deadline) {
+      ++offer_timeouts;
+      offer_socket.reset();
+      wanted_model_id.reset();
+      connect();
+      return true;
+    }
+    if (now >= deadline) return false;
+    const auto left = std::chrono::ceil<std::chrono::milliseconds>(std::min(deadline, offer_deadline) - now);
+    std::chrono::steady_clock::time_point arrival;
+    const size_t n = offer_socket->receive(datagram, left, arrival);
+    if (n == 0) continue;
+    bytes += n;
+    std::optional<wire::OfferReassembler::Offer> complete;
+    try {
+      complete = offer->add(std::span<const unsigned char>(datagram).first(n), arrival);
+    } catch (const wire::DecodeError& e) {
+      last_error = std::string("bad offer datagram: ") + e.what();  // counted by the reassembler
+      continue;
+    }
+    if (!complete) continue;
+    if (wanted_model_id && complete->header.model_id != *wanted_model_id) {
+      offer->restart();  // the old subject's, still going round: the next edition is the new one's
+      continue;
+    }
+    // Anyone on the LAN can send to the group: an offer that is not a subject's is counted, and
+    // the next round tried.
+    try {
+      const wire::OfferContent content = wire::decode_offer(complete->bytes, complete->header.model_id);
+      on_mesh_info(content.mesh_info.payload);
+      on_model(content.model.payload);
+    } catch (const wire::DecodeError& e) {
+      ++offers_rejected;
+      last_error = std::string("bad offer: ") + e.what();
+      offer->restart();
+      continue;
+    } catch (const Error& e) {
+      ++offers_rejected;
+      last_error = std::string("bad offer: ") + e.what();
+      offer->restart();
+      continue;
+    }
+    ++offers_taken;
+    model_id = complete->header.model_id;
+    wanted_model_id.reset();
+    offer_socket.reset();
+    return true;
+  }
 }
 
 bool Subscriber::State::read_connection(Frame& frame, std::chrono::steady_clock::time_point deadline) {
@@ -271,7 +354,8 @@ bool Subscriber::State::read_group(Frame& frame, std::chrono::steady_clock::time
     }
     if (!message) continue;
     if (message->header.model_id != model_id) {
-      if (other_model(message->header.model_id, std::chrono::steady_clock::now())) return false;  // the Model comes over TCP
+      if (other_model(message->header.model_id, std::chrono::steady_clock::now()))
+        return false;  // the new Model comes next
       continue;
     }
     other_model_since = {};
@@ -316,7 +400,12 @@ bool Subscriber::State::other_model(uint32_t id, std::chrono::steady_clock::time
   other_model_since = {};
   ready_message.clear();  // of the Model that is going
   last_own_frame = now;  // the next fetch, if it comes to that, a second from now at the soonest
-  connect();
+  if (offer) {
+    wanted_model_id = id;
+    listen_to_offer();
+  } else {
+    connect();
+  }
   return true;
 }
 
@@ -508,7 +597,11 @@ MulticastStats Subscriber::multicast_stats() const {
           r.datagrams_unauthenticated,
           r.resyncs,
           s.frames_other_model,
-          s.model_fetches};
+          s.model_fetches,
+          s.offer ? s.offer->stats().datagrams : 0,
+          s.offers_taken,
+          s.offers_rejected,
+          s.offer_timeouts};
 }
 
 }  // namespace skinstream::client

@@ -1,8 +1,9 @@
 // The client library's multicast receiver against the real skinstreamd between network
 // namespaces on one bridge (multicast does not loop back on these machines): the daemon in one,
 // replaying the demo subject and sending its parameters to a group; receivers in the others,
-// each fetching the Model over TCP and evaluating the group's frames, compared with the daemon's
-// float vertex buffer of the same frames; and one receiver that loses a tenth of its datagrams.
+// each taking the Model from the daemon's offer on the group (or over TCP) and evaluating the
+// group's frames, compared with the daemon's float vertex buffer of the same frames; and one
+// receiver that loses a tenth of its datagrams, the offer's too.
 #include <arpa/inet.h>
 #include <gtest/gtest.h>
 #include <netinet/in.h>
@@ -137,7 +138,9 @@ TEST_F(MulticastDemo, EveryReceiverEvaluatesTheDaemonsVertices) {
     threads.emplace_back([&, r] {
       try {
         lan_->enter(kClean + r);
-        client::Subscriber sub(options_on(kClean + r));
+        client::Options options = options_on(kClean + r);
+        options.multicast.offer = r == 0;  // the second fetches MeshInfo and the Model over TCP
+        client::Subscriber sub(options);
         received[r] = test::receive_frames<Stamped>(sub, kFrames, keep_stamped);
         stats[r] = sub.multicast_stats();
       } catch (const std::exception& e) {
@@ -156,6 +159,8 @@ TEST_F(MulticastDemo, EveryReceiverEvaluatesTheDaemonsVertices) {
     EXPECT_LE(d.position_mm, 0.01) << "receiver " << r;
     EXPECT_LE(d.normal_degrees, 0.01) << "receiver " << r;
     EXPECT_EQ(stats[r].datagrams_rejected + stats[r].messages_rejected, 0u) << stats[r].last_error;
+    EXPECT_EQ(stats[r].offers_taken, r == 0 ? 1u : 0u) << "receiver " << r;
+    EXPECT_EQ(stats[r].offer_timeouts + stats[r].offers_rejected, 0u) << stats[r].last_error;
     std::printf("receiver %zu: %d frames compared, largest difference %.3g mm %.3g deg; %llu datagrams, %llu frames, %llu lost\n", r,
                 d.frames, d.position_mm, d.normal_degrees, static_cast<unsigned long long>(stats[r].datagrams),
                 static_cast<unsigned long long>(stats[r].frames_completed), static_cast<unsigned long long>(stats[r].frames_lost));
@@ -163,13 +168,16 @@ TEST_F(MulticastDemo, EveryReceiverEvaluatesTheDaemonsVertices) {
 }
 
 // A tenth of the datagrams to one receiver are dropped on their way in (nftables in its
-// namespace; this kernel has no netem): it loses only frames one of whose datagrams was dropped,
-// hands out no stale frame, and the frames it completes are still the daemon's.
+// namespace; this kernel has no netem): it takes the offer from the rounds after the first (what
+// one lost, the next brings), loses only frames one of whose datagrams was dropped, hands out no
+// stale frame, and the frames it completes are still the daemon's.
 TEST_F(MulticastDemo, ALossyReceiverLosesOnlyTheFramesItsDatagramsCarried) {
   if (test::run_program("nft --version").exit_code != 0) GTEST_SKIP() << "needs nftables' nft to drop datagrams (Debian: apt-get install nftables)";
   lan_->run_in(kLossy, "nft add table inet loss");
   lan_->run_in(kLossy, "nft add chain inet loss input '{ type filter hook input priority 0; }'");
   lan_->run_in(kLossy, "nft add rule inet loss input udp dport " + std::to_string(kGroupPort) + " numgen random mod 10 '<' 1 counter drop");
+  lan_->run_in(kLossy, "nft add rule inet loss input udp dport " + std::to_string(kGroupPort + 1) +
+                           " numgen random mod 10 '<' 1 counter drop");
   constexpr auto kListen = std::chrono::seconds(5);
   std::map<uint32_t, Stamped> truth, received;
   client::MulticastStats stats;
@@ -198,7 +206,8 @@ TEST_F(MulticastDemo, ALossyReceiverLosesOnlyTheFramesItsDatagramsCarried) {
       error = e.what();
     }
   });
-  std::thread reference_thread([&] { truth = reference(40); });
+  // Until after the lossy receiver began (it first takes the offer, a few rounds with a tenth lost).
+  std::thread reference_thread([&] { truth = reference(150); });
   lossy.join();
   reference_thread.join();
   const std::string counters = lan_->run_in(kLossy, "nft list table inet loss");
@@ -216,9 +225,13 @@ TEST_F(MulticastDemo, ALossyReceiverLosesOnlyTheFramesItsDatagramsCarried) {
   // asserted: the daemon itself pauses for seconds when this shared machine is loaded.)
   EXPECT_LT(stalest_s, 1.0);
   EXPECT_EQ(stats.datagrams_rejected + stats.messages_rejected, 0u) << stats.last_error;
+  EXPECT_EQ(stats.offers_taken, 1u);
+  EXPECT_EQ(stats.offer_timeouts, 0u) << "the offer did not complete within 3 s of rounds with a tenth lost";
   const Difference d = compare_same(truth, received);
   EXPECT_GE(d.frames, 3);
   EXPECT_LE(d.position_mm, 0.01);
+  std::printf("lossy receiver: the offer taken from %llu of its datagrams\n",
+              static_cast<unsigned long long>(stats.offer_datagrams));
   std::printf("lossy receiver: %llu datagrams dropped on the way, %llu frames completed, %llu lost (%llu incomplete), longest wait "
               "%.3f s, stalest frame %.3f s; %d frames compared, largest difference %.3g mm\n",
               static_cast<unsigned long long>(dropped), static_cast<unsigned long long>(stats.frames_completed),
@@ -466,8 +479,9 @@ TEST_F(MulticastDemo, ForgedCopiesOfRealDatagramsDoNotStopTheReceiver) {
 
 // Frames of another Model than the one fetched, and nothing else, for more than a second: the
 // daemon's subject changed (restarted with another). The receiver ended with "the multicast
-// frames fit another Model"; now it fetches MeshInfo and the Model again over TCP and goes on.
-// (Here a host sends such frames to a group of its own, where the daemon sends nothing.)
+// frames fit another Model"; now it takes MeshInfo and the Model again and goes on. (Here a host
+// sends such frames to a group of its own, where the daemon sends nothing, and no offer: the
+// receiver waits for one for half a second, then fetches over TCP.)
 TEST_F(MulticastDemo, OnlyFramesOfAnotherModelMakeTheReceiverFetchTheModelAgain) {
   constexpr const char* kOtherGroup = "239.255.77.2";
   std::atomic<bool> sending{true};
@@ -490,6 +504,7 @@ TEST_F(MulticastDemo, OnlyFramesOfAnotherModelMakeTheReceiverFetchTheModelAgain)
       lan_->enter(kClean);
       client::Options options = options_on(kClean);
       options.multicast.group = kOtherGroup;
+      options.multicast.offer_wait = std::chrono::milliseconds(500);
       client::Subscriber sub(options);
       client::Frame frame;
       for (const auto end = std::chrono::steady_clock::now() + std::chrono::milliseconds(3500); std::chrono::steady_clock::now() < end;)
@@ -504,6 +519,8 @@ TEST_F(MulticastDemo, OnlyFramesOfAnotherModelMakeTheReceiverFetchTheModelAgain)
   other.join();
   ASSERT_EQ(error, "");
   EXPECT_GE(stats.model_fetches, 1u);
+  EXPECT_GE(stats.offer_timeouts, 2u);  // no offer on that group: at the start, and after the change
+  EXPECT_EQ(stats.offers_taken, 0u);
   EXPECT_GT(stats.frames_other_model, 50u);
   EXPECT_EQ(stats.frames_completed, stats.frames_other_model);
   std::printf("%llu frames of another Model skipped, the Model fetched again %llu times\n",
@@ -511,9 +528,9 @@ TEST_F(MulticastDemo, OnlyFramesOfAnotherModelMakeTheReceiverFetchTheModelAgain)
 }
 
 // A subject swapped while receivers take its parameters by multicast (the operator's
-// POST /subjects/NAME/file): the sender stamps the new model's id, the receiver fetches the new
-// Model over TCP and evaluates the frames after it with it. Two fits of one body to two CMU takes
-// (tests/support/make_swap_subjects.sh), a CMU take replayed at half speed.
+// POST /subjects/NAME/file): the sender stamps the new model's id and offers the new Model; the
+// receiver takes it from the offer and evaluates the frames after it with it. Two fits of one body to two CMU
+// takes (tests/support/make_swap_subjects.sh), a CMU take replayed at half speed.
 TEST(MulticastSwap, AReceiverFetchesTheNewModelWhenTheSubjectIsSwapped) {
   const std::string skip = test::BridgedNamespaces::unavailable_reason();
   if (!skip.empty()) GTEST_SKIP() << skip;
@@ -590,6 +607,9 @@ TEST(MulticastSwap, AReceiverFetchesTheNewModelWhenTheSubjectIsSwapped) {
   EXPECT_NE(swap_answer.find("\"state\":\"done\""), std::string::npos) << swap_answer;
   EXPECT_GT(before.frames_completed, 0u);
   EXPECT_GE(after.model_fetches, before.model_fetches + 1) << "the receiver kept the old Model";
+  EXPECT_EQ(before.offers_taken, 1u);
+  EXPECT_GE(after.offers_taken, 2u) << "the new Model not taken from the offer: " << after.last_error;
+  EXPECT_EQ(after.offer_timeouts, 0u);
   EXPECT_GT(frames_after, 30u);
   EXPECT_GE(meshes, 2u);
   std::printf(
@@ -627,6 +647,7 @@ TEST_F(MulticastKeyDemo, ForgedCopiesAreRefusedForTheirTags) {
   EXPECT_GE(attack.stats.datagrams_unauthenticated, attack.forged * 9 / 10);  // a few may still be on their way
   EXPECT_EQ(attack.stats.frames_other_model, 0u);
   EXPECT_EQ(attack.stats.frames_lost, 0u);
+  EXPECT_EQ(attack.stats.offers_taken, 1u);  // signed with the key as the frames are
   EXPECT_GE(attack.received.size(), 48u);
   const Difference d = compare_same(truth, attack.received);
   EXPECT_GE(d.frames, 3);

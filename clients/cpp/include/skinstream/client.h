@@ -32,15 +32,17 @@ const char* to_string(Encoding encoding);
 Encoding encoding_from_string(const std::string& name);
 
 // Frames from the daemon's multicast group instead of the TCP connection (the daemon's
-// --multicast; docs/subscriber-protocol.md, "Multicast"): the Subscriber fetches MeshInfo and the
-// Model over TCP from host:port, closes that connection, and then reads the parameters of every
-// frame from the group. A lost datagram costs the frame it carried; next() never waits for it,
-// and gives the newest complete frame (a reader slower than the stream skips frames instead of
-// falling behind by what the socket buffer holds). Anyone on the LAN can send to the group: with
+// --multicast; docs/subscriber-protocol.md, "Multicast"): the Subscriber takes MeshInfo and the
+// Model from the daemon's offer on the group's next port (what it sends round and round, so
+// that receivers joining together take one copy), or, when none is complete within offer_wait
+// (no offer, or its datagrams lost), over TCP from host:port, closing that connection after; it
+// then reads the parameters of every frame from the group. A lost datagram costs the frame it carried; next()
+// never waits for it, and gives the newest complete frame (a reader slower than the stream skips frames
+// instead of falling behind by what the socket buffer holds). Anyone on the LAN can send to the group: with
 // the daemon's key (its multicast_key_file) only datagrams signed with it are taken; without
 // one, a forged or stale datagram costs at most 100 ms of frames. Frames of another Model than
 // the one fetched are counted and skipped; when only such frames came for a second, the
-// daemon's subject changed, and the Model is fetched again over TCP.
+// daemon's subject changed, and the new Model is taken again (from the offer, else over TCP).
 struct MulticastOptions {
   std::string group{};                       // IPv4 multicast address; empty: frames over TCP
   uint16_t port = 0;
@@ -48,6 +50,8 @@ struct MulticastOptions {
   uint32_t stream_id = 0;                    // the subject's stream (0: the daemon's first)
   std::chrono::milliseconds window{50};      // a frame's datagrams must all arrive within it
   std::string key{};                         // the daemon's multicast key (at least 16 bytes); empty: none checked
+  bool offer = true;                         // take MeshInfo and the Model from the offer (port + 1) first
+  std::chrono::milliseconds offer_wait{3000};  // the offer complete within this, else over TCP
 };
 
 // What arrived from the multicast group so far.
@@ -68,6 +72,11 @@ struct MulticastStats {
   uint64_t resyncs = 0;                    // the stream taken up afresh after 100 ms without a frame
   uint64_t frames_other_model = 0;         // complete frames of another Model than the one fetched, skipped
   uint64_t model_fetches = 0;              // the Model fetched again (the daemon's subject changed)
+  // The offer: MeshInfo and the Model from the group.
+  uint64_t offer_datagrams = 0;  // of this stream, taken (while this receiver listened to the offer)
+  uint64_t offers_taken = 0;     // complete, and MeshInfo and the Model taken from them
+  uint64_t offers_rejected = 0;  // complete, and refused (last_error says why): the next round is tried
+  uint64_t offer_timeouts = 0;   // none taken within offer_wait: MeshInfo and the Model fetched over TCP
 };
 
 struct Options {
@@ -161,7 +170,9 @@ struct SourceStatus {
 
 class Subscriber {
  public:
-  // Connects and sends Hello; throws Error when the daemon cannot be reached.
+  // Connects and sends Hello; throws Error when the daemon cannot be reached. With multicast and
+  // its offer, it only joins the group: the daemon is reached over TCP only if the offer does not
+  // come (next() then throws Error when it cannot be reached).
   explicit Subscriber(Options options);
   ~Subscriber();
   Subscriber(const Subscriber&) = delete;
