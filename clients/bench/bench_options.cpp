@@ -81,6 +81,16 @@ std::optional<int> parse_bench_options(int argc, char** argv, BenchOptions& o) {
                "--join-wave: each joiner is a skinstream-sub process (beside this program) rather than a "
                "thread of this one; "
                "its summary is reported under join_wave.processes");
+  app.add_option("--joiner-multicast", o.joiner_multicast,
+                 "--join-wave: the joiners take every frame's parameters from the daemon's multicast group "
+                 "GROUP:PORT over the shaped link, MeshInfo and the Model from its offer (needs --link-mbit "
+                 "and --encoding parameters)");
+  app.add_option(
+         "--multicast-offer-mbit", o.multicast_offer_mbit,
+         "--joiner-multicast: the daemon offers MeshInfo and the Model to the group at this rate (Mbit/s); "
+         "0: none, the joiners fetch them over TCP")
+      ->check(CLI::Range(0, 1000))
+      ->capture_default_str();
   app.add_option(
          "--record-ab", o.record_ab_seconds,
          "recording A/B in one run: the daemon records a take for this many seconds, then none for as long, "

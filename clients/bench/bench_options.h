@@ -54,6 +54,11 @@ struct BenchOptions {
   // The joiners as skinstream-sub processes (as render nodes are programs of their own) instead
   // of threads of this one.
   bool joiner_processes = false;
+  // --join-wave: the joiners take the parameters from the daemon's multicast group
+  // (GROUP:PORT; over --link-mbit's link), MeshInfo and the Model from its offer at this rate
+  // (0: no offer, over TCP).
+  std::string joiner_multicast;
+  int multicast_offer_mbit = 20;
   // Recording A/B in one run: a take starts and stops every this many seconds through the control
   // API (0: off); the report splits the subscribers' figures by whether a take was recording.
   double record_ab_seconds = 0.0;

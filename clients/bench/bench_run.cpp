@@ -74,9 +74,25 @@ struct Window {
   std::atomic<bool> recording{false};  // --record-ab: a take is recording
 };
 
-void subscribe(const BenchOptions& o, const std::string& host, int port, int index, const SendTimes& send_times, Window& window,
-               StallLog& stalls, SubscriberTally& tally) {
+// --joiner-multicast's group, joined on `interface`; throws std::runtime_error for a bad GROUP:PORT.
+client::MulticastOptions joiner_multicast_options(const BenchOptions& o, const std::string& interface) {
+  const size_t colon = o.joiner_multicast.rfind(':');
+  const int port = colon == std::string::npos ? 0 : std::atoi(o.joiner_multicast.c_str() + colon + 1);
+  if (port <= 0 || port > 65534)
+    throw std::runtime_error("--joiner-multicast must be GROUP:PORT (a port below 65535), not " +
+                             o.joiner_multicast);
+  client::MulticastOptions multicast{o.joiner_multicast.substr(0, colon), static_cast<uint16_t>(port),
+                                     interface};
+  multicast.offer = o.multicast_offer_mbit > 0;
+  return multicast;
+}
+
+// `multicast_interface`: a joiner of --joiner-multicast, which joins the group on this address.
+void subscribe(const BenchOptions& o, const std::string& host, int port, int index,
+               const SendTimes& send_times, Window& window, StallLog& stalls, SubscriberTally& tally,
+               const std::string& multicast_interface = "") {
   client::Options options;
+  if (!multicast_interface.empty()) options.multicast = joiner_multicast_options(o, multicast_interface);
   options.host = host;
   options.port = static_cast<uint16_t>(port);
   options.encoding = o.encoding;
@@ -173,8 +189,9 @@ nlohmann::json join_wave_report(const BenchOptions& o, const std::vector<Subscri
 
 // --joiner-processes: one joiner as a skinstream-sub process, until it has `frames` frames or
 // `limit` passes (then killed). Its summary (the JSON it prints last), or {"error": ...}.
+// `receiver_address`: with --joiner-multicast, this host's address on the link to join the group on.
 nlohmann::json run_joiner_process(const BenchOptions& o, const std::string& address, int port, long frames,
-                                  std::chrono::seconds limit) {
+                                  std::chrono::seconds limit, const std::string& receiver_address) {
   std::vector<std::string> argv = {(own_folder() / "skinstream-sub").string(),
                                    address + ":" + std::to_string(port),
                                    "--encoding",
@@ -185,6 +202,10 @@ nlohmann::json run_joiner_process(const BenchOptions& o, const std::string& addr
   if (o.paced) argv.push_back("--paced");
   if (o.decode) argv.push_back("--evaluate");
   if (o.plain_first_contact) argv.push_back("--plain-first-contact");
+  if (!o.joiner_multicast.empty()) {
+    argv.insert(argv.end(), {"--multicast", o.joiner_multicast, "--multicast-interface", receiver_address});
+    if (o.multicast_offer_mbit == 0) argv.push_back("--multicast-no-offer");
+  }
   CommandResult run;
   try {
     run = run_command(argv, {.nice = o.joiner_nice, .limit = limit});
@@ -206,7 +227,7 @@ nlohmann::json run_joiner_process(const BenchOptions& o, const std::string& addr
 // The summaries of the joiner processes: the slowest rate once in, the first frames' wait, drops.
 nlohmann::json joiner_processes_report(const std::vector<nlohmann::json>& summaries) {
   std::vector<double> rates, first;
-  long dropped = 0, pipeline_dropped = 0, failed = 0;
+  long dropped = 0, pipeline_dropped = 0, failed = 0, offers_taken = 0, offer_timeouts = 0, frames_lost = 0;
   std::string first_error;
   for (const nlohmann::json& s : summaries) {
     if (!s.is_object() || s.contains("error") || s.value("frames", 0L) < 2) {
@@ -219,19 +240,28 @@ nlohmann::json joiner_processes_report(const std::vector<nlohmann::json>& summar
     first.push_back(s["first_frame_seconds"].get<double>());
     dropped += s["subscriber_dropped_after_first"].get<long>();
     pipeline_dropped = std::max(pipeline_dropped, s["pipeline_dropped"].get<long>());
+    if (s.contains("multicast")) {
+      offers_taken += s["multicast"]["offers_taken"].get<long>();
+      offer_timeouts += s["multicast"]["offer_timeouts"].get<long>();
+      frames_lost += s["multicast"]["frames_lost"].get<long>();
+    }
   }
   std::sort(rates.begin(), rates.end());
   std::sort(first.begin(), first.end());
   auto at = [](const std::vector<double>& v, double q) {
     return v.empty() ? 0.0 : v[static_cast<size_t>(q * (v.size() - 1))];
   };
-  return {{"processes", summaries.size()},
-          {"failed", failed},
-          {"first_error", first_error},
-          {"frames_per_second_after_first", {{"slowest", at(rates, 0.0)}, {"median", at(rates, 0.5)}}},
-          {"first_frame_seconds", {{"p50", at(first, 0.5)}, {"max", at(first, 1.0)}}},
-          {"dropped_for_them_after_their_first_frame", dropped},
-          {"dropped_in_pipeline_by_their_last_frame", pipeline_dropped}};
+  return {
+      {"processes", summaries.size()},
+      {"failed", failed},
+      {"first_error", first_error},
+      {"frames_per_second_after_first", {{"slowest", at(rates, 0.0)}, {"median", at(rates, 0.5)}}},
+      {"first_frame_seconds", {{"p50", at(first, 0.5)}, {"max", at(first, 1.0)}}},
+      {"dropped_for_them_after_their_first_frame", dropped},
+      {"dropped_in_pipeline_by_their_last_frame", pipeline_dropped},
+      // --joiner-multicast: MeshInfo and the Model from the offer, else over TCP; frames lost on the group.
+      {"multicast",
+       {{"offers_taken", offers_taken}, {"offer_timeouts", offer_timeouts}, {"frames_lost", frames_lost}}}};
 }
 
 // Sleeps until `until`, in short steps, throwing once `stop` is set.
@@ -266,6 +296,11 @@ nlohmann::json run_bench(const BenchOptions& o, const std::atomic<bool>& stop) {
   if (o.hostile_waves && o.link_mbit > 0) throw std::runtime_error("--hostile-waves runs on loopback only, not with --link-mbit");
   if (o.join_wave > 0 && o.join_after_seconds >= o.seconds)
     throw std::runtime_error("--join-after-seconds must be less than --seconds, or the joiners never join");
+  if (!o.joiner_multicast.empty() && (o.link_mbit <= 0 || o.encoding != client::Encoding::Parameters))
+    throw std::runtime_error(
+        "--joiner-multicast needs --link-mbit (multicast does not loop back here) and --encoding parameters");
+  if (!o.joiner_multicast.empty())
+    joiner_multicast_options(o, "0.0.0.0");  // its GROUP:PORT checked before anything starts
   if (o.link_mbit > 0) link = std::make_unique<ShapedLink>(ShapedLinkOptions{.rate_mbit = o.link_mbit});
   const std::string replay_address = link ? link->host_address() : "127.0.0.1";
   const std::string daemon_address = link ? link->inner_address() : "127.0.0.1";
@@ -315,6 +350,9 @@ nlohmann::json run_bench(const BenchOptions& o, const std::atomic<bool>& stop) {
     launch.arguments += " --record-dir " + server::shell_word((work / "takes").string()) +
                         " --control-token-file " + server::shell_word(token_file.string());
   }
+  if (!o.joiner_multicast.empty())
+    launch.arguments += " --multicast " + server::shell_word(o.joiner_multicast) + " --multicast-interface " +
+                        daemon_address + " --multicast-offer-mbit " + std::to_string(o.multicast_offer_mbit);
   launch.bind = daemon_address;
   launch.files_stem = (work / "skinstreamd").string();
   if (link)
@@ -396,12 +434,12 @@ nlohmann::json run_bench(const BenchOptions& o, const std::atomic<bool>& stop) {
         const double in_window = o.seconds - o.join_after_seconds;
         joiner_summaries[j] =
             run_joiner_process(o, daemon_address, daemon.sub_port(), std::lround(in_window * 120.0),
-                               std::chrono::seconds(static_cast<long>(in_window) + 30));
+                               std::chrono::seconds(static_cast<long>(in_window) + 30), replay_address);
         return;
       }
       try {
         subscribe(o, daemon_address, daemon.sub_port(), o.subscribers + j, send_times, window, stalls,
-                  joiner_tallies[j]);
+                  joiner_tallies[j], o.joiner_multicast.empty() ? "" : replay_address);
       } catch (const std::exception& e) {
         joiner_errors[j] = e.what();
       }
@@ -538,7 +576,10 @@ nlohmann::json run_bench(const BenchOptions& o, const std::atomic<bool>& stop) {
         {"paced", o.paced},
         {"packed_first_contact", !o.plain_first_contact},
         {"joiner_nice", o.joiner_nice},
-        {"joiner_processes", o.joiner_processes}}},
+        {"joiner_processes", o.joiner_processes},
+        {"joiner_multicast", o.joiner_multicast},
+        {"multicast_offer_mbit",
+         o.joiner_multicast.empty() ? nlohmann::json(nullptr) : nlohmann::json(o.multicast_offer_mbit)}}},
       {"seconds_until_every_subscriber_had_a_frame", seconds_to_first_frames},
       {"deform_threads", o.deform_threads},
       {"deform", health["deform"]},  // as the daemon applied it: threads, CPUs pinned to, spin lead
