@@ -112,7 +112,8 @@ HostPort host_port_of(const std::string& flag, const std::string& text) {
 
 MulticastSenderOptions multicast_options_of(const DaemonConfig& config, uint32_t stream_id) {
   const HostPort group = host_port_of("--multicast", config.multicast);
-  MulticastSenderOptions options{group.host, group.port, config.multicast_interface, config.multicast_ttl, stream_id};
+  MulticastSenderOptions options{{group.host, group.port, config.multicast_interface, config.multicast_ttl},
+                                 stream_id};
   options.offer_mbit = config.multicast_offer_mbit;
   if (!config.multicast_key_file.empty()) {
     try {

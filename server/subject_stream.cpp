@@ -145,9 +145,12 @@ SubjectStream::SubjectStream(SubjectConfig config, const SubjectStreamOptions& o
       multicast_->set_model(
           std::span<const unsigned char>(*body->model_message).subspan(subscriber::kHeaderBytes));
       pipeline->prepare_encoding(MulticastSender::sent_key());
-      spdlog::info("subject {}: multicast: every frame's parameters to {}:{} from {} (TTL {}), stream {}, model id {:08x}", name_,
-                   options.multicast->group, options.multicast->port, options.multicast->interface_address, options.multicast->ttl,
-                   options.multicast->stream_id, multicast_->model_id());
+      const MulticastGroupAddress& frames = options.multicast->frames;
+      spdlog::info(
+          "subject {}: multicast: every frame's parameters to {}:{} from {} (TTL {}), stream {}, model id "
+          "{:08x}",
+          name_, frames.group, frames.port, frames.interface_address, frames.ttl,
+          options.multicast->stream_id, multicast_->model_id());
     }
     if (multicast_ && options.multicast->offer_mbit > 0) {
       offer_ = std::make_unique<MulticastOffer>(*options.multicast, [hub = hub_.get()] {
@@ -157,7 +160,7 @@ SubjectStream::SubjectStream(SubjectConfig config, const SubjectStreamOptions& o
       spdlog::info(
           "subject {}: multicast: the packed MeshInfo and Model offered round and round to {}:{} at {} "
           "Mbit/s",
-          name_, options.multicast->group, options.multicast->offer_address().port,
+          name_, options.multicast->frames.group, options.multicast->offer_address().port,
           options.multicast->offer_mbit);
     }
   }

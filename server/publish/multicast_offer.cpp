@@ -32,8 +32,8 @@ MulticastOffer::MulticastOffer(const MulticastSenderOptions& options, ContentSou
     : options_(options), content_(std::move(content)) {
   if (!(options.offer_mbit > 0))
     throw std::runtime_error(describe(options.offer_address()) + ": the offer's rate must be above 0 Mbit/s");
-  if (options.port == 65535)
-    throw std::runtime_error(describe(options.frames_address()) +
+  if (options.frames.port == 65535)
+    throw std::runtime_error(describe(options.frames) +
                              ": the offer goes to the next port, and there is none");
   fd_ = open_multicast_group_socket(options.offer_address());
   if (!options.key.empty()) {

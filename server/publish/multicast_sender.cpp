@@ -13,14 +13,14 @@ namespace {
 
 namespace wire = skinstream::subscriber;
 
-std::string where(const MulticastSenderOptions& o) { return describe(o.frames_address()); }
+std::string where(const MulticastSenderOptions& o) { return describe(o.frames); }
 
 }  // namespace
 
 StreamKey MulticastSender::sent_key() { return stream_key(wire::kFrameParameters, wire::kVersion2); }
 
 MulticastSender::MulticastSender(FrameConsumer& next, const MulticastSenderOptions& options) : next_(next), options_(options) {
-  fd_ = open_multicast_group_socket(options.frames_address());
+  fd_ = open_multicast_group_socket(options.frames);
   if (!options.key.empty()) {
     try {
       authenticator_ = std::make_unique<wire::DatagramAuthenticator>(options.key);
@@ -113,10 +113,10 @@ void MulticastSender::publish(const FrameRef& frame) {
 
 nlohmann::json MulticastSender::health() const {
   const LatencyHistogram::Summary send = send_time_.summary();
-  return {{"group", options_.group},
-          {"port", options_.port},
-          {"interface", options_.interface_address},
-          {"ttl", options_.ttl},
+  return {{"group", options_.frames.group},
+          {"port", options_.frames.port},
+          {"interface", options_.frames.interface_address},
+          {"ttl", options_.frames.ttl},
           {"stream_id", options_.stream_id},
           {"authenticated", authenticator_ != nullptr},
           {"model_id", model_id_.load()},

@@ -32,17 +32,16 @@
 namespace skinstream::server {
 
 struct MulticastSenderOptions {
-  std::string group;                         // IPv4 multicast address (224.0.0.0/4)
-  uint16_t port = 0;
-  std::string interface_address = "0.0.0.0";  // this host's address to send from; 0.0.0.0: the system's route
-  int ttl = 1;                               // 1: the link only
-  uint32_t stream_id = 0;                    // the subject's stream
-  std::vector<unsigned char> key{};          // the shared key (at least 16 bytes); empty: datagrams are not signed
-  double offer_mbit = 0;                     // the offer (MulticastOffer) to port + 1 at this rate; 0: none
+  MulticastGroupAddress frames;      // where every frame's datagrams go
+  uint32_t stream_id = 0;            // the subject's stream
+  std::vector<unsigned char> key{};  // the shared key (at least 16 bytes); empty: datagrams are not signed
+  double offer_mbit = 0;             // the offer (MulticastOffer) to the next port at this rate; 0: none
 
-  MulticastGroupAddress frames_address() const { return {group, port, interface_address, ttl}; }
+  // Where the offer goes: the frames' group, the next port.
   MulticastGroupAddress offer_address() const {
-    return {group, static_cast<uint16_t>(port + 1), interface_address, ttl};
+    MulticastGroupAddress offer = frames;
+    offer.port = static_cast<uint16_t>(frames.port + 1);
+    return offer;
   }
 };
 

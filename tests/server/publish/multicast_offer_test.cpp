@@ -33,7 +33,7 @@ struct OfferedContent {
 };
 
 MulticastSenderOptions loopback(double mbit) {
-  MulticastSenderOptions o{"239.255.77.1", 9577, "127.0.0.1", 0};
+  MulticastSenderOptions o{{"239.255.77.1", 9577, "127.0.0.1", 0}};
   o.offer_mbit = mbit;
   return o;
 }
@@ -127,10 +127,10 @@ std::string error_of(const MulticastSenderOptions& options) {
 TEST(MulticastOffer, BadOptionsAreOneLineErrors) {
   EXPECT_NE(error_of(loopback(0)).find("rate must be above 0"), std::string::npos);
   MulticastSenderOptions last_port = loopback(10);
-  last_port.port = 65535;
+  last_port.frames.port = 65535;
   EXPECT_NE(error_of(last_port).find("there is none"), std::string::npos);
   MulticastSenderOptions foreign = loopback(10);
-  foreign.interface_address = "192.0.2.77";
+  foreign.frames.interface_address = "192.0.2.77";
   const std::string error = error_of(foreign);
   EXPECT_NE(error.find("multicast 239.255.77.1:9578: cannot set the interface"), std::string::npos) << error;
   EXPECT_EQ(error.find('\n'), std::string::npos);

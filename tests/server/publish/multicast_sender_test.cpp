@@ -26,12 +26,14 @@ std::string error_of(const MulticastSenderOptions& options, SubscriberHub& hub) 
 TEST(MulticastSender, BadOptionsAreOneLineErrors) {
   Metrics metrics;
   SubscriberHub hub(metrics, {}, {}, true);
-  EXPECT_NE(error_of({"10.1.2.3", 9577}, hub).find("is not an IPv4 multicast address"), std::string::npos);
-  EXPECT_NE(error_of({"stage", 9577}, hub).find("is not an IPv4 multicast address"), std::string::npos);
-  EXPECT_NE(error_of({"239.255.77.1", 9577, "eth0"}, hub).find("interface eth0 is not an IPv4 address"), std::string::npos);
-  EXPECT_NE(error_of({"239.255.77.1", 9577, "0.0.0.0", 300}, hub).find("ttl must be 0-255"), std::string::npos);
+  EXPECT_NE(error_of({{"10.1.2.3", 9577}}, hub).find("is not an IPv4 multicast address"), std::string::npos);
+  EXPECT_NE(error_of({{"stage", 9577}}, hub).find("is not an IPv4 multicast address"), std::string::npos);
+  EXPECT_NE(error_of({{"239.255.77.1", 9577, "eth0"}}, hub).find("interface eth0 is not an IPv4 address"),
+            std::string::npos);
+  EXPECT_NE(error_of({{"239.255.77.1", 9577, "0.0.0.0", 300}}, hub).find("ttl must be 0-255"),
+            std::string::npos);
   // An address that is not this host's.
-  const std::string foreign = error_of({"239.255.77.1", 9577, "192.0.2.77"}, hub);
+  const std::string foreign = error_of({{"239.255.77.1", 9577, "192.0.2.77"}}, hub);
   EXPECT_NE(foreign.find("cannot set the interface"), std::string::npos) << foreign;
   EXPECT_EQ(foreign.find('\n'), std::string::npos);
 }
@@ -39,7 +41,7 @@ TEST(MulticastSender, BadOptionsAreOneLineErrors) {
 TEST(MulticastSender, SendsEachFrameOfTheParameterStreamOnceWithoutAllocating) {
   Metrics metrics;
   SubscriberHub hub(metrics, {}, {}, true);
-  MulticastSender sender(hub, {"239.255.77.1", 9577, "127.0.0.1", 0});
+  MulticastSender sender(hub, {{"239.255.77.1", 9577, "127.0.0.1", 0}});
   EXPECT_TRUE(hub.wanted_encodings().empty());
   EXPECT_TRUE(sender.wanted_encodings().has(MulticastSender::sent_key()));  // the pipeline fits the parts for the group alone
 
