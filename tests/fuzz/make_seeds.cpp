@@ -238,7 +238,8 @@ int main(int argc, char** argv) {
       const std::vector<unsigned char> offer{std::istreambuf_iterator<char>(in),
                                              std::istreambuf_iterator<char>()};
       std::vector<unsigned char> seed;
-      for (const std::vector<unsigned char>* d : {&std::as_const(datagrams[0]), &offer, &std::as_const(datagrams[1])}) {
+      for (const std::vector<unsigned char>* d :
+           {&std::as_const(datagrams[0]), &offer, &std::as_const(datagrams[1])}) {
         seed.push_back(static_cast<unsigned char>(d->size() & 0xFF));
         seed.push_back(static_cast<unsigned char>(d->size() >> 8));
         seed.insert(seed.end(), d->begin(), d->end());
