@@ -77,6 +77,10 @@ std::optional<int> parse_bench_options(int argc, char** argv, BenchOptions& o) {
          "other machines' CPU) does not take this machine's cores from the daemon")
       ->check(CLI::Range(0, 19))
       ->capture_default_str();
+  app.add_flag(
+      "--joiner-idle", o.joiner_idle,
+      "--join-wave: the joiners' threads (or processes) under SCHED_IDLE: they take only the CPU nothing "
+      "else wants, as other machines' would (sixty at nice 19 still weigh about one at nice 0)");
   app.add_flag("--joiner-processes", o.joiner_processes,
                "--join-wave: each joiner is a skinstream-sub process (beside this program) rather than a "
                "thread of this one; "

@@ -51,6 +51,10 @@ struct BenchOptions {
   // The joiners' threads at this nice level: render nodes are other machines on a stage, and on
   // this one their unpacking competes with the daemon for the same cores (0: as the watchers).
   int joiner_nice = 0;
+  // The joiners under SCHED_IDLE instead: sixty threads at nice 19 still weigh about one thread
+  // at nice 0 with the kernel, and took the watchers' and the replay's cores for 40-90 ms as they
+  // joined; idle ones take only what nothing else wants.
+  bool joiner_idle = false;
   // The joiners as skinstream-sub processes (as render nodes are programs of their own) instead
   // of threads of this one.
   bool joiner_processes = false;

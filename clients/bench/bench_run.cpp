@@ -10,14 +10,20 @@
 // so end to end = ingest + processing + delivery (+ decoding, with --decode), frame by frame.
 #include "clients/bench/bench_run.h"
 
+#include <fcntl.h>
+#include <pthread.h>
+#include <sched.h>
 #include <sys/resource.h>
 #include <unistd.h>
 
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <memory>
 #include <optional>
@@ -190,14 +196,16 @@ nlohmann::json join_wave_report(const BenchOptions& o, const std::vector<Subscri
 // --joiner-processes: one joiner as a skinstream-sub process, until it has `frames` frames or
 // `limit` passes (then killed). Its summary (the JSON it prints last), or {"error": ...}.
 // `receiver_address`: with --joiner-multicast, this host's address on the link to join the group on.
+// `go`: its standard input, closed by the bench when the joiners join (it is started before).
 nlohmann::json run_joiner_process(const BenchOptions& o, const std::string& address, int port, long frames,
-                                  std::chrono::seconds limit, const std::string& receiver_address) {
+                                  std::chrono::seconds limit, const std::string& receiver_address, int go) {
   std::vector<std::string> argv = {(own_folder() / "skinstream-sub").string(),
                                    address + ":" + std::to_string(port),
                                    "--encoding",
                                    client::to_string(o.encoding),
                                    "--frames",
-                                   std::to_string(frames)};
+                                   std::to_string(frames),
+                                   "--start-at-stdin-end"};
   if (o.normals) argv.push_back("--normals");
   if (o.paced) argv.push_back("--paced");
   if (o.decode) argv.push_back("--evaluate");
@@ -208,7 +216,7 @@ nlohmann::json run_joiner_process(const BenchOptions& o, const std::string& addr
   }
   CommandResult run;
   try {
-    run = run_command(argv, {.nice = o.joiner_nice, .limit = limit});
+    run = run_command(argv, {.nice = o.joiner_nice, .idle = o.joiner_idle, .stdin_fd = go, .limit = limit});
   } catch (const std::runtime_error& e) {
     return {{"error", e.what()}};
   }
@@ -391,7 +399,75 @@ nlohmann::json run_bench(const BenchOptions& o, const std::atomic<bool>& stop) {
     sleep_until_or_stop(Clock::now() + std::chrono::milliseconds(10), stop);
   }
   const double seconds_to_first_frames = std::chrono::duration<double>(Clock::now() - connect_started).count();
-  sleep_until_or_stop(Clock::now() + std::chrono::milliseconds(500), stop);  // let the joins' backlog drain
+  // The join wave: more subscribers at once, into the running stream.
+  std::vector<SubscriberTally> joiner_tallies(static_cast<size_t>(o.join_wave));
+  std::vector<std::string> joiner_errors(static_cast<size_t>(o.join_wave));
+  std::vector<nlohmann::json> joiner_summaries(static_cast<size_t>(o.join_wave));  // --joiner-processes
+  // Their threads are started now and wait: started at the join, 60 threads' stacks and first
+  // allocations stalled this whole process (the replay's sends and the watchers) for 55-65 ms.
+  std::vector<std::thread> joiners;
+  std::atomic<bool> joiners_go{false};
+  // --joiner-processes: started now too, each waiting for its standard input to end (a pipe of
+  // its own, closed at the join): forking 60 processes from this one at the join stalled its
+  // threads as long again.
+  std::vector<std::array<int, 2>> go_pipes;
+  if (o.joiner_processes)
+    for (int j = 0; j < o.join_wave; ++j) {
+      std::array<int, 2> p{};
+      if (pipe2(p.data(), O_CLOEXEC) != 0)
+        throw std::runtime_error(std::string("pipe: ") + std::strerror(errno));
+      go_pipes.push_back(p);
+    }
+  const auto release_processes = [&go_pipes](bool go) {
+    for (std::array<int, 2>& p : go_pipes)
+      if (p[1] >= 0) {
+        if (!go) (void)!::write(p[1], "q", 1);  // stop without connecting
+        close(p[1]);
+        p[1] = -1;
+      }
+  };
+  struct ReleaseJoiners {  // (a run that ends before the join: they return at once)
+    Window& window;
+    std::atomic<bool>& go;
+    const std::function<void(bool)>& release_processes;
+    ~ReleaseJoiners() {
+      window.closed = true;
+      release_processes(false);
+      go = true;
+      go.notify_all();
+    }
+  };
+  const std::function<void(bool)> release = release_processes;
+  JoinSubscribers join_joiners{window, joiners};  // the same guard: joined first, being declared later
+  ReleaseJoiners release_joiners{window, joiners_go, release};  // released before they are joined
+  for (int j = 0; j < o.join_wave; ++j)
+    joiners.emplace_back([&, j] {
+      if (o.joiner_nice > 0) setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), o.joiner_nice);
+      if (o.joiner_idle) {
+        const sched_param none{};
+        pthread_setschedparam(pthread_self(), SCHED_IDLE, &none);
+      }
+      if (o.joiner_processes) {
+        const double in_window = o.seconds - o.join_after_seconds;
+        joiner_summaries[j] = run_joiner_process(
+            o, daemon_address, daemon.sub_port(), std::lround(in_window * 120.0),
+            std::chrono::seconds(static_cast<long>(o.seconds) + 30), replay_address, go_pipes[j][0]);
+        close(go_pipes[j][0]);
+        return;
+      }
+      joiners_go.wait(false);
+      if (window.closed) return;
+      try {
+        subscribe(o, daemon_address, daemon.sub_port(), o.subscribers + j, send_times, window, stalls,
+                  joiner_tallies[j], o.joiner_multicast.empty() ? "" : replay_address);
+      } catch (const std::exception& e) {
+        joiner_errors[j] = e.what();
+      }
+    });
+  // Let the joins' backlog drain; and the joiner processes load (sixty programs starting stalled
+  // this one's threads for 30-70 ms at a time over a second) before the window opens.
+  sleep_until_or_stop(
+      Clock::now() + std::chrono::milliseconds(o.joiner_processes && o.join_wave > 0 ? 2500 : 500), stop);
 
   const nlohmann::json health_before = daemon.health();
   const int64_t period_ns = static_cast<int64_t>(1e9 / capture.rate_hz);
@@ -406,44 +482,6 @@ nlohmann::json run_bench(const BenchOptions& o, const std::atomic<bool>& stop) {
   window.start_ns = window_start_ns;
   const Clock::time_point deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(o.seconds));
 
-  // The join wave: more subscribers at once, into the running stream.
-  std::vector<SubscriberTally> joiner_tallies(static_cast<size_t>(o.join_wave));
-  std::vector<std::string> joiner_errors(static_cast<size_t>(o.join_wave));
-  std::vector<nlohmann::json> joiner_summaries(static_cast<size_t>(o.join_wave));  // --joiner-processes
-  // Their threads are started now and wait: started at the join, 60 threads' stacks and first
-  // allocations stalled this whole process (the replay's sends and the watchers) for 55-65 ms.
-  std::vector<std::thread> joiners;
-  std::atomic<bool> joiners_go{false};
-  struct ReleaseJoiners {  // (a run that ends before the join: they return at once)
-    Window& window;
-    std::atomic<bool>& go;
-    ~ReleaseJoiners() {
-      window.closed = true;
-      go = true;
-      go.notify_all();
-    }
-  };
-  JoinSubscribers join_joiners{window, joiners};       // the same guard: joined first, being declared later
-  ReleaseJoiners release_joiners{window, joiners_go};  // released before they are joined
-  for (int j = 0; j < o.join_wave; ++j)
-    joiners.emplace_back([&, j] {
-      if (o.joiner_nice > 0) setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), o.joiner_nice);
-      joiners_go.wait(false);
-      if (window.closed) return;
-      if (o.joiner_processes) {
-        const double in_window = o.seconds - o.join_after_seconds;
-        joiner_summaries[j] =
-            run_joiner_process(o, daemon_address, daemon.sub_port(), std::lround(in_window * 120.0),
-                               std::chrono::seconds(static_cast<long>(in_window) + 30), replay_address);
-        return;
-      }
-      try {
-        subscribe(o, daemon_address, daemon.sub_port(), o.subscribers + j, send_times, window, stalls,
-                  joiner_tallies[j], o.joiner_multicast.empty() ? "" : replay_address);
-      } catch (const std::exception& e) {
-        joiner_errors[j] = e.what();
-      }
-    });
   const Clock::time_point join_at = Clock::now() + std::chrono::duration_cast<Clock::duration>(
                                                        std::chrono::duration<double>(o.join_after_seconds));
   bool joined = o.join_wave == 0;
@@ -486,6 +524,7 @@ nlohmann::json run_bench(const BenchOptions& o, const std::atomic<bool>& stop) {
     }
     if (!joined && join_at < next) {
       sleep_until_or_stop(join_at, stop);
+      release_processes(true);
       joiners_go = true;
       joiners_go.notify_all();
       joined = true;
@@ -576,6 +615,7 @@ nlohmann::json run_bench(const BenchOptions& o, const std::atomic<bool>& stop) {
         {"paced", o.paced},
         {"packed_first_contact", !o.plain_first_contact},
         {"joiner_nice", o.joiner_nice},
+        {"joiner_idle", o.joiner_idle},
         {"joiner_processes", o.joiner_processes},
         {"joiner_multicast", o.joiner_multicast},
         {"multicast_offer_mbit",

@@ -2,6 +2,7 @@
 
 #include <fcntl.h>
 #include <poll.h>
+#include <sched.h>
 #include <signal.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
@@ -31,6 +32,11 @@ CommandResult run_command(const std::vector<std::string>& argv, const CommandOpt
   }
   if (pid == 0) {
     if (options.nice > 0) setpriority(PRIO_PROCESS, 0, options.nice);
+    if (options.idle) {
+      const sched_param none{};
+      sched_setscheduler(0, SCHED_IDLE, &none);
+    }
+    if (options.stdin_fd >= 0) dup2(options.stdin_fd, STDIN_FILENO);
     dup2(pipe_fds[1], STDOUT_FILENO);
     dup2(pipe_fds[1], STDERR_FILENO);
     execvp(args[0], args.data());

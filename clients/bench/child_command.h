@@ -10,6 +10,8 @@ namespace skinstream::bench {
 
 struct CommandOptions {
   int nice = 0;                        // the child's nice level (0: the bench's own)
+  bool idle = false;                   // the child under SCHED_IDLE: only CPU nothing else wants
+  int stdin_fd = -1;                   // the child's standard input (-1: the bench's own)
   std::chrono::milliseconds limit{0};  // killed once it has run this long (0: no limit)
 };
 

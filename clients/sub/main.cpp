@@ -93,6 +93,11 @@ int main(int argc, char** argv) {
                  "else from ADDRESS over TCP");
   app.add_option("--multicast-interface", multicast_interface, "multicast: this host's IPv4 address to join the group on");
   app.add_option("--multicast-stream", multicast_stream, "multicast: the subject's stream id (0: the daemon's first)");
+  bool wait_for_stdin = false;
+  app.add_flag("--start-at-stdin-end", wait_for_stdin,
+               "connect only once standard input ends (a load generator's processes, started beforehand, "
+               "join together when it closes their pipes), and exit without connecting if anything is "
+               "written to it first; first_frame_seconds counts from then");
   bool multicast_no_offer = false;
   app.add_flag("--multicast-no-offer", multicast_no_offer,
                "multicast: fetch MeshInfo and the Model over TCP, not from the daemon's offer");
@@ -159,6 +164,10 @@ int main(int argc, char** argv) {
       options.encoding = client::Encoding::Parameters;
     }
     if (save_every > 0) std::filesystem::create_directories(save_dir);
+    if (wait_for_stdin && std::fgetc(stdin) != EOF) {
+      std::fprintf(stderr, "skinstream-sub: told to stop before it started\n");
+      return 0;
+    }
     const auto connecting = std::chrono::steady_clock::now();
     client::Subscriber sub(options);
 

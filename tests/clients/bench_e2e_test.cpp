@@ -138,13 +138,14 @@ TEST(BenchProgram, AJoinWaveIsReportedApartFromTheWatchers) {
       << late.output;
 }
 
-// --joiner-processes: each joiner is a skinstream-sub process; their summaries are gathered.
+// --joiner-processes: each joiner is a skinstream-sub process, started before the window and let
+// go at the join (here under SCHED_IDLE); their summaries are gathered.
 TEST(BenchProgram, JoinerProcessesReportTheirOwnSummaries) {
-  const test::ProgramRun r = test::run_program(
-      bench("--subject " + kDemo + "/subject.sksubj --recording " + kDemo +
-            "/live.c3d --seconds 3 --subscribers 1 --encoding parameters "
-            "--join-wave 2 --join-after-seconds 1 --joiner-processes --joiner-nice 5 --json"),
-      /*stderr_too=*/false);
+  const test::ProgramRun r =
+      test::run_program(bench("--subject " + kDemo + "/subject.sksubj --recording " + kDemo +
+                              "/live.c3d --seconds 3 --subscribers 1 --encoding parameters "
+                              "--join-wave 2 --join-after-seconds 1 --joiner-processes --joiner-idle --json"),
+                        /*stderr_too=*/false);
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const auto j = nlohmann::json::parse(r.output);
   const auto& processes = j["join_wave"]["processes"];
@@ -153,6 +154,7 @@ TEST(BenchProgram, JoinerProcessesReportTheirOwnSummaries) {
   EXPECT_GT(processes["first_frame_seconds"]["max"].get<double>(), 0.0);
   EXPECT_GT(processes["frames_per_second_after_first"]["slowest"].get<double>(), 10.0);
   EXPECT_TRUE(j["subscribers_want"]["joiner_processes"].get<bool>());
+  EXPECT_TRUE(j["subscribers_want"]["joiner_idle"].get<bool>());
 }
 
 // Recording A/B in one run: takes start and stop through the control API, and the figures are
