@@ -418,7 +418,7 @@ nlohmann::json run_bench(const BenchOptions& o, const std::atomic<bool>& stop) {
         throw std::runtime_error(std::string("pipe: ") + std::strerror(errno));
       go_pipes.push_back(p);
     }
-  const auto release_processes = [&go_pipes](bool go) {
+  const std::function<void(bool)> release_processes = [&go_pipes](bool go) {
     for (std::array<int, 2>& p : go_pipes)
       if (p[1] >= 0) {
         if (!go) (void)!::write(p[1], "q", 1);  // stop without connecting
@@ -437,9 +437,8 @@ nlohmann::json run_bench(const BenchOptions& o, const std::atomic<bool>& stop) {
       go.notify_all();
     }
   };
-  const std::function<void(bool)> release = release_processes;
   JoinSubscribers join_joiners{window, joiners};  // the same guard: joined first, being declared later
-  ReleaseJoiners release_joiners{window, joiners_go, release};  // released before they are joined
+  ReleaseJoiners release_joiners{window, joiners_go, release_processes};  // released before they are joined
   for (int j = 0; j < o.join_wave; ++j)
     joiners.emplace_back([&, j] {
       if (o.joiner_nice > 0) setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), o.joiner_nice);

@@ -77,8 +77,9 @@ bool MulticastOffer::wait_until(std::chrono::steady_clock::time_point when) {
 void MulticastOffer::run() {
   bool has_edition = false;
   for (;;) {
+    // Made again only when the messages change: an offer too large stays so until then.
     const Content content = content_();
-    if (content.packed_mesh_info != sent_mesh_info_ || content.packed_model != sent_model_ || !has_edition)
+    if (content.packed_mesh_info != sent_mesh_info_ || content.packed_model != sent_model_)
       has_edition = make_edition(content);
     if (!has_edition) {
       if (!wait_until(std::chrono::steady_clock::now() + std::chrono::seconds(1))) return;

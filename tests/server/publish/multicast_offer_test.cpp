@@ -110,8 +110,10 @@ TEST(MulticastOffer, NothingToOfferOrTooMuchSendsNothing) {
   MulticastOffer too_large(loopback(50), huge.source());
   too_large.start();
   ASSERT_TRUE(wait_for([&] { return too_large.health()["too_large"] >= 1; }));
+  std::this_thread::sleep_for(std::chrono::milliseconds(1200));  // past the offer thread's 1 s wait
   too_large.stop();
   EXPECT_EQ(too_large.health()["datagrams_sent"], 0);
+  EXPECT_EQ(too_large.health()["too_large"], 1) << "made again though nothing changed";
 }
 
 std::string error_of(const MulticastSenderOptions& options) {
