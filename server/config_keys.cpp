@@ -504,7 +504,9 @@ std::vector<ConfigKey> make_config_keys() {
         "+ 1) at this rate, Mbit/s (flag --multicast-offer-mbit; docs/subscriber-protocol.md, \"The\n"
         "offer\"). Render nodes that join together take one copy from the group instead of one each\n"
         "over TCP: at 20 a round of the demo body's takes 0.34 s. Receivers that have the Model do\n"
-        "not listen to that port. 0 = no offer: receivers fetch them over TCP."},
+        "not listen to that port. The group is open to the LAN, where subscriber_token and\n"
+        "allow_subscribers do not reach. 0 = no offer: receivers fetch them over TCP, through\n"
+        "admission."},
             between(0, 1000), "0-1000 (0 = no offer)"),
       bound(&DaemonConfig::max_subscribers,
             {.name = "max_subscribers", .new_group = true,

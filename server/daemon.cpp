@@ -115,6 +115,15 @@ MulticastSenderOptions multicast_options_of(const DaemonConfig& config, uint32_t
   MulticastSenderOptions options{{group.host, group.port, config.multicast_interface, config.multicast_ttl},
                                  stream_id};
   options.offer_mbit = config.multicast_offer_mbit;
+  // The group is open to the LAN: what the offer carries is no longer behind the subscriber port's
+  // admission. Said once, at start-up, where the operator set admission.
+  if (options.offer_mbit > 0 && stream_id == 0 &&
+      (!config.subscriber_token.empty() || !config.allow_subscribers.empty()))
+    spdlog::warn(
+        "multicast: MeshInfo and the Model are offered to {} on the LAN, where subscriber_token and "
+        "allow_subscribers "
+        "do not reach (as the frames there); multicast_offer_mbit 0 keeps them behind admission",
+        config.multicast);
   if (!config.multicast_key_file.empty()) {
     try {
       options.key = subscriber::read_datagram_key_file(config.multicast_key_file);

@@ -915,6 +915,26 @@ double expect_vertices_equal(const PointCache& offline, const DemoPass& pass, in
   return worst;
 }
 
+// The multicast offer puts MeshInfo and the Model on the LAN, where the subscriber port's
+// admission does not reach: the daemon says so once at start-up when a token is set, and not
+// without one or with the offer off (sent through loopback, where nobody listens).
+TEST_F(DaemonDemo, TheOfferOutsideAdmissionIsSaidAtStartUp) {
+  const std::string with_token = test::scratch_path("offer_token.json");
+  std::ofstream(with_token) << "{ \"subscriber_token\": \"stage-token-0123456789\" }";
+  const std::string multicast = " --multicast 239.255.77.9:9591 --multicast-interface 127.0.0.1";
+  const std::string warning = "where subscriber_token and allow_subscribers do not reach";
+  for (const auto& [extra, warned] :
+       {std::pair{" --config " + with_token, true}, std::pair{std::string(), false},
+        std::pair{" --config " + with_token + " --multicast-offer-mbit 0", false}}) {
+    DaemonProcess daemon("--subject " + subject_ + " --replay " + live_ + " --loop --speed 0.2" + multicast +
+                         extra);
+    ASSERT_TRUE(eventually([&] { return daemon.log().find("multicast: every frame") != std::string::npos; }))
+        << daemon.log();
+    EXPECT_EQ(daemon.stop(), 0) << daemon.log();
+    EXPECT_EQ(count_lines_with(daemon.log(), warning), warned ? 1 : 0) << extra << "\n" << daemon.log();
+  }
+}
+
 TEST_F(DaemonDemo, VertexBuffersEqualTheOfflinePipeline) {
   ASSERT_EQ(offline_.point_count, 53514);
   ASSERT_EQ(static_cast<int>(offline_.start_frame), first_frame_);
