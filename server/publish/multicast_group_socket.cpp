@@ -46,4 +46,23 @@ int open_multicast_group_socket(const MulticastGroupAddress& a) {
   return fd;
 }
 
+GroupSend send_to_group(int fd, mmsghdr* datagrams, size_t count) {
+  GroupSend result;
+  while (result.sent < count) {
+    const int n =
+        sendmmsg(fd, datagrams + result.sent, static_cast<unsigned>(count - result.sent), MSG_DONTWAIT);
+    if (n > 0) {
+      result.sent += static_cast<size_t>(n);
+      continue;
+    }
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK || errno == ENOBUFS))
+      result.buffer_full = true;
+    else
+      result.error = n < 0 ? errno : EIO;
+    break;
+  }
+  return result;
+}
+
 }  // namespace skinstream::server

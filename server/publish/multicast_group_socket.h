@@ -3,6 +3,9 @@
 // never waits on it), connected to group:port, with the TTL and the interface to send from.
 // Shared by the frames (MulticastSender) and the offer (MulticastOffer).
 
+#include <sys/socket.h>
+
+#include <cstddef>
 #include <cstdint>
 #include <string>
 
@@ -20,5 +23,15 @@ std::string describe(const MulticastGroupAddress& address);
 // The socket's descriptor (the caller closes it). Throws std::runtime_error with one line: a bad
 // group or interface, a TTL out of 0-255, no socket, no route.
 int open_multicast_group_socket(const MulticastGroupAddress& address);
+
+// Hands `count` datagrams to the non-blocking socket `fd` (sendmmsg, again after EINTR and after
+// taking some), never waiting. What it took, and when it stopped short, why: `buffer_full`
+// (EAGAIN, ENOBUFS: the datagrams left are dropped) or `error` (an errno).
+struct GroupSend {
+  size_t sent = 0;
+  bool buffer_full = false;
+  int error = 0;
+};
+GroupSend send_to_group(int fd, mmsghdr* datagrams, size_t count);
 
 }  // namespace skinstream::server

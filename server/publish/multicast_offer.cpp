@@ -93,13 +93,14 @@ bool MulticastOffer::make_edition(const Content& content) {
   sent_mesh_info_ = content.packed_mesh_info;
   sent_model_ = content.packed_model;
   if (!content.packed_mesh_info || !content.packed_model || !content.model) return false;
-  offer_ = wire::encode_offer(*content.packed_mesh_info, *content.packed_model);
+  const std::vector<unsigned char> offer =
+      wire::encode_offer(*content.packed_mesh_info, *content.packed_model);
   const bool signed_datagrams = authenticator_ != nullptr;
-  const uint16_t count = wire::fragment_count(offer_.size(), signed_datagrams, wire::kMaxOfferFragments);
+  const uint16_t count = wire::fragment_count(offer.size(), signed_datagrams, wire::kMaxOfferFragments);
   if (count == 0) {
     too_large_.fetch_add(1, std::memory_order_relaxed);
     error_log_.warn("too_large", describe(options_.offer_address()) + ": an offer of " +
-                                     std::to_string(offer_.size()) + " bytes is over what " +
+                                     std::to_string(offer.size()) + " bytes is over what " +
                                      std::to_string(wire::kMaxOfferFragments) +
                                      " datagrams carry; not offered (receivers fetch the Model over TCP)");
     return false;
@@ -111,7 +112,7 @@ bool MulticastOffer::make_edition(const Content& content) {
                                     edition,
                                     0,
                                     count,
-                                    static_cast<uint32_t>(offer_.size()),
+                                    static_cast<uint32_t>(offer.size()),
                                     signed_datagrams,
                                     true};
   // Every datagram of the round made once per edition (the tags too): a round then only sends.
@@ -124,8 +125,8 @@ bool MulticastOffer::make_edition(const Content& content) {
     datagrams_.resize(start + wire::kDatagramHeaderBytes);
     wire::encode_datagram_header(h, std::span<unsigned char, wire::kDatagramHeaderBytes>(
                                         datagrams_.data() + start, wire::kDatagramHeaderBytes));
-    const auto fragment = std::span<const unsigned char>(offer_).subspan(
-        wire::fragment_offset(offer_.size(), count, i), wire::fragment_bytes(offer_.size(), count, i));
+    const auto fragment = std::span<const unsigned char>(offer).subspan(
+        wire::fragment_offset(offer.size(), count, i), wire::fragment_bytes(offer.size(), count, i));
     datagrams_.insert(datagrams_.end(), fragment.begin(), fragment.end());
     if (authenticator_) {
       const std::span<const unsigned char> parts[] = {
@@ -138,7 +139,7 @@ bool MulticastOffer::make_edition(const Content& content) {
   edition_.store(edition, std::memory_order_relaxed);
   model_id_.store(header.model_id, std::memory_order_relaxed);
   fragments_.store(count, std::memory_order_relaxed);
-  offer_bytes_.store(offer_.size(), std::memory_order_relaxed);
+  offer_bytes_.store(offer.size(), std::memory_order_relaxed);
   return true;
 }
 
@@ -149,7 +150,7 @@ bool MulticastOffer::send_round() {
   mmsghdr batch[kBatch];
   for (size_t first = 0; first < datagram_ends_.size(); first += kBatch) {
     const size_t n = std::min(kBatch, datagram_ends_.size() - first);
-    size_t bytes = 0;
+    size_t bytes = 0;  // of the batch: its pacing
     std::memset(batch, 0, sizeof batch);
     for (size_t k = 0; k < n; ++k) {
       const size_t begin = first + k == 0 ? 0 : datagram_ends_[first + k - 1];
@@ -158,25 +159,18 @@ bool MulticastOffer::send_round() {
       batch[k].msg_hdr.msg_iovlen = 1;
       bytes += pieces[k].iov_len;
     }
-    size_t sent = 0;
-    while (sent < n) {
-      const int got = sendmmsg(fd_, batch + sent, static_cast<unsigned>(n - sent), MSG_DONTWAIT);
-      if (got > 0) {
-        sent += static_cast<size_t>(got);
-        continue;
-      }
-      if (got < 0 && errno == EINTR) continue;
-      if (got < 0 && (errno == EAGAIN || errno == EWOULDBLOCK || errno == ENOBUFS)) {
-        datagrams_dropped_.fetch_add(n - sent, std::memory_order_relaxed);  // the next round brings them
-      } else {
-        send_errors_.fetch_add(1, std::memory_order_relaxed);
-        error_log_.warn("send",
-                        describe(options_.offer_address()) + ": send failed: " + std::strerror(errno));
-      }
-      break;
+    const GroupSend send = send_to_group(fd_, batch, n);
+    if (send.buffer_full)
+      datagrams_dropped_.fetch_add(n - send.sent, std::memory_order_relaxed);  // the next round brings them
+    if (send.error != 0) {
+      send_errors_.fetch_add(1, std::memory_order_relaxed);
+      error_log_.warn("send",
+                      describe(options_.offer_address()) + ": send failed: " + std::strerror(send.error));
     }
-    datagrams_sent_.fetch_add(sent, std::memory_order_relaxed);
-    bytes_sent_.fetch_add(bytes, std::memory_order_relaxed);
+    datagrams_sent_.fetch_add(send.sent, std::memory_order_relaxed);
+    uint64_t bytes_sent = 0;  // of the datagrams the socket took
+    for (size_t k = 0; k < send.sent; ++k) bytes_sent += pieces[k].iov_len;
+    bytes_sent_.fetch_add(bytes_sent, std::memory_order_relaxed);
     if (first + n == datagram_ends_.size()) rounds_.fetch_add(1, std::memory_order_relaxed);
     next += std::chrono::duration_cast<std::chrono::steady_clock::duration>(
         std::chrono::duration<double>(bytes / bytes_per_second));

@@ -69,8 +69,7 @@ class MulticastOffer {
 
   // The edition being offered (offer thread only).
   ControlMessage sent_mesh_info_, sent_model_;  // what it was made of
-  std::vector<unsigned char> offer_;
-  std::vector<unsigned char> datagrams_;  // every datagram of a round, one after the other
+  std::vector<unsigned char> datagrams_;        // every datagram of a round, one after the other
   std::vector<size_t> datagram_ends_;
 
   std::atomic<uint32_t> edition_{0}, model_id_{0}, fragments_{0};

@@ -86,26 +86,18 @@ void MulticastSender::publish(const FrameRef& frame) {
       tags_[i] = authenticator_->tag(parts);
     }
   }
-  int sent = 0;
-  while (sent < count) {
-    const int n = sendmmsg(fd_, datagrams_ + sent, static_cast<unsigned>(count - sent), MSG_DONTWAIT);
-    if (n > 0) {
-      sent += n;
-      continue;
-    }
-    if (n < 0 && errno == EINTR) continue;
-    if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK || errno == ENOBUFS)) {
-      datagrams_dropped_.fetch_add(static_cast<uint64_t>(count - sent), std::memory_order_relaxed);
-    } else {
-      send_errors_.fetch_add(1, std::memory_order_relaxed);
-      error_log_.warn("send", where(options_) + ": send failed: " + std::strerror(errno) + "; the frame's other datagrams are dropped");
-    }
-    break;
+  const GroupSend send = send_to_group(fd_, datagrams_, count);
+  const size_t sent = send.sent;
+  if (send.buffer_full) datagrams_dropped_.fetch_add(count - sent, std::memory_order_relaxed);
+  if (send.error != 0) {
+    send_errors_.fetch_add(1, std::memory_order_relaxed);
+    error_log_.warn("send", where(options_) + ": send failed: " + std::strerror(send.error) +
+                                "; the frame's other datagrams are dropped");
   }
   if (sent == count) frames_sent_.fetch_add(1, std::memory_order_relaxed);
   datagrams_sent_.fetch_add(static_cast<uint64_t>(sent), std::memory_order_relaxed);
   uint64_t bytes = 0;
-  for (int i = 0; i < sent; ++i)
+  for (size_t i = 0; i < sent; ++i)
     bytes += wire::kDatagramHeaderBytes + pieces_[3 * i + 1].iov_len + (signed_datagrams ? wire::kDatagramTagBytes : 0);
   bytes_sent_.fetch_add(bytes, std::memory_order_relaxed);
   send_time_.observe_ns(std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - start).count());
