@@ -7,14 +7,12 @@
 #include "core/rigid_fit_leverage.h"
 
 namespace skinstream {
-namespace {
-
-}  // namespace
 
 GapFiller::GapFiller(const SubjectModel& model, const GapFillerOptions& options)
     : model_(model),
       options_(options),
       n_(model.marker_count()),
+      tracks_(model.marker_count()),
       carry_(model, options.rate_hz),
       single_gaps_(model),
       ring_calibration_(model, options.rate_hz),
@@ -35,10 +33,6 @@ GapFiller::GapFiller(const SubjectModel& model, const GapFillerOptions& options)
     eps2_.push_back(model.parameters.alpha2 * model.neighbour_distance(i));
   }
 
-  previous_.assign(n_, Vec3::Zero());
-  before_previous_.assign(n_, Vec3::Zero());
-  before_previous_seen_.assign(n_, 0);
-  previous_status_.assign(n_, MarkerStatus::Held);
   assigned_id_.assign(n_, kNoFragment);
   probation_start_.assign(n_, -1);
   refused_id_.assign(n_, kNoFragment);
@@ -99,8 +93,7 @@ GapFiller::GapFiller(const SubjectModel& model, const GapFillerOptions& options)
 }
 
 void GapFiller::reset() {
-  has_previous_ = false;
-  std::fill(before_previous_seen_.begin(), before_previous_seen_.end(), 0);
+  tracks_.reset();
   std::fill(assigned_id_.begin(), assigned_id_.end(), kNoFragment);
   std::fill(probation_start_.begin(), probation_start_.end(), -1);
   std::fill(refused_id_.begin(), refused_id_.end(), kNoFragment);
@@ -147,7 +140,7 @@ FillStats GapFiller::run(const FrameInput& in, const FrameOutput& out) {
     add_free_point(in.unlabelled[p], in.unlabelled_ids.empty() ? static_cast<int>(p) : in.unlabelled_ids[p]);
 
   suspects_.clear();
-  if (options_.check_labels && has_previous_) find_suspect_labels();
+  if (options_.check_labels && tracks_.has_last()) find_suspect_labels();
   estimate_rigid();
   if (!suspects_.empty()) judge_suspect_labels();
   std::fill(revoked_.begin(), revoked_.end(), 0);
@@ -168,10 +161,6 @@ FillStats GapFiller::run(const FrameInput& in, const FrameOutput& out) {
     if (!out.fragments.empty()) out.fragments[i] = status_[i] == MarkerStatus::Relabelled ? assigned_id_[i] : kNoFragment;
     if (!out.revoked.empty()) out.revoked[i] = revoked_[i];
     if (is_present(in.labelled[i]) && current_[i] != in.labelled[i]) ++stats_.changed_measured;
-    before_previous_[i] = previous_[i];
-    before_previous_seen_[i] = has_previous_ && is_observed(previous_status_[i]);
-    previous_[i] = current_[i];
-    previous_status_[i] = status_[i];
     switch (status_[i]) {
       case MarkerStatus::Measured: ++stats_.measured; break;
       case MarkerStatus::Relabelled: ++stats_.relabelled; break;
@@ -180,7 +169,7 @@ FillStats GapFiller::run(const FrameInput& in, const FrameOutput& out) {
       case MarkerStatus::Held: ++stats_.held; break;
     }
   }
-  has_previous_ = true;
+  tracks_.advance(current_, status_);
   if (options_.use_regions && options_.learn_regions) region_statistics_.learn(current_, status_);
   if (options_.calibrate_rings) ring_calibration_.check(current_, status_, single_gaps_);
   return stats_;
@@ -195,11 +184,11 @@ bool GapFiller::carried_position(int i, Vec3& out) const {
   for (int k = model_.ring_offsets[i]; k < model_.ring_offsets[i + 1]; ++k) {
     const int j = model_.ring[k];
     if (!observed_[j]) continue;
-    displacement += current_[j] - previous_[j];
+    displacement += current_[j] - tracks_.last(j);
     ++count;
   }
   if (count < 2) return false;
-  out = previous_[i] + displacement / count;
+  out = tracks_.last(i) + displacement / count;
   return true;
 }
 
@@ -212,8 +201,8 @@ bool GapFiller::carried_position(int i, Vec3& out) const {
 void GapFiller::find_suspect_labels() {
   for (int i = 0; i < n_; ++i) {
     Vec3 expected;
-    if (!observed_[i] || previous_status_[i] == MarkerStatus::Held) continue;
-    if (!carried_position(i, expected)) expected = previous_[i];
+    if (!observed_[i] || tracks_.last_status(i) == MarkerStatus::Held) continue;
+    if (!carried_position(i, expected)) expected = tracks_.last(i);
     if ((current_[i] - expected).norm() > eps2_[i]) suspects_.push_back(i);
   }
   for (int i : suspects_) observed_[i] = 0;
@@ -237,11 +226,12 @@ void GapFiller::judge_suspect_labels() {
     const bool own_confident = has_own && own_distance * own_distance > kConfidentMiss * own_variance;
     // With no estimate of its own, the point's own track is the evidence left: where its motion
     // takes it, and whether another marker's estimate or track reaches the point clearly better.
-    const bool reject = has_own ? (own_distance > eps2_[i] || own_confident) &&
-                                      (explained_by_another(i, own_distance) ||
-                                       (own_distance > eps2_[i] && off_own_track(i)))
-                                : explained_by_another(i, (current_[i] - track_prediction(i)).norm()) ||
-                                      off_own_track(i);
+    const bool reject = has_own
+                            ? (own_distance > eps2_[i] || own_confident) &&
+                                  (explained_by_another(i, own_distance) ||
+                                   (own_distance > eps2_[i] && tracks_.off_track(i, current_[i], eps2_[i])))
+                            : explained_by_another(i, (current_[i] - tracks_.prediction(i)).norm()) ||
+                                  tracks_.off_track(i, current_[i], eps2_[i]);
     if (reject) {
       add_free_point(current_[i], -(i + 1));
       ++stats_.rejected_labels;
@@ -263,37 +253,14 @@ bool GapFiller::explained_by_another(int i, double own_distance) {
   return std::isfinite(nearest) && nearest <= 0.5 * own_distance;
 }
 
-// Whether marker i was measured (or relabelled) in each of the last two frames: then it has a
-// velocity of its own.
-bool GapFiller::measured_last_two_frames(int i) const {
-  return before_previous_seen_[i] && is_observed(previous_status_[i]);
-}
-
-// Where marker i's own motion takes it this frame: its last position moved on by its last
-// frame's velocity when it was measured in the last two frames, else its last position (its
-// estimate, during a gap).
-Vec3 GapFiller::track_prediction(int i) const {
-  if (!measured_last_two_frames(i)) return previous_[i];
-  return 2.0 * previous_[i] - before_previous_[i];
-}
-
-// Whether marker i, measured in the last two frames, is now farther from where its own velocity
-// takes it than eps2 plus a frame's travel: a label that jumps off its track (a swap, a ghost),
-// where a fast limb at a low frame rate stays near it (a serve's hand: 240 mm a frame at 50 Hz).
-bool GapFiller::off_own_track(int i) const {
-  if (!measured_last_two_frames(i)) return false;
-  const double travel = (previous_[i] - before_previous_[i]).norm();
-  return (current_[i] - track_prediction(i)).norm() > eps2_[i] + travel;
-}
-
 // The distance from point p to the track prediction of the nearest other missing (or suspect)
 // marker that has no estimate this frame and a position last frame, within eps1 (infinity: none).
 double GapFiller::nearest_other_on_track(int i, const Vec3& p) {
   double nearest = std::numeric_limits<double>::infinity();
   Vec3 unused;
   for (int j : missing_) {
-    if (observed_[j] || j == i || previous_status_[j] == MarkerStatus::Held) continue;
-    const double d = (p - track_prediction(j)).norm();
+    if (observed_[j] || j == i || tracks_.last_status(j) == MarkerStatus::Held) continue;
+    const double d = (p - tracks_.prediction(j)).norm();
     if (d <= eps1_[j] && d < nearest && !expected_position(j, unused)) nearest = d;
   }
   return nearest;
@@ -412,7 +379,7 @@ void GapFiller::relabel() {
     if (id == kNoFragment) continue;
     const int found = find_free_point(id);
     Vec3 expected;
-    if (found >= 0 && !expected_position(i, expected)) expected = previous_[i];  // no estimate: continuity
+    if (found >= 0 && !expected_position(i, expected)) expected = tracks_.last(i);  // no estimate: continuity
     const double distance = found >= 0 ? (free_points_[found] - expected).norm() : 0.0;
     const bool on_probation = probation_start_[i] >= 0;
     const bool keep = found >= 0 && (on_probation ? ambiguity_free_match(i, found, distance) : distance <= eps2_[i]);
@@ -427,7 +394,7 @@ void GapFiller::relabel() {
       revoked_[i] = static_cast<int>(frame_ - probation_start_[i]);
       refused_id_[i] = id;
       probation_start_[i] = -1;
-      previous_status_[i] = MarkerStatus::FilledRigid;  // still in its gap: no continuity from the fragment
+      tracks_.take_last_as_estimated(i);  // still in its gap: no continuity from the fragment
     }
     assigned_id_[i] = kNoFragment;
   }
@@ -585,8 +552,8 @@ bool GapFiller::transfer_motion(int first, int last, const std::vector<int>& mem
   int count = 0;
   for (int k = first; k < last; ++k) {
     const int j = members[k];
-    if (!observed_[j] || !is_observed(previous_status_[j])) continue;
-    scratch_source_[count] = previous_[j];
+    if (!observed_[j] || !is_observed(tracks_.last_status(j))) continue;
+    scratch_source_[count] = tracks_.last(j);
     scratch_target_[count] = estimate_[j];
     ++count;
   }
@@ -687,8 +654,8 @@ void GapFiller::fill_missing() {
   auto combined_variance = [](double variance_a, double variance_b) { return variance_a * variance_b / (variance_a + variance_b); };
   for (int i : missing_) {
     if (observed_[i]) continue;  // relabelled
-    if (has_previous_ && is_observed(previous_status_[i])) {
-      carry_.remember_gap_start(i, frame_, previous_, previous_status_);
+    if (tracks_.has_last() && is_observed(tracks_.last_status(i))) {
+      carry_.remember_gap_start(i, frame_, tracks_.last_positions(), tracks_.last_statuses());
       gap_offset_[i].setZero();  // set below when this frame has a neighbourhood rotation
     }
     Vec3 carried;
@@ -724,10 +691,11 @@ void GapFiller::fill_missing() {
       Vec3 moved;
       if (carry)
         current_[i] = carried;
-      else if (has_previous_ && transfer_motion(model_.anchor_offsets[i], model_.anchor_offsets[i + 1], model_.anchors, previous_[i], moved))
+      else if (tracks_.has_last() && transfer_motion(model_.anchor_offsets[i], model_.anchor_offsets[i + 1],
+                                                     model_.anchors, tracks_.last(i), moved))
         current_[i] = moved;
       else
-        current_[i] = has_previous_ ? previous_[i] : model_.reference_positions[i];
+        current_[i] = tracks_.has_last() ? tracks_.last(i) : model_.reference_positions[i];
       status_[i] = MarkerStatus::Held;
       continue;
     }
@@ -735,10 +703,11 @@ void GapFiller::fill_missing() {
     // Continuity: the gap starts where the last measurement, moved with the neighbours, would be.
     // The offset is made at the gap's first frame (none if that frame has no neighbourhood
     // rotation to keep it in) and decays with the gap's age.
-    if (decay_frames <= 0.0 || !has_rotation_[i] || !has_previous_) continue;
+    if (decay_frames <= 0.0 || !has_rotation_[i] || !tracks_.has_last()) continue;
     Vec3 expected;
-    if (is_observed(previous_status_[i]) &&
-        transfer_motion(model_.ring_offsets[i], model_.ring_offsets[i + 1], model_.ring, previous_[i], expected))
+    if (is_observed(tracks_.last_status(i)) &&
+        transfer_motion(model_.ring_offsets[i], model_.ring_offsets[i + 1], model_.ring, tracks_.last(i),
+                        expected))
       gap_offset_[i] = rotation_[i].transpose() * (expected - current_[i]);
     const double age = static_cast<double>(frame_ - carry_.gap_start_frame(i));
     current_[i] += rotation_[i] * gap_offset_[i] * std::exp(-age / decay_frames);

@@ -54,6 +54,7 @@
 #include "core/absolute_orientation.h"
 #include "core/gap_start_carry.h"
 #include "core/marker_status.h"
+#include "core/marker_tracks.h"
 #include "core/pca_fit.h"
 #include "core/region_online_statistics.h"
 #include "core/region_pca_fit.h"
@@ -142,9 +143,6 @@ class GapFiller {
   void find_suspect_labels();
   void judge_suspect_labels();
   bool explained_by_another(int i, double own_distance);
-  bool measured_last_two_frames(int i) const;
-  Vec3 track_prediction(int i) const;
-  bool off_own_track(int i) const;
   double nearest_other_expected(int i, const Vec3& p);
   double nearest_other_on_track(int i, const Vec3& p);
   bool carried_position(int i, Vec3& out) const;
@@ -180,18 +178,15 @@ class GapFiller {
   // A labelled point this many variances (squared distance over the calibrated predictive
   // variance) from its own estimate is confidently not where the marker is expected.
   static constexpr double kConfidentMiss = 16.0;
-  bool has_previous_ = false;
   long frame_ = 0;
-  long solve_stamp_ = 0;  // this frame's: a PCA solve made in it stands until its ring changes (refresh_estimates)
-  std::vector<Vec3> previous_;
-  std::vector<MarkerStatus> previous_status_;
-  std::vector<Vec3> before_previous_;       // two frames back, for a marker's own track
-  std::vector<char> before_previous_seen_;  // measured (or relabelled) two frames back
+  long solve_stamp_ =
+      0;  // this frame's: a PCA solve made in it stands until its ring changes (refresh_estimates)
   std::vector<int> assigned_id_;      // free-point trajectory currently standing for marker i
   std::vector<long> probation_start_;  // frame its relabel was taken while still on probation, else -1
   std::vector<int> refused_id_;        // a fragment whose relabel was revoked, not taken again while it lasts
   std::vector<int> revoked_;           // this frame's FrameOutput::revoked
   std::vector<Vec3> gap_offset_;      // continuity offset in the local frame, made at the gap's first frame
+  MarkerTracks tracks_;               // each marker's last two frames: where it was and its own velocity
   GapStartCarry carry_;               // also where each marker's gap started
 
   // Per-frame scratch.
