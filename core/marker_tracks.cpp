@@ -22,6 +22,7 @@ void MarkerTracks::advance(std::span<const Vec3> positions, std::span<const Mark
 
 void MarkerTracks::reset() {
   has_last_ = false;
+  std::fill(last_status_.begin(), last_status_.end(), MarkerStatus::Held);
   std::fill(before_last_measured_.begin(), before_last_measured_.end(), 0);
 }
 

@@ -511,6 +511,49 @@ TEST(GapFiller, NeverOutputsNaN) {
   }
 }
 
+// reset() forgets the take: the next one is filled as a new filler fills it, bit for bit. The
+// second take starts where the first one's markers are not: the limb moved so that the point
+// standing for the middle marker lies on the track the opposite marker had in the first take,
+// and every marker but the middle one's ring is hidden, so nothing else estimates the opposite
+// one. A filler that kept the old tracks would find the point ambiguous and not take it.
+TEST(GapFiller, AfterResetATakeIsFilledAsByANewFiller) {
+  Fixture fx;
+  const int n = fx.model.marker_count();
+  GapFiller used(fx.model), fresh(fx.model);
+  Frame frame(n), again(n);
+  for (int f = 0; f < 40; ++f) {
+    load(fx.truth, f, frame);
+    frame.run(used);
+  }
+  const Vec3 opposite_last = fx.truth.at(39, kOther);
+  used.reset();
+
+  const Vec3 shift = opposite_last - fx.truth.at(100, kMiddle);
+  std::vector<char> ring(n, 0);
+  for (int k = fx.model.ring_offsets[kMiddle]; k < fx.model.ring_offsets[kMiddle + 1]; ++k)
+    ring[fx.model.ring[k]] = 1;
+  for (int f = 100; f < 130; ++f) {
+    load(fx.truth, f, frame);
+    for (Vec3& p : frame.labelled) p += shift;
+    if (f == 100) {
+      for (int i = 0; i < n; ++i)
+        if (!ring[i]) frame.labelled[i] = missing_point();
+      frame.unlabelled = {fx.truth.at(f, kMiddle) + shift};
+      frame.ids = {7};
+    }
+    again.labelled = frame.labelled;
+    again.unlabelled = frame.unlabelled;
+    again.ids = frame.ids;
+    frame.run(used);
+    again.run(fresh);
+    if (f == 100) EXPECT_EQ(again.status[kMiddle], MarkerStatus::Relabelled);
+    for (int i = 0; i < n; ++i) {
+      ASSERT_EQ(frame.status[i], again.status[i]) << "frame " << f << ", marker " << i;
+      ASSERT_EQ(frame.positions[i], again.positions[i]) << "frame " << f << ", marker " << i;
+    }
+  }
+}
+
 // Also with new relabels on probation (confirm_frames 6) and the fragments and revocations asked for.
 TEST(GapFiller, AllocatesNothingPerFrame) {
   Fixture fx;
