@@ -4,7 +4,7 @@
 #   - its size, printed as one JSON line, at most IMAGE_MAX_MB (400) megabytes;
 #   - a container with its ports published on loopback only (free ports Docker picks): GET /health
 #     answers, GET / and /app.js serve the page, a TCP subscriber receives Frame messages,
-#     /metrics counts published frames rising, the daemon runs as a user other than root, and
+#     /metrics counts frames published and received frames rising, the daemon runs as a user other than root, and
 #     the image's HEALTHCHECK reports the container healthy.
 # The container is stopped and removed, the image kept. Any failure: exit 1 with one line saying why.
 # Usage: bash scripts/image.sh [TAG]   (default skinstream:latest)
@@ -103,14 +103,19 @@ done
 exec 3>&-
 [ "${types[${#types[@]}-1]}" -eq 3 ] || fail "no Frame among the first ${#types[@]} subscriber messages (types ${types[*]})"
 
-# Frames published keep rising.
-published() {
-  curl -fsS --max-time 5 "$base/metrics" | awk '/^skinstream_frames_published_total/ { n += $NF } END { printf "%d", n }'
+# The subscriber above was published frames, and the replay keeps coming in. The daemon hands
+# frames to its publishers only while someone subscribes, so with nobody left the published
+# count stands still: what keeps rising is the frames received from the source.
+counter() {
+  curl -fsS --max-time 5 "$base/metrics" |
+    awk -v name="$1" 'index($1, name "{") == 1 || $1 == name { n += $NF } END { printf "%d", n }'
 }
-first=$(published) || fail "GET /metrics failed"
+published=$(counter skinstream_frames_published_total) || fail "GET /metrics failed"
+[ "$published" -gt 0 ] || fail "skinstream_frames_published_total is 0 after the subscriber's Frame messages"
+first=$(counter skinstream_frames_received_total) || fail "GET /metrics failed"
 sleep 2
-second=$(published) || fail "GET /metrics failed"
-[ "$second" -gt "$first" ] || fail "skinstream_frames_published_total did not rise in 2 s ($first, then $second)"
+second=$(counter skinstream_frames_received_total) || fail "GET /metrics failed"
+[ "$second" -gt "$first" ] || fail "skinstream_frames_received_total did not rise in 2 s ($first, then $second)"
 
 # The image's own HEALTHCHECK (every 10 s).
 for _ in $(seq 1 45); do
@@ -127,4 +132,4 @@ done
 docker rm -f "$container" > /dev/null || fail "cannot remove the container $name"
 container=""
 echo "image.sh: $tag ($megabytes MB) ok: /health, the page, a TCP subscriber's Frame messages" \
-     "(after types ${types[*]}), frames published $first -> $second in 2 s, user $user, healthy"
+     "(after types ${types[*]}), $published frames published, frames received $first -> $second in 2 s, user $user, healthy"
