@@ -8,9 +8,15 @@
 # is kept in build-fuzz/fuzz/findings/TARGET/ (replay it: build-fuzz/bin/fuzz_TARGET FILE).
 # Exits non-zero when any target found anything. Usage: scripts/fuzz.sh [SECONDS] [TARGET...]
 # FUZZ_RUNS=N also stops each target after N executions (a long run: FUZZ_RUNS=10000000 with
-# SECONDS as the cap on each target).
+# SECONDS as the cap on each target). scripts/fuzz.sh --build-only: the clang build alone (the
+# test command runs it beside the suite).
 set -euo pipefail
 cd "$(dirname "$0")/.."
+build_only=0
+if [ "${1:-}" = "--build-only" ]; then
+  build_only=1
+  shift
+fi
 seconds=${1:-10}
 shift || true
 runs=()
@@ -32,6 +38,7 @@ cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_
   -DCMAKE_CXX_COMPILER=clang++ "${launcher[@]}" -DSKINSTREAM_FUZZ=ON -DSKINSTREAM_UNITY_BUILD=OFF \
   -DSKINSTREAM_BUILD_TESTS=OFF -DSKINSTREAM_BUILD_BENCHMARKS=OFF >&2
 cmake --build build-fuzz -j "$(nproc)" --target skinstream_fuzz >&2
+if [ "$build_only" -eq 1 ]; then exit 0; fi
 
 # The made seeds come from the test build (uninstrumented; tests/CMakeLists.txt).
 make_seeds=build/bin/fuzz_make_seeds

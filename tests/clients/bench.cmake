@@ -16,7 +16,7 @@ if(TARGET skinstream-bench AND TARGET skinstreamd)
   add_dependencies(bench_tests skinstream-bench skinstreamd)
   gtest_discover_tests(bench_tests TEST_FILTER "StallLog.*:ChildCommand.*" DISCOVERY_TIMEOUT 60 PROPERTIES LABELS clients)
   gtest_discover_tests(bench_tests TEST_FILTER "BenchProgram.*-BenchProgram.ShapedLink*:BenchProgram.Interrupted*" DISCOVERY_TIMEOUT 60
-    PROPERTIES LABELS clients TIMEOUT ${time_limit_120} FIXTURES_REQUIRED demo_subject)
+    PROPERTIES LABELS clients TIMEOUT ${time_limit_120} FIXTURES_REQUIRED demo_subject COST 4)
   # The shaped link's tests count the bench's network namespaces before and after: alone.
   gtest_discover_tests(bench_tests TEST_FILTER "BenchProgram.ShapedLink*:BenchProgram.Interrupted*" DISCOVERY_TIMEOUT 60
     PROPERTIES LABELS clients TIMEOUT ${time_limit_120} FIXTURES_REQUIRED demo_subject RUN_SERIAL TRUE)

@@ -21,8 +21,8 @@ if(TARGET skinstreamd AND TARGET skinstream_client)
   # MulticastDemo needs root and iproute2 (network namespaces on a bridge); without them it is
   # skipped with the reason.
   gtest_discover_tests(client_library_tests TEST_FILTER "ClientSubscriberDemo.*:EvaluatorCDemo.*:MulticastDemo.*:MulticastKeyDemo.*" DISCOVERY_TIMEOUT 60
-    PROPERTIES LABELS clients TIMEOUT ${time_limit_300} FIXTURES_REQUIRED demo_subject)
+    PROPERTIES LABELS clients TIMEOUT ${time_limit_300} FIXTURES_REQUIRED demo_subject COST 4)
   # Two subject files of one body (tests/support/make_swap_subjects.sh), swapped under a multicast receiver.
   gtest_discover_tests(client_library_tests TEST_FILTER "MulticastSwap.*" DISCOVERY_TIMEOUT 60
-    PROPERTIES LABELS clients TIMEOUT ${time_limit_300} FIXTURES_REQUIRED swap_subjects)
+    PROPERTIES LABELS clients TIMEOUT ${time_limit_300} FIXTURES_REQUIRED swap_subjects COST 6)
 endif()

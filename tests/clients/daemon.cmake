@@ -25,10 +25,10 @@ if(TARGET skinstreamd AND TARGET skinstream-sub AND TARGET skinstream-replay)
     target_compile_definitions(daemon_tests PRIVATE SKINSTREAM_UBSAN_VPTR)  # its vptr check, on with undefined
   endif()
   add_dependencies(daemon_tests skinstreamd skinstream-sub skinstream-replay skinstream skinstream-ctl)
-  gtest_discover_tests(daemon_tests TEST_FILTER "-DaemonDemo*" DISCOVERY_TIMEOUT 60 PROPERTIES LABELS clients TIMEOUT ${time_limit_120})
+  gtest_discover_tests(daemon_tests TEST_FILTER "-DaemonDemo*" DISCOVERY_TIMEOUT 60 PROPERTIES LABELS clients TIMEOUT ${time_limit_120} COST 2)
   # The demo subject's tests need the demo_subject fixture (tests/clients/CMakeLists.txt).
   gtest_discover_tests(daemon_tests TEST_FILTER "DaemonDemo*" DISCOVERY_TIMEOUT 60
-    PROPERTIES LABELS clients TIMEOUT ${time_limit_300} FIXTURES_REQUIRED demo_subject)
+    PROPERTIES LABELS clients TIMEOUT ${time_limit_300} FIXTURES_REQUIRED demo_subject COST 6)
 
   # Usage errors of the programs themselves.
   add_test(NAME daemon.unknown_flag COMMAND skinstreamd --no-such-flag)
