@@ -26,9 +26,10 @@ phase_done build
 # browsers), and an idle-priority compiler runs only when nothing else wants a core.
 mkdir -p build
 fuzz_build_log=build/fuzz-build.log
-chrt --idle 0 bash scripts/fuzz.sh --build-only > "$fuzz_build_log" 2>&1 &
+# In a process group of its own (setsid), so that a failing suite stops the whole build with it.
+setsid chrt --idle 0 bash scripts/fuzz.sh --build-only > "$fuzz_build_log" 2>&1 &
 fuzz_build=$!
-trap 'kill "$fuzz_build" 2>/dev/null || true' EXIT
+trap 'kill -- -"$fuzz_build" 2>/dev/null || true' EXIT
 ctest --test-dir build --output-on-failure -j "$(nproc)" --timeout 600
 phase_done tests
 if ! wait "$fuzz_build"; then

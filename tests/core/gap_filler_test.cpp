@@ -513,9 +513,9 @@ TEST(GapFiller, NeverOutputsNaN) {
 
 // reset() forgets the take: the next one is filled as a new filler fills it, bit for bit. The
 // second take starts where the first one's markers are not: the limb moved so that the point
-// standing for the middle marker lies on the track the opposite marker had in the first take,
-// and every marker but the middle one's ring is hidden, so nothing else estimates the opposite
-// one. A filler that kept the old tracks would find the point ambiguous and not take it.
+// standing for the middle marker lies where the opposite marker was last in the first take, and
+// every marker but the middle one's ring is hidden. A filler that kept the first take's statuses
+// (and so its tracks) filled this take's first frame otherwise.
 TEST(GapFiller, AfterResetATakeIsFilledAsByANewFiller) {
   Fixture fx;
   const int n = fx.model.marker_count();
