@@ -13,6 +13,7 @@ GapFiller::GapFiller(const SubjectModel& model, const GapFillerOptions& options)
       options_(options),
       n_(model.marker_count()),
       tracks_(model.marker_count()),
+      label_check_(model),
       carry_(model, options.rate_hz),
       single_gaps_(model),
       ring_calibration_(model, options.rate_hz),
@@ -43,7 +44,6 @@ GapFiller::GapFiller(const SubjectModel& model, const GapFillerOptions& options)
   observed_.assign(n_, 0);
   estimated_.assign(n_, 0);
   has_rotation_.assign(n_, 0);
-  suspects_.reserve(n_);
   changed_.reserve(n_);
   estimate_.assign(n_, Vec3::Zero());
   rotation_.assign(n_, Eigen::Matrix3d::Identity());
@@ -139,10 +139,11 @@ FillStats GapFiller::run(const FrameInput& in, const FrameOutput& out) {
   for (size_t p = 0; p < in.unlabelled.size(); ++p)
     add_free_point(in.unlabelled[p], in.unlabelled_ids.empty() ? static_cast<int>(p) : in.unlabelled_ids[p]);
 
-  suspects_.clear();
-  if (options_.check_labels && tracks_.has_last()) find_suspect_labels();
+  label_check_.clear();
+  if (options_.check_labels && tracks_.has_last())
+    label_check_.find_suspects(current_, observed_, eps2_, tracks_);
   estimate_rigid();
-  if (!suspects_.empty()) judge_suspect_labels();
+  if (!label_check_.suspects().empty()) judge_suspect_labels();
   std::fill(revoked_.begin(), revoked_.end(), 0);
   for (int i = 0; i < n_; ++i)
     if (observed_[i]) {  // the capture system has it again
@@ -175,64 +176,13 @@ FillStats GapFiller::run(const FrameInput& in, const FrameOutput& out) {
   return stats_;
 }
 
-// Where marker i would be now had it moved with its neighbours since the last frame: its last
-// position (measured, or estimated during a gap) carried by the mean displacement of its
-// observed one-ring. False with fewer than two of them.
-bool GapFiller::carried_position(int i, Vec3& out) const {
-  Vec3 displacement = Vec3::Zero();
-  int count = 0;
-  for (int k = model_.ring_offsets[i]; k < model_.ring_offsets[i + 1]; ++k) {
-    const int j = model_.ring[k];
-    if (!observed_[j]) continue;
-    displacement += current_[j] - tracks_.last(j);
-    ++count;
-  }
-  if (count < 2) return false;
-  out = tracks_.last(i) + displacement / count;
-  return true;
-}
-
-// A correctly labelled point moves with its neighbours: within a frame its offset from them
-// changes by millimetres, while a swapped or mislabelled point is off by about the marker
-// spacing. A labelled point farther than eps2 from where its marker was carried is suspect, and
-// held back from the estimates until judged. With fewer than two ring members seen (where skin
-// touches skin, or a limb is hidden) it is compared with the marker's last position instead:
-// a label that jumps by more than eps2 in one frame is just as suspect.
-void GapFiller::find_suspect_labels() {
-  for (int i = 0; i < n_; ++i) {
-    Vec3 expected;
-    if (!observed_[i] || tracks_.last_status(i) == MarkerStatus::Held) continue;
-    if (!carried_position(i, expected)) expected = tracks_.last(i);
-    if ((current_[i] - expected).norm() > eps2_[i]) suspects_.push_back(i);
-  }
-  for (int i : suspects_) observed_[i] = 0;
-}
-
-// Being off is not proof: a fast limb at a low frame rate, or the end of a gap whose estimate
-// was poor, puts a true measurement beyond eps2 too, and so does a rejected point that another
-// marker took last frame and carried along. A suspect point is judged against estimates made
-// this frame from the other markers alone. It stands when its own estimate agrees (within eps2
-// and within four of its calibrated standard deviations); it is taken as unlabelled when
-// another marker explains it clearly better (a swap), or when its own estimate disagrees by more
-// than eps2 and it left its own track as well (measured in the last two frames and now off where
-// its velocity takes it): a point that keeps to its track is the marker the capture system was
-// following, whatever its neighbourhood's estimate says. Otherwise the measurement stands.
+// The suspects (label_check.h) judged one by one, each against the estimates of the others as
+// they stand: one kept is measured again for the next one's judgement; one rejected becomes a free
+// point for the relabelling. The estimates are then redone with the points kept.
 void GapFiller::judge_suspect_labels() {
-  for (int i : suspects_) {
-    Vec3 own;
-    double own_variance = 0.0;
-    const bool has_own = expected_position(i, own, &own_variance);
-    const double own_distance = has_own ? (current_[i] - own).norm() : std::numeric_limits<double>::infinity();
-    const bool own_confident = has_own && own_distance * own_distance > kConfidentMiss * own_variance;
-    // With no estimate of its own, the point's own track is the evidence left: where its motion
-    // takes it, and whether another marker's estimate or track reaches the point clearly better.
-    const bool reject = has_own
-                            ? (own_distance > eps2_[i] || own_confident) &&
-                                  (explained_by_another(i, own_distance) ||
-                                   (own_distance > eps2_[i] && tracks_.off_track(i, current_[i], eps2_[i])))
-                            : explained_by_another(i, (current_[i] - tracks_.prediction(i)).norm()) ||
-                                  tracks_.off_track(i, current_[i], eps2_[i]);
-    if (reject) {
+  const FrameEstimates frame = frame_estimates();
+  for (int i : label_check_.suspects()) {
+    if (label_check_.rejects(i, frame, eps2_, *this)) {
       add_free_point(current_[i], -(i + 1));
       ++stats_.rejected_labels;
     } else {
@@ -243,44 +193,8 @@ void GapFiller::judge_suspect_labels() {
   refresh_estimates();
 }
 
-// Whether another missing (or suspect) marker is expected within eps1 of i's labelled point and
-// at most half as far from it as i's own estimate: a swap, or a point where skin touches skin.
-// Where no other marker has an estimate (a hidden patch, every label in it suspect at once), each
-// one's own track stands in for it: two labels swapped on returning from a gap are each near
-// where the other one was.
-bool GapFiller::explained_by_another(int i, double own_distance) {
-  const double nearest = std::min(nearest_other_expected(i, current_[i]), nearest_other_on_track(i, current_[i]));
-  return std::isfinite(nearest) && nearest <= 0.5 * own_distance;
-}
-
-// The distance from point p to the track prediction of the nearest other missing (or suspect)
-// marker that has no estimate this frame and a position last frame, within eps1 (infinity: none).
-double GapFiller::nearest_other_on_track(int i, const Vec3& p) {
-  double nearest = std::numeric_limits<double>::infinity();
-  Vec3 unused;
-  for (int j : missing_) {
-    if (observed_[j] || j == i || tracks_.last_status(j) == MarkerStatus::Held) continue;
-    const double d = (p - tracks_.prediction(j)).norm();
-    if (d <= eps1_[j] && d < nearest && !expected_position(j, unused)) nearest = d;
-  }
-  return nearest;
-}
-
-// The distance from point p to the nearest estimate of another missing marker that is within
-// eps1 of it (infinity: none). Any marker may be the other, not only i's neighbours: skin that
-// touches is rarely neighbouring on the marker surface.
-double GapFiller::nearest_other_expected(int i, const Vec3& p) {
-  double nearest = std::numeric_limits<double>::infinity();
-  for (int j : missing_) {
-    if (observed_[j] || j == i || !estimated_[j]) continue;
-    const double reach = kPrefilterReach * eps1_[j];
-    if ((p - estimate_[j]).squaredNorm() > reach * reach) continue;
-    Vec3 expected;
-    if (!expected_position(j, expected)) continue;
-    const double d = (p - expected).norm();
-    if (d <= eps1_[j]) nearest = std::min(nearest, d);
-  }
-  return nearest;
+FrameEstimates GapFiller::frame_estimates() const {
+  return {current_, observed_, missing_, estimated_, estimate_, eps1_, tracks_};
 }
 
 // Eq. 2, greedy: repeatedly estimate the missing marker with the most available neighbours
@@ -444,8 +358,9 @@ void GapFiller::relabel() {
 bool GapFiller::ambiguity_free_match(int i, int p, double distance) {
   if (distance > eps1_[i]) return false;
   if (free_ids_[p] == -(i + 1)) return true;  // its own labelled point, held back by the label check
-  return nearest_other_expected(i, free_points_[p]) >= 2.0 * distance &&
-         nearest_other_on_track(i, free_points_[p]) >= 2.0 * distance;
+  const FrameEstimates frame = frame_estimates();
+  return nearest_other_expected(frame, *this, i, free_points_[p]) >= 2.0 * distance &&
+         nearest_other_on_track(frame, *this, i, free_points_[p]) >= 2.0 * distance;
 }
 
 int GapFiller::find_free_point(int id) const {

@@ -2,8 +2,8 @@
 // The online, causal per-frame job of section 4.2-4.3: takes one frame of labelled points
 // (NaN = missing) and unlabelled points, and returns every marker of the subject.
 //
-//   1. Label check: a labelled point that did not move with its one-ring since the last frame
-//      (off by more than eps2) is suspect: that is how swapped and mislabelled fragments look,
+//   1. Label check (label_check.h): a labelled point that did not move with its one-ring since
+//      the last frame (off by more than eps2) is suspect: so swapped and mislabelled fragments look,
 //      but also a true measurement after a gap whose estimate was poor (with its ring unseen,
 //      against its last position). It is treated as unlabelled only on strong evidence, judged
 //      against this frame's estimates from the other markers: any missing marker explains it
@@ -53,8 +53,10 @@
 
 #include "core/absolute_orientation.h"
 #include "core/gap_start_carry.h"
+#include "core/label_check.h"
 #include "core/marker_status.h"
 #include "core/marker_tracks.h"
+#include "core/other_markers_near.h"
 #include "core/pca_fit.h"
 #include "core/region_online_statistics.h"
 #include "core/region_pca_fit.h"
@@ -127,7 +129,7 @@ struct FillStats {
   int ignored_points = 0;   // non-finite or beyond capacity
 };
 
-class GapFiller {
+class GapFiller : private MarkerExpectation {
  public:
   static constexpr int kMaxFreePoints = 1024;
 
@@ -140,12 +142,11 @@ class GapFiller {
   double ring_calibration(int ring_entry) const { return ring_calibration_.ring(ring_entry); }
 
  private:
-  void find_suspect_labels();
   void judge_suspect_labels();
-  bool explained_by_another(int i, double own_distance);
-  double nearest_other_expected(int i, const Vec3& p);
-  double nearest_other_on_track(int i, const Vec3& p);
-  bool carried_position(int i, Vec3& out) const;
+  FrameEstimates frame_estimates() const;
+  bool expected(int marker, Vec3& out, double* out_variance) override {
+    return expected_position(marker, out, out_variance);
+  }
   void estimate_rigid();
   void fit_rigid_estimate(int i);
   void relabel();
@@ -174,10 +175,6 @@ class GapFiller {
 
   // Carried from frame to frame.
   static constexpr int kRelabelRounds = 3;
-  static constexpr double kPrefilterReach = 3.0;  // in eps1, around the rigid estimate
-  // A labelled point this many variances (squared distance over the calibrated predictive
-  // variance) from its own estimate is confidently not where the marker is expected.
-  static constexpr double kConfidentMiss = 16.0;
   long frame_ = 0;
   long solve_stamp_ =
       0;  // this frame's: a PCA solve made in it stands until its ring changes (refresh_estimates)
@@ -187,13 +184,13 @@ class GapFiller {
   std::vector<int> revoked_;           // this frame's FrameOutput::revoked
   std::vector<Vec3> gap_offset_;      // continuity offset in the local frame, made at the gap's first frame
   MarkerTracks tracks_;               // each marker's last two frames: where it was and its own velocity
+  LabelCheck label_check_;            // step 1: the labelled points held back, and their judgement
   GapStartCarry carry_;               // also where each marker's gap started
 
   // Per-frame scratch.
   std::vector<Vec3> current_;
   std::vector<MarkerStatus> status_;
   std::vector<char> observed_, estimated_, has_rotation_;
-  std::vector<int> suspects_;  // labelled points that did not move with their ring, held back
   std::vector<int> changed_;   // markers that became observed since the estimates were made
   std::vector<Vec3> estimate_;
   std::vector<Eigen::Matrix3d> rotation_;

@@ -546,7 +546,9 @@ TEST(GapFiller, AfterResetATakeIsFilledAsByANewFiller) {
     again.ids = frame.ids;
     frame.run(used);
     again.run(fresh);
-    if (f == 100) EXPECT_EQ(again.status[kMiddle], MarkerStatus::Relabelled);
+    if (f == 100) {
+      EXPECT_EQ(again.status[kMiddle], MarkerStatus::Relabelled);
+    }
     for (int i = 0; i < n; ++i) {
       ASSERT_EQ(frame.status[i], again.status[i]) << "frame " << f << ", marker " << i;
       ASSERT_EQ(frame.positions[i], again.positions[i]) << "frame " << f << ", marker " << i;
