@@ -27,11 +27,13 @@ if find_meshoptimizer()[0] is not None:
     SUBSCRIBERS.append(('compressed', True, 'libmeshoptimizer'))
 
 
-def receive(port, encoding, libraries, count, results):
+def receive(port, encoding, libraries, count, results, until=None):
+    """Keeps the first `count` frames the subscriber gets; with `until` (an event), goes on until
+    it is set, keeping at most `count`."""
     frames = {}
     with skinstream.Subscriber(port=port, encoding=encoding, normals=True, markers=True, libraries=libraries) as sub:
         deadline = time.monotonic() + 120
-        while len(frames) < count and time.monotonic() < deadline:
+        while len(frames) < count and time.monotonic() < deadline and not (until and until.is_set()):
             frame = sub.next_frame(1.0)
             if frame is not None:
                 # A frame is its number and its receive time: the demo take loops every 10 s,
@@ -49,21 +51,29 @@ def angles_degrees(a, b):
 
 class DemoSubject(unittest.TestCase):
     def test_every_encoding_gives_the_daemons_vertices(self):
-        # Each subscriber keeps the first 60 frames it gets; on a loaded machine the daemon's
-        # newest-wins queues give two of them a third of their frames in common (11 of 30 seen),
-        # so 60 are kept and at least 10 in common compared.
-        count, compared = 60, 10
+        # Each subscriber keeps the first 60 frames it gets, and at least 10 of them are compared
+        # with the float subscriber's frame of the same number. The daemon's newest-wins queues
+        # drop a slow decoder's frames (numpy's on a loaded machine: one in several), so its 60
+        # span seconds: the float subscriber, the reference, receives until the others are done
+        # (at most 400 frames, about 0.5 GB). With 60 of its own it had 9 in common with a
+        # compressed subscriber's 60 on a loaded machine.
+        count, compared, reference_count = 60, 10, 400
         results = {}
+        others_done = threading.Event()
         with demo_daemon() as daemon:
+            reference_thread = threading.Thread(target=receive, args=(daemon.sub_port, 'float', True, reference_count,
+                                                                      results, others_done))
             threads = [threading.Thread(target=receive, args=(daemon.sub_port, e, libraries, count, results))
-                       for e, libraries, _ in SUBSCRIBERS]
-            for t in threads:
+                       for e, libraries, _ in SUBSCRIBERS if (e, libraries) != ('float', True)]
+            for t in threads + [reference_thread]:
                 t.start()
             for t in threads:
                 t.join()
+            others_done.set()
+            reference_thread.join()
             self.assertEqual(daemon.stop(), 0, daemon.log())
         reference, _, mesh, _, _ = results['float', True]
-        self.assertEqual(len(reference), count)
+        self.assertGreaterEqual(len(reference), count)
         first = next(iter(reference.values()))
         self.assertEqual(first.vertices.shape, (53514, 3))
         self.assertEqual(first.vertices.dtype, np.float32)
