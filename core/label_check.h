@@ -7,8 +7,9 @@
 // spacing. So a labelled point farther than eps2 from where its marker was carried by its
 // one-ring is suspect, and held back from the estimates until judged. Being off is not proof: a
 // fast limb at a low frame rate, or the end of a gap whose estimate was poor, puts a true
-// measurement beyond eps2 too. So a suspect is judged against the estimates made this frame from
-// the other markers, and taken as unlabelled only on strong evidence.
+// measurement beyond eps2 too, and so does a rejected point that another marker took last frame
+// and carried along. So a suspect is judged against the estimates made this frame from the other
+// markers, and taken as unlabelled only on strong evidence.
 
 #include <span>
 #include <vector>
