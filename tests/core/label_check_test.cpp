@@ -64,6 +64,14 @@ struct LabelFixture {
   }
   FrameEstimates frame() const { return {points, observed, missing, estimated, estimate, eps1, tracks}; }
   bool rejects(int i) { return check.rejects(i, frame(), eps2, expectation); }
+  // Marker j missing this frame, its eq. 2 estimate and its expected position at `at`.
+  void missing_expected_at(int j, const Vec3& at) {
+    missing = {j};
+    observed[j] = 0;
+    estimated[j] = 1;
+    estimate[j] = at;
+    expectation.position[j] = at;
+  }
 };
 
 TEST(LabelCheck, PointsThatMoveWithTheirRingAreNotSuspect) {
@@ -121,11 +129,7 @@ TEST(LabelCheck, ASwapIsRejectedWhenAnotherMarkerExplainsThePointClearlyBetter) 
   // b's point is 40 mm from b's estimate and 10 mm from missing marker c's.
   LabelFixture fx(line_at(20));
   fx.expectation.position[1] = fx.points[1] + Vec3(0, 40, 0);
-  fx.missing = {2};
-  fx.observed[2] = 0;
-  fx.estimated[2] = 1;
-  fx.estimate[2] = fx.points[1] + Vec3(0, 10, 0);
-  fx.expectation.position[2] = fx.estimate[2];
+  fx.missing_expected_at(2, fx.points[1] + Vec3(0, 10, 0));
   EXPECT_TRUE(fx.rejects(1));
   // c farther than half of b's own miss (25 of 40 mm): not clearly better, and b kept to its
   // own track (10 mm a frame along x): it stands.
@@ -164,11 +168,7 @@ TEST(LabelCheck, AConfidentMissWithinEps2IsRejectedOnlyWhenAnotherExplainsIt) {
   fx.expectation.position[1] = fx.points[1] + Vec3(0, 10, 0);
   fx.expectation.variance[1] = 4.0;
   EXPECT_FALSE(fx.rejects(1));
-  fx.missing = {3};
-  fx.observed[3] = 0;
-  fx.estimated[3] = 1;
-  fx.estimate[3] = fx.points[1] + Vec3(0, 4, 0);
-  fx.expectation.position[3] = fx.estimate[3];
+  fx.missing_expected_at(3, fx.points[1] + Vec3(0, 4, 0));
   EXPECT_TRUE(fx.rejects(1));
 }
 
