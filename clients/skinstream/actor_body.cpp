@@ -25,7 +25,10 @@ ActorBody::ActorBody(const std::string& mesh_path, const MeshFrameOptions& flags
     fit_body_ = fit_body_of(template_, segments_);
     return;
   }
-  scan_ = skin_scan(template_, segments_, to_skinstream_axes(frame_, mesh.vertices), mesh.faces);
+  ScanBodyOptions scan_options;
+  scan_options.arm_elevation_deg = frame_.side_arm_elevation_deg;  // a T pose's arms start raised
+  scan_ =
+      skin_scan(template_, segments_, to_skinstream_axes(frame_, mesh.vertices), mesh.faces, scan_options);
   fit_body_ = scan_->body;
 }
 

@@ -24,8 +24,11 @@ namespace skinstream::cli {
 namespace {
 
 nlohmann::ordered_json surface_json(const SurfaceCheck& c) {
-  return {{"strained_fraction", c.strained_fraction}, {"max_strain", c.max_strain},
-          {"flipped_triangles", c.flipped_triangles}, {"self_intersecting_triangles", c.self_intersecting_triangles},
+  return {{"strained_fraction", c.strained_fraction},
+          {"max_strain", c.max_strain},
+          {"longest_stretched_edge", c.longest_stretched_edge},
+          {"flipped_triangles", c.flipped_triangles},
+          {"self_intersecting_triangles", c.self_intersecting_triangles},
           {"problem", c.problem}};
 }
 
@@ -55,7 +58,8 @@ nlohmann::ordered_json actor_json(const ActorSubject& s, const MarkerPriors& pri
           {"height_mm", s.check.height_mm},
           {"proportions", proportions},
           {"segment_lengths", lengths},
-          {"parts_by", s.skeleton_parts ? "skeleton segments (sparse marker set)" : "mean shift on the marker surface (dense set)"},
+          {"parts_by", s.skeleton_parts ? "skeleton segments (sparse marker set)"
+                                        : "mean shift on the marker surface (dense set)"},
           {"parts", parts},
           {"skeleton_rms_mm", s.skeletal_report.skeleton_rms_mm},
           {"checks",
@@ -66,6 +70,10 @@ nlohmann::ordered_json actor_json(const ActorSubject& s, const MarkerPriors& pri
             {"take_frames_checked", s.check.take_frames_checked},
             {"worst_take_frame", s.check.worst_take_frame_index},
             {"worst_take_frame_surface", surface_json(s.check.worst_take_frame)},
+            {"take_longest_stretched_edge",
+             {{"typical_edges", s.check.take_longest_stretched_edge},
+              {"frame", s.check.take_longest_stretched_edge_frame},
+              {"limit", s.check.take_edge_stretch_limit}}},
             {"unplaced_markers", s.check.unplaced_markers}}},
           {"markers", markers},
           {"seconds", {{"fit", s.fit_seconds}, {"build", s.build_seconds}, {"checks", s.check_seconds}}}};

@@ -148,6 +148,25 @@ class Fit {
     return out;
   }
 
+  // The pose with each upper arm turned from its rest direction to the given one (left, right;
+  // rest-pose axes; not finite leaves it at rest). Its parents are at rest in `pose`, so the
+  // turn is its local rotation.
+  SegmentPose with_arms_turned(SegmentPose pose, const std::array<Vec3, 2>& direction) const {
+    for (const char* name : {"upperarm.L", "upperarm.R"}) {
+      const int arm = body_.find(name);
+      if (arm < 0) continue;
+      int child = -1;
+      for (int s = 0; s < segment_count(); ++s)
+        if (body_.segment_parents[s] == arm) child = s;
+      if (child < 0) continue;
+      const Vec3 bone = pivots_[child] - pivots_[arm];
+      const Vec3& to = direction[pivots_[arm].x() < 0.0 ? 0 : 1];  // left is -X
+      if (!to.allFinite() || to.norm() <= 0.0 || bone.norm() <= 0.0) continue;
+      pose.local[static_cast<size_t>(arm)] = Eigen::Quaterniond::FromTwoVectors(bone, to).toRotationMatrix();
+    }
+    return pose;
+  }
+
   // Sets the overall scale from a guess and returns the pelvis pose that places the template.
   SegmentPose pose_from(const Similarity& similarity) {
     BodyProportions p = proportionable() ? BodyProportions::neutral(*body_.segments) : BodyProportions{};
@@ -486,8 +505,12 @@ ActorFit fit_actor(const FitBody& body, std::span<const Vec3> frames, int frame_
   double best = std::numeric_limits<double>::infinity();
   std::vector<MarkerAttachment> best_places;
   BodyProportions best_proportions;
-  for (const Similarity& guess : guesses) {
+  const size_t starts = guesses.size() * (1 + options.arm_starts.size());
+  for (size_t start = 0; start < starts; ++start) {
+    const Similarity& guess = guesses[start % guesses.size()];
     SegmentPose pose = fit.pose_from(guess);
+    if (start >= guesses.size())
+      pose = fit.with_arms_turned(pose, options.arm_starts[start / guesses.size() - 1]);
     fit.attachments_.assign(static_cast<size_t>(marker_count), MarkerAttachment{-1});
     fit.place_defined();
     if (out.blind) fit.attach_nearest(pose, reference_frame, false);
@@ -555,7 +578,8 @@ ActorFit fit_actor(const FitBody& body, std::span<const Vec3> frames, int frame_
   out.rest_vertices = fit.rest_;
   out.rest_pivots = fit.pivots_;
   out.vertex_weights = fit.vertex_weights_;
-  const std::vector<RigidTransform> at_reference = fit.motions(out.poses[0]);
+  out.reference_motions = fit.motions(out.poses[0]);
+  const std::vector<RigidTransform>& at_reference = out.reference_motions;
   out.reference_vertices = pose_vertices(out.rest_vertices, out.vertex_weights, at_reference);
   std::vector<Vec3> rest_markers;
   out.reference_skeleton = fit.skeleton(rest_markers);

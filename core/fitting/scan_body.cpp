@@ -21,6 +21,38 @@ Vec3 extent_high(std::span<const Vec3> points) {
   return high;
 }
 
+// Where the template's arms start when fitted to a scan, beside the rest pose's A: raised
+// sideways to the elevations the scan's frame measured. (Forward and overhead starts as well let
+// the fit follow a scan's arms held forward, but its subject was then refused all the same, as
+// crumpled in the reference pose, for 3.5 s more a build.)
+std::vector<std::array<Vec3, 2>> scan_arm_starts(const std::array<double, 2>& elevation_deg) {
+  std::array<Vec3, 2> raised;
+  for (int side = 0; side < 2; ++side) {
+    const double a = elevation_deg[static_cast<size_t>(side)] * M_PI / 180.0;  // NaN stays NaN
+    raised[static_cast<size_t>(side)] = Vec3((side == 0 ? -1.0 : 1.0) * std::sin(a), 0.0, -std::cos(a));
+  }
+  if (!raised[0].allFinite() && !raised[1].allFinite()) return {};
+  return {raised};
+}
+
+// An offset at a posed vertex turned back into the rest pose: by the inverse of the vertex's blend
+// of the segments' rotations, or its heaviest segment's rotation alone when the blend is near
+// singular (rotations far apart average to a matrix that squashes space).
+Vec3 offset_at_rest(const Vec3& posed_offset, std::span<const SegmentWeight> weights,
+                    std::span<const RigidTransform> motions, bool* by_one_segment) {
+  Eigen::Matrix3d blend = Eigen::Matrix3d::Zero();
+  const SegmentWeight* heaviest = &weights.front();
+  for (const SegmentWeight& w : weights) {
+    blend += w.weight * motions[static_cast<size_t>(w.segment)].rotation;
+    if (w.weight > heaviest->weight) heaviest = &w;
+  }
+  // Rotations up to about 110 degrees apart blend to a determinant above 0.2.
+  *by_one_segment = !(blend.determinant() > 0.2);
+  if (*by_one_segment)
+    return motions[static_cast<size_t>(heaviest->segment)].rotation.transpose() * posed_offset;
+  return blend.inverse() * posed_offset;
+}
+
 // The point of a surface nearest to p, as a place on it.
 MarkerAttachment nearest_place(const Vec3& p, const std::vector<Vec3>& vertices, const std::vector<Triangle>& triangles,
                                const TriangleBvh& bvh) {
@@ -50,6 +82,7 @@ ScanBody skin_scan(const Body& template_body, const TemplateSegments& segments, 
   start.rigid.translation = 0.5 * (scan_low + scan_high) - start.scale * 0.5 * (low + high);
   ActorFitOptions fit_options = options.fit;
   fit_options.start = start;
+  fit_options.arm_starts = scan_arm_starts(options.arm_elevation_deg);
   const int count = static_cast<int>(points.size());
   const std::vector<MarkerPrior> unnamed(static_cast<size_t>(count));
   const ActorFit fit = fit_actor(body, points, 1, count, 0, unnamed, fit_options);
@@ -67,17 +100,18 @@ ScanBody skin_scan(const Body& template_body, const TemplateSegments& segments, 
   out.template_on_scan = register_mesh(fit.reference_vertices, body.triangles, points, landmarks, registration, &report);
   out.registered_rms_mm = report.after.rms;
 
-  // 3. The scan inherits the template's segment weights, vertex by vertex, and its joints.
+  // 3. The scan inherits the template's segment weights, vertex by vertex.
   const TriangleBvh on_scan(out.template_on_scan, body.triangles);
   FitBody& skinned = out.body;
-  skinned.rest.assign(scan.begin(), scan.end());
+  out.as_given.assign(scan.begin(), scan.end());
   skinned.triangles.assign(scan_triangles.begin(), scan_triangles.end());
   std::vector<double> distances;
+  std::vector<MarkerAttachment> places;
   for (const Vec3& v : scan) {
     Vec3 nearest;
     distances.push_back(on_scan.closest(v, nullptr, &nearest));
-    const MarkerAttachment place = nearest_place(v, out.template_on_scan, body.triangles, on_scan);
-    attachment_segment_weights(place, body.triangles, body.weights, skinned.weights.weights);
+    places.push_back(nearest_place(v, out.template_on_scan, body.triangles, on_scan));
+    attachment_segment_weights(places.back(), body.triangles, body.weights, skinned.weights.weights);
     skinned.weights.offsets.push_back(static_cast<int>(skinned.weights.weights.size()));
   }
   std::sort(distances.begin(), distances.end());
@@ -85,20 +119,37 @@ ScanBody skin_scan(const Body& template_body, const TemplateSegments& segments, 
   out.inherited_max_mm = distances.back();
   skinned.segment_names = body.segment_names;
   skinned.segment_parents = body.segment_parents;
-  // Joints where the fit put them (the scan's pose), twist axes turned with their segments.
-  std::vector<Eigen::Matrix3d> turn(static_cast<size_t>(body.segment_count()));
-  for (int s = 0; s < body.segment_count(); ++s) {
-    const int parent = body.segment_parents[s];
-    turn[s] = parent < 0 ? fit.poses[0].local[s] : Eigen::Matrix3d(turn[parent] * fit.poses[0].local[s]);
-    skinned.rest_pivots.push_back(fit.reference_skeleton.segments[s].pivot);
-    skinned.twist_axes.push_back(turn[s] * body.twist_axes[s]);
+
+  // 4. Unposed into the fitted template's rest pose, with its joints there. Only the offset from
+  // the fitted template (its miss and the scan's own shape: millimetres to centimetres) goes
+  // through the inverted blend, so where the blend turns fast (an armpit) no vertex is thrown far;
+  // inverting each vertex's whole position tore a wrist seam to 18 times its length.
+  skinned.rest.reserve(scan.size());
+  for (size_t v = 0; v < scan.size(); ++v) {
+    const Triangle& t = body.triangles[static_cast<size_t>(places[v].triangle)];
+    const Vec3& b = places[v].barycentric;
+    const Vec3 at_rest =
+        b[0] * fit.rest_vertices[t[0]] + b[1] * fit.rest_vertices[t[1]] + b[2] * fit.rest_vertices[t[2]];
+    const Vec3 posed = b[0] * fit.reference_vertices[t[0]] + b[1] * fit.reference_vertices[t[1]] +
+                       b[2] * fit.reference_vertices[t[2]];
+    const std::span<const SegmentWeight> weights(
+        skinned.weights.weights.data() + skinned.weights.offsets[v],
+        skinned.weights.weights.data() + skinned.weights.offsets[v + 1]);
+    bool by_one_segment = false;
+    skinned.rest.push_back(at_rest +
+                           offset_at_rest(scan[v] - posed, weights, fit.reference_motions, &by_one_segment));
+    out.unposed_by_one_segment += by_one_segment ? 1 : 0;
   }
+  skinned.rest_pivots = fit.rest_pivots;
+  skinned.twist_axes = body.twist_axes;
   return out;
 }
 
 std::vector<MarkerPrior> transfer_priors(std::span<const MarkerPrior> template_priors,
                                          std::span<const Triangle> template_triangles, const ScanBody& scan) {
-  const TriangleBvh bvh(scan.body.rest, scan.body.triangles);
+  // Nearest points are sought in the scan's own pose, where the registered template lies; a place
+  // (triangle, barycentric) is the same on the unposed scan.
+  const TriangleBvh bvh(scan.as_given, scan.body.triangles);
   auto point_on_template = [&](int triangle, const Vec3& barycentric) {
     const Triangle& t = template_triangles[static_cast<size_t>(triangle)];
     return Vec3(barycentric[0] * scan.template_on_scan[t[0]] + barycentric[1] * scan.template_on_scan[t[1]] +
@@ -109,15 +160,16 @@ std::vector<MarkerPrior> transfer_priors(std::span<const MarkerPrior> template_p
   std::vector<int> counterpart(scan.body.triangles.size());
   for (size_t t = 0; t < counterpart.size(); ++t) {
     const Triangle& tri = scan.body.triangles[t];
-    on_scan.closest((scan.body.rest[tri[0]] + scan.body.rest[tri[1]] + scan.body.rest[tri[2]]) / 3.0, &counterpart[t]);
+    on_scan.closest((scan.as_given[tri[0]] + scan.as_given[tri[1]] + scan.as_given[tri[2]]) / 3.0,
+                    &counterpart[t]);
   }
   std::vector<char> allowed(template_triangles.size(), 0);
   std::vector<MarkerPrior> out;
   for (const MarkerPrior& prior : template_priors) {
     MarkerPrior moved;
     if (prior.place.triangle >= 0) {
-      moved.place = nearest_place(point_on_template(prior.place.triangle, prior.place.barycentric), scan.body.rest,
-                                  scan.body.triangles, bvh);
+      moved.place = nearest_place(point_on_template(prior.place.triangle, prior.place.barycentric),
+                                  scan.as_given, scan.body.triangles, bvh);
       moved.place.offset_mm = prior.place.offset_mm;
     }
     for (int t : prior.allowed_triangles) allowed[static_cast<size_t>(t)] = 1;

@@ -45,11 +45,16 @@ SubjectCheck check_subject(const ActorFit& fit, const FitBody& body, const Defor
     throw std::invalid_argument("check_subject: one name per fitted marker is needed");
   if (deformed_take.size() != take_frames.size()) throw std::invalid_argument("check_subject: one index per deformed frame");
   SubjectCheck out;
+  out.take_edge_stretch_limit = limits.take.max_edge_stretch;
   out.registration = check_surface(fit.reference_vertices, model.reference_vertices, model.faces, limits.registration);
   out.pose = check_surface(model.rest_vertices, model.reference_vertices, model.faces, limits.pose);
   for (size_t k = 0; k < deformed_take.size(); ++k) {
     const SurfaceCheck c = check_surface(model.rest_vertices, deformed_take[k], model.faces, limits.take);
     ++out.take_frames_checked;
+    if (c.longest_stretched_edge > out.take_longest_stretched_edge) {
+      out.take_longest_stretched_edge = c.longest_stretched_edge;
+      out.take_longest_stretched_edge_frame = take_frames[k];
+    }
     const bool worse = out.worst_take_frame_index < 0 || !c.ok() > !out.worst_take_frame.ok() ||
                        (c.ok() == out.worst_take_frame.ok() && c.strained_fraction > out.worst_take_frame.strained_fraction);
     if (worse) {

@@ -76,6 +76,11 @@ struct SubjectCheck {
   SurfaceCheck pose;
   SurfaceCheck worst_take_frame;  // the frame with the most strained edges
   int worst_take_frame_index = -1;
+  // The take's longest stretched edge over the frames checked, in typical edges, and its frame:
+  // how near the take came to the stretch limit, which any one frame can cross.
+  double take_longest_stretched_edge = 0.0;
+  int take_longest_stretched_edge_frame = -1;
+  double take_edge_stretch_limit = 0.0;  // the limit it was checked against
   int take_frames_checked = 0;
   std::vector<std::string> unplaced_markers;  // by name, worst first
   double height_mm = 0.0;
