@@ -40,6 +40,8 @@ std::vector<std::array<Vec3, 2>> scan_arm_starts(const std::array<double, 2>& el
 // singular (rotations far apart average to a matrix that squashes space).
 Vec3 offset_at_rest(const Vec3& posed_offset, std::span<const SegmentWeight> weights,
                     std::span<const RigidTransform> motions, bool* by_one_segment) {
+  *by_one_segment = false;
+  if (weights.empty()) return posed_offset;  // a vertex no segment holds stays as it is
   Eigen::Matrix3d blend = Eigen::Matrix3d::Zero();
   const SegmentWeight* heaviest = &weights.front();
   for (const SegmentWeight& w : weights) {
