@@ -110,9 +110,8 @@ ScanBody skin_scan(const Body& template_body, const TemplateSegments& segments, 
   std::vector<double> distances;
   std::vector<MarkerAttachment> places;
   for (const Vec3& v : scan) {
-    Vec3 nearest;
-    distances.push_back(on_scan.closest(v, nullptr, &nearest));
     places.push_back(nearest_place(v, out.template_on_scan, body.triangles, on_scan));
+    distances.push_back((v - skin_point(places.back(), out.template_on_scan, body.triangles)).norm());
     attachment_segment_weights(places.back(), body.triangles, body.weights, skinned.weights.weights);
     skinned.weights.offsets.push_back(static_cast<int>(skinned.weights.weights.size()));
   }
@@ -128,12 +127,8 @@ ScanBody skin_scan(const Body& template_body, const TemplateSegments& segments, 
   // inverting each vertex's whole position tore a wrist seam to 18 times its length.
   skinned.rest.reserve(scan.size());
   for (size_t v = 0; v < scan.size(); ++v) {
-    const Triangle& t = body.triangles[static_cast<size_t>(places[v].triangle)];
-    const Vec3& b = places[v].barycentric;
-    const Vec3 at_rest =
-        b[0] * fit.rest_vertices[t[0]] + b[1] * fit.rest_vertices[t[1]] + b[2] * fit.rest_vertices[t[2]];
-    const Vec3 posed = b[0] * fit.reference_vertices[t[0]] + b[1] * fit.reference_vertices[t[1]] +
-                       b[2] * fit.reference_vertices[t[2]];
+    const Vec3 at_rest = skin_point(places[v], fit.rest_vertices, body.triangles);
+    const Vec3 posed = skin_point(places[v], fit.reference_vertices, body.triangles);
     const std::span<const SegmentWeight> weights(
         skinned.weights.weights.data() + skinned.weights.offsets[v],
         skinned.weights.weights.data() + skinned.weights.offsets[v + 1]);
@@ -152,11 +147,6 @@ std::vector<MarkerPrior> transfer_priors(std::span<const MarkerPrior> template_p
   // Nearest points are sought in the scan's own pose, where the registered template lies; a place
   // (triangle, barycentric) is the same on the unposed scan.
   const TriangleBvh bvh(scan.as_given, scan.body.triangles);
-  auto point_on_template = [&](int triangle, const Vec3& barycentric) {
-    const Triangle& t = template_triangles[static_cast<size_t>(triangle)];
-    return Vec3(barycentric[0] * scan.template_on_scan[t[0]] + barycentric[1] * scan.template_on_scan[t[1]] +
-                barycentric[2] * scan.template_on_scan[t[2]]);
-  };
   // Each scan triangle's counterpart: the template triangle nearest to its centre.
   const TriangleBvh on_scan(scan.template_on_scan, std::vector<Triangle>(template_triangles.begin(), template_triangles.end()));
   std::vector<int> counterpart(scan.body.triangles.size());
@@ -170,7 +160,7 @@ std::vector<MarkerPrior> transfer_priors(std::span<const MarkerPrior> template_p
   for (const MarkerPrior& prior : template_priors) {
     MarkerPrior moved;
     if (prior.place.triangle >= 0) {
-      moved.place = nearest_place(point_on_template(prior.place.triangle, prior.place.barycentric),
+      moved.place = nearest_place(skin_point(prior.place, scan.template_on_scan, template_triangles),
                                   scan.as_given, scan.body.triangles, bvh);
       moved.place.offset_mm = prior.place.offset_mm;
     }
